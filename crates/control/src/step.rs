@@ -1,0 +1,120 @@
+//! What a controller sees at one control step: the kinematic quantities of Eqs. 2–4.
+
+use emg_kinematics::{
+    DampedPseudoInverse, JointVector, Kinematics, Robot, TaskBasis, Vec3, damped_pseudo_inverse,
+    directional_manipulability, null_space_basis, task_aligned_basis, tool_alignment_gradient,
+};
+use nalgebra::SVector;
+
+use crate::config::RolloutConfig;
+use crate::constraints::tool_angle_deg;
+use crate::task::Task;
+
+/// A null-space action `a ∈ [−1, 1]⁴`: coordinates in the basis `B(q)` (Sec. 4.2).
+pub type NullAction = SVector<f64, 4>;
+
+/// The state of one control step, computed once and shared by every controller.
+#[derive(Clone, Debug)]
+pub struct StepContext<'a> {
+    /// The robot.
+    pub robot: &'a Robot,
+    /// The task being followed.
+    pub task: &'a Task,
+    /// The rollout settings.
+    pub config: &'a RolloutConfig,
+    /// Step index (0 at the seed).
+    pub step: usize,
+    /// Current configuration `q`.
+    pub q: JointVector,
+    /// Forward kinematics at `q`.
+    pub kinematics: Kinematics,
+    /// Normalised configuration `q̄ ∈ [−1, 1]⁷`.
+    pub q_normalised: JointVector,
+    /// Joint-limit proximity `ρ(q) = max_i |q̄_i|` (Eq. 8).
+    pub rho: f64,
+    /// Angle between tool axis and `n` (degrees).
+    pub tool_angle_deg: f64,
+    /// Directional manipulability `w_d` along `d`.
+    pub manipulability: f64,
+    /// `∇w_d` (SPEC §4).
+    pub manipulability_gradient: JointVector,
+    /// `∇(z·n)`.
+    pub alignment_gradient: JointVector,
+    /// `∇(−mean q̄²)`, the joint-centring direction of `B(q)`.
+    pub centring_gradient: JointVector,
+    /// Damped pseudo-inverse `J⁺`.
+    pub pseudo_inverse: DampedPseudoInverse,
+    /// Task-aligned null-space basis `B(q)`.
+    pub basis: TaskBasis,
+    /// The previous action (zero at reset).
+    pub previous_action: NullAction,
+}
+
+impl<'a> StepContext<'a> {
+    /// Computes every quantity of the step at `q` from its forward kinematics (no allocation).
+    pub fn new(
+        robot: &'a Robot,
+        task: &'a Task,
+        config: &'a RolloutConfig,
+        step: usize,
+        q: JointVector,
+        kinematics: Kinematics,
+        previous_action: NullAction,
+    ) -> Self {
+        let limits = robot.limits();
+        let q_normalised = limits.normalise(&q);
+        let rho = q_normalised.amax();
+        let (manipulability, manipulability_gradient) =
+            directional_manipulability(&kinematics, &task.d, config.manipulability_damping);
+        let alignment_gradient = tool_alignment_gradient(&kinematics, &task.n);
+        let centring_gradient =
+            -q_normalised.component_div(&limits.half_range()) * (2.0 / q.len() as f64);
+        let jacobian = kinematics.jacobian();
+        let null = null_space_basis(jacobian);
+        let basis = task_aligned_basis(
+            jacobian,
+            &null,
+            [&manipulability_gradient, &alignment_gradient, &centring_gradient],
+            &config.basis,
+        );
+        let pseudo_inverse = damped_pseudo_inverse(jacobian, &config.damping);
+        let tool_angle_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n);
+        Self {
+            robot,
+            task,
+            config,
+            step,
+            q,
+            kinematics,
+            q_normalised,
+            rho,
+            tool_angle_deg,
+            manipulability,
+            manipulability_gradient,
+            alignment_gradient,
+            centring_gradient,
+            pseudo_inverse,
+            basis,
+            previous_action,
+        }
+    }
+
+    /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3).
+    pub fn task_velocity(&self) -> Vec3 {
+        let lateral = self.task.lateral_error(&self.kinematics.tcp());
+        self.task.d * self.config.speed_m_per_s + lateral * self.config.lateral_gain_per_s
+    }
+
+    /// Joint velocity `q̇ = J⁺ẋ + a_max B a` for a (clipped) action `a` (Eq. 2).
+    pub fn joint_velocity(&self, action: &NullAction) -> JointVector {
+        self.pseudo_inverse.matrix * self.task_velocity()
+            + self.basis.columns * action * self.config.null_speed_max_rad_per_s
+    }
+
+    /// Coordinates `clip(Bᵀξ / a_max, −1, 1)` of a secondary command `ξ` in `B(q)`: the one
+    /// parameterisation shared by every controller.
+    pub fn action_from_secondary(&self, xi: &JointVector) -> NullAction {
+        (self.basis.columns.transpose() * xi / self.config.null_speed_max_rad_per_s)
+            .map(|a| a.clamp(-1.0, 1.0))
+    }
+}

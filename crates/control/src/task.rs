@@ -1,0 +1,150 @@
+//! The task model `c = [p0, d, n]` (Eq. 1) and its validation.
+
+use emg_kinematics::{JointVector, Robot, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// Largest `|d·n|` accepted as perpendicular; smaller deviations are removed exactly.
+pub const PERPENDICULAR_TOLERANCE: f64 = 1e-6;
+
+/// Largest distance (m) between `p0` and the TCP of a supplied `q0_seed`.
+pub const SEED_POSITION_TOLERANCE_M: f64 = 1e-6;
+
+/// A straight-line task: start `p0`, unit direction `d`, unit task-plane normal `n` (`d ⟂ n`),
+/// and optionally the configuration that generated it (`q0_seed`, the fallback seed).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Task {
+    /// Start position `p0` (m).
+    pub p0: Vec3,
+    /// Unit motion direction `d`.
+    pub d: Vec3,
+    /// Unit task-plane normal `n`; the tool axis must stay within `θ_max` of it.
+    pub n: Vec3,
+    /// Configuration that generated the task, if known (`q0_seed`).
+    #[serde(default)]
+    pub q0_seed: Option<JointVector>,
+}
+
+/// Why a task was rejected; names the field and what is wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TaskError {
+    /// A field holds NaN or infinity.
+    #[error("task field '{field}' is not finite: {value:?}")]
+    NotFinite {
+        /// Field name.
+        field: &'static str,
+        /// Values given.
+        value: Vec<f64>,
+    },
+    /// A direction field is (numerically) the zero vector.
+    #[error("task field '{field}' is a zero vector; it must be a direction")]
+    ZeroVector {
+        /// Field name.
+        field: &'static str,
+    },
+    /// `d` and `n` are not perpendicular.
+    #[error("task fields 'd' and 'n' are not perpendicular: |d·n| = {dot:.3e} exceeds {PERPENDICULAR_TOLERANCE:e}")]
+    NotPerpendicular {
+        /// `|d·n|` after normalisation.
+        dot: f64,
+    },
+    /// `p0` lies outside the arm's reach.
+    #[error("task field 'p0' = {p0:?} is unreachable: {distance_m:.3} m from the first joint, reach is {reach_m:.3} m")]
+    Unreachable {
+        /// The start given.
+        p0: [f64; 3],
+        /// Its distance from the reach centre (m).
+        distance_m: f64,
+        /// The arm's reach (m).
+        reach_m: f64,
+    },
+    /// `q0_seed` is not a valid generating configuration of this task.
+    #[error("task field 'q0_seed' {problem}")]
+    BadSeed {
+        /// What is wrong with it.
+        problem: String,
+    },
+}
+
+impl Task {
+    /// Builds and validates a task: `d` and `n` are normalised, `d` is made exactly
+    /// perpendicular to `n` when it already is within [`PERPENDICULAR_TOLERANCE`], and `p0` must
+    /// lie within the robot's reach. A given `q0_seed` must lie within the joint limits and put the
+    /// TCP at `p0`.
+    pub fn new(
+        robot: &Robot,
+        p0: Vec3,
+        d: Vec3,
+        n: Vec3,
+        q0_seed: Option<JointVector>,
+    ) -> Result<Self, TaskError> {
+        finite("p0", p0.as_slice())?;
+        let d = unit("d", d)?;
+        let n = unit("n", n)?;
+        let dot = d.dot(&n);
+        if dot.abs() > PERPENDICULAR_TOLERANCE {
+            return Err(TaskError::NotPerpendicular { dot: dot.abs() });
+        }
+        let d = (d - n * dot).normalize();
+        let (centre, reach) = robot.reach_sphere();
+        let distance = (p0 - centre).norm();
+        if distance > reach {
+            return Err(TaskError::Unreachable {
+                p0: [p0.x, p0.y, p0.z],
+                distance_m: distance,
+                reach_m: reach,
+            });
+        }
+        if let Some(q) = &q0_seed {
+            finite("q0_seed", q.as_slice())?;
+            if let Some(joint) = robot.limits().first_violation(q, 0.0) {
+                return Err(TaskError::BadSeed {
+                    problem: format!(
+                        "joint {} = {:.4} rad is outside its limits [{:.4}, {:.4}]",
+                        joint + 1,
+                        q[joint],
+                        robot.limits().lower[joint],
+                        robot.limits().upper[joint]
+                    ),
+                });
+            }
+            let offset = (robot.forward(q).tcp() - p0).norm();
+            if offset > SEED_POSITION_TOLERANCE_M {
+                return Err(TaskError::BadSeed {
+                    problem: format!("puts the TCP {offset:.3e} m from p0"),
+                });
+            }
+        }
+        Ok(Self { p0, d, n, q0_seed })
+    }
+
+    /// Signed progress `(p − p0)·d` of a TCP position along the line (m).
+    pub fn progress(&self, p: &Vec3) -> f64 {
+        (p - self.p0).dot(&self.d)
+    }
+
+    /// Lateral error vector from `p` to the task line (component of `p0 − p` ⟂ `d`).
+    pub fn lateral_error(&self, p: &Vec3) -> Vec3 {
+        let offset = self.p0 - p;
+        offset - self.d * offset.dot(&self.d)
+    }
+}
+
+fn finite(field: &'static str, values: &[f64]) -> Result<(), TaskError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(TaskError::NotFinite {
+            field,
+            value: values.to_vec(),
+        })
+    }
+}
+
+fn unit(field: &'static str, v: Vec3) -> Result<Vec3, TaskError> {
+    finite(field, v.as_slice())?;
+    let norm = v.norm();
+    if norm < 1e-9 {
+        return Err(TaskError::ZeroVector { field });
+    }
+    Ok(v / norm)
+}

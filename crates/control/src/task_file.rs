@@ -1,0 +1,201 @@
+//! Task-set files: a compact versioned binary for generated sets, JSON for hand-written tasks.
+//!
+//! Binary layout (little endian): the 8-byte magic `EMGTASKS`, `u32` format version (1), `u32`
+//! values per task (16), `u64` task count, then per task `p0` (3), `d` (3), `n` (3), `q0_seed` (7)
+//! as `f64` (`q0_seed` all NaN when unknown).
+//!
+//! JSON layout: an array of objects `{"p0": [x, y, z], "d": [..], "n": [..], "q0_seed": [7 values]}`
+//! (`q0_seed` optional), or one such object.
+
+use std::io::Write;
+use std::path::Path;
+
+use emg_kinematics::{JointVector, Robot, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::task::{Task, TaskError};
+
+const MAGIC: &[u8; 8] = b"EMGTASKS";
+/// Version of the binary task-set layout written by [`write_task_set`].
+pub const TASK_FORMAT_VERSION: u32 = 1;
+const VALUES_PER_TASK: usize = 16;
+const HEADER_BYTES: usize = 8 + 4 + 4 + 8;
+
+/// Why a task file could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum TaskFileError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// File path.
+        path: String,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The file is not in either task layout.
+    #[error("{path}: {problem}")]
+    Format {
+        /// File path.
+        path: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// One task of the file is invalid.
+    #[error("{path}: task {index}: {source}")]
+    Task {
+        /// File path.
+        path: String,
+        /// 0-based index of the task in the file.
+        index: usize,
+        /// Why it is invalid.
+        source: TaskError,
+    },
+}
+
+/// A task as written by hand in JSON (validated into a [`Task`] on reading).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TaskSpec {
+    /// Start position (m).
+    pub p0: [f64; 3],
+    /// Motion direction (normalised on reading).
+    pub d: [f64; 3],
+    /// Task-plane normal (normalised on reading).
+    pub n: [f64; 3],
+    /// Generating configuration, if known (rad).
+    #[serde(default)]
+    pub q0_seed: Option<[f64; 7]>,
+}
+
+impl TaskSpec {
+    /// Validates the spec into a task for `robot`.
+    pub fn to_task(&self, robot: &Robot) -> Result<Task, TaskError> {
+        Task::new(
+            robot,
+            Vec3::from(self.p0),
+            Vec3::from(self.d),
+            Vec3::from(self.n),
+            self.q0_seed.map(JointVector::from),
+        )
+    }
+}
+
+impl From<&Task> for TaskSpec {
+    fn from(task: &Task) -> Self {
+        Self {
+            p0: task.p0.into(),
+            d: task.d.into(),
+            n: task.n.into(),
+            q0_seed: task.q0_seed.map(Into::into),
+        }
+    }
+}
+
+/// Writes `tasks` in the binary layout (bit-exact values).
+pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> {
+    let io = |source| TaskFileError::Io { path: path.display().to_string(), source };
+    let mut bytes = Vec::with_capacity(HEADER_BYTES + tasks.len() * VALUES_PER_TASK * 8);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&TASK_FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(VALUES_PER_TASK as u32).to_le_bytes());
+    bytes.extend_from_slice(&(tasks.len() as u64).to_le_bytes());
+    for task in tasks {
+        let seed = task.q0_seed.unwrap_or_else(|| JointVector::repeat(f64::NAN));
+        for value in task.p0.iter().chain(&task.d).chain(&task.n).chain(&seed) {
+            bytes.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    let mut file = std::fs::File::create(path).map_err(io)?;
+    file.write_all(&bytes).map_err(io)
+}
+
+/// Reads tasks from a binary task set or a JSON file (chosen by the `.json` extension),
+/// validating every task against `robot`.
+pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError> {
+    let bytes = std::fs::read(path).map_err(|source| TaskFileError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    let name = path.display().to_string();
+    let specs = if path.extension().is_some_and(|e| e == "json") {
+        parse_json(&name, &bytes)?
+    } else {
+        parse_binary(&name, &bytes)?
+    };
+    specs
+        .iter()
+        .enumerate()
+        .map(|(index, spec)| {
+            spec.to_task(robot).map_err(|source| TaskFileError::Task {
+                path: name.clone(),
+                index,
+                source,
+            })
+        })
+        .collect()
+}
+
+fn parse_json(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        Many(Vec<TaskSpec>),
+        One(TaskSpec),
+    }
+    match serde_json::from_slice::<OneOrMany>(bytes) {
+        Ok(OneOrMany::Many(specs)) => Ok(specs),
+        Ok(OneOrMany::One(spec)) => Ok(vec![spec]),
+        Err(_) => {
+            // Re-parse as a list to report the precise field and position of the problem.
+            let problem = match serde_json::from_slice::<Vec<TaskSpec>>(bytes) {
+                Err(e) => e.to_string(),
+                Ok(_) => "unreadable task JSON".into(),
+            };
+            Err(TaskFileError::Format { path: path.into(), problem })
+        }
+    }
+}
+
+fn parse_binary(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {
+    let format = |problem: String| TaskFileError::Format { path: path.into(), problem };
+    if bytes.len() < HEADER_BYTES || &bytes[..8] != MAGIC {
+        return Err(format("not a task set: missing the EMGTASKS header".into()));
+    }
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    let version = word(8);
+    if version != TASK_FORMAT_VERSION {
+        return Err(format(format!(
+            "task-set format version {version} is not supported (this build reads {TASK_FORMAT_VERSION})"
+        )));
+    }
+    if word(12) as usize != VALUES_PER_TASK {
+        return Err(format(format!("{} values per task, expected {VALUES_PER_TASK}", word(12))));
+    }
+    let count = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes")) as usize;
+    let expected = count
+        .checked_mul(VALUES_PER_TASK * 8)
+        .and_then(|b| b.checked_add(HEADER_BYTES))
+        .ok_or_else(|| format(format!("task count {count} is implausible")))?;
+    if bytes.len() != expected {
+        return Err(format(format!(
+            "truncated or padded: header announces {count} tasks ({expected} bytes), file has {} bytes",
+            bytes.len()
+        )));
+    }
+    Ok(bytes[HEADER_BYTES..]
+        .chunks_exact(VALUES_PER_TASK * 8)
+        .map(|record| {
+            let v: Vec<f64> = record
+                .chunks_exact(8)
+                .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
+                .collect();
+            let seed: [f64; 7] = v[9..16].try_into().expect("7 values");
+            TaskSpec {
+                p0: [v[0], v[1], v[2]],
+                d: [v[3], v[4], v[5]],
+                n: [v[6], v[7], v[8]],
+                q0_seed: (!seed.iter().all(|x| x.is_nan())).then_some(seed),
+            }
+        })
+        .collect())
+}

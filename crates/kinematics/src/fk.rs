@@ -1,0 +1,108 @@
+//! Forward kinematics: joint frames, TCP position `p(q)`, tool axis `z(q)` and their Jacobians.
+
+use nalgebra::{Isometry3, Matrix3, SMatrix, Translation3, UnitQuaternion};
+
+use crate::robot::Robot;
+use crate::{DOF, JointVector, Vec3};
+
+/// The 3×7 position Jacobian `J = ∂p/∂q` of the TCP.
+pub type PositionJacobian = SMatrix<f64, 3, DOF>;
+
+/// Everything forward kinematics yields for one configuration; computed on the stack.
+///
+/// Segment `s` is the rigid body after joint `s` (segment 0 is the base): its frame is the
+/// frame of joint `s`, turned by `q_s` about its local +z.
+#[derive(Clone, Debug)]
+pub struct Kinematics {
+    rotations: [Matrix3<f64>; DOF + 1],
+    positions: [Vec3; DOF + 1],
+    tcp: Vec3,
+    tcp_rotation: Matrix3<f64>,
+    jacobian: PositionJacobian,
+}
+
+impl Robot {
+    /// Forward kinematics of configuration `q` (no allocation).
+    pub fn forward(&self, q: &JointVector) -> Kinematics {
+        let mut rotations = [Matrix3::identity(); DOF + 1];
+        let mut positions = [Vec3::zeros(); DOF + 1];
+        for (i, joint) in self.joints.iter().enumerate() {
+            let (parent_rotation, parent_position) = (rotations[i], positions[i]);
+            let fixed: Matrix3<f64> = parent_rotation * joint.rotation;
+            let (sin, cos) = q[i].sin_cos();
+            let (c0, c1) = (fixed.column(0), fixed.column(1));
+            let mut rotation = fixed;
+            rotation.set_column(0, &(c0 * cos + c1 * sin));
+            rotation.set_column(1, &(c1 * cos - c0 * sin));
+            rotations[i + 1] = rotation;
+            positions[i + 1] = parent_position + parent_rotation * joint.translation;
+        }
+        let last = rotations[DOF];
+        let tcp = positions[DOF] + last * self.tcp_offset.translation;
+        let tcp_rotation = last * self.tcp_offset.rotation;
+        let mut jacobian = PositionJacobian::zeros();
+        for i in 0..DOF {
+            let axis = rotations[i + 1].column(2).into_owned();
+            jacobian.set_column(i, &axis.cross(&(tcp - positions[i + 1])));
+        }
+        Kinematics {
+            rotations,
+            positions,
+            tcp,
+            tcp_rotation,
+            jacobian,
+        }
+    }
+}
+
+impl Kinematics {
+    /// TCP (pen tip) position `p(q)`, metres.
+    pub fn tcp(&self) -> Vec3 {
+        self.tcp
+    }
+
+    /// Tool axis `z(q)`: the TCP frame's unit z-axis.
+    pub fn tool_axis(&self) -> Vec3 {
+        self.tcp_rotation.column(2).into_owned()
+    }
+
+    /// TCP orientation as a rotation matrix (columns are the TCP frame axes).
+    pub fn tcp_rotation(&self) -> &Matrix3<f64> {
+        &self.tcp_rotation
+    }
+
+    /// Position Jacobian `J(q)`, column `i` = `ω_i × (p − o_i)`.
+    pub fn jacobian(&self) -> &PositionJacobian {
+        &self.jacobian
+    }
+
+    /// Unit rotation axis `ω_i` of joint `i` (0-based) in the base frame.
+    pub fn joint_axis(&self, i: usize) -> Vec3 {
+        self.rotations[i + 1].column(2).into_owned()
+    }
+
+    /// Position `o_i` of joint `i` (0-based) in the base frame.
+    pub fn joint_origin(&self, i: usize) -> Vec3 {
+        self.positions[i + 1]
+    }
+
+    /// Tool-axis Jacobian `∂z/∂q`: column `i` = `ω_i × z`.
+    pub fn tool_axis_jacobian(&self) -> PositionJacobian {
+        let z = self.tool_axis();
+        PositionJacobian::from_fn(|r, c| self.joint_axis(c).cross(&z)[r])
+    }
+
+    /// Pose of segment `s` (0 = base, `s` = the body after joint `s`) in the base frame.
+    pub fn segment_frame(&self, s: usize) -> Isometry3<f64> {
+        let rotation = nalgebra::Rotation3::from_matrix_unchecked(self.rotations[s]);
+        Isometry3::from_parts(
+            Translation3::from(self.positions[s]),
+            UnitQuaternion::from_rotation_matrix(&rotation),
+        )
+    }
+
+    /// Maps a point given in segment `s`'s frame to the base frame.
+    pub fn segment_point(&self, s: usize, local: &Vec3) -> Vec3 {
+        self.positions[s] + self.rotations[s] * local
+    }
+}

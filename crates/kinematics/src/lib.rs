@@ -1,0 +1,57 @@
+//! Kinematics of a 7-DoF serial arm holding a tool, as used by extreme straight-line motion.
+//!
+//! A [`Robot`] is read once from a URDF file (the chain between two named links, its joint
+//! limits, velocity limits and capsule collision geometry) and then shared freely across
+//! threads. Everything else is a plain function of the robot and a joint vector, computed on
+//! the stack with fixed-size `nalgebra` types so the control step allocates nothing:
+//!
+//! * [`Robot::forward`]: every joint frame, the TCP position `p(q)` and the tool axis `z(q)`;
+//!   from it the 3×7 position Jacobian and the tool-axis Jacobian ([`Kinematics`]).
+//! * [`directional_manipulability`]: `w_d` and its Hessian-based analytic gradient.
+//! * [`tool_alignment_gradient`]: the gradient of `z(q)·n`.
+//! * [`damped_pseudo_inverse`]: `J⁺` with variable damping (Eq. 2 of the paper).
+//! * [`null_space_basis`] and [`task_aligned_basis`]: `N` and the Gram–Schmidt basis `B(q)`.
+//! * [`Robot::self_collision`]: capsule distances between bodies at least three links apart.
+//! * [`project_to_pose`]: Newton projection onto an exact `(p0, n[, roll])` pose within limits.
+//!
+//! ```
+//! use emg_kinematics::{JointVector, Robot, Vec3};
+//! use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
+//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let home = JointVector::from_column_slice(&[0.0, -FRAC_PI_4, 0.0, -3.0 * FRAC_PI_4, 0.0, FRAC_PI_2, FRAC_PI_4]);
+//! let kin = robot.forward(&home);
+//! assert!((kin.tcp() - Vec3::new(0.306891, 0.0, 0.386882)).norm() < 1e-6);
+//! assert!((kin.tool_axis() - Vec3::new(0.0, 0.0, -1.0)).norm() < 1e-9);
+//! assert!(robot.first_collision(&kin, 0.0).is_none());
+//! # Ok::<(), emg_kinematics::RobotError>(())
+//! ```
+
+mod collision;
+mod fk;
+mod manipulability;
+mod nullspace;
+mod projection;
+mod pseudo_inverse;
+mod robot;
+
+pub use collision::{Capsule, CollisionHit, CollisionPair, segment_distance};
+pub use fk::{Kinematics, PositionJacobian};
+pub use manipulability::{directional_manipulability, tool_alignment_gradient};
+pub use nullspace::{BasisConfig, NullSpaceBasis, TaskBasis, null_space_basis, task_aligned_basis};
+pub use projection::{PoseTarget, ProjectionConfig, ProjectionError, project_to_pose};
+pub use pseudo_inverse::{DampingConfig, DampedPseudoInverse, damped_pseudo_inverse};
+pub use robot::{JointLimits, Robot, RobotError};
+
+/// Number of actuated joints of every supported arm.
+pub const DOF: usize = 7;
+
+/// A joint-space vector (configuration, velocity or gradient), radians.
+pub type JointVector = nalgebra::SVector<f64, DOF>;
+
+/// A Cartesian 3-vector, metres or unit direction.
+pub type Vec3 = nalgebra::Vector3<f64>;
+
+/// Path of the FR3-with-pen robot file shipped in the workspace's `data/robots/`.
+pub fn default_robot_path() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf")
+}

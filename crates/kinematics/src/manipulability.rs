@@ -1,0 +1,45 @@
+//! Directional manipulability `w_d` and the tool-alignment objective `z·n`, with analytic gradients.
+
+use nalgebra::Matrix3;
+
+use crate::fk::Kinematics;
+use crate::{DOF, JointVector, Vec3};
+
+/// Directional manipulability `w_d = (dᵀ(JJᵀ + λ_μ²I)⁻¹d)^(−1/2)` (SPEC §4, the `k_μ` term of
+/// Eq. 3) and its analytic gradient.
+///
+/// With `A = JJᵀ + λ_μ²I`, `w = A⁻¹d`, `s = dᵀw`:
+/// `∂w_d/∂q_i = s^(−3/2) · wᵀ H_i (Jᵀw)` where `H_i = ∂J/∂q_i` has columns
+/// `∂J_k/∂q_i = ω_min(i,k) × J_max(i,k)` (revolute joints).
+/// Returns `(w_d, ∇w_d)`; allocation-free.
+pub fn directional_manipulability(kin: &Kinematics, d: &Vec3, lambda_mu: f64) -> (f64, JointVector) {
+    let jacobian = kin.jacobian();
+    let a = jacobian * jacobian.transpose() + Matrix3::identity() * (lambda_mu * lambda_mu);
+    let w = a.try_inverse().unwrap_or_else(Matrix3::zeros) * d;
+    let s = d.dot(&w);
+    if s <= 0.0 {
+        return (0.0, JointVector::zeros());
+    }
+    let value = s.powf(-0.5);
+    let u = jacobian.transpose() * w;
+    let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
+    let columns: [Vec3; DOF] = std::array::from_fn(|k| jacobian.column(k).into_owned());
+    let scale = value * value * value;
+    let gradient = JointVector::from_fn(|i, _| {
+        (0..DOF)
+            .map(|k| {
+                let (lo, hi) = (i.min(k), i.max(k));
+                w.dot(&axes[lo].cross(&columns[hi])) * u[k]
+            })
+            .sum::<f64>()
+            * scale
+    });
+    (value, gradient)
+}
+
+/// Gradient of the tool alignment `z(q)·n` (the `k_θ` term of Eq. 3):
+/// `∂(z·n)/∂q_i = n·(ω_i × z) = ω_i·(z × n)`.
+pub fn tool_alignment_gradient(kin: &Kinematics, n: &Vec3) -> JointVector {
+    let z_cross_n = kin.tool_axis().cross(n);
+    JointVector::from_fn(|i, _| kin.joint_axis(i).dot(&z_cross_n))
+}

@@ -1,0 +1,190 @@
+//! Newton projection of a configuration onto an exact TCP pose within the joint limits.
+
+use nalgebra::{Matrix3, Rotation3, SMatrix, SVector};
+use serde::{Deserialize, Serialize};
+
+use crate::robot::Robot;
+use crate::{DOF, JointVector, Vec3};
+
+/// The pose a configuration is projected onto.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PoseTarget {
+    /// TCP position `p0` (m).
+    pub position: Vec3,
+    /// Unit tool axis the TCP z-axis must equal (`n`).
+    pub tool_axis: Vec3,
+    /// Optional unit TCP x-axis (fixes the roll about the tool axis); must be ⟂ `tool_axis`.
+    pub roll_axis: Option<Vec3>,
+}
+
+impl PoseTarget {
+    /// The target of SPEC §6: `z = n`, `x = normalise(d − (d·n)n)`.
+    pub fn with_roll_from_direction(position: Vec3, n: Vec3, d: Vec3) -> Self {
+        let x = (d - n * d.dot(&n)).normalize();
+        Self {
+            position,
+            tool_axis: n,
+            roll_axis: Some(x),
+        }
+    }
+}
+
+/// Settings of the damped Newton iteration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProjectionConfig {
+    /// Iteration cap.
+    pub max_iterations: usize,
+    /// Position error (m) below which the pose counts as reached.
+    pub position_tolerance_m: f64,
+    /// Orientation error (rad) below which the pose counts as reached.
+    pub orientation_tolerance_rad: f64,
+    /// Levenberg damping added to `MMᵀ`.
+    pub damping: f64,
+    /// Largest joint change of one iteration (rad, max-norm).
+    pub max_step_rad: f64,
+    /// Required distance from every joint limit (rad).
+    pub joint_margin_rad: f64,
+}
+
+impl Default for ProjectionConfig {
+    fn default() -> Self {
+        Self {
+            max_iterations: 60,
+            position_tolerance_m: 1e-10,
+            orientation_tolerance_rad: 1e-10,
+            damping: 1e-10,
+            max_step_rad: 0.3,
+            joint_margin_rad: 0.0,
+        }
+    }
+}
+
+/// Why a projection failed; the projection never returns a configuration that misses the pose.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ProjectionError {
+    /// The iteration did not reach the pose (typically held back by a joint limit).
+    #[error(
+        "Newton projection did not converge in {iterations} iterations \
+         (position error {position_error_m:.3e} m, orientation error {orientation_error_rad:.3e} rad)"
+    )]
+    NotConverged {
+        /// Iterations run.
+        iterations: usize,
+        /// Remaining position error (m).
+        position_error_m: f64,
+        /// Remaining orientation error (rad).
+        orientation_error_rad: f64,
+    },
+    /// The target itself is unusable.
+    #[error("pose target field '{field}' {problem}")]
+    BadTarget {
+        /// Offending field.
+        field: &'static str,
+        /// What is wrong with it.
+        problem: &'static str,
+    },
+}
+
+/// Projects `start` onto the exact pose `target` by damped Newton steps, keeping every joint
+/// within `[q_min + margin, q_max − margin]` (Sec. 4.1). Returns the configuration and the number
+/// of iterations, or an honest failure. Allocation-free.
+pub fn project_to_pose(
+    robot: &Robot,
+    start: &JointVector,
+    target: &PoseTarget,
+    cfg: &ProjectionConfig,
+) -> Result<(JointVector, usize), ProjectionError> {
+    check_target(target)?;
+    let limits = robot.limits();
+    let margin = JointVector::repeat(cfg.joint_margin_rad);
+    let (lower, upper) = (limits.lower + margin, limits.upper - margin);
+    let mut q = start.zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
+    let (mut position_error, mut orientation_error) = (f64::INFINITY, f64::INFINITY);
+    for iteration in 0..=cfg.max_iterations {
+        let kin = robot.forward(&q);
+        let (rows, error) = pose_residual(&kin, target);
+        position_error = error.fixed_rows::<3>(0).norm();
+        orientation_error = error.fixed_rows::<3>(3).norm();
+        if position_error < cfg.position_tolerance_m && orientation_error < cfg.orientation_tolerance_rad {
+            return Ok((q, iteration));
+        }
+        if iteration == cfg.max_iterations {
+            break;
+        }
+        let gram = rows * rows.transpose() + SMatrix::<f64, 6, 6>::identity() * cfg.damping;
+        let Some(solved) = gram.cholesky().map(|c| c.solve(&error)) else {
+            break;
+        };
+        let mut step = rows.transpose() * solved;
+        let largest = step.amax();
+        if largest > cfg.max_step_rad {
+            step *= cfg.max_step_rad / largest;
+        }
+        q = (q + step).zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
+    }
+    Err(ProjectionError::NotConverged {
+        iterations: cfg.max_iterations,
+        position_error_m: position_error,
+        orientation_error_rad: orientation_error,
+    })
+}
+
+fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
+    let unit = |v: &Vec3| v.iter().all(|c| c.is_finite()) && (v.norm() - 1.0).abs() < 1e-6;
+    if !target.position.iter().all(|c| c.is_finite()) {
+        return Err(ProjectionError::BadTarget { field: "position", problem: "is not finite" });
+    }
+    if !unit(&target.tool_axis) {
+        return Err(ProjectionError::BadTarget { field: "tool_axis", problem: "is not a unit vector" });
+    }
+    if let Some(x) = &target.roll_axis {
+        if !unit(x) || x.dot(&target.tool_axis).abs() > 1e-6 {
+            return Err(ProjectionError::BadTarget {
+                field: "roll_axis",
+                problem: "is not a unit vector perpendicular to tool_axis",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Task rows `M` (6×7) and residual `e` (position error; rotation vector toward the target).
+/// Without a roll target, the orientation rows only constrain the two directions ⟂ `z`.
+fn pose_residual(
+    kin: &crate::Kinematics,
+    target: &PoseTarget,
+) -> (SMatrix<f64, 6, DOF>, SVector<f64, 6>) {
+    let mut rows = SMatrix::<f64, 6, DOF>::zeros();
+    rows.fixed_rows_mut::<3>(0).copy_from(kin.jacobian());
+    let mut error = SVector::<f64, 6>::zeros();
+    error.fixed_rows_mut::<3>(0).copy_from(&(target.position - kin.tcp()));
+    let current = kin.tcp_rotation();
+    let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
+    match &target.roll_axis {
+        Some(x) => {
+            let goal = Matrix3::from_columns(&[*x, target.tool_axis.cross(x), target.tool_axis]);
+            let rotation = Rotation3::from_matrix_unchecked(goal * current.transpose());
+            error.fixed_rows_mut::<3>(3).copy_from(&rotation.scaled_axis());
+            for (i, axis) in axes.iter().enumerate() {
+                rows.fixed_view_mut::<3, 1>(3, i).copy_from(axis);
+            }
+        }
+        None => {
+            let z = kin.tool_axis();
+            let (u, v) = (current.column(0).into_owned(), current.column(1).into_owned());
+            let cross = z.cross(&target.tool_axis);
+            let sin = cross.norm();
+            let angle = sin.atan2(z.dot(&target.tool_axis));
+            let rotation_axis = if sin > 1e-12 { cross / sin } else { u };
+            let phi = rotation_axis * angle;
+            error[3] = u.dot(&phi);
+            error[4] = v.dot(&phi);
+            for (i, axis) in axes.iter().enumerate() {
+                rows[(3, i)] = u.dot(axis);
+                rows[(4, i)] = v.dot(axis);
+            }
+        }
+    }
+    (rows, error)
+}

@@ -1,0 +1,73 @@
+//! Damped pseudo-inverse `J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹` with variable damping (SPEC §3, Eq. 2).
+
+use nalgebra::{Matrix3, SMatrix};
+use serde::{Deserialize, Serialize};
+
+use crate::DOF;
+use crate::fk::PositionJacobian;
+
+/// Variable-damping schedule: `λ = λ_max·√(1 − (σ_min/σ_0)²)` when `σ_min < σ_0`, else 0.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DampingConfig {
+    /// Singular-value threshold `σ_0` below which damping starts.
+    pub sigma_threshold: f64,
+    /// Damping `λ_max` reached at a singularity (`σ_min = 0`).
+    pub lambda_max: f64,
+}
+
+impl Default for DampingConfig {
+    fn default() -> Self {
+        Self {
+            sigma_threshold: 0.05,
+            lambda_max: 0.05,
+        }
+    }
+}
+
+/// The damped pseudo-inverse and the quantities it was built from.
+#[derive(Clone, Debug)]
+pub struct DampedPseudoInverse {
+    /// `J⁺` (7×3).
+    pub matrix: SMatrix<f64, DOF, 3>,
+    /// Smallest singular value `σ_min` of `J`.
+    pub sigma_min: f64,
+    /// Damping `λ` that was applied.
+    pub lambda: f64,
+}
+
+/// `J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹` with `λ` from [`DampingConfig`] (no allocation).
+pub fn damped_pseudo_inverse(jacobian: &PositionJacobian, cfg: &DampingConfig) -> DampedPseudoInverse {
+    let jjt = jacobian * jacobian.transpose();
+    let sigma_min = smallest_symmetric_eigenvalue(&jjt).max(0.0).sqrt();
+    let lambda = if sigma_min < cfg.sigma_threshold {
+        cfg.lambda_max * (1.0 - (sigma_min / cfg.sigma_threshold).powi(2)).sqrt()
+    } else {
+        0.0
+    };
+    let damped = jjt + Matrix3::identity() * (lambda * lambda);
+    let inverse = damped.try_inverse().unwrap_or_else(Matrix3::zeros);
+    DampedPseudoInverse {
+        matrix: jacobian.transpose() * inverse,
+        sigma_min,
+        lambda,
+    }
+}
+
+/// Smallest eigenvalue of a symmetric 3×3 matrix, in closed form (trigonometric method).
+pub(crate) fn smallest_symmetric_eigenvalue(m: &Matrix3<f64>) -> f64 {
+    let p1 = m[(0, 1)].powi(2) + m[(0, 2)].powi(2) + m[(1, 2)].powi(2);
+    let trace_third = m.trace() / 3.0;
+    if p1 <= f64::EPSILON * m.norm_squared() {
+        return m[(0, 0)].min(m[(1, 1)]).min(m[(2, 2)]);
+    }
+    let p2 = (m[(0, 0)] - trace_third).powi(2)
+        + (m[(1, 1)] - trace_third).powi(2)
+        + (m[(2, 2)] - trace_third).powi(2)
+        + 2.0 * p1;
+    let p = (p2 / 6.0).sqrt();
+    let b = (m - Matrix3::identity() * trace_third) / p;
+    let r = (b.determinant() * 0.5).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    trace_third + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos()
+}

@@ -1,0 +1,457 @@
+//! The robot model: a serial chain of seven revolute joints read from a URDF file.
+
+use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use std::collections::HashMap;
+use std::path::Path;
+
+use crate::collision::{Capsule, CollisionPair};
+use crate::{DOF, JointVector, Vec3};
+
+/// Smallest chain-index separation of two bodies whose capsules are checked against each other
+/// (adjacent links always touch at their joint).
+const MIN_LINK_SEPARATION: usize = 3;
+
+/// Why a robot file could not be turned into a [`Robot`].
+#[derive(Debug, thiserror::Error)]
+pub enum RobotError {
+    /// The file could not be read from disk.
+    #[error("cannot read robot file {path}: {source}")]
+    Io {
+        /// File that was asked for.
+        path: String,
+        /// Underlying I/O error.
+        source: std::io::Error,
+    },
+    /// The text is not well-formed URDF.
+    #[error("malformed URDF: {0}")]
+    Malformed(String),
+    /// A link named as the chain's base or tip does not exist.
+    #[error("{role} link '{name}' is not in the robot file (links: {available})")]
+    MissingLink {
+        /// `"base"` or `"tip"`.
+        role: &'static str,
+        /// Requested link name.
+        name: String,
+        /// Comma-separated names the file does define.
+        available: String,
+    },
+    /// The tip link is not a descendant of the base link.
+    #[error("tip link '{tip}' is not below base link '{base}' in the kinematic tree")]
+    NotAChain {
+        /// Base link name.
+        base: String,
+        /// Tip link name.
+        tip: String,
+    },
+    /// A link inside the chain has more than one child joint.
+    #[error("link '{link}' branches into {count} child joints ({joints}); a serial chain is required")]
+    Branching {
+        /// The branching link.
+        link: String,
+        /// How many child joints it has.
+        count: usize,
+        /// Their names.
+        joints: String,
+    },
+    /// A joint of the chain is neither revolute nor fixed.
+    #[error("joint '{joint}' is {kind}; only revolute and fixed joints are supported")]
+    UnsupportedJoint {
+        /// Joint name.
+        joint: String,
+        /// Its URDF type.
+        kind: String,
+    },
+    /// The chain does not have exactly [`DOF`] revolute joints.
+    #[error("the chain from '{base}' to '{tip}' has {found} revolute joints; exactly {DOF} are required")]
+    WrongDof {
+        /// Base link name.
+        base: String,
+        /// Tip link name.
+        tip: String,
+        /// Revolute joints found.
+        found: usize,
+    },
+    /// A joint has an unusable axis, limit or velocity limit.
+    #[error("joint '{joint}': {field} {problem}")]
+    BadJoint {
+        /// Joint name.
+        joint: String,
+        /// Offending field (`axis`, `limit`, `velocity`).
+        field: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A collision element uses geometry other than a capsule or sphere.
+    #[error("link '{link}': collision geometry {kind} is not supported; use <capsule> or <sphere>")]
+    UnsupportedGeometry {
+        /// Link carrying the geometry.
+        link: String,
+        /// Geometry kind found.
+        kind: &'static str,
+    },
+}
+
+/// Lower, upper and velocity limits of the seven joints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct JointLimits {
+    /// Lower position limits `q_min` (rad).
+    pub lower: JointVector,
+    /// Upper position limits `q_max` (rad).
+    pub upper: JointVector,
+    /// Velocity limits (rad/s).
+    pub velocity: JointVector,
+}
+
+impl JointLimits {
+    /// Mid-range configuration `q_mid = (q_min + q_max)/2`.
+    pub fn mid(&self) -> JointVector {
+        (self.lower + self.upper) * 0.5
+    }
+
+    /// Half range `(q_max − q_min)/2` per joint.
+    pub fn half_range(&self) -> JointVector {
+        (self.upper - self.lower) * 0.5
+    }
+
+    /// Normalised configuration `q̄ = (q − q_mid)/q_half ∈ [−1, 1]` (SPEC §4).
+    pub fn normalise(&self, q: &JointVector) -> JointVector {
+        (q - self.mid()).component_div(&self.half_range())
+    }
+
+    /// Normalised joint-limit distance `ρ(q) = max_i |q̄_i|` (Eq. 8): 0 at mid-range, 1 at a limit.
+    pub fn limit_proximity(&self, q: &JointVector) -> f64 {
+        self.normalise(q).amax()
+    }
+
+    /// Index of the first joint outside `[q_min + margin, q_max − margin]`, if any.
+    pub fn first_violation(&self, q: &JointVector, margin: f64) -> Option<usize> {
+        (0..DOF).find(|&i| !(q[i] >= self.lower[i] + margin && q[i] <= self.upper[i] - margin))
+    }
+
+    /// `q` clamped into the limits.
+    pub fn clamp(&self, q: &JointVector) -> JointVector {
+        q.zip_zip_map(&self.lower, &self.upper, |v, lo, hi| v.clamp(lo, hi))
+    }
+}
+
+/// Fixed transform of one revolute joint, expressed so that the joint turns about its local +z.
+#[derive(Clone, Debug)]
+pub(crate) struct JointFrame {
+    pub(crate) rotation: Matrix3<f64>,
+    pub(crate) translation: Vec3,
+}
+
+/// A 7-DoF serial arm with a tool: the immutable model every algorithm reads.
+///
+/// Built once from a URDF file; cheap to share between threads (`&Robot` is all any
+/// algorithm needs). Joint frames are normalised at load time so that every joint turns about
+/// its local +z axis whatever axis the file gives.
+#[derive(Clone, Debug)]
+pub struct Robot {
+    pub(crate) name: String,
+    pub(crate) joint_names: Vec<String>,
+    pub(crate) joints: [JointFrame; DOF],
+    pub(crate) tcp_offset: JointFrame,
+    pub(crate) limits: JointLimits,
+    pub(crate) capsules: Vec<Capsule>,
+    pub(crate) pairs: Vec<CollisionPair>,
+    pub(crate) reach_centre: Vec3,
+    pub(crate) reach_radius: f64,
+}
+
+struct ChainLink<'a> {
+    link: &'a urdf_rs::Link,
+    segment: usize,
+    offset: Isometry3<f64>,
+}
+
+impl Robot {
+    /// Reads the chain from `base_link` to `tip_link` of a URDF file.
+    pub fn from_urdf_file(
+        path: impl AsRef<Path>,
+        base_link: &str,
+        tip_link: &str,
+    ) -> Result<Self, RobotError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_urdf_str(&text, base_link, tip_link)
+    }
+
+    /// Reads the chain from `base_link` to `tip_link` of URDF text.
+    pub fn from_urdf_str(text: &str, base_link: &str, tip_link: &str) -> Result<Self, RobotError> {
+        let urdf =
+            urdf_rs::read_from_string(text).map_err(|e| RobotError::Malformed(e.to_string()))?;
+        let path = chain_joints(&urdf, base_link, tip_link)?;
+        let links: HashMap<&str, &urdf_rs::Link> =
+            urdf.links.iter().map(|l| (l.name.as_str(), l)).collect();
+
+        let mut joints = Vec::with_capacity(DOF);
+        let mut joint_names = Vec::with_capacity(DOF);
+        let (mut lower, mut upper, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
+        let mut chain = vec![ChainLink {
+            link: links[base_link],
+            segment: 0,
+            offset: Isometry3::identity(),
+        }];
+        // Transform from the current segment frame (the last revolute joint's frame) to the
+        // current link's URDF frame.
+        let mut offset = Isometry3::identity();
+        for joint in &path {
+            let origin = pose_to_isometry(&joint.origin);
+            match joint.joint_type {
+                urdf_rs::JointType::Fixed => offset *= origin,
+                urdf_rs::JointType::Revolute => {
+                    let axis_alignment = axis_alignment(joint)?;
+                    let frame = offset * origin * axis_alignment;
+                    joints.push(JointFrame {
+                        rotation: frame.rotation.to_rotation_matrix().into_inner(),
+                        translation: frame.translation.vector,
+                    });
+                    check_limits(joint)?;
+                    joint_names.push(joint.name.clone());
+                    lower.push(joint.limit.lower);
+                    upper.push(joint.limit.upper);
+                    velocity.push(joint.limit.velocity);
+                    offset = axis_alignment.inverse();
+                }
+                ref other => {
+                    return Err(RobotError::UnsupportedJoint {
+                        joint: joint.name.clone(),
+                        kind: format!("{other:?}").to_lowercase(),
+                    });
+                }
+            }
+            chain.push(ChainLink {
+                link: links[joint.child.link.as_str()],
+                segment: joints.len(),
+                offset,
+            });
+        }
+        if joints.len() != DOF {
+            return Err(RobotError::WrongDof {
+                base: base_link.into(),
+                tip: tip_link.into(),
+                found: joints.len(),
+            });
+        }
+        let capsules = chain_capsules(&chain)?;
+        let pairs = collision_pairs(&capsules);
+        let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
+        let reach_centre = joints[0].translation;
+        let reach_radius = joints[1..]
+            .iter()
+            .map(|j| j.translation.norm())
+            .sum::<f64>()
+            + offset.translation.vector.norm();
+        Ok(Self {
+            name: urdf.name.clone(),
+            joint_names,
+            joints,
+            tcp_offset: JointFrame {
+                rotation: offset.rotation.to_rotation_matrix().into_inner(),
+                translation: offset.translation.vector,
+            },
+            limits: JointLimits {
+                lower: JointVector::from_column_slice(&lower),
+                upper: JointVector::from_column_slice(&upper),
+                velocity: JointVector::from_column_slice(&velocity),
+            },
+            capsules,
+            pairs,
+            reach_centre,
+            reach_radius,
+        })
+    }
+
+    /// The robot's name from the file.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Names of the seven revolute joints, base to tip.
+    pub fn joint_names(&self) -> &[String] {
+        &self.joint_names
+    }
+
+    /// Joint position and velocity limits.
+    pub fn limits(&self) -> &JointLimits {
+        &self.limits
+    }
+
+    /// The collision capsules of every body of the chain.
+    pub fn capsules(&self) -> &[Capsule] {
+        &self.capsules
+    }
+
+    /// The capsule pairs checked for self-collision: bodies at least three links apart that
+    /// move relative to each other.
+    pub fn collision_pairs(&self) -> &[CollisionPair] {
+        &self.pairs
+    }
+
+    /// Mid-range configuration `q_mid`, the default seed (the robot file carries no home pose).
+    pub fn mid_range(&self) -> JointVector {
+        self.limits.mid()
+    }
+
+    /// A sphere (centre, radius) that contains every TCP position the arm can reach.
+    pub fn reach_sphere(&self) -> (Vec3, f64) {
+        (self.reach_centre, self.reach_radius)
+    }
+}
+
+/// The joints from `base` down to `tip`, in order, checking the chain is serial.
+fn chain_joints<'a>(
+    urdf: &'a urdf_rs::Robot,
+    base: &str,
+    tip: &str,
+) -> Result<Vec<&'a urdf_rs::Joint>, RobotError> {
+    let available = || {
+        urdf.links
+            .iter()
+            .map(|l| l.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    for (role, name) in [("base", base), ("tip", tip)] {
+        if !urdf.links.iter().any(|l| l.name == name) {
+            return Err(RobotError::MissingLink {
+                role,
+                name: name.into(),
+                available: available(),
+            });
+        }
+    }
+    let parent_joint: HashMap<&str, &urdf_rs::Joint> = urdf
+        .joints
+        .iter()
+        .map(|j| (j.child.link.as_str(), j))
+        .collect();
+    let mut path = Vec::new();
+    let mut link = tip;
+    while link != base {
+        let joint = parent_joint.get(link).ok_or_else(|| RobotError::NotAChain {
+            base: base.into(),
+            tip: tip.into(),
+        })?;
+        path.push(*joint);
+        link = joint.parent.link.as_str();
+    }
+    path.reverse();
+    for joint in &path {
+        let parent = joint.parent.link.as_str();
+        let children: Vec<&str> = urdf
+            .joints
+            .iter()
+            .filter(|j| j.parent.link == parent)
+            .map(|j| j.name.as_str())
+            .collect();
+        if children.len() > 1 {
+            return Err(RobotError::Branching {
+                link: parent.into(),
+                count: children.len(),
+                joints: children.join(", "),
+            });
+        }
+    }
+    Ok(path)
+}
+
+fn pose_to_isometry(pose: &urdf_rs::Pose) -> Isometry3<f64> {
+    let [x, y, z] = pose.xyz.0;
+    let [roll, pitch, yaw] = pose.rpy.0;
+    Isometry3::from_parts(
+        Translation3::new(x, y, z),
+        UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+    )
+}
+
+/// Rotation that takes local +z onto the joint's axis, so the joint turns about +z after it.
+fn axis_alignment(joint: &urdf_rs::Joint) -> Result<Isometry3<f64>, RobotError> {
+    let axis = Vector3::from(joint.axis.xyz.0);
+    let norm = axis.norm();
+    if !(norm.is_finite() && norm > 1e-9) {
+        return Err(RobotError::BadJoint {
+            joint: joint.name.clone(),
+            field: "axis",
+            problem: format!("{:?} is not a usable direction", joint.axis.xyz.0),
+        });
+    }
+    let rotation = Rotation3::rotation_between(&Vector3::z(), &(axis / norm))
+        .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI));
+    Ok(Isometry3::from_parts(
+        Translation3::identity(),
+        UnitQuaternion::from_rotation_matrix(&rotation),
+    ))
+}
+
+fn check_limits(joint: &urdf_rs::Joint) -> Result<(), RobotError> {
+    let bad = |field, problem: String| RobotError::BadJoint {
+        joint: joint.name.clone(),
+        field,
+        problem,
+    };
+    let (lo, hi) = (joint.limit.lower, joint.limit.upper);
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(bad(
+            "limit",
+            format!("lower {lo} must be finite and below upper {hi}"),
+        ));
+    }
+    let v = joint.limit.velocity;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(bad("velocity", format!("{v} must be a positive number")));
+    }
+    Ok(())
+}
+
+fn chain_capsules(chain: &[ChainLink<'_>]) -> Result<Vec<Capsule>, RobotError> {
+    let mut capsules = Vec::new();
+    for (chain_index, entry) in chain.iter().enumerate() {
+        for collision in &entry.link.collision {
+            let (radius, half_length) = match collision.geometry {
+                urdf_rs::Geometry::Capsule { radius, length } => (radius, 0.5 * length),
+                urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
+                ref other => {
+                    return Err(RobotError::UnsupportedGeometry {
+                        link: entry.link.name.clone(),
+                        kind: match other {
+                            urdf_rs::Geometry::Box { .. } => "box",
+                            urdf_rs::Geometry::Cylinder { .. } => "cylinder",
+                            _ => "mesh",
+                        },
+                    });
+                }
+            };
+            let frame = entry.offset * pose_to_isometry(&collision.origin);
+            let a = frame * Point3::new(0.0, 0.0, -half_length);
+            let b = frame * Point3::new(0.0, 0.0, half_length);
+            capsules.push(Capsule {
+                link: entry.link.name.clone(),
+                chain_index,
+                segment: entry.segment,
+                start: a.coords,
+                end: b.coords,
+                radius,
+            });
+        }
+    }
+    Ok(capsules)
+}
+
+fn collision_pairs(capsules: &[Capsule]) -> Vec<CollisionPair> {
+    let mut pairs = Vec::new();
+    for (i, a) in capsules.iter().enumerate() {
+        for (j, b) in capsules.iter().enumerate().skip(i + 1) {
+            if b.chain_index.abs_diff(a.chain_index) >= MIN_LINK_SEPARATION
+                && a.segment != b.segment
+            {
+                pairs.push(CollisionPair { first: i, second: j });
+            }
+        }
+    }
+    pairs
+}
