@@ -1,0 +1,89 @@
+//! `cargo xtask make-tasks`: the evaluation set and the training pool.
+//!
+//! Candidates are drawn in index order from one seeded population (SPEC §2); the first
+//! `eval_count` accepted tasks form the evaluation set and the next `train_count` the training
+//! pool, so the two are disjoint by construction and each file is reproducible bit for bit.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, TASK_FORMAT_VERSION, TaskSampler, write_task_set};
+use serde::Serialize;
+
+use crate::{progress, workspace};
+
+/// Options of `make-tasks`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Tasks in the evaluation set.
+    #[arg(long, default_value_t = 10_000)]
+    eval_count: usize,
+    /// Tasks in the training pool.
+    #[arg(long, default_value_t = 50_000)]
+    train_count: usize,
+    /// Seed of the population.
+    #[arg(long, default_value_t = SamplerConfig::default().seed)]
+    seed: u64,
+    /// Output directory.
+    #[arg(long, default_value_os_t = workspace::root().join("data/tasks"))]
+    out_dir: PathBuf,
+    /// Robot file.
+    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    robot: PathBuf,
+}
+
+/// What a task-set directory holds, written beside the sets as `tasks-v<version>.json`.
+#[derive(Serialize)]
+struct Manifest {
+    format_version: u32,
+    robot: String,
+    sampler: SamplerConfig,
+    rollout: RolloutConfig,
+    gains: ClassicalGains,
+    eval_file: String,
+    eval_count: usize,
+    train_file: String,
+    train_count: usize,
+    candidates_drawn: u64,
+    split: &'static str,
+}
+
+/// Runs the sampler and writes both sets and their manifest.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = workspace::load_robot(&args.robot)?;
+    let sampler_config = SamplerConfig { seed: args.seed, ..SamplerConfig::default() };
+    let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());
+    let mut sampler = TaskSampler::new(&robot, &rollout, &gains, &sampler_config);
+    std::fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let version = TASK_FORMAT_VERSION;
+    let mut files = Vec::new();
+    for (name, count) in [("eval", args.eval_count), ("train", args.train_count)] {
+        let bar = progress::bar(count as u64, name);
+        let tasks = sampler.take(count, &|accepted| bar.set_position(accepted as u64));
+        bar.finish();
+        let file = args.out_dir.join(format!("{name}-v{version}.tasks"));
+        write_task_set(&file, &tasks)?;
+        println!("wrote {} tasks to {}", tasks.len(), file.display());
+        files.push(file);
+    }
+    let candidates_drawn = sampler.candidates_drawn();
+    drop(sampler);
+    let manifest = Manifest {
+        format_version: version,
+        robot: workspace::relative(&args.robot),
+        sampler: sampler_config,
+        rollout,
+        gains,
+        eval_file: workspace::relative(&files[0]),
+        eval_count: args.eval_count,
+        train_file: workspace::relative(&files[1]),
+        train_count: args.train_count,
+        candidates_drawn,
+        split: "first eval_count accepted candidates, then the next train_count",
+    };
+    let manifest_path = args.out_dir.join(format!("tasks-v{version}.json"));
+    std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest)? + "\n")?;
+    println!("wrote {}", manifest_path.display());
+    Ok(())
+}

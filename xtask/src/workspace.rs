@@ -1,0 +1,32 @@
+//! Paths and shared loading of the workspace's data.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use emg_kinematics::Robot;
+
+/// The workspace root (parent of `xtask/`).
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives inside the workspace")
+        .to_path_buf()
+}
+
+/// Path relative to the workspace root, for records that must not depend on the checkout place.
+pub fn relative(path: &Path) -> String {
+    let canonical = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
+    let (path, root) = (canonical(path), canonical(&root()));
+    path.strip_prefix(&root).unwrap_or(&path).display().to_string()
+}
+
+/// Loads the robot file (base `link0`, tip `pen_tip`).
+pub fn load_robot(path: &Path) -> anyhow::Result<Robot> {
+    Robot::from_urdf_file(path, "link0", "pen_tip")
+        .with_context(|| format!("loading robot {}", path.display()))
+}
+
+/// Builds a rayon pool with `threads` threads (0 = one per core).
+pub fn thread_pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).build()?)
+}
