@@ -73,7 +73,10 @@ struct EvalResult {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
     let mut tasks = read_tasks(&args.tasks, &robot).with_context(|| {
-        format!("reading {} (create it with `cargo xtask make-tasks`)", args.tasks.display())
+        format!(
+            "reading {} (create it with `cargo xtask make-tasks`)",
+            args.tasks.display()
+        )
     })?;
     if let Some(limit) = args.limit {
         tasks.truncate(limit);
@@ -92,7 +95,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bar = progress::bar(tasks.len() as u64, "rollouts");
     let started = Instant::now();
     let trajectories = pool.install(|| {
-        rollout_all(&robot, &tasks, seed_of, || ClassicalController::new(gains.clone()), &rollout, &|| bar.inc(1))
+        rollout_all(
+            &robot,
+            &tasks,
+            seed_of,
+            || ClassicalController::new(gains.clone()),
+            &rollout,
+            &|| bar.inc(1),
+        )
     });
     let rollout_seconds = started.elapsed().as_secs_f64();
     bar.finish();
@@ -100,7 +110,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut check_seconds = None;
     let mut checked = 0;
     if !args.no_check {
-        let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip").map_err(anyhow::Error::msg)?;
+        let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip")
+            .map_err(anyhow::Error::msg)?;
         let bar = progress::bar(tasks.len() as u64, "checking");
         let started = Instant::now();
         let failures: Vec<String> = pool.install(|| {
@@ -111,20 +122,30 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .enumerate()
                 .filter_map(|(i, (task, trajectory))| {
                     bar.inc(1);
-                    checker.check(task, trajectory, &rollout.constraints).err().map(|e| format!("task {i}: {e}"))
+                    checker
+                        .check(task, trajectory, &rollout.constraints)
+                        .err()
+                        .map(|e| format!("task {i}: {e}"))
                 })
                 .collect()
         });
         bar.finish();
         if !failures.is_empty() {
-            bail!("{} trajectories fail the independent check, first: {}", failures.len(), failures[0]);
+            bail!(
+                "{} trajectories fail the independent check, first: {}",
+                failures.len(),
+                failures[0]
+            );
         }
         checked = tasks.len();
         check_seconds = Some(started.elapsed().as_secs_f64());
     }
 
     let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
-    let steps: Vec<f64> = trajectories.iter().map(|t| (t.steps.len() - 1) as f64).collect();
+    let steps: Vec<f64> = trajectories
+        .iter()
+        .map(|t| (t.steps.len() - 1) as f64)
+        .collect();
     let result = EvalResult {
         controller: args.controller,
         tasks: workspace::relative(&args.tasks),
@@ -143,7 +164,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let json_path = args.out_dir.join(format!("{name}.json"));
     std::fs::write(&json_path, serde_json::to_string_pretty(&result)? + "\n")?;
     let md_path = args.out_dir.join(format!("{name}.md"));
-    std::fs::write(&md_path, markdown(&result, rollout_seconds, check_seconds, pool.current_num_threads()))?;
+    std::fs::write(
+        &md_path,
+        markdown(
+            &result,
+            rollout_seconds,
+            check_seconds,
+            pool.current_num_threads(),
+        ),
+    )?;
     println!(
         "path length mean {:.3} m (std {:.3}, min {:.3}, max {:.3}) over {} tasks; rollouts {:.2} s wall",
         result.path_length_m.mean,
@@ -157,7 +186,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn markdown(result: &EvalResult, rollout_seconds: f64, check_seconds: Option<f64>, threads: usize) -> String {
+fn markdown(
+    result: &EvalResult,
+    rollout_seconds: f64,
+    check_seconds: Option<f64>,
+    threads: usize,
+) -> String {
     let s = &result.path_length_m;
     let mut md = format!(
         "# Evaluation: {name} controller from q0_seed\n\n\
@@ -178,7 +212,10 @@ fn markdown(result: &EvalResult, rollout_seconds: f64, check_seconds: Option<f64
         k_lat = result.rollout.lateral_gain_per_s,
     );
     for (reason, n) in &result.termination {
-        md += &format!("| {reason} | {n} | {:.1} % |\n", 100.0 * *n as f64 / result.task_count as f64);
+        md += &format!(
+            "| {reason} | {n} | {:.1} % |\n",
+            100.0 * *n as f64 / result.task_count as f64
+        );
     }
     md += "\n## Joint limits reached\n\n| joint | tasks |\n|---|---|\n";
     for (joint, n) in &result.joint_limit_by_joint {
@@ -202,7 +239,13 @@ fn machine() -> String {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
     let model = cpuinfo
         .lines()
-        .find_map(|l| l.strip_prefix("model name").map(|m| m.trim_start_matches([' ', '\t', ':']).to_string()))
+        .find_map(|l| {
+            l.strip_prefix("model name")
+                .map(|m| m.trim_start_matches([' ', '\t', ':']).to_string())
+        })
         .unwrap_or_else(|| "unknown CPU".into());
-    format!("{model}, {} cores", std::thread::available_parallelism().map_or(0, |n| n.get()))
+    format!(
+        "{model}, {} cores",
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    )
 }

@@ -7,7 +7,9 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, TASK_FORMAT_VERSION, TaskSampler, write_task_set};
+use emg_control::{
+    ClassicalGains, RolloutConfig, SamplerConfig, TASK_FORMAT_VERSION, TaskSampler, write_task_set,
+};
 use serde::Serialize;
 
 use crate::{progress, workspace};
@@ -51,7 +53,10 @@ struct Manifest {
 /// Runs the sampler and writes both sets and their manifest.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
-    let sampler_config = SamplerConfig { seed: args.seed, ..SamplerConfig::default() };
+    let sampler_config = SamplerConfig {
+        seed: args.seed,
+        ..SamplerConfig::default()
+    };
     let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());
     let mut sampler = TaskSampler::new(&robot, &rollout, &gains, &sampler_config);
     std::fs::create_dir_all(&args.out_dir)
@@ -68,7 +73,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         files.push(file);
     }
     let candidates_drawn = sampler.candidates_drawn();
-    drop(sampler);
     let manifest = Manifest {
         format_version: version,
         robot: workspace::relative(&args.robot),
@@ -83,7 +87,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         split: "first eval_count accepted candidates, then the next train_count",
     };
     let manifest_path = args.out_dir.join(format!("tasks-v{version}.json"));
-    std::fs::write(&manifest_path, serde_json::to_string_pretty(&manifest)? + "\n")?;
+    std::fs::write(
+        &manifest_path,
+        serde_json::to_string_pretty(&manifest)? + "\n",
+    )?;
     println!("wrote {}", manifest_path.display());
     Ok(())
 }

@@ -17,7 +17,10 @@ pub fn root() -> PathBuf {
 pub fn relative(path: &Path) -> String {
     let canonical = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
     let (path, root) = (canonical(path), canonical(&root()));
-    path.strip_prefix(&root).unwrap_or(&path).display().to_string()
+    path.strip_prefix(&root)
+        .unwrap_or(&path)
+        .display()
+        .to_string()
 }
 
 /// Loads the robot file (base `link0`, tip `pen_tip`).
@@ -28,5 +31,7 @@ pub fn load_robot(path: &Path) -> anyhow::Result<Robot> {
 
 /// Builds a rayon pool with `threads` threads (0 = one per core).
 pub fn thread_pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
-    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).build()?)
+    Ok(rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()?)
 }

@@ -83,7 +83,11 @@ impl ReferenceModel {
             });
         }
         for (chain_index, name) in link_names.iter().enumerate() {
-            let link = urdf.links.iter().find(|l| &l.name == name).ok_or("missing link")?;
+            let link = urdf
+                .links
+                .iter()
+                .find(|l| &l.name == name)
+                .ok_or("missing link")?;
             for collision in &link.collision {
                 let (radius, half) = match collision.geometry {
                     urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0),
@@ -185,7 +189,19 @@ impl ReferenceModel {
     ) -> Result<(), CheckFailure> {
         let limits = self.limits();
         let fail = |step: usize, problem: String| Err(CheckFailure { step, problem });
+        if trajectory.steps.is_empty() {
+            return fail(0, "the trajectory holds no step, not even its seed".into());
+        }
         let valid_steps = match trajectory.termination {
+            Termination::InvalidStart { .. } if trajectory.steps.len() != 1 => {
+                return fail(
+                    1,
+                    format!(
+                        "an invalid start must hold only the seed, found {} steps",
+                        trajectory.steps.len()
+                    ),
+                );
+            }
             Termination::InvalidStart { .. } => 0,
             _ => trajectory.steps.len(),
         };
@@ -193,53 +209,78 @@ impl ReferenceModel {
             let q = step.q.as_slice();
             for (i, (lo, hi)) in limits.iter().enumerate() {
                 if !(q[i] >= *lo && q[i] <= *hi) {
-                    return fail(k, format!("joint {} = {} outside [{lo}, {hi}]", i + 1, q[i]));
+                    return fail(
+                        k,
+                        format!("joint {} = {} outside [{lo}, {hi}]", i + 1, q[i]),
+                    );
                 }
             }
             let (tcp, z) = self.tcp_pose(q);
-            if (tcp - step.tcp).norm() > SLACK {
-                return fail(k, format!("recorded TCP {:?} but FK gives {:?}", step.tcp, tcp));
+            if !within((tcp - step.tcp).norm(), SLACK) {
+                return fail(
+                    k,
+                    format!("recorded TCP {:?} but FK gives {:?}", step.tcp, tcp),
+                );
             }
             let offset = tcp - task.p0;
             let lateral = (offset - task.d * offset.dot(&task.d)).norm();
-            if lateral > constraints.line_tolerance_m + SLACK {
+            if !within(lateral, constraints.line_tolerance_m + SLACK) {
                 return fail(k, format!("TCP {lateral} m off the line"));
             }
-            let angle = z.dot(&task.n).clamp(-1.0, 1.0).acos().to_degrees();
-            if angle > constraints.theta_max_deg + 1e-6 {
+            let angle = angle_deg(&z, &task.n);
+            if !within(angle, constraints.theta_max_deg + 1e-6) {
                 return fail(k, format!("tool axis {angle}° from n"));
             }
-            if (angle - step.tool_angle_deg).abs() > 1e-6 {
-                return fail(k, format!("recorded tool angle {} but FK gives {angle}", step.tool_angle_deg));
+            if !within((angle - step.tool_angle_deg).abs(), 1e-6) {
+                return fail(
+                    k,
+                    format!(
+                        "recorded tool angle {} but FK gives {angle}",
+                        step.tool_angle_deg
+                    ),
+                );
             }
             let (gap, a, b) = self.min_clearance(q);
-            if gap < constraints.collision_margin_m - SLACK {
+            if !within(constraints.collision_margin_m - SLACK, gap) {
                 return fail(k, format!("{a} and {b} collide (clearance {gap} m)"));
             }
-            if k > 0 && step.time_s <= trajectory.steps[k - 1].time_s {
+            if !step.time_s.is_finite() {
+                return fail(k, format!("timestamp {} is not finite", step.time_s));
+            }
+            if k > 0 && within(step.time_s, trajectory.steps[k - 1].time_s) {
                 return fail(k, "timestamps do not increase".into());
             }
         }
         if let Some(last) = trajectory.steps.last() {
             let length = (last.tcp - task.p0).dot(&task.d);
-            if (length - trajectory.path_length_m).abs() > SLACK {
+            if !within((length - trajectory.path_length_m).abs(), SLACK) {
                 return fail(
                     trajectory.steps.len() - 1,
-                    format!("reported path length {} but the last step gives {length}", trajectory.path_length_m),
+                    format!(
+                        "reported path length {} but the last step gives {length}",
+                        trajectory.path_length_m
+                    ),
                 );
             }
         }
         let blamed = match &trajectory.termination {
-            Termination::Violation { violation, rejected_q } => Some((violation, rejected_q.as_slice().to_vec())),
-            Termination::InvalidStart { violation } => {
-                trajectory.steps.first().map(|s| (violation, s.q.as_slice().to_vec()))
-            }
+            Termination::Violation {
+                violation,
+                rejected_q,
+            } => Some((violation, rejected_q.as_slice().to_vec())),
+            Termination::InvalidStart { violation } => trajectory
+                .steps
+                .first()
+                .map(|s| (violation, s.q.as_slice().to_vec())),
             Termination::StepCap => None,
         };
-        if let Some((violation, q)) = blamed {
-            if !self.breaks(task, &q, violation, constraints) {
-                return fail(trajectory.steps.len(), format!("the final configuration does not break {violation:?}"));
-            }
+        if let Some((violation, q)) = blamed
+            && !self.breaks(task, &q, violation, constraints)
+        {
+            return fail(
+                trajectory.steps.len(),
+                format!("the final configuration does not break {violation:?}"),
+            );
         }
         Ok(())
     }
@@ -255,16 +296,24 @@ impl ReferenceModel {
         use crate::constraints::Violation;
         let (tcp, z) = self.tcp_pose(q);
         match violation {
+            // NaN breaks every bound (as in the rollout); a joint number out of range breaks none.
             Violation::JointLimit { joint, .. } => {
-                let (lo, hi) = self.limits()[joint - 1];
-                q[joint - 1] < lo || q[joint - 1] > hi
+                match joint
+                    .checked_sub(1)
+                    .and_then(|i| self.limits().get(i).copied().zip(q.get(i)))
+                {
+                    Some(((lo, hi), value)) => !(*value >= lo && *value <= hi),
+                    None => false,
+                }
             }
             Violation::LineTolerance { .. } => {
                 let offset = tcp - task.p0;
-                (offset - task.d * offset.dot(&task.d)).norm() > constraints.line_tolerance_m - SLACK
+                let lateral = (offset - task.d * offset.dot(&task.d)).norm();
+                !within(lateral, constraints.line_tolerance_m - SLACK)
             }
             Violation::ToolCone { .. } => {
-                z.dot(&task.n).clamp(-1.0, 1.0).acos().to_degrees() > constraints.theta_max_deg - 1e-6
+                let angle = angle_deg(&z, &task.n);
+                !within(angle, constraints.theta_max_deg - 1e-6)
             }
             Violation::SelfCollision { .. } => {
                 self.min_clearance(q).0 < constraints.collision_margin_m + SLACK
@@ -273,13 +322,28 @@ impl ReferenceModel {
     }
 }
 
+/// Angle between unit vectors (degrees) as `atan2(|a × b|, a·b)`: `acos(a·b)` loses half the
+/// digits near 0°, where one rounding of the dot product already reads as ~1e-6°.
+fn angle_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b)).to_degrees()
+}
+
+/// `value <= bound`; false when either is NaN, so that every check fails closed.
+fn within(value: f64, bound: f64) -> bool {
+    value <= bound
+}
+
 /// Distance between segments `a0–a1` and `b0–b1`: the minimum over the unconstrained stationary
 /// point (when it lies inside both segments) and the four end-point-to-segment distances.
 fn segments_gap(a0: &Vector3<f64>, a1: &Vector3<f64>, b0: &Vector3<f64>, b1: &Vector3<f64>) -> f64 {
     let point_to_segment = |p: &Vector3<f64>, s0: &Vector3<f64>, s1: &Vector3<f64>| {
         let axis = s1 - s0;
         let length2 = axis.norm_squared();
-        let t = if length2 > 0.0 { ((p - s0).dot(&axis) / length2).clamp(0.0, 1.0) } else { 0.0 };
+        let t = if length2 > 0.0 {
+            ((p - s0).dot(&axis) / length2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         (p - (s0 + axis * t)).norm()
     };
     let mut best = point_to_segment(a0, b0, b1)

@@ -55,17 +55,32 @@ impl Violation {
 impl std::fmt::Display for Violation {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::JointLimit { joint, value_rad, limit_rad } => write!(
+            Self::JointLimit {
+                joint,
+                value_rad,
+                limit_rad,
+            } => write!(
                 f,
                 "joint {joint} reached its limit ({value_rad:.4} rad past {limit_rad:.4} rad)"
             ),
             Self::LineTolerance { distance_m } => {
-                write!(f, "TCP left the line tolerance ({:.2} mm off the line)", distance_m * 1e3)
+                write!(
+                    f,
+                    "TCP left the line tolerance ({:.2} mm off the line)",
+                    distance_m * 1e3
+                )
             }
             Self::ToolCone { angle_deg } => {
-                write!(f, "tool axis left the cone ({angle_deg:.2}° from the normal)")
+                write!(
+                    f,
+                    "tool axis left the cone ({angle_deg:.2}° from the normal)"
+                )
             }
-            Self::SelfCollision { first_link, second_link, clearance_m } => write!(
+            Self::SelfCollision {
+                first_link,
+                second_link,
+                clearance_m,
+            } => write!(
                 f,
                 "self-collision between {first_link} and {second_link} (clearance {:.2} mm)",
                 clearance_m * 1e3
@@ -89,7 +104,11 @@ pub fn first_violation(
 ) -> Option<Violation> {
     let limits = robot.limits();
     if let Some(i) = limits.first_violation(q, 0.0) {
-        let limit = if q[i] < limits.lower[i] { limits.lower[i] } else { limits.upper[i] };
+        let limit = if q[i] < limits.lower[i] {
+            limits.lower[i]
+        } else {
+            limits.upper[i]
+        };
         return Some(Violation::JointLimit {
             joint: i + 1,
             value_rad: q[i],
@@ -97,19 +116,24 @@ pub fn first_violation(
         });
     }
     let distance = task.lateral_error(&kin.tcp()).norm();
-    if !(distance <= cfg.line_tolerance_m) {
-        return Some(Violation::LineTolerance { distance_m: distance });
+    // NaN counts as a violation.
+    if distance.is_nan() || distance > cfg.line_tolerance_m {
+        return Some(Violation::LineTolerance {
+            distance_m: distance,
+        });
     }
     let angle = tool_angle_deg(&kin.tool_axis(), &task.n);
-    if !(angle <= cfg.theta_max_deg) {
+    if angle.is_nan() || angle > cfg.theta_max_deg {
         return Some(Violation::ToolCone { angle_deg: angle });
     }
-    robot.first_collision(kin, cfg.collision_margin_m).map(|hit| {
-        let capsules = robot.capsules();
-        Violation::SelfCollision {
-            first_link: capsules[hit.pair.first].link.clone(),
-            second_link: capsules[hit.pair.second].link.clone(),
-            clearance_m: hit.clearance,
-        }
-    })
+    robot
+        .first_collision(kin, cfg.collision_margin_m)
+        .map(|hit| {
+            let capsules = robot.capsules();
+            Violation::SelfCollision {
+                first_link: capsules[hit.pair.first].link.clone(),
+                second_link: capsules[hit.pair.second].link.clone(),
+                clearance_m: hit.clearance,
+            }
+        })
 }

@@ -76,7 +76,9 @@ impl Summary {
 pub fn termination_histogram(trajectories: &[Trajectory]) -> BTreeMap<String, usize> {
     let mut histogram = BTreeMap::new();
     for trajectory in trajectories {
-        *histogram.entry(trajectory.termination.label().to_string()).or_insert(0) += 1;
+        *histogram
+            .entry(trajectory.termination.label().to_string())
+            .or_insert(0) += 1;
     }
     histogram
 }

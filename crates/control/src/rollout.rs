@@ -99,26 +99,48 @@ pub fn rollout(
     }
     let mut previous = NullAction::zeros();
     for step in 0..config.max_steps {
-        let context =
-            StepContext::new(robot, task, config, step, q, kinematics, previous);
+        let context = StepContext::new(robot, task, config, step, q, kinematics, previous);
         if step == 0 {
             controller.reset(&context);
         }
         let (raw, acting) = controller.act(&context);
         let action = raw.map(|a| a.clamp(-1.0, 1.0));
         let next = q + context.joint_velocity(&action) * config.dt_s;
-        steps.push(record(step, config, robot, task, &q, &context.kinematics, Some(acting)));
+        steps.push(record(
+            step,
+            config,
+            robot,
+            task,
+            &q,
+            &context.kinematics,
+            Some(acting),
+        ));
         let next_kinematics = robot.forward(&next);
         if let Some(violation) =
             first_violation(robot, task, &next, &next_kinematics, &config.constraints)
         {
-            return finish(task, steps, Termination::Violation { violation, rejected_q: next });
+            return finish(
+                task,
+                steps,
+                Termination::Violation {
+                    violation,
+                    rejected_q: next,
+                },
+            );
         }
         q = next;
         kinematics = next_kinematics;
         previous = action;
     }
-    steps.push(record(config.max_steps, config, robot, task, &q, &kinematics, None));
+    steps.push(record(
+        config.max_steps,
+        config,
+        robot,
+        task,
+        &q,
+        &kinematics,
+        None,
+    ));
     finish(task, steps, Termination::StepCap)
 }
 

@@ -21,7 +21,7 @@ pub struct SamplerConfig {
     pub max_tilt_deg: f64,
     /// A task is kept only if the classical controller from `q0_seed` travels this far (m).
     pub min_classical_length_m: f64,
-    /// Candidates drawn per parallel batch (does not change the result).
+    /// Candidates drawn per parallel batch (does not change the result; 0 counts as 1).
     pub batch_size: usize,
 }
 
@@ -73,7 +73,7 @@ impl<'a> TaskSampler<'a> {
         let mut tasks = Vec::with_capacity(count);
         while tasks.len() < count {
             let first = self.next_candidate;
-            let batch: Vec<Option<Task>> = (first..first + self.config.batch_size as u64)
+            let batch: Vec<Option<Task>> = (first..first + self.config.batch_size.max(1) as u64)
                 .into_par_iter()
                 .map(|index| self.accepted_candidate(index))
                 .collect();
@@ -115,14 +115,19 @@ pub fn candidate(robot: &Robot, config: &SamplerConfig, index: u64) -> Option<Ta
     let z = kinematics.tool_axis();
     let tilt = rng.random_range(0.0..=config.max_tilt_deg).to_radians();
     let tilt_axis = perpendicular_direction(&z, rng.random_range(0.0..std::f64::consts::TAU));
-    let n = nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(tilt_axis), tilt) * z;
+    let n =
+        nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(tilt_axis), tilt) * z;
     let d = perpendicular_direction(&n, rng.random_range(0.0..std::f64::consts::TAU));
     Task::new(robot, kinematics.tcp(), d, n, Some(q)).ok()
 }
 
 /// The unit vector at angle `phi` in a fixed orthonormal frame of the plane ⟂ `axis`.
 fn perpendicular_direction(axis: &Vec3, phi: f64) -> Vec3 {
-    let helper = if axis.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+    let helper = if axis.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
     let e1 = axis.cross(&helper).normalize();
     let e2 = axis.cross(&e1);
     e1 * phi.cos() + e2 * phi.sin()

@@ -2,7 +2,7 @@
 
 use emg_kinematics::{
     DampedPseudoInverse, JointVector, Kinematics, Robot, TaskBasis, Vec3, damped_pseudo_inverse,
-    directional_manipulability, null_space_basis, task_aligned_basis, tool_alignment_gradient,
+    directional_manipulability, task_aligned_basis, tool_alignment_gradient,
 };
 use nalgebra::SVector;
 
@@ -70,11 +70,13 @@ impl<'a> StepContext<'a> {
         let centring_gradient =
             -q_normalised.component_div(&limits.half_range()) * (2.0 / q.len() as f64);
         let jacobian = kinematics.jacobian();
-        let null = null_space_basis(jacobian);
         let basis = task_aligned_basis(
             jacobian,
-            &null,
-            [&manipulability_gradient, &alignment_gradient, &centring_gradient],
+            [
+                &manipulability_gradient,
+                &alignment_gradient,
+                &centring_gradient,
+            ],
             &config.basis,
         );
         let pseudo_inverse = damped_pseudo_inverse(jacobian, &config.damping);

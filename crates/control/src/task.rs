@@ -6,6 +6,10 @@ use serde::{Deserialize, Serialize};
 /// Largest `|d·n|` accepted as perpendicular; smaller deviations are removed exactly.
 pub const PERPENDICULAR_TOLERANCE: f64 = 1e-6;
 
+/// Deviations (of `‖v‖` from 1, of `d·n` from 0) this small are rounding: such vectors are kept
+/// unchanged, so that `Task::new` on an already validated task returns it bit for bit.
+const ROUNDING: f64 = 4.0 * f64::EPSILON;
+
 /// Largest distance (m) between `p0` and the TCP of a supplied `q0_seed`.
 pub const SEED_POSITION_TOLERANCE_M: f64 = 1e-6;
 
@@ -42,13 +46,17 @@ pub enum TaskError {
         field: &'static str,
     },
     /// `d` and `n` are not perpendicular.
-    #[error("task fields 'd' and 'n' are not perpendicular: |d·n| = {dot:.3e} exceeds {PERPENDICULAR_TOLERANCE:e}")]
+    #[error(
+        "task fields 'd' and 'n' are not perpendicular: |d·n| = {dot:.3e} exceeds {PERPENDICULAR_TOLERANCE:e}"
+    )]
     NotPerpendicular {
         /// `|d·n|` after normalisation.
         dot: f64,
     },
     /// `p0` lies outside the arm's reach.
-    #[error("task field 'p0' = {p0:?} is unreachable: {distance_m:.3} m from the first joint, reach is {reach_m:.3} m")]
+    #[error(
+        "task field 'p0' = {p0:?} is unreachable: {distance_m:.3} m from the first joint, reach is {reach_m:.3} m"
+    )]
     Unreachable {
         /// The start given.
         p0: [f64; 3],
@@ -67,7 +75,9 @@ pub enum TaskError {
 
 impl Task {
     /// Builds and validates a task: `d` and `n` are normalised, `d` is made exactly
-    /// perpendicular to `n` when it already is within [`PERPENDICULAR_TOLERANCE`], and `p0` must
+    /// perpendicular to `n` when it already is within [`PERPENDICULAR_TOLERANCE`] (vectors
+    /// already unit and perpendicular to rounding are kept bit for bit, so validation is
+    /// idempotent), and `p0` must
     /// lie within the robot's reach. A given `q0_seed` must lie within the joint limits and put the
     /// TCP at `p0`.
     pub fn new(
@@ -84,7 +94,13 @@ impl Task {
         if dot.abs() > PERPENDICULAR_TOLERANCE {
             return Err(TaskError::NotPerpendicular { dot: dot.abs() });
         }
-        let d = (d - n * dot).normalize();
+        // Already perpendicular to rounding: keep `d` as is, so that validating a validated task
+        // (e.g. one read back from a task file) reproduces it bit for bit.
+        let d = if dot.abs() <= ROUNDING {
+            d
+        } else {
+            (d - n * dot).normalize()
+        };
         let (centre, reach) = robot.reach_sphere();
         let distance = (p0 - centre).norm();
         if distance > reach {
@@ -146,5 +162,10 @@ fn unit(field: &'static str, v: Vec3) -> Result<Vec3, TaskError> {
     if norm < 1e-9 {
         return Err(TaskError::ZeroVector { field });
     }
-    Ok(v / norm)
+    // A vector that is unit to rounding is kept unchanged (idempotent validation).
+    Ok(if (norm - 1.0).abs() <= ROUNDING {
+        v
+    } else {
+        v / norm
+    })
 }

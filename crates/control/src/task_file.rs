@@ -93,14 +93,19 @@ impl From<&Task> for TaskSpec {
 
 /// Writes `tasks` in the binary layout (bit-exact values).
 pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> {
-    let io = |source| TaskFileError::Io { path: path.display().to_string(), source };
+    let io = |source| TaskFileError::Io {
+        path: path.display().to_string(),
+        source,
+    };
     let mut bytes = Vec::with_capacity(HEADER_BYTES + tasks.len() * VALUES_PER_TASK * 8);
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&TASK_FORMAT_VERSION.to_le_bytes());
     bytes.extend_from_slice(&(VALUES_PER_TASK as u32).to_le_bytes());
     bytes.extend_from_slice(&(tasks.len() as u64).to_le_bytes());
     for task in tasks {
-        let seed = task.q0_seed.unwrap_or_else(|| JointVector::repeat(f64::NAN));
+        let seed = task
+            .q0_seed
+            .unwrap_or_else(|| JointVector::repeat(f64::NAN));
         for value in task.p0.iter().chain(&task.d).chain(&task.n).chain(&seed) {
             bytes.extend_from_slice(&value.to_le_bytes());
         }
@@ -136,30 +141,34 @@ pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError
 }
 
 fn parse_json(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {
-    #[derive(Deserialize)]
-    #[serde(untagged)]
-    enum OneOrMany {
-        Many(Vec<TaskSpec>),
-        One(TaskSpec),
-    }
-    match serde_json::from_slice::<OneOrMany>(bytes) {
-        Ok(OneOrMany::Many(specs)) => Ok(specs),
-        Ok(OneOrMany::One(spec)) => Ok(vec![spec]),
-        Err(_) => {
-            // Re-parse as a list to report the precise field and position of the problem.
-            let problem = match serde_json::from_slice::<Vec<TaskSpec>>(bytes) {
-                Err(e) => e.to_string(),
-                Ok(_) => "unreadable task JSON".into(),
-            };
-            Err(TaskFileError::Format { path: path.into(), problem })
-        }
+    // Dispatch on the first token rather than trying both shapes, so that the error of the
+    // shape actually written (unknown key, missing field, position) is the one reported.
+    let format = |e: serde_json::Error| TaskFileError::Format {
+        path: path.into(),
+        problem: e.to_string(),
+    };
+    match bytes.iter().find(|b| !b.is_ascii_whitespace()) {
+        Some(b'{') => serde_json::from_slice::<TaskSpec>(bytes)
+            .map(|spec| vec![spec])
+            .map_err(format),
+        _ => serde_json::from_slice::<Vec<TaskSpec>>(bytes).map_err(format),
     }
 }
 
 fn parse_binary(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {
-    let format = |problem: String| TaskFileError::Format { path: path.into(), problem };
-    if bytes.len() < HEADER_BYTES || &bytes[..8] != MAGIC {
+    let format = |problem: String| TaskFileError::Format {
+        path: path.into(),
+        problem,
+    };
+    let magic_len = bytes.len().min(MAGIC.len());
+    if bytes[..magic_len] != MAGIC[..magic_len] || bytes.is_empty() {
         return Err(format("not a task set: missing the EMGTASKS header".into()));
+    }
+    if bytes.len() < HEADER_BYTES {
+        return Err(format(format!(
+            "truncated header: {} of its {HEADER_BYTES} bytes",
+            bytes.len()
+        )));
     }
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
     let version = word(8);
@@ -169,7 +178,10 @@ fn parse_binary(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError
         )));
     }
     if word(12) as usize != VALUES_PER_TASK {
-        return Err(format(format!("{} values per task, expected {VALUES_PER_TASK}", word(12))));
+        return Err(format(format!(
+            "{} values per task, expected {VALUES_PER_TASK}",
+            word(12)
+        )));
     }
     let count = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes")) as usize;
     let expected = count

@@ -1,8 +1,8 @@
 //! Capsule self-collision between bodies of the chain.
 
+use crate::Vec3;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
-use crate::Vec3;
 
 /// A capsule: the segment `start`–`end` (in its segment's frame) swept by `radius`.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,7 +56,9 @@ impl Robot {
             .iter()
             .map(|&pair| CollisionHit {
                 pair,
-                clearance: self.pair_clearance(kin, pair, f64::INFINITY).unwrap_or(f64::INFINITY),
+                clearance: self
+                    .pair_clearance(kin, pair, f64::INFINITY)
+                    .unwrap_or(f64::INFINITY),
             })
             .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
     }
@@ -64,8 +66,14 @@ impl Robot {
     /// Clearance of one pair, or `None` when bounding spheres already show it exceeds `margin`.
     fn pair_clearance(&self, kin: &Kinematics, pair: CollisionPair, margin: f64) -> Option<f64> {
         let (a, b) = (&self.capsules[pair.first], &self.capsules[pair.second]);
-        let (a0, a1) = (kin.segment_point(a.segment, &a.start), kin.segment_point(a.segment, &a.end));
-        let (b0, b1) = (kin.segment_point(b.segment, &b.start), kin.segment_point(b.segment, &b.end));
+        let (a0, a1) = (
+            kin.segment_point(a.segment, &a.start),
+            kin.segment_point(a.segment, &a.end),
+        );
+        let (b0, b1) = (
+            kin.segment_point(b.segment, &b.start),
+            kin.segment_point(b.segment, &b.end),
+        );
         let radii = a.radius + b.radius;
         let spheres_apart = ((a0 + a1) - (b0 + b1)).norm() * 0.5
             - 0.5 * ((a1 - a0).norm() + (b1 - b0).norm())
@@ -94,7 +102,14 @@ pub fn segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f64 {
         } else {
             let b = d1.dot(&d2);
             let denom = a * e - b * b;
-            let mut s = if denom > EPS { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            // Any s is exact for parallel segments (t is then optimal for it, and a clamped t
+            // re-optimises s), so only an exactly zero denominator needs a fallback; an absolute
+            // threshold here cost up to L·sinθ (~1e-6 m) on nearly parallel segments.
+            let mut s = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
             let mut t = (b * s + f) / e;
             if t < 0.0 {
                 t = 0.0;

@@ -12,7 +12,11 @@ use crate::{DOF, JointVector, Vec3};
 /// `∂w_d/∂q_i = s^(−3/2) · wᵀ H_i (Jᵀw)` where `H_i = ∂J/∂q_i` has columns
 /// `∂J_k/∂q_i = ω_min(i,k) × J_max(i,k)` (revolute joints).
 /// Returns `(w_d, ∇w_d)`; allocation-free.
-pub fn directional_manipulability(kin: &Kinematics, d: &Vec3, lambda_mu: f64) -> (f64, JointVector) {
+pub fn directional_manipulability(
+    kin: &Kinematics,
+    d: &Vec3,
+    lambda_mu: f64,
+) -> (f64, JointVector) {
     let jacobian = kin.jacobian();
     let a = jacobian * jacobian.transpose() + Matrix3::identity() * (lambda_mu * lambda_mu);
     let w = a.try_inverse().unwrap_or_else(Matrix3::zeros) * d;
@@ -25,15 +29,19 @@ pub fn directional_manipulability(kin: &Kinematics, d: &Vec3, lambda_mu: f64) ->
     let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
     let columns: [Vec3; DOF] = std::array::from_fn(|k| jacobian.column(k).into_owned());
     let scale = value * value * value;
-    let gradient = JointVector::from_fn(|i, _| {
-        (0..DOF)
-            .map(|k| {
-                let (lo, hi) = (i.min(k), i.max(k));
-                w.dot(&axes[lo].cross(&columns[hi])) * u[k]
-            })
-            .sum::<f64>()
-            * scale
-    });
+    // wᵀH_i u = Σ_{k≥i} u_k w·(ω_i × J_k) + Σ_{k<i} u_k w·(ω_k × J_i)
+    //         = ω_i·Σ_{k≥i} u_k (J_k × w) + J_i·Σ_{k<i} u_k (w × ω_k):
+    // suffix and prefix sums turn the 49 triple products into 14 cross products.
+    let mut suffix = [Vec3::zeros(); DOF + 1];
+    for k in (0..DOF).rev() {
+        suffix[k] = suffix[k + 1] + columns[k].cross(&w) * u[k];
+    }
+    let mut prefix = Vec3::zeros();
+    let mut gradient = JointVector::zeros();
+    for i in 0..DOF {
+        gradient[i] = (axes[i].dot(&suffix[i]) + columns[i].dot(&prefix)) * scale;
+        prefix += w.cross(&axes[i]) * u[i];
+    }
     (value, gradient)
 }
 

@@ -1,6 +1,6 @@
 //! The null space `N` of the position Jacobian and the task-aligned basis `B(q)` (SPEC §4).
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::{Matrix3, Matrix4, SMatrix, Vector4};
 use serde::{Deserialize, Serialize};
 
 use crate::fk::PositionJacobian;
@@ -41,94 +41,115 @@ pub struct TaskBasis {
     pub fallback: [bool; 3],
 }
 
-/// Orthonormal basis `N` of the null space of `J`: the orthogonal complement of `J`'s row
-/// space, completed from the coordinate axes with largest residual first. Spans the same space
-/// as the right singular vectors of `J`'s zero singular values.
+/// Orthonormal basis `N` of the null space of `J`: the last four columns of the orthogonal
+/// factor of a Householder QR of `Jᵀ` (no allocation). Spans the same space as the right
+/// singular vectors of `J`'s zero singular values.
 pub fn null_space_basis(jacobian: &PositionJacobian) -> NullSpaceBasis {
-    let mut rows = [JointVector::zeros(); 3];
-    let mut rank = 0;
-    for r in 0..3 {
-        let row = jacobian.row(r).transpose();
-        let scale = row.norm();
-        let residual = orthogonalise(row, &rows[..rank]);
-        let norm = residual.norm();
-        if norm > 1e-12 * scale.max(1e-300) && norm > 1e-300 {
-            rows[rank] = residual / norm;
-            rank += 1;
-        }
-    }
-    let mut basis = [JointVector::zeros(); DOF];
-    basis[..rank].copy_from_slice(&rows[..rank]);
-    let mut found = rank;
-    let mut null = NullSpaceBasis::zeros();
-    for column in 0..NULL_DIM {
-        let best = (0..DOF)
-            .map(|axis| orthogonalise(JointVector::ith(axis, 1.0), &basis[..found]))
-            .max_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
-            .expect("DOF > 0");
-        let unit = best / best.norm();
-        basis[found] = unit;
-        found += 1;
-        null.set_column(column, &unit);
-    }
-    null
+    householder_null_space(jacobian).0
 }
 
-/// The task-aligned basis `B(q)`: modified Gram–Schmidt (applied twice) of `N Nᵀ g` for the
-/// three `gradients` in order; a residual below `max(floor, relative·‖g‖)` is replaced by the
-/// unused column of `N` with the largest residual (sign aligned with `g`); the fourth column is
-/// the remaining orthogonal complement, oriented so that `det[J; Bᵀ] > 0` (continuous in `q`).
+/// The task-aligned basis `B(q) = N C`: modified Gram–Schmidt (applied twice) of the null-space
+/// projections `N Nᵀ g` of the three `gradients` in order, carried out in the coordinates of `N`;
+/// a residual below `max(floor, relative·‖g‖)` is replaced by the unused column of `N` with the
+/// largest residual (sign aligned with `g`); the fourth column is the remaining orthogonal
+/// complement, oriented so that `det[J; Bᵀ] > 0` (so it varies continuously with `q`).
+/// Allocation-free.
 pub fn task_aligned_basis(
     jacobian: &PositionJacobian,
-    null: &NullSpaceBasis,
     gradients: [&JointVector; 3],
     cfg: &BasisConfig,
 ) -> TaskBasis {
-    let mut columns = [JointVector::zeros(); NULL_DIM];
+    let (null, orientation) = householder_null_space(jacobian);
+    let mut coords = [Vector4::zeros(); NULL_DIM];
     let mut fallback = [false; 3];
     for (k, gradient) in gradients.into_iter().enumerate() {
-        let projected = null * (null.transpose() * gradient);
-        let residual = orthogonalise(projected, &columns[..k]);
-        let threshold = cfg.residual_floor.max(cfg.residual_relative * gradient.norm());
+        let projected = null.transpose() * gradient;
+        let residual = orthogonalise(projected, &coords[..k]);
+        let threshold = cfg
+            .residual_floor
+            .max(cfg.residual_relative * gradient.norm());
         let norm = residual.norm();
-        columns[k] = if norm >= threshold {
+        coords[k] = if norm >= threshold {
             residual / norm
         } else {
             fallback[k] = true;
-            let unit = largest_complement(null, &columns[..k]);
-            if unit.dot(gradient) < 0.0 { -unit } else { unit }
+            let unit = (0..NULL_DIM)
+                .map(|axis| orthogonalise(Vector4::ith(axis, 1.0), &coords[..k]))
+                .max_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
+                .expect("null space is not empty");
+            let unit = unit / unit.norm();
+            if unit.dot(&projected) < 0.0 {
+                -unit
+            } else {
+                unit
+            }
         };
     }
-    let mut last = largest_complement(null, &columns[..3]);
-    let mut frame = SMatrix::<f64, DOF, DOF>::zeros();
-    for r in 0..3 {
-        frame.set_row(r, &jacobian.row(r));
-    }
-    for (k, column) in columns[..3].iter().enumerate() {
-        frame.set_row(3 + k, &column.transpose());
-    }
-    frame.set_row(6, &last.transpose());
-    if frame.determinant() < 0.0 {
-        last = -last;
-    }
-    columns[3] = last;
+    coords[3] = complement(&coords[0], &coords[1], &coords[2]) * orientation;
     TaskBasis {
-        columns: NullSpaceBasis::from_columns(&columns),
+        columns: null * Matrix4::from_columns(&coords),
         fallback,
     }
 }
 
-/// The column of `N` with the largest residual against `used`, orthogonalised and normalised.
-fn largest_complement(null: &NullSpaceBasis, used: &[JointVector]) -> JointVector {
-    let best = (0..NULL_DIM)
-        .map(|c| orthogonalise(null.column(c).into_owned(), used))
-        .max_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
-        .expect("null space is not empty");
-    best / best.norm()
+/// Householder QR `Jᵀ = Q R`: returns `N` = the last four columns of `Q` and the sign of
+/// `det[J; Nᵀ] = det(R₃ₓ₃)·det(Q)` (each proper reflector contributes `det = −1`).
+fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) {
+    let mut a = jacobian.transpose();
+    let mut reflectors = [JointVector::zeros(); 3];
+    let mut sign = 1.0;
+    for k in 0..3 {
+        let mut v = JointVector::zeros();
+        for r in k..DOF {
+            v[r] = a[(r, k)];
+        }
+        let norm = v.norm();
+        let alpha = if v[k] > 0.0 { -norm } else { norm };
+        v[k] -= alpha;
+        let length = v.norm();
+        if length > 0.0 {
+            v /= length;
+            for c in k..3 {
+                let projection = (0..DOF).map(|r| v[r] * a[(r, c)]).sum::<f64>();
+                for r in k..DOF {
+                    a[(r, c)] -= 2.0 * projection * v[r];
+                }
+            }
+            sign = -sign;
+        }
+        if alpha < 0.0 {
+            sign = -sign;
+        }
+        reflectors[k] = v;
+    }
+    let mut null = NullSpaceBasis::zeros();
+    for c in 0..NULL_DIM {
+        let mut column = JointVector::ith(3 + c, 1.0);
+        for v in reflectors.iter().rev() {
+            column -= v * (2.0 * v.dot(&column));
+        }
+        null.set_column(c, &column);
+    }
+    (null, sign)
+}
+
+/// The unit vector `x` with `det[a b c x] = 1` for orthonormal `a`, `b`, `c` in R⁴ (the
+/// four-dimensional cross product: cofactors of the last column).
+fn complement(a: &Vector4<f64>, b: &Vector4<f64>, c: &Vector4<f64>) -> Vector4<f64> {
+    let minor = |skip: usize| {
+        let rows: [usize; 3] = match skip {
+            0 => [1, 2, 3],
+            1 => [0, 2, 3],
+            2 => [0, 1, 3],
+            _ => [0, 1, 2],
+        };
+        Matrix3::from_fn(|r, col| [a, b, c][col][rows[r]]).determinant()
+    };
+    Vector4::new(-minor(0), minor(1), -minor(2), minor(3))
 }
 
 /// Modified Gram–Schmidt of `v` against orthonormal `basis`, applied twice for stability.
-fn orthogonalise<const R: usize>(mut v: SVector<f64, R>, basis: &[SVector<f64, R>]) -> SVector<f64, R> {
+fn orthogonalise(mut v: Vector4<f64>, basis: &[Vector4<f64>]) -> Vector4<f64> {
     for _ in 0..2 {
         for b in basis {
             v -= b * b.dot(&v);

@@ -1,6 +1,6 @@
 //! Newton projection of a configuration onto an exact TCP pose within the joint limits.
 
-use nalgebra::{Matrix3, Rotation3, SMatrix, SVector};
+use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use crate::robot::Robot;
@@ -106,7 +106,9 @@ pub fn project_to_pose(
         let (rows, error) = pose_residual(&kin, target);
         position_error = error.fixed_rows::<3>(0).norm();
         orientation_error = error.fixed_rows::<3>(3).norm();
-        if position_error < cfg.position_tolerance_m && orientation_error < cfg.orientation_tolerance_rad {
+        if position_error < cfg.position_tolerance_m
+            && orientation_error < cfg.orientation_tolerance_rad
+        {
             return Ok((q, iteration));
         }
         if iteration == cfg.max_iterations {
@@ -133,18 +135,24 @@ pub fn project_to_pose(
 fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
     let unit = |v: &Vec3| v.iter().all(|c| c.is_finite()) && (v.norm() - 1.0).abs() < 1e-6;
     if !target.position.iter().all(|c| c.is_finite()) {
-        return Err(ProjectionError::BadTarget { field: "position", problem: "is not finite" });
+        return Err(ProjectionError::BadTarget {
+            field: "position",
+            problem: "is not finite",
+        });
     }
     if !unit(&target.tool_axis) {
-        return Err(ProjectionError::BadTarget { field: "tool_axis", problem: "is not a unit vector" });
+        return Err(ProjectionError::BadTarget {
+            field: "tool_axis",
+            problem: "is not a unit vector",
+        });
     }
-    if let Some(x) = &target.roll_axis {
-        if !unit(x) || x.dot(&target.tool_axis).abs() > 1e-6 {
-            return Err(ProjectionError::BadTarget {
-                field: "roll_axis",
-                problem: "is not a unit vector perpendicular to tool_axis",
-            });
-        }
+    if let Some(x) = &target.roll_axis
+        && (!unit(x) || x.dot(&target.tool_axis).abs() > 1e-6)
+    {
+        return Err(ProjectionError::BadTarget {
+            field: "roll_axis",
+            problem: "is not a unit vector perpendicular to tool_axis",
+        });
     }
     Ok(())
 }
@@ -158,21 +166,27 @@ fn pose_residual(
     let mut rows = SMatrix::<f64, 6, DOF>::zeros();
     rows.fixed_rows_mut::<3>(0).copy_from(kin.jacobian());
     let mut error = SVector::<f64, 6>::zeros();
-    error.fixed_rows_mut::<3>(0).copy_from(&(target.position - kin.tcp()));
+    error
+        .fixed_rows_mut::<3>(0)
+        .copy_from(&(target.position - kin.tcp()));
     let current = kin.tcp_rotation();
     let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
     match &target.roll_axis {
         Some(x) => {
             let goal = Matrix3::from_columns(&[*x, target.tool_axis.cross(x), target.tool_axis]);
-            let rotation = Rotation3::from_matrix_unchecked(goal * current.transpose());
-            error.fixed_rows_mut::<3>(3).copy_from(&rotation.scaled_axis());
+            error
+                .fixed_rows_mut::<3>(3)
+                .copy_from(&rotation_vector(&(goal * current.transpose())));
             for (i, axis) in axes.iter().enumerate() {
                 rows.fixed_view_mut::<3, 1>(3, i).copy_from(axis);
             }
         }
         None => {
             let z = kin.tool_axis();
-            let (u, v) = (current.column(0).into_owned(), current.column(1).into_owned());
+            let (u, v) = (
+                current.column(0).into_owned(),
+                current.column(1).into_owned(),
+            );
             let cross = z.cross(&target.tool_axis);
             let sin = cross.norm();
             let angle = sin.atan2(z.dot(&target.tool_axis));
@@ -187,4 +201,39 @@ fn pose_residual(
         }
     }
     (rows, error)
+}
+
+/// Rotation vector (axis · angle) of rotation matrix `r`, accurate for every angle.
+///
+/// `Rotation3::scaled_axis` takes the angle from `acos((tr r − 1)/2)`, which is blind below
+/// ~1e-8 rad (and returns zero outright when the skew part is below machine epsilon), so a
+/// 1e-10 orientation tolerance could be declared met with an error of ~2e-8 rad. Here the angle is
+/// `atan2(‖skew‖, (tr r − 1)/2)`; near π the axis comes from the symmetric part.
+fn rotation_vector(r: &Matrix3<f64>) -> Vec3 {
+    let skew = Vec3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    ) * 0.5;
+    let sin = skew.norm();
+    let cos = (r.trace() - 1.0) * 0.5;
+    let angle = sin.atan2(cos);
+    if cos > 0.0 || sin > 1e-6 {
+        return if sin > 0.0 {
+            skew * (angle / sin)
+        } else {
+            Vec3::zeros()
+        };
+    }
+    // Angle near π: r ≈ 2aaᵀ − I, so (r + I)/2 ≈ aaᵀ; take its largest column, signed by skew.
+    let outer = (r + Matrix3::identity()) * 0.5;
+    let k = (0..3)
+        .max_by(|&i, &j| outer[(i, i)].total_cmp(&outer[(j, j)]))
+        .unwrap_or(0);
+    let mut axis = outer.column(k).into_owned();
+    axis /= axis.norm();
+    if axis.dot(&skew) < 0.0 {
+        axis = -axis;
+    }
+    axis * angle
 }

@@ -37,7 +37,10 @@ pub struct DampedPseudoInverse {
 }
 
 /// `J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹` with `λ` from [`DampingConfig`] (no allocation).
-pub fn damped_pseudo_inverse(jacobian: &PositionJacobian, cfg: &DampingConfig) -> DampedPseudoInverse {
+pub fn damped_pseudo_inverse(
+    jacobian: &PositionJacobian,
+    cfg: &DampingConfig,
+) -> DampedPseudoInverse {
     let jjt = jacobian * jacobian.transpose();
     let sigma_min = smallest_symmetric_eigenvalue(&jjt).max(0.0).sqrt();
     let lambda = if sigma_min < cfg.sigma_threshold {

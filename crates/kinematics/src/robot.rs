@@ -44,7 +44,9 @@ pub enum RobotError {
         tip: String,
     },
     /// A link inside the chain has more than one child joint.
-    #[error("link '{link}' branches into {count} child joints ({joints}); a serial chain is required")]
+    #[error(
+        "link '{link}' branches into {count} child joints ({joints}); a serial chain is required"
+    )]
     Branching {
         /// The branching link.
         link: String,
@@ -62,7 +64,9 @@ pub enum RobotError {
         kind: String,
     },
     /// The chain does not have exactly [`DOF`] revolute joints.
-    #[error("the chain from '{base}' to '{tip}' has {found} revolute joints; exactly {DOF} are required")]
+    #[error(
+        "the chain from '{base}' to '{tip}' has {found} revolute joints; exactly {DOF} are required"
+    )]
     WrongDof {
         /// Base link name.
         base: String,
@@ -333,10 +337,12 @@ fn chain_joints<'a>(
     let mut path = Vec::new();
     let mut link = tip;
     while link != base {
-        let joint = parent_joint.get(link).ok_or_else(|| RobotError::NotAChain {
-            base: base.into(),
-            tip: tip.into(),
-        })?;
+        let joint = parent_joint
+            .get(link)
+            .ok_or_else(|| RobotError::NotAChain {
+                base: base.into(),
+                tip: tip.into(),
+            })?;
         path.push(*joint);
         link = joint.parent.link.as_str();
     }
@@ -449,7 +455,10 @@ fn collision_pairs(capsules: &[Capsule]) -> Vec<CollisionPair> {
             if b.chain_index.abs_diff(a.chain_index) >= MIN_LINK_SEPARATION
                 && a.segment != b.segment
             {
-                pairs.push(CollisionPair { first: i, second: j });
+                pairs.push(CollisionPair {
+                    first: i,
+                    second: j,
+                });
             }
         }
     }

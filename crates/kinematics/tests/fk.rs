@@ -12,18 +12,24 @@ use std::f64::consts::FRAC_PI_2;
 
 const DH_A: [f64; 7] = [0.0, 0.0, 0.0, 0.0825, -0.0825, 0.0, 0.088];
 const DH_D: [f64; 7] = [0.333, 0.0, 0.316, 0.0, 0.384, 0.0, 0.0];
-const DH_ALPHA: [f64; 7] = [0.0, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2];
+const DH_ALPHA: [f64; 7] = [
+    0.0, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2, -FRAC_PI_2, FRAC_PI_2, FRAC_PI_2,
+];
 const FLANGE_D: f64 = 0.107;
 const PEN_FROM_FLANGE: f64 = 0.2034;
 
 fn rot_x(a: f64) -> Matrix4<f64> {
     let (s, c) = a.sin_cos();
-    Matrix4::new(1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0)
+    Matrix4::new(
+        1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0,
+    )
 }
 
 fn rot_z(a: f64) -> Matrix4<f64> {
     let (s, c) = a.sin_cos();
-    Matrix4::new(c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+    Matrix4::new(
+        c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+    )
 }
 
 fn trans(x: f64, y: f64, z: f64) -> Matrix4<f64> {
@@ -40,7 +46,11 @@ fn dh_frames(q: &JointVector) -> Vec<Matrix4<f64>> {
     let mut t = Matrix4::identity();
     let mut frames = Vec::new();
     for i in 0..7 {
-        t = t * rot_x(DH_ALPHA[i]) * trans(DH_A[i], 0.0, 0.0) * rot_z(q[i]) * trans(0.0, 0.0, DH_D[i]);
+        t = t
+            * rot_x(DH_ALPHA[i])
+            * trans(DH_A[i], 0.0, 0.0)
+            * rot_z(q[i])
+            * trans(0.0, 0.0, DH_D[i]);
         frames.push(t);
     }
     frames.push(t * trans(0.0, 0.0, FLANGE_D + PEN_FROM_FLANGE));
@@ -59,7 +69,10 @@ fn rotation(t: &Matrix4<f64>) -> Matrix3<f64> {
 fn zero_configuration_matches_spec() {
     let robot = robot();
     let q = JointVector::zeros();
-    assert!(robot.limits().first_violation(&q, 0.0).is_some(), "q = 0 is outside the limits");
+    assert!(
+        robot.limits().first_violation(&q, 0.0).is_some(),
+        "q = 0 is outside the limits"
+    );
     let kin = robot.forward(&q);
     let p_err = (kin.tcp() - Vec3::new(0.088, 0.0, 0.7226)).norm();
     let z_err = (kin.tool_axis() - Vec3::new(0.0, 0.0, -1.0)).norm();
@@ -72,7 +85,10 @@ fn zero_configuration_matches_spec() {
 fn home_configuration_matches_spec() {
     let robot = robot();
     let kin = robot.forward(&home());
-    assert!(robot.limits().first_violation(&home(), 0.0).is_none(), "home is within the limits");
+    assert!(
+        robot.limits().first_violation(&home(), 0.0).is_none(),
+        "home is within the limits"
+    );
     // The SPEC gives the home TCP to six decimals.
     let p_err = (kin.tcp() - Vec3::new(0.306891, 0.0, 0.386882)).amax();
     let z_err = (kin.tool_axis() - Vec3::new(0.0, 0.0, -1.0)).norm();
@@ -101,9 +117,9 @@ fn matches_independent_modified_dh_on_random_configurations() {
         // The pen adds no rotation to link7: the whole TCP frame matches the DH frame 7.
         worst_r = worst_r.max((kin.tcp_rotation() - tip_rotation).amax());
         // Every joint turns about the DH frame's z axis, through a point on that axis line.
-        for i in 0..7 {
-            let axis = rotation(&frames[i]).column(2).into_owned();
-            let offset = kin.joint_origin(i) - position(&frames[i]);
+        for (i, frame) in frames.iter().take(7).enumerate() {
+            let axis = rotation(frame).column(2).into_owned();
+            let offset = kin.joint_origin(i) - position(frame);
             worst_axis = worst_axis
                 .max((kin.joint_axis(i) - axis).norm())
                 .max(offset.cross(&axis).norm());
@@ -115,8 +131,14 @@ fn matches_independent_modified_dh_on_random_configurations() {
     );
     assert!(worst_p < 1e-9, "tcp differs from DH by {worst_p:e}");
     assert!(worst_z < 1e-9, "tool axis differs from DH by {worst_z:e}");
-    assert!(worst_r < 1e-9, "tcp rotation differs from DH by {worst_r:e}");
-    assert!(worst_axis < 1e-9, "joint axis lines differ from DH by {worst_axis:e}");
+    assert!(
+        worst_r < 1e-9,
+        "tcp rotation differs from DH by {worst_r:e}"
+    );
+    assert!(
+        worst_axis < 1e-9,
+        "joint axis lines differ from DH by {worst_axis:e}"
+    );
 }
 
 #[test]

@@ -52,7 +52,11 @@ fn tool_axis_jacobian_matches_finite_differences() {
 }
 
 /// `w_d` computed directly from its definition, independently of the crate's function.
-fn directional_manipulability_value(robot: &emg_kinematics::Robot, q: &JointVector, d: &Vec3) -> f64 {
+fn directional_manipulability_value(
+    robot: &emg_kinematics::Robot,
+    q: &JointVector,
+    d: &Vec3,
+) -> f64 {
     let kin = robot.forward(q);
     let j = kin.jacobian();
     let a = j * j.transpose() + Matrix3::identity() * (LAMBDA_MU * LAMBDA_MU);
@@ -72,12 +76,17 @@ fn directional_manipulability_gradient_matches_finite_differences() {
         let reference = directional_manipulability_value(&robot, &q, &d);
         worst_value = worst_value.max((value - reference).abs() / reference.max(1.0));
         let numeric = JointVector::from_fn(|i, _| {
-            central_difference(&q, i, |q| Vector1::new(directional_manipulability_value(&robot, q, &d)))[0]
+            central_difference(&q, i, |q| {
+                Vector1::new(directional_manipulability_value(&robot, q, &d))
+            })[0]
         });
         worst = worst.max((gradient - numeric).norm() / gradient.norm().max(1.0));
     }
     println!("w_d: worst value error {worst_value:.3e}, worst gradient relative error {worst:.3e}");
-    assert!(worst_value < 1e-9, "w_d value differs from its definition by {worst_value:e}");
+    assert!(
+        worst_value < 1e-9,
+        "w_d value differs from its definition by {worst_value:e}"
+    );
     assert!(worst < TOLERANCE, "worst relative error {worst:e}");
 }
 
@@ -96,7 +105,10 @@ fn directional_manipulability_value_is_the_directional_singular_value_without_da
             let d: Vec3 = u.column(k).into_owned();
             let (value, _) = directional_manipulability(&kin, &d, 0.0);
             let sigma = svd.singular_values[k];
-            assert!((value - sigma).abs() < 1e-9 * sigma.max(1.0), "w_d {value} vs σ {sigma}");
+            assert!(
+                (value - sigma).abs() < 1e-9 * sigma.max(1.0),
+                "w_d {value} vs σ {sigma}"
+            );
         }
     }
 }
@@ -111,7 +123,9 @@ fn tool_alignment_gradient_matches_finite_differences() {
         let n = random_unit(&mut rng);
         let gradient = tool_alignment_gradient(&robot.forward(&q), &n);
         let numeric = JointVector::from_fn(|i, _| {
-            central_difference(&q, i, |q| Vector1::new(robot.forward(q).tool_axis().dot(&n)))[0]
+            central_difference(&q, i, |q| {
+                Vector1::new(robot.forward(q).tool_axis().dot(&n))
+            })[0]
         });
         worst = worst.max((gradient - numeric).norm() / gradient.norm().max(1.0));
     }

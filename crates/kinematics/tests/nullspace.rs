@@ -31,7 +31,7 @@ fn basis_at(robot: &Robot, q: &JointVector, d: &Vec3, n: &Vec3) -> (NullSpaceBas
     let kin = robot.forward(q);
     let null = null_space_basis(kin.jacobian());
     let [g0, g1, g2] = gradients(robot, q, d, n);
-    let basis = task_aligned_basis(kin.jacobian(), &null, [&g0, &g1, &g2], &BasisConfig::default());
+    let basis = task_aligned_basis(kin.jacobian(), [&g0, &g1, &g2], &BasisConfig::default());
     (null, basis)
 }
 
@@ -55,17 +55,23 @@ fn null_space_basis_is_orthonormal_and_annihilated_by_the_jacobian() {
         let reference = SMatrix::<f64, 7, 7>::identity() - row_projector;
         worst_svd = worst_svd.max((null * null.transpose() - reference).amax());
     }
-    println!("N: ‖NᵀN − I‖max {worst_orth:.3e}, ‖JN‖max {worst_null:.3e}, projector vs SVD {worst_svd:.3e}");
+    println!(
+        "N: ‖NᵀN − I‖max {worst_orth:.3e}, ‖JN‖max {worst_null:.3e}, projector vs SVD {worst_svd:.3e}"
+    );
     assert!(worst_orth < 1e-10, "NᵀN − I = {worst_orth:e}");
     assert!(worst_null < 1e-10, "J·N = {worst_null:e}");
-    assert!(worst_svd < 1e-9, "N Nᵀ differs from the SVD null-space projector by {worst_svd:e}");
+    assert!(
+        worst_svd < 1e-9,
+        "N Nᵀ differs from the SVD null-space projector by {worst_svd:e}"
+    );
 }
 
 #[test]
 fn task_aligned_basis_is_an_ordered_gram_schmidt_basis_of_the_null_space() {
     let robot = robot();
     let mut rng = rng(11);
-    let (mut worst_orth, mut worst_null, mut worst_span, mut worst_order) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut worst_orth, mut worst_null, mut worst_span, mut worst_order) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut non_fallback = [0usize; 3];
     for _ in 0..CONFIGS {
         let q = random_q(&mut rng, &robot);
@@ -103,15 +109,27 @@ fn task_aligned_basis_is_an_ordered_gram_schmidt_basis_of_the_null_space() {
         "B: ‖BᵀB − I‖ {worst_orth:.3e}, ‖JB‖ {worst_null:.3e}, ‖BBᵀ − NNᵀ‖ {worst_span:.3e}, \
          columns vs Gram–Schmidt {worst_order:.3e} (non-fallback counts {non_fallback:?})"
     );
-    assert!(non_fallback[0] > CONFIGS * 9 / 10, "∇w_d should rarely fall back");
+    assert!(
+        non_fallback[0] > CONFIGS * 9 / 10,
+        "∇w_d should rarely fall back"
+    );
     assert!(worst_orth < 1e-10, "BᵀB − I = {worst_orth:e}");
     assert!(worst_null < 1e-10, "J·B = {worst_null:e}");
     assert!(worst_span < 1e-9, "B Bᵀ − N Nᵀ = {worst_span:e}");
-    assert!(worst_order < 1e-6, "columns differ from ordered Gram–Schmidt by {worst_order:e}");
+    assert!(
+        worst_order < 1e-6,
+        "columns differ from ordered Gram–Schmidt by {worst_order:e}"
+    );
 }
 
 /// Largest change of any column of `B` between `q` and `q + dq`.
-fn column_changes(robot: &Robot, q: &JointVector, dq: &JointVector, d: &Vec3, n: &Vec3) -> [f64; 4] {
+fn column_changes(
+    robot: &Robot,
+    q: &JointVector,
+    dq: &JointVector,
+    d: &Vec3,
+    n: &Vec3,
+) -> [f64; 4] {
     let (_, b1) = basis_at(robot, q, d, n);
     let (_, b2) = basis_at(robot, &(q + dq), d, n);
     std::array::from_fn(|k| (b1.columns.column(k) - b2.columns.column(k)).norm())
@@ -157,10 +175,22 @@ fn task_aligned_basis_is_continuous_in_q() {
         "B continuity (|Δq| = 1e-5): 4th column {worst_last:.3e}, all columns {worst_all:.3e}, \
          well-conditioned configs {worst_conditioned:.3e}; worst change ratio 1e-6/1e-5 step {worst_ratio:.4}"
     );
-    assert!(worst_last < 1e-2, "4th column moved by {worst_last:e} for |Δq| = 1e-5");
-    assert!(worst_all < 1e-2, "a column moved by {worst_all:e} for |Δq| = 1e-5");
-    assert!(worst_conditioned < 1e-3, "a column moved by {worst_conditioned:e} on a well-conditioned config");
-    assert!(worst_ratio < 0.15, "a column change did not scale with the step (ratio {worst_ratio})");
+    assert!(
+        worst_last < 1e-2,
+        "4th column moved by {worst_last:e} for |Δq| = 1e-5"
+    );
+    assert!(
+        worst_all < 1e-2,
+        "a column moved by {worst_all:e} for |Δq| = 1e-5"
+    );
+    assert!(
+        worst_conditioned < 1e-3,
+        "a column moved by {worst_conditioned:e} on a well-conditioned config"
+    );
+    assert!(
+        worst_ratio < 0.15,
+        "a column change did not scale with the step (ratio {worst_ratio})"
+    );
 }
 
 #[test]
@@ -191,7 +221,10 @@ fn fourth_column_never_flips_along_a_path() {
         previous = current;
     }
     println!("path: smallest dot product of consecutive 4th columns {worst_dot:.6}");
-    assert!(worst_dot > 0.5, "4th column reversed along the path (dot {worst_dot})");
+    assert!(
+        worst_dot > 0.5,
+        "4th column reversed along the path (dot {worst_dot})"
+    );
 }
 
 #[test]
@@ -206,7 +239,7 @@ fn zero_gradient_falls_back_to_a_null_space_column() {
         let null = null_space_basis(kin.jacobian());
         let [_, g1, g2] = gradients(&robot, &q, &d, &n);
         let zero = JointVector::zeros();
-        let basis = task_aligned_basis(kin.jacobian(), &null, [&zero, &g1, &g2], &BasisConfig::default());
+        let basis = task_aligned_basis(kin.jacobian(), [&zero, &g1, &g2], &BasisConfig::default());
         assert!(basis.fallback[0], "a zero gradient must fall back");
         let b = basis.columns;
         assert!((b.transpose() * b - Identity4::identity()).amax() < 1e-10);
@@ -214,8 +247,15 @@ fn zero_gradient_falls_back_to_a_null_space_column() {
         assert!((b * b.transpose() - null * null.transpose()).amax() < 1e-9);
         // A gradient lying entirely in J's row space projects to zero in the null space too.
         let row_gradient: JointVector = kin.jacobian().transpose() * random_unit(&mut rng);
-        let basis = task_aligned_basis(kin.jacobian(), &null, [&g1, &row_gradient, &g2], &BasisConfig::default());
-        assert!(basis.fallback[1], "a gradient in the row space of J must fall back");
+        let basis = task_aligned_basis(
+            kin.jacobian(),
+            [&g1, &row_gradient, &g2],
+            &BasisConfig::default(),
+        );
+        assert!(
+            basis.fallback[1],
+            "a gradient in the row space of J must fall back"
+        );
         assert!(!basis.fallback[0]);
         let b = basis.columns;
         assert!((b.transpose() * b - Identity4::identity()).amax() < 1e-10);

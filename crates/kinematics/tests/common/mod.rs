@@ -12,7 +12,8 @@ pub const FD_STEP: f64 = 1e-6;
 
 /// The FR3-with-pen chain of the shipped robot file.
 pub fn robot() -> Robot {
-    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").expect("shipped robot file loads")
+    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip")
+        .expect("shipped robot file loads")
 }
 
 /// The text of the shipped robot file.
@@ -27,7 +28,15 @@ pub fn rng(seed: u64) -> ChaCha8Rng {
 
 /// SPEC §1 home configuration.
 pub fn home() -> JointVector {
-    JointVector::from_column_slice(&[0.0, -FRAC_PI_4, 0.0, -3.0 * FRAC_PI_4, 0.0, FRAC_PI_2, FRAC_PI_4])
+    JointVector::from_column_slice(&[
+        0.0,
+        -FRAC_PI_4,
+        0.0,
+        -3.0 * FRAC_PI_4,
+        0.0,
+        FRAC_PI_2,
+        FRAC_PI_4,
+    ])
 }
 
 /// A configuration drawn uniformly within the robot's joint limits.

@@ -1,0 +1,136 @@
+//! Command-line arguments of `emg` (clap derive) and the small value parsers they need.
+
+use std::path::PathBuf;
+use std::str::FromStr;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use emg_kinematics::{DOF, JointVector};
+
+/// Extreme straight-line motion on a 7-DoF arm holding a pen.
+#[derive(Debug, Parser)]
+#[command(name = "emg", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Plan straight-line motions: seed, roll out a controller, write the trajectories.
+    Plan(PlanArgs),
+}
+
+/// Options of `emg plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Robot description (URDF). Defaults to the FR3-with-pen file shipped in data/robots/.
+    #[arg(long, value_name = "URDF", default_value_os_t = emg_kinematics::default_robot_path())]
+    pub robot: PathBuf,
+    /// Base link of the kinematic chain.
+    #[arg(long, default_value = "link0")]
+    pub base_link: String,
+    /// Tip link of the chain (the TCP; its z-axis is the tool axis).
+    #[arg(long, default_value = "pen_tip")]
+    pub tip_link: String,
+    /// Task start position p0 (m), as x,y,z. Needs --d and --n.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["d", "n"], conflicts_with = "task_file")]
+    pub p0: Option<[f64; 3]>,
+    /// Task motion direction d, as x,y,z (normalised; must be perpendicular to n).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "n"])]
+    pub d: Option<[f64; 3]>,
+    /// Task-plane normal n, as x,y,z (normalised); the tool axis must stay near it.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "d"])]
+    pub n: Option<[f64; 3]>,
+    /// Task set to plan: JSON (by the .json extension) or the binary EMGTASKS layout.
+    #[arg(long, value_name = "FILE")]
+    pub task_file: Option<PathBuf>,
+    /// Seed source: `generating` (the task's q0_seed), `home` (mid-range of the joint limits)
+    /// or `q=v1,...,v7` (radians). Default: `generating` when the task has a q0_seed, else `home`.
+    #[arg(long, value_name = "SOURCE", value_parser = SeedRequest::from_str, allow_hyphen_values = true)]
+    pub seed: Option<SeedRequest>,
+    /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
+    #[arg(long, value_name = "JSON")]
+    pub config: Option<PathBuf>,
+    /// Output path stem: writes STEM.json and STEM.csv (STEM-00000.json/.csv, ... for a task
+    /// file holding several tasks).
+    #[arg(long, value_name = "STEM", default_value = "trajectory")]
+    pub out: PathBuf,
+    /// Null-space controller.
+    #[arg(long, value_enum, default_value_t = ControllerKind::Classical)]
+    pub controller: ControllerKind,
+}
+
+/// The null-space controllers the CLI can run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ControllerKind {
+    /// The classical gradient controller (Eq. 3).
+    Classical,
+}
+
+impl ControllerKind {
+    /// Name written to result files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Classical => "classical",
+        }
+    }
+}
+
+/// Where the rollout's seed configuration comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SeedRequest {
+    /// The task's generating configuration `q0_seed`.
+    Generating,
+    /// The mid-range configuration of the joint limits.
+    Home,
+    /// A configuration given on the command line (rad).
+    Given(JointVector),
+}
+
+impl FromStr for SeedRequest {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "generating" => Ok(Self::Generating),
+            "home" => Ok(Self::Home),
+            _ => match s.strip_prefix("q=") {
+                Some(values) => {
+                    let q: [f64; DOF] = parse_numbers(values)?;
+                    Ok(Self::Given(JointVector::from(q)))
+                }
+                None => Err(format!(
+                    "unknown seed source '{s}': use generating, home or q=v1,...,v7 (radians)"
+                )),
+            },
+        }
+    }
+}
+
+/// Parses `x,y,z`.
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    parse_numbers(s)
+}
+
+/// Parses exactly `N` comma-separated finite numbers.
+fn parse_numbers<const N: usize>(s: &str) -> Result<[f64; N], String> {
+    let values = s
+        .split(',')
+        .map(|v| {
+            let v = v.trim();
+            match v.parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                _ => Err(format!("'{v}' is not a finite number")),
+            }
+        })
+        .collect::<Result<Vec<f64>, String>>()?;
+    let count = values.len();
+    values
+        .try_into()
+        .map_err(|_| format!("expected {N} comma-separated numbers, got {count}"))
+}

@@ -1,0 +1,120 @@
+//! `emg`: plan extreme straight-line motions for a 7-DoF arm holding a pen (Franka FR3).
+//!
+//! ```text
+//! emg plan                                   # built-in demo task → trajectory.json, trajectory.csv
+//! emg plan --p0 0.4,0.1,0.3 --d 0,1,0 --n 0,0,-1 --seed home --out runs/line
+//! emg plan --task-file tasks.json --config plan.json --out runs/set   # runs/set-00000.json, ...
+//! ```
+//!
+//! * Robot: `--robot <urdf>` (default: the FR3-with-pen file in `data/robots/`), `--base-link`
+//!   (`link0`), `--tip-link` (`pen_tip`).
+//! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON by the `.json`
+//!   extension, else the binary `EMGTASKS` set), or nothing for the demo task: from the
+//!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n`.
+//! * Seed: `--seed generating` (the task's `q0_seed`), `home` (the mid-range configuration of
+//!   the joint limits; the robot file carries no home pose) or `q=v1,...,v7` (radians). Default:
+//!   `generating` when the task has a `q0_seed`, else `home`. A seed not already at `p0` with
+//!   its tool axis in the cone is Newton-projected onto the exact pose `(p0, n)`.
+//! * `--config <json>`: optional `rollout` and `gains` objects; unset fields keep SPEC defaults.
+//! * `--controller classical` (the only one so far).
+//! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv`; a task file with several
+//!   tasks gives `<stem>-00000.json/.csv`, `<stem>-00001...` and so on, each written as soon as
+//!   its task is planned. Parent directories are created.
+//!
+//! The file layout is documented in `docs/trajectory-format.md`. Errors go to stderr with a
+//! nonzero exit status; with several tasks a failing task is reported and the rest still run.
+
+mod args;
+mod output;
+mod plan;
+mod seed;
+mod settings;
+mod tasks;
+
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use emg_kinematics::Robot;
+
+use crate::args::{Cli, Command, PlanArgs};
+use crate::output::{TrajectoryFile, result_paths, write_result};
+use crate::settings::Settings;
+
+fn main() -> ExitCode {
+    let result = match Cli::parse().command {
+        Command::Plan(args) => run_plan(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run_plan(args: &PlanArgs) -> Result<()> {
+    let robot = Robot::from_urdf_file(&args.robot, &args.base_link, &args.tip_link)
+        .with_context(|| format!("cannot load robot {}", args.robot.display()))?;
+    let settings = Settings::load(args.config.as_deref())?;
+    let tasks = tasks::requested_tasks(&robot, args)?;
+    let many = tasks.len() > 1;
+    let mut failures = 0;
+    for (index, task) in tasks.iter().enumerate() {
+        let label = if many {
+            format!("task {index}: ")
+        } else {
+            String::new()
+        };
+        match plan_and_write(&robot, args, &settings, task, many.then_some(index)) {
+            Ok(report) => println!("{label}{report}"),
+            Err(error) if many => {
+                failures += 1;
+                eprintln!("{label}error: {error:#}");
+            }
+            Err(error) => return Err(error),
+        }
+    }
+    anyhow::ensure!(failures == 0, "{failures} of {} tasks failed", tasks.len());
+    Ok(())
+}
+
+/// Plans one task, writes its files and returns the lines to print.
+fn plan_and_write(
+    robot: &Robot,
+    args: &PlanArgs,
+    settings: &Settings,
+    task: &emg_control::Task,
+    index: Option<usize>,
+) -> Result<String> {
+    let plan = plan::plan_task(robot, task, args.seed.as_ref(), args.controller, settings)?;
+    let trajectory = &plan.trajectory;
+    let (json_path, csv_path) = result_paths(&args.out, index);
+    let file = TrajectoryFile::new(
+        &args.robot,
+        robot.joint_names(),
+        task,
+        plan.seed.source,
+        args.controller.name(),
+        &settings.rollout,
+        &settings.gains,
+        trajectory,
+    );
+    write_result(&file, &json_path, &csv_path)?;
+    let steps = trajectory.steps.len() - 1;
+    let duration = trajectory.steps.last().map_or(0.0, |s| s.time_s);
+    let projected = match plan.seed.projection_iterations {
+        Some(n) => format!(", projected onto (p0, n) in {n} Newton iterations"),
+        None => String::new(),
+    };
+    Ok(format!(
+        "path length {:.4} m, {steps} steps, {duration:.2} s; ended: {}\n  \
+         seed: {}{projected}\n  wrote {} and {}",
+        trajectory.path_length_m,
+        trajectory.termination,
+        plan.seed.source,
+        json_path.display(),
+        csv_path.display()
+    ))
+}

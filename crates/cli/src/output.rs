@@ -1,0 +1,125 @@
+//! The result files: `<stem>.json` (format `emg-trajectory/1`) and `<stem>.csv`.
+//! The layout is documented in `docs/trajectory-format.md`.
+
+use std::ffi::OsString;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use emg_control::{ClassicalGains, RolloutConfig, StepRecord, Task, Termination, Trajectory};
+use serde::Serialize;
+
+/// Value of the `format` field of every trajectory file this build writes.
+pub const TRAJECTORY_FORMAT: &str = "emg-trajectory/1";
+
+/// One planned task as written to `<stem>.json`.
+#[derive(Debug, Serialize)]
+pub struct TrajectoryFile<'a> {
+    /// Always [`TRAJECTORY_FORMAT`].
+    pub format: &'static str,
+    /// Robot file path as given on the command line.
+    pub robot: String,
+    /// Names of the seven joints, base to tip (the order of every `q`).
+    pub joint_names: &'a [String],
+    /// The validated task.
+    pub task: &'a Task,
+    /// `generating`, `home` or `given`.
+    pub seed_source: &'a str,
+    /// Controller requested on the command line.
+    pub controller: &'a str,
+    /// Rollout settings used.
+    pub config: &'a RolloutConfig,
+    /// Controller gains used.
+    pub gains: &'a ClassicalGains,
+    /// Accepted steps, the seed first.
+    pub steps: &'a [StepRecord],
+    /// Why the rollout ended.
+    pub termination: &'a Termination,
+    /// `(p_T − p0)·d` at the last accepted step (m).
+    pub path_length_m: f64,
+}
+
+impl<'a> TrajectoryFile<'a> {
+    /// Borrows the parts of a result; `trajectory` supplies steps, termination and length.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        robot: &Path,
+        joint_names: &'a [String],
+        task: &'a Task,
+        seed_source: &'a str,
+        controller: &'a str,
+        config: &'a RolloutConfig,
+        gains: &'a ClassicalGains,
+        trajectory: &'a Trajectory,
+    ) -> Self {
+        Self {
+            format: TRAJECTORY_FORMAT,
+            robot: robot.display().to_string(),
+            joint_names,
+            task,
+            seed_source,
+            controller,
+            config,
+            gains,
+            steps: &trajectory.steps,
+            termination: &trajectory.termination,
+            path_length_m: trajectory.path_length_m,
+        }
+    }
+}
+
+/// The `.json` and `.csv` paths for `stem`: `<stem>.json`, or `<stem>-00007.json` for task 7
+/// of a multi-task run (`index = Some(7)`).
+pub fn result_paths(stem: &Path, index: Option<usize>) -> (PathBuf, PathBuf) {
+    let mut base = OsString::from(stem.as_os_str());
+    if let Some(i) = index {
+        base.push(format!("-{i:05}"));
+    }
+    let with = |ext: &str| {
+        let mut name = base.clone();
+        name.push(ext);
+        PathBuf::from(name)
+    };
+    (with(".json"), with(".csv"))
+}
+
+/// Writes `file` as JSON to `json_path` and its steps as CSV to `csv_path`, creating parent
+/// directories. Each file is written to a temporary name and renamed into place.
+pub fn write_result(file: &TrajectoryFile<'_>, json_path: &Path, csv_path: &Path) -> Result<()> {
+    let mut json = serde_json::to_string(file).context("cannot serialise the trajectory")?;
+    json.push('\n');
+    write_atomic(json_path, &json)?;
+    write_atomic(csv_path, &csv(file.steps))
+}
+
+/// The CSV table of `steps`: header `time_s,q1..q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller`.
+pub fn csv(steps: &[StepRecord]) -> String {
+    let mut out = String::from(
+        "time_s,q1,q2,q3,q4,q5,q6,q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller\n",
+    );
+    for step in steps {
+        let mut row = vec![step.time_s];
+        row.extend(step.q.iter());
+        row.extend(step.tcp.iter());
+        row.extend([step.tool_angle_deg, step.rho]);
+        for value in row {
+            let _ = write!(out, "{value:?},");
+        }
+        out.push_str(step.controller.map_or("", |c| c.name()));
+        out.push('\n');
+    }
+    out
+}
+
+fn write_atomic(path: &Path, contents: &str) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent)
+            .with_context(|| format!("cannot create directory {}", parent.display()))?;
+    }
+    let mut partial = OsString::from(path.as_os_str());
+    partial.push(".partial");
+    let partial = PathBuf::from(partial);
+    std::fs::write(&partial, contents)
+        .with_context(|| format!("cannot write {}", partial.display()))?;
+    std::fs::rename(&partial, path).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,44 @@
+//! Planning one task: seed it, build the requested controller and run the shared rollout.
+
+use anyhow::Result;
+use emg_control::{ClassicalController, NullSpaceController, Task, Trajectory, rollout};
+use emg_kinematics::Robot;
+
+use crate::args::{ControllerKind, SeedRequest};
+use crate::seed::{Seed, prepare_seed};
+use crate::settings::Settings;
+
+/// A planned task: the seed it started from and the rollout.
+#[derive(Debug)]
+pub struct Plan {
+    /// The seed actually used (after projection).
+    pub seed: Seed,
+    /// The rollout from that seed.
+    pub trajectory: Trajectory,
+}
+
+/// The controller named on the command line, configured from `settings`.
+pub fn controller(kind: ControllerKind, settings: &Settings) -> Box<dyn NullSpaceController> {
+    match kind {
+        ControllerKind::Classical => Box::new(ClassicalController::new(settings.gains.clone())),
+    }
+}
+
+/// Seeds `task` and rolls out a fresh controller of `kind` from that seed.
+pub fn plan_task(
+    robot: &Robot,
+    task: &Task,
+    seed: Option<&SeedRequest>,
+    kind: ControllerKind,
+    settings: &Settings,
+) -> Result<Plan> {
+    let seed = prepare_seed(
+        robot,
+        task,
+        seed,
+        settings.rollout.constraints.theta_max_deg,
+    )?;
+    let mut controller = controller(kind, settings);
+    let trajectory = rollout(robot, task, &seed.q, controller.as_mut(), &settings.rollout);
+    Ok(Plan { seed, trajectory })
+}

@@ -1,0 +1,41 @@
+//! Where the tasks to plan come from: the command line, a task file, or the built-in demo.
+
+use anyhow::{Context, Result};
+use emg_control::{Task, read_tasks};
+use emg_kinematics::{Robot, Vec3};
+
+use crate::args::PlanArgs;
+
+/// The tasks requested by `args`, each validated by [`Task::new`].
+pub fn requested_tasks(robot: &Robot, args: &PlanArgs) -> Result<Vec<Task>> {
+    if let Some(path) = &args.task_file {
+        let tasks = read_tasks(path, robot)
+            .with_context(|| format!("cannot read task file {}", path.display()))?;
+        anyhow::ensure!(
+            !tasks.is_empty(),
+            "task file {} holds no tasks",
+            path.display()
+        );
+        return Ok(tasks);
+    }
+    match (args.p0, args.d, args.n) {
+        (Some(p0), Some(d), Some(n)) => {
+            let task = Task::new(robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), None)
+                .context("invalid task given on the command line")?;
+            Ok(vec![task])
+        }
+        _ => Ok(vec![demo_task(robot)?]),
+    }
+}
+
+/// The built-in demo task: from the mid-range configuration, `p0` = its TCP, `n` = its tool
+/// axis, `d` = +y made perpendicular to `n`; `q0_seed` = the mid-range configuration.
+pub fn demo_task(robot: &Robot) -> Result<Task> {
+    let seed = robot.mid_range();
+    let kinematics = robot.forward(&seed);
+    let n = kinematics.tool_axis();
+    let y = Vec3::y();
+    let d = (y - n * y.dot(&n)).normalize();
+    Task::new(robot, kinematics.tcp(), d, n, Some(seed))
+        .context("the built-in demo task is invalid")
+}

@@ -1,0 +1,279 @@
+//! End-to-end tests of `emg plan`: run the built binary and read back what it wrote.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use emg_control::{ReferenceModel, RolloutConfig, Task, Trajectory};
+use emg_kinematics::{JointVector, Robot, default_robot_path};
+use serde_json::Value;
+
+/// A fresh, empty directory under the system temp dir, unique to this test run.
+fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!(
+        "emg-cli-{name}-{}-{nanos}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+fn emg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(args)
+        .output()
+        .expect("run emg")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn read_json(path: &Path) -> Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).expect("valid JSON")
+}
+
+/// Runs `emg plan` with `args`, asserting success.
+fn plan_ok(args: &[&str]) -> String {
+    let output = emg(&[&["plan"], args].concat());
+    assert!(
+        output.status.success(),
+        "emg plan {args:?} failed: {}",
+        stderr(&output)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+/// Runs `emg plan` with `args`, asserting failure, and returns stderr.
+fn plan_err(args: &[&str]) -> String {
+    let output = emg(&[&["plan"], args].concat());
+    assert!(!output.status.success(), "emg plan {args:?} should fail");
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "runtime errors exit with status 1"
+    );
+    stderr(&output)
+}
+
+#[test]
+fn demo_task_writes_documented_json_and_csv() {
+    let dir = temp_dir("demo");
+    let stem = dir.join("nested/demo");
+    let stdout = plan_ok(&["--out", stem.to_str().unwrap()]);
+    assert!(
+        stdout.contains("path length") && stdout.contains("wrote"),
+        "{stdout}"
+    );
+    let (json_path, csv_path) = (dir.join("nested/demo.json"), dir.join("nested/demo.csv"));
+    assert!(json_path.is_file() && csv_path.is_file());
+
+    let doc = read_json(&json_path);
+    assert_eq!(doc["format"], "emg-trajectory/1");
+    assert_eq!(doc["seed_source"], "generating");
+    assert_eq!(doc["controller"], "classical");
+    assert_eq!(doc["joint_names"].as_array().unwrap().len(), 7);
+    assert!(doc["robot"].as_str().unwrap().ends_with("fr3_pen.urdf"));
+    for field in ["p0", "d", "n", "q0_seed"] {
+        assert!(doc["task"][field].is_array(), "task.{field}");
+    }
+    assert_eq!(doc["config"]["dt_s"], 0.05);
+    assert_eq!(doc["gains"]["k_mu"], 0.8);
+    let steps = doc["steps"].as_array().unwrap();
+    assert!(steps.len() > 10);
+    for key in ["time_s", "q", "tcp", "tool_angle_deg", "rho", "controller"] {
+        assert!(steps[0].get(key).is_some(), "step field {key}");
+    }
+    assert_eq!(steps[0]["q"].as_array().unwrap().len(), 7);
+    assert_eq!(steps[0]["tcp"].as_array().unwrap().len(), 3);
+    assert_eq!(steps[0]["controller"], "classical");
+    let reason = doc["termination"]["reason"].as_str().unwrap();
+    assert!(["violation", "invalid_start", "step_cap"].contains(&reason));
+    if reason == "violation" {
+        assert!(doc["termination"]["violation"]["constraint"].is_string());
+    }
+    assert!(doc["path_length_m"].as_f64().unwrap() > 0.1);
+
+    let csv = std::fs::read_to_string(&csv_path).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "time_s,q1,q2,q3,q4,q5,q6,q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), steps.len());
+    assert!(rows.iter().all(|r| r.split(',').count() == 14));
+    let first: Vec<&str> = rows[0].split(',').collect();
+    assert_eq!(first[13], "classical");
+    let q1: f64 = first[1].parse().unwrap();
+    assert_eq!(q1, steps[0]["q"][0].as_f64().unwrap());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn written_trajectory_passes_the_independent_checker() {
+    let dir = temp_dir("check");
+    let stem = dir.join("line");
+    plan_ok(&[
+        "--p0",
+        "0.45,0.0,0.35",
+        "--d",
+        "0,1,0",
+        "--n",
+        "0,0,-1",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    let doc = read_json(&dir.join("line.json"));
+    assert_eq!(doc["seed_source"], "home");
+    assert!(doc["task"]["q0_seed"].is_null());
+    let task: Task = serde_json::from_value(doc["task"].clone()).unwrap();
+    let config: RolloutConfig = serde_json::from_value(doc["config"].clone()).unwrap();
+    // The file's steps/termination/path_length_m read back as the library's Trajectory.
+    let trajectory: Trajectory = serde_json::from_value(doc.clone()).unwrap();
+    assert!(
+        trajectory.path_length_m > 0.05,
+        "{}",
+        trajectory.path_length_m
+    );
+    let checker =
+        ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip").unwrap();
+    checker
+        .check(&task, &trajectory, &config.constraints)
+        .unwrap();
+    // The seed was projected onto the exact start pose.
+    let (tcp, _) = checker.tcp_pose(trajectory.steps[0].q.as_slice());
+    assert!((tcp - task.p0).norm() < 1e-8);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_inputs_fail_naming_the_field() {
+    let dir = temp_dir("bad");
+    let out = dir.join("never");
+    let out = out.to_str().unwrap();
+
+    let err = plan_err(&[
+        "--p0",
+        "0.4,0,0.3",
+        "--d",
+        "0,0,0",
+        "--n",
+        "0,0,-1",
+        "--out",
+        out,
+    ]);
+    assert!(err.contains("'d'") && err.contains("zero vector"), "{err}");
+
+    let err = plan_err(&[
+        "--p0", "5,5,5", "--d", "1,0,0", "--n", "0,0,-1", "--out", out,
+    ]);
+    assert!(err.contains("'p0'") && err.contains("unreachable"), "{err}");
+
+    let config = dir.join("config.json");
+    std::fs::write(&config, r#"{"rollout": {"max_steps": 10, "dt": 0.1}}"#).unwrap();
+    let err = plan_err(&["--config", config.to_str().unwrap(), "--out", out]);
+    assert!(err.contains("unknown field `dt`"), "{err}");
+    std::fs::write(&config, r#"{"gain": {}}"#).unwrap();
+    let err = plan_err(&["--config", config.to_str().unwrap(), "--out", out]);
+    assert!(err.contains("unknown field `gain`"), "{err}");
+
+    let err = plan_err(&[
+        "--p0",
+        "0.4,0,0.3",
+        "--d",
+        "0,1,0",
+        "--n",
+        "0,0,-1",
+        "--seed",
+        "generating",
+        "--out",
+        out,
+    ]);
+    assert!(
+        err.contains("--seed generating") && err.contains("q0_seed"),
+        "{err}"
+    );
+
+    assert!(!dir.join("never.json").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn task_file_with_three_tasks_gives_three_results() {
+    let dir = temp_dir("set");
+    let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
+    let mid = robot.mid_range();
+    let configs = [
+        mid,
+        mid + JointVector::from([0.3, 0.2, -0.2, 0.3, 0.1, -0.2, 0.4]),
+        mid + JointVector::from([-0.4, -0.2, 0.3, 0.2, -0.3, 0.3, -0.5]),
+    ];
+    let tasks: Vec<Value> = configs
+        .iter()
+        .enumerate()
+        .map(|(i, q)| {
+            let kin = robot.forward(q);
+            let n = kin.tool_axis();
+            let y = emg_kinematics::Vec3::y();
+            let d = (y - n * y.dot(&n)).normalize();
+            let mut task = serde_json::json!({
+                "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(),
+            });
+            if i != 2 {
+                task["q0_seed"] = serde_json::json!(q.as_slice());
+            }
+            task
+        })
+        .collect();
+    let task_file = dir.join("tasks.json");
+    std::fs::write(&task_file, serde_json::to_string_pretty(&tasks).unwrap()).unwrap();
+    let stem = dir.join("out/set");
+    let stdout = plan_ok(&[
+        "--task-file",
+        task_file.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert_eq!(stdout.matches("path length").count(), 3, "{stdout}");
+    for i in 0..3 {
+        let json = dir.join(format!("out/set-{i:05}.json"));
+        assert!(dir.join(format!("out/set-{i:05}.csv")).is_file());
+        let doc = read_json(&json);
+        assert_eq!(
+            doc["seed_source"],
+            if i == 2 { "home" } else { "generating" }
+        );
+    }
+    assert!(!dir.join("out/set.json").exists());
+    assert!(!dir.join("out/set-00003.json").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn given_seed_is_projected_and_recorded() {
+    let dir = temp_dir("given");
+    let stem = dir.join("given");
+    let stdout = plan_ok(&[
+        "--p0",
+        "0.45,0.0,0.35",
+        "--d",
+        "0,1,0",
+        "--n",
+        "0,0,-1",
+        "--seed",
+        "q=0,-0.5,0,-2.0,0,1.6,0.8",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("projected"), "{stdout}");
+    let doc = read_json(&dir.join("given.json"));
+    assert_eq!(doc["seed_source"], "given");
+    std::fs::remove_dir_all(&dir).ok();
+}
