@@ -38,7 +38,9 @@ pub use collision::{Capsule, CollisionHit, CollisionPair, segment_distance};
 pub use fk::{Kinematics, PositionJacobian};
 pub use manipulability::{directional_manipulability, tool_alignment_gradient};
 pub use nullspace::{BasisConfig, NullSpaceBasis, TaskBasis, null_space_basis, task_aligned_basis};
-pub use projection::{PoseTarget, ProjectionConfig, ProjectionError, project_to_pose};
+pub use projection::{
+    PoseTarget, ProjectionConfig, ProjectionError, pose_residual, project_to_pose,
+};
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{JointLimits, Robot, RobotError};
 

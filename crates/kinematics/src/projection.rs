@@ -29,18 +29,24 @@ impl PoseTarget {
     }
 }
 
-/// Settings of the damped Newton iteration.
+/// Settings of the Levenberg–Marquardt (damped Newton) iteration.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ProjectionConfig {
-    /// Iteration cap.
+    /// Iteration cap (every trial step counts, accepted or not).
     pub max_iterations: usize,
     /// Position error (m) below which the pose counts as reached.
     pub position_tolerance_m: f64,
     /// Orientation error (rad) below which the pose counts as reached.
     pub orientation_tolerance_rad: f64,
-    /// Levenberg damping added to `MMᵀ`.
+    /// Initial Levenberg damping `μ` added to `MMᵀ`; adapted by `damping_factor` per trial.
     pub damping: f64,
+    /// Factor dividing `μ` after an accepted step and multiplying it after a rejected one.
+    pub damping_factor: f64,
+    /// Smallest damping (near the solution the step is a pure Gauss–Newton step).
+    pub min_damping: f64,
+    /// Largest damping (far steps become short gradient steps).
+    pub max_damping: f64,
     /// Largest joint change of one iteration (rad, max-norm).
     pub max_step_rad: f64,
     /// Required distance from every joint limit (rad).
@@ -50,10 +56,13 @@ pub struct ProjectionConfig {
 impl Default for ProjectionConfig {
     fn default() -> Self {
         Self {
-            max_iterations: 60,
+            max_iterations: 100,
             position_tolerance_m: 1e-10,
             orientation_tolerance_rad: 1e-10,
-            damping: 1e-10,
+            damping: 1e-4,
+            damping_factor: 10.0,
+            min_damping: 1e-14,
+            max_damping: 1e4,
             max_step_rad: 0.3,
             joint_margin_rad: 0.0,
         }
@@ -86,9 +95,11 @@ pub enum ProjectionError {
     },
 }
 
-/// Projects `start` onto the exact pose `target` by damped Newton steps, keeping every joint
-/// within `[q_min + margin, q_max − margin]` (Sec. 4.1). Returns the configuration and the number
-/// of iterations, or an honest failure. Allocation-free.
+/// Projects `start` onto the exact pose `target` by Levenberg–Marquardt steps, keeping every
+/// joint within `[q_min + margin, q_max − margin]` (Sec. 4.1). A trial step is accepted only if it
+/// lowers the squared pose error (then `μ` shrinks, else it grows); joints resting on a bound
+/// whose step points outward are frozen for that step, so clamping never stalls the iteration.
+/// Returns the configuration and the number of iterations, or an honest failure. Allocation-free.
 pub fn project_to_pose(
     robot: &Robot,
     start: &JointVector,
@@ -99,13 +110,12 @@ pub fn project_to_pose(
     let limits = robot.limits();
     let margin = JointVector::repeat(cfg.joint_margin_rad);
     let (lower, upper) = (limits.lower + margin, limits.upper - margin);
-    let mut q = start.zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
-    let (mut position_error, mut orientation_error) = (f64::INFINITY, f64::INFINITY);
+    let clamp = |q: JointVector| q.zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
+    let mut q = clamp(*start);
+    let (mut rows, mut error) = pose_residual(&robot.forward(&q), target);
+    let mut damping = cfg.damping;
     for iteration in 0..=cfg.max_iterations {
-        let kin = robot.forward(&q);
-        let (rows, error) = pose_residual(&kin, target);
-        position_error = error.fixed_rows::<3>(0).norm();
-        orientation_error = error.fixed_rows::<3>(3).norm();
+        let (position_error, orientation_error) = split_norms(&error);
         if position_error < cfg.position_tolerance_m
             && orientation_error < cfg.orientation_tolerance_rad
         {
@@ -114,22 +124,63 @@ pub fn project_to_pose(
         if iteration == cfg.max_iterations {
             break;
         }
-        let gram = rows * rows.transpose() + SMatrix::<f64, 6, 6>::identity() * cfg.damping;
-        let Some(solved) = gram.cholesky().map(|c| c.solve(&error)) else {
+        let Some(mut step) = damped_step(&rows, &error, damping) else {
             break;
         };
-        let mut step = rows.transpose() * solved;
+        // Freeze joints on a bound that the step would push further out, and solve again.
+        let mut frozen = rows;
+        let mut any_frozen = false;
+        for i in 0..DOF {
+            let outward =
+                (q[i] <= lower[i] && step[i] < 0.0) || (q[i] >= upper[i] && step[i] > 0.0);
+            if outward {
+                frozen.column_mut(i).fill(0.0);
+                any_frozen = true;
+            }
+        }
+        if any_frozen {
+            let Some(free_step) = damped_step(&frozen, &error, damping) else {
+                break;
+            };
+            step = free_step;
+        }
         let largest = step.amax();
         if largest > cfg.max_step_rad {
             step *= cfg.max_step_rad / largest;
         }
-        q = (q + step).zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
+        let trial = clamp(q + step);
+        let (trial_rows, trial_error) = pose_residual(&robot.forward(&trial), target);
+        if trial_error.norm_squared() < error.norm_squared() {
+            (q, rows, error) = (trial, trial_rows, trial_error);
+            damping = (damping / cfg.damping_factor).max(cfg.min_damping);
+        } else {
+            damping = (damping * cfg.damping_factor).min(cfg.max_damping);
+        }
     }
+    let (position_error_m, orientation_error_rad) = split_norms(&error);
     Err(ProjectionError::NotConverged {
         iterations: cfg.max_iterations,
-        position_error_m: position_error,
-        orientation_error_rad: orientation_error,
+        position_error_m,
+        orientation_error_rad,
     })
+}
+
+/// Norms of the position and orientation parts of a pose residual.
+fn split_norms(error: &SVector<f64, 6>) -> (f64, f64) {
+    (
+        error.fixed_rows::<3>(0).norm(),
+        error.fixed_rows::<3>(3).norm(),
+    )
+}
+
+/// The Levenberg–Marquardt step `Mᵀ(MMᵀ + μI)⁻¹e`.
+fn damped_step(
+    rows: &SMatrix<f64, 6, DOF>,
+    error: &SVector<f64, 6>,
+    damping: f64,
+) -> Option<JointVector> {
+    let gram = rows * rows.transpose() + SMatrix::<f64, 6, 6>::identity() * damping;
+    gram.cholesky().map(|c| rows.transpose() * c.solve(error))
 }
 
 fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
@@ -157,9 +208,11 @@ fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
     Ok(())
 }
 
-/// Task rows `M` (6×7) and residual `e` (position error; rotation vector toward the target).
-/// Without a roll target, the orientation rows only constrain the two directions ⟂ `z`.
-fn pose_residual(
+/// Task rows `M` (6×7) and residual `e` of the pose constraint at `kin`: rows 0–2 are the
+/// position Jacobian and `e` the position error; rows 3–5 the angular Jacobian and the rotation
+/// vector toward the target. Without a roll target only the two directions ⟂ `z` are
+/// constrained (rows 3–4) and row 5 and `e[5]` are zero, so `M` has rank 5.
+pub fn pose_residual(
     kin: &crate::Kinematics,
     target: &PoseTarget,
 ) -> (SMatrix<f64, 6, DOF>, SVector<f64, 6>) {
