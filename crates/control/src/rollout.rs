@@ -1,6 +1,6 @@
 //! The one rollout loop shared by every controller (SPEC §3).
 
-use emg_kinematics::{JointVector, Robot};
+use emg_kinematics::{JointVector, Kinematics, Robot};
 use serde::{Deserialize, Serialize};
 
 use crate::config::RolloutConfig;
@@ -79,10 +79,172 @@ pub struct Trajectory {
     pub path_length_m: f64,
 }
 
-/// Runs `controller` on `task` from `seed` until a constraint would break or the step cap.
+/// What one applied step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StepOutcome {
+    /// The step was accepted; the episode goes on. `progress_m` is its advance along `d`.
+    Continued {
+        /// `(p_{t+1} − p_t)·d` (m).
+        progress_m: f64,
+    },
+    /// The step was accepted and reached the step cap (a truncation, not a failure).
+    Truncated {
+        /// `(p_{t+1} − p_t)·d` (m).
+        progress_m: f64,
+    },
+    /// The step would break a constraint; it was rejected and the episode ended.
+    Terminated,
+}
+
+/// A rollout in progress, advanced one control step at a time: the one implementation of the
+/// step (SPEC §3) that [`rollout`] and every learning environment share.
 ///
-/// Each step: build the [`StepContext`] at `q_t`, ask the controller for `a`, clip it, apply
-/// `q̇ = J⁺ẋ + a_max B a` for `Δt`, and accept `q_{t+1}` only if it holds every constraint.
+/// Each step: build the [`StepContext`] at `q_t` ([`Episode::context`]), choose an action, and
+/// [`Episode::apply`] it: clip to `[−1, 1]⁴`, integrate `q̇ = J⁺ẋ + a_max B a` for `Δt`, and
+/// accept `q_{t+1}` only if it holds every constraint.
+#[derive(Clone, Debug)]
+pub struct Episode<'a> {
+    robot: &'a Robot,
+    task: &'a Task,
+    config: &'a RolloutConfig,
+    q: JointVector,
+    kinematics: Kinematics,
+    previous_action: NullAction,
+    steps: Vec<StepRecord>,
+    termination: Option<Termination>,
+}
+
+impl<'a> Episode<'a> {
+    /// Starts at `seed`; the episode is already over if the seed breaks a constraint.
+    pub fn start(
+        robot: &'a Robot,
+        task: &'a Task,
+        seed: &JointVector,
+        config: &'a RolloutConfig,
+    ) -> Self {
+        let kinematics = robot.forward(seed);
+        let mut episode = Self {
+            robot,
+            task,
+            config,
+            q: *seed,
+            kinematics,
+            previous_action: NullAction::zeros(),
+            steps: Vec::with_capacity(config.max_steps + 1),
+            termination: None,
+        };
+        if let Some(violation) =
+            first_violation(robot, task, seed, &episode.kinematics, &config.constraints)
+        {
+            episode.record(None);
+            episode.termination = Some(Termination::InvalidStart { violation });
+        } else if config.max_steps == 0 {
+            episode.record(None);
+            episode.termination = Some(Termination::StepCap);
+        }
+        episode
+    }
+
+    /// The state a controller sees at the current step, or `None` once the episode is over.
+    pub fn context(&self) -> Option<StepContext<'a>> {
+        self.termination.is_none().then(|| {
+            StepContext::new(
+                self.robot,
+                self.task,
+                self.config,
+                self.steps.len(),
+                self.q,
+                self.kinematics.clone(),
+                self.previous_action,
+            )
+        })
+    }
+
+    /// Applies `action` (clipped to `[−1, 1]⁴`) chosen by `acting` at `context` (which must be
+    /// this episode's current [`Episode::context`]).
+    pub fn apply(
+        &mut self,
+        context: &StepContext<'_>,
+        action: &NullAction,
+        acting: ActingController,
+    ) -> StepOutcome {
+        debug_assert!(self.termination.is_none(), "apply after the episode ended");
+        let action = action.map(|a| a.clamp(-1.0, 1.0));
+        let next = self.q + context.joint_velocity(&action) * self.config.dt_s;
+        self.record(Some(acting));
+        let next_kinematics = self.robot.forward(&next);
+        if let Some(violation) = first_violation(
+            self.robot,
+            self.task,
+            &next,
+            &next_kinematics,
+            &self.config.constraints,
+        ) {
+            self.termination = Some(Termination::Violation {
+                violation,
+                rejected_q: next,
+            });
+            return StepOutcome::Terminated;
+        }
+        let progress_m = (next_kinematics.tcp() - self.kinematics.tcp()).dot(&self.task.d);
+        self.q = next;
+        self.kinematics = next_kinematics;
+        self.previous_action = action;
+        if self.steps.len() == self.config.max_steps {
+            self.record(None);
+            self.termination = Some(Termination::StepCap);
+            return StepOutcome::Truncated { progress_m };
+        }
+        StepOutcome::Continued { progress_m }
+    }
+
+    /// Whether the episode is over.
+    pub fn is_finished(&self) -> bool {
+        self.termination.is_some()
+    }
+
+    /// Steps accepted so far (the seed counts as step 0).
+    pub fn step_count(&self) -> usize {
+        self.steps.len()
+    }
+
+    /// The recorded trajectory; an episode stopped before its end is reported as reaching the
+    /// step cap at its current step.
+    pub fn finish(mut self) -> Trajectory {
+        let termination = match self.termination.take() {
+            Some(termination) => termination,
+            None => {
+                self.record(None);
+                Termination::StepCap
+            }
+        };
+        let last = self
+            .steps
+            .last()
+            .expect("a trajectory holds at least its seed");
+        let path_length_m = self.task.progress(&last.tcp);
+        Trajectory {
+            steps: self.steps,
+            termination,
+            path_length_m,
+        }
+    }
+
+    fn record(&mut self, controller: Option<ActingController>) {
+        let kinematics = &self.kinematics;
+        self.steps.push(StepRecord {
+            time_s: self.steps.len() as f64 * self.config.dt_s,
+            q: self.q,
+            tcp: kinematics.tcp(),
+            tool_angle_deg: tool_angle_deg(&kinematics.tool_axis(), &self.task.n),
+            rho: self.robot.limits().limit_proximity(&self.q),
+            controller,
+        });
+    }
+}
+
+/// Runs `controller` on `task` from `seed` until a constraint would break or the step cap
+/// (an [`Episode`] driven by one controller).
 pub fn rollout(
     robot: &Robot,
     task: &Task,
@@ -90,85 +252,13 @@ pub fn rollout(
     controller: &mut dyn NullSpaceController,
     config: &RolloutConfig,
 ) -> Trajectory {
-    let mut steps = Vec::with_capacity(config.max_steps + 1);
-    let mut q = *seed;
-    let mut kinematics = robot.forward(&q);
-    if let Some(violation) = first_violation(robot, task, &q, &kinematics, &config.constraints) {
-        steps.push(record(0, config, robot, task, &q, &kinematics, None));
-        return finish(task, steps, Termination::InvalidStart { violation });
-    }
-    let mut previous = NullAction::zeros();
-    for step in 0..config.max_steps {
-        let context = StepContext::new(robot, task, config, step, q, kinematics, previous);
-        if step == 0 {
+    let mut episode = Episode::start(robot, task, seed, config);
+    while let Some(context) = episode.context() {
+        if context.step == 0 {
             controller.reset(&context);
         }
-        let (raw, acting) = controller.act(&context);
-        let action = raw.map(|a| a.clamp(-1.0, 1.0));
-        let next = q + context.joint_velocity(&action) * config.dt_s;
-        steps.push(record(
-            step,
-            config,
-            robot,
-            task,
-            &q,
-            &context.kinematics,
-            Some(acting),
-        ));
-        let next_kinematics = robot.forward(&next);
-        if let Some(violation) =
-            first_violation(robot, task, &next, &next_kinematics, &config.constraints)
-        {
-            return finish(
-                task,
-                steps,
-                Termination::Violation {
-                    violation,
-                    rejected_q: next,
-                },
-            );
-        }
-        q = next;
-        kinematics = next_kinematics;
-        previous = action;
+        let (action, acting) = controller.act(&context);
+        episode.apply(&context, &action, acting);
     }
-    steps.push(record(
-        config.max_steps,
-        config,
-        robot,
-        task,
-        &q,
-        &kinematics,
-        None,
-    ));
-    finish(task, steps, Termination::StepCap)
-}
-
-fn record(
-    step: usize,
-    config: &RolloutConfig,
-    robot: &Robot,
-    task: &Task,
-    q: &JointVector,
-    kinematics: &emg_kinematics::Kinematics,
-    controller: Option<ActingController>,
-) -> StepRecord {
-    StepRecord {
-        time_s: step as f64 * config.dt_s,
-        q: *q,
-        tcp: kinematics.tcp(),
-        tool_angle_deg: tool_angle_deg(&kinematics.tool_axis(), &task.n),
-        rho: robot.limits().limit_proximity(q),
-        controller,
-    }
-}
-
-fn finish(task: &Task, steps: Vec<StepRecord>, termination: Termination) -> Trajectory {
-    let last = steps.last().expect("a trajectory holds at least its seed");
-    let path_length_m = task.progress(&last.tcp);
-    Trajectory {
-        steps,
-        termination,
-        path_length_m,
-    }
+    episode.finish()
 }
