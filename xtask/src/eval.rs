@@ -223,7 +223,7 @@ fn markdown(
     }
     md += &format!(
         "\n## Run\n\nRollouts: {rollout_seconds:.2} s wall on {threads} threads ({}).\n",
-        machine()
+        workspace::machine()
     );
     if let Some(check) = check_seconds {
         md += &format!(
@@ -232,20 +232,4 @@ fn markdown(
         );
     }
     md
-}
-
-/// CPU model and core count of this machine.
-fn machine() -> String {
-    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let model = cpuinfo
-        .lines()
-        .find_map(|l| {
-            l.strip_prefix("model name")
-                .map(|m| m.trim_start_matches([' ', '\t', ':']).to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    format!(
-        "{model}, {} cores",
-        std::thread::available_parallelism().map_or(0, |n| n.get())
-    )
 }

@@ -34,7 +34,7 @@ pub struct Args {
     robot: PathBuf,
 }
 
-/// What a task-set directory holds, written beside the sets as `tasks-v<version>.json`.
+/// What a task-set directory holds, written beside the sets as `tasks-v<version>.manifest.json`.
 #[derive(Serialize)]
 struct Manifest {
     format_version: u32,
@@ -86,7 +86,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         candidates_drawn,
         split: "first eval_count accepted candidates, then the next train_count",
     };
-    let manifest_path = args.out_dir.join(format!("tasks-v{version}.json"));
+    let manifest_path = args.out_dir.join(format!("tasks-v{version}.manifest.json"));
     std::fs::write(
         &manifest_path,
         serde_json::to_string_pretty(&manifest)? + "\n",

@@ -1,0 +1,74 @@
+//! The control step allocates nothing: building a step's context, choosing the classical action,
+//! integrating the joint velocity and checking every constraint run with zero heap allocations
+//! (counted by a global allocator wrapper).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use emg_control::{
+    ClassicalController, NullAction, NullSpaceController, RolloutConfig, SamplerConfig,
+    StepContext, candidate, first_violation,
+};
+use emg_kinematics::Robot;
+
+struct CountingAllocator;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: CountingAllocator = CountingAllocator;
+
+#[test]
+fn classical_control_step_and_constraint_check_do_not_allocate() {
+    let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
+        .expect("robot loads");
+    let config = RolloutConfig::default();
+    let tasks: Vec<_> = (0..40)
+        .filter_map(|i| candidate(&robot, &SamplerConfig::default(), i))
+        .collect();
+    assert!(tasks.len() > 20);
+    let mut controller = ClassicalController::default();
+    let mut steps = 0;
+    for task in &tasks {
+        let mut q = task.q0_seed.expect("sampled tasks keep their seed");
+        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        for step in 0..20 {
+            let kinematics = robot.forward(&q);
+            let context = StepContext::new(
+                &robot,
+                task,
+                &config,
+                step,
+                q,
+                kinematics,
+                NullAction::zeros(),
+            );
+            let (action, _) = controller.act(&context);
+            let next = q + context.joint_velocity(&action) * config.dt_s;
+            let next_kinematics = robot.forward(&next);
+            steps += 1;
+            if first_violation(&robot, task, &next, &next_kinematics, &config.constraints).is_some()
+            {
+                break;
+            }
+            q = next;
+        }
+        assert_eq!(
+            ALLOCATIONS.load(Ordering::SeqCst),
+            before,
+            "the control step allocated"
+        );
+    }
+    assert!(steps > 200, "only {steps} steps exercised");
+}
