@@ -20,8 +20,24 @@
 //! # Ok::<(), emg_seeding::LabelError>(())
 //! ```
 
+mod branch;
+mod config;
+mod heuristic;
+mod ik;
+mod journal;
+mod labelling;
 mod labels;
+mod tangent;
 
+pub use branch::{
+    BranchSamples, SelfMotionWalk, WalkEnd, connected, sample_branches, tangent_directions, walk,
+};
+pub use config::{BranchConfig, HeuristicConfig, IkConfig, LabelConfig, StabilityConfig};
+pub use heuristic::{HeuristicError, HeuristicObjective, HeuristicSeed, heuristic_seed};
+pub use ik::{cone_ik_solutions, solve_cone_ik};
+pub use journal::{LabelJob, RunProgress, Shard};
+pub use labelling::{TaskStats, label_task};
 pub use labels::{
     LABEL_FORMAT_VERSION, Label, LabelError, LabelSet, TaskLabels, hex, task_set_sha256,
 };
+pub use tangent::self_motion_projector;

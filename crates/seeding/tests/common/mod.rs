@@ -1,0 +1,47 @@
+//! Helpers shared by the integration tests of `emg-seeding`: the shipped robot, the independent
+//! checker, the first tasks of the shipped evaluation set and a small, fast labelling config.
+#![allow(dead_code)]
+
+use emg_control::{ReferenceModel, Task, read_tasks};
+use emg_kinematics::{Robot, default_robot_path};
+use emg_seeding::LabelConfig;
+
+/// The FR3-with-pen chain of the shipped robot file.
+pub fn robot() -> Robot {
+    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").expect("robot loads")
+}
+
+/// The independent checker built from the same file.
+pub fn checker() -> ReferenceModel {
+    ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip")
+        .expect("checker loads")
+}
+
+/// Path of the shipped evaluation set.
+pub fn eval_path() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/tasks/eval-v1.tasks")
+}
+
+/// The first `count` tasks of the shipped evaluation set.
+pub fn eval_tasks(robot: &Robot, count: usize) -> Vec<Task> {
+    let mut tasks = read_tasks(&eval_path(), robot).expect("evaluation set reads");
+    tasks.truncate(count);
+    tasks
+}
+
+/// The default labelling config with fewer restarts and shorter walks (fast in debug tests).
+pub fn small_config() -> LabelConfig {
+    let mut config = LabelConfig::default();
+    config.ik.restarts = 12;
+    config.branch.max_steps = 24;
+    config.stability.perturbations = 2;
+    config
+}
+
+/// A fresh temporary directory for one test.
+pub fn temporary_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("emg-seeding-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temporary directory");
+    dir
+}
