@@ -16,8 +16,12 @@
 
 mod boundary;
 mod controller;
+mod protocol;
 mod switch;
 
 pub use boundary::BoundaryMeasure;
 pub use controller::{HybridController, count_switches};
+pub use protocol::{
+    BucketConfig, CellStats, Difficulty, bucket_members, cell_stats, reference_length,
+};
 pub use switch::{HysteresisSwitch, Regime, SwitchConfig, SwitchConfigError};

@@ -1,0 +1,104 @@
+//! The evaluation protocol of Sec. 5: per-task reference lengths, difficulty buckets, and the
+//! length / ratio-to-reference statistics of every table.
+
+use emg_control::Summary;
+use serde::{Deserialize, Serialize};
+
+/// Difficulty buckets by reference length `ℓ_ref` (Sec. 5.1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BucketConfig {
+    /// `ℓ_ref` at or above which a task is Easy (m).
+    pub easy_min_m: f64,
+    /// `ℓ_ref` below which a task is Difficult (m); Medium lies between.
+    pub difficult_below_m: f64,
+}
+
+impl Default for BucketConfig {
+    fn default() -> Self {
+        Self {
+            easy_min_m: 0.80,
+            difficult_below_m: 0.45,
+        }
+    }
+}
+
+/// A task's difficulty.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Difficulty {
+    /// `ℓ_ref ≥ easy_min_m`.
+    Easy,
+    /// Between the two thresholds.
+    Medium,
+    /// `ℓ_ref < difficult_below_m`.
+    Difficult,
+}
+
+impl Difficulty {
+    /// All buckets in table order.
+    pub const ALL: [Difficulty; 3] = [Self::Easy, Self::Medium, Self::Difficult];
+
+    /// Capitalised name for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Easy => "Easy",
+            Self::Medium => "Medium",
+            Self::Difficult => "Difficult",
+        }
+    }
+}
+
+impl BucketConfig {
+    /// The bucket of a task with reference length `reference_m`.
+    pub fn classify(&self, reference_m: f64) -> Difficulty {
+        if reference_m >= self.easy_min_m {
+            Difficulty::Easy
+        } else if reference_m >= self.difficult_below_m {
+            Difficulty::Medium
+        } else {
+            Difficulty::Difficult
+        }
+    }
+}
+
+/// Path length and ratio-to-reference statistics of one table cell.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellStats {
+    /// Path length (m).
+    pub length_m: Summary,
+    /// `100 · L / ℓ_ref` (%).
+    pub ratio_percent: Summary,
+}
+
+/// Statistics of `lengths` over the tasks `members` (indices into `lengths` and `references`);
+/// `None` when `members` is empty. References must be positive.
+pub fn cell_stats(lengths: &[f64], references: &[f64], members: &[usize]) -> Option<CellStats> {
+    let picked: Vec<f64> = members.iter().map(|&i| lengths[i]).collect();
+    let ratios: Vec<f64> = members
+        .iter()
+        .map(|&i| 100.0 * lengths[i] / references[i])
+        .collect();
+    Some(CellStats {
+        length_m: Summary::of(&picked)?,
+        ratio_percent: Summary::of(&ratios)?,
+    })
+}
+
+/// The reference length `ℓ_ref` of a task: the longest of its candidate rollouts (Sec. 5).
+pub fn reference_length(candidate_lengths: &[f64]) -> Option<f64> {
+    candidate_lengths.iter().copied().reduce(f64::max)
+}
+
+/// Task indices grouped by bucket, in task order.
+pub fn bucket_members(references: &[f64], config: &BucketConfig) -> Vec<(Difficulty, Vec<usize>)> {
+    Difficulty::ALL
+        .iter()
+        .map(|&bucket| {
+            let members = (0..references.len())
+                .filter(|&i| config.classify(references[i]) == bucket)
+                .collect();
+            (bucket, members)
+        })
+        .collect()
+}
