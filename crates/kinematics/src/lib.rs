@@ -53,7 +53,10 @@ pub type JointVector = nalgebra::SVector<f64, DOF>;
 /// A Cartesian 3-vector, metres or unit direction.
 pub type Vec3 = nalgebra::Vector3<f64>;
 
-/// Path of the FR3-with-pen robot file shipped in the workspace's `data/robots/`.
+/// Path of the FR3-with-pen robot file shipped in the workspace's `data/robots/` (canonical when
+/// the file exists).
 pub fn default_robot_path() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf")
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+    path.canonicalize().unwrap_or(path)
 }
