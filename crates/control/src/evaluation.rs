@@ -27,11 +27,32 @@ where
     M: Fn() -> C + Sync,
     S: Fn(&Task) -> JointVector + Sync,
 {
+    let seeds: Vec<JointVector> = tasks.iter().map(seed_of).collect();
+    rollout_from(robot, tasks, &seeds, make_controller, config, progress)
+}
+
+/// Runs a fresh controller from `make_controller` on task `i` from `seeds[i]`, in parallel.
+/// Results are in task order and independent of the number of threads; `progress()` is called
+/// once per finished task.
+pub fn rollout_from<C, M>(
+    robot: &Robot,
+    tasks: &[Task],
+    seeds: &[JointVector],
+    make_controller: M,
+    config: &RolloutConfig,
+    progress: &(dyn Fn() + Sync),
+) -> Vec<Trajectory>
+where
+    C: NullSpaceController,
+    M: Fn() -> C + Sync,
+{
+    assert_eq!(tasks.len(), seeds.len(), "one seed per task");
     tasks
         .par_iter()
-        .map(|task| {
+        .zip(seeds)
+        .map(|(task, seed)| {
             let mut controller = make_controller();
-            let trajectory = rollout(robot, task, &seed_of(task), &mut controller, config);
+            let trajectory = rollout(robot, task, seed, &mut controller, config);
             progress();
             trajectory
         })

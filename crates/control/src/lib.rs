@@ -39,7 +39,9 @@ pub use classical::ClassicalController;
 pub use config::{ClassicalGains, ConstraintConfig, RolloutConfig};
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
-pub use evaluation::{Summary, joint_limit_histogram, rollout_all, termination_histogram};
+pub use evaluation::{
+    Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram,
+};
 pub use rollout::{Episode, StepOutcome, StepRecord, Termination, Trajectory, rollout};
 pub use sampler::{SamplerConfig, TaskSampler, candidate};
 pub use step::{NullAction, StepContext};
