@@ -4,9 +4,12 @@
 //! * `cargo xtask eval --controller classical`: path-length statistics over the evaluation set,
 //!   written to `docs/results/`.
 
+mod ablate;
 mod eval;
+mod figure_dp_seeds;
 mod make_tasks;
 mod progress;
+mod train_diffusion;
 mod workspace;
 
 use clap::{Parser, Subcommand};
@@ -25,11 +28,21 @@ enum Command {
     MakeTasks(make_tasks::Args),
     /// Evaluate a controller over the evaluation set and write the results to docs/results/.
     Eval(eval::Args),
+    /// Train the diffusion seeder on the seed labels (resumable); ship its EMA weights in data/models/.
+    TrainDiffusion(train_diffusion::Args),
+    /// Ablations written to docs/results/ablate-<variant>.{json,md}.
+    #[command(subcommand)]
+    Ablate(ablate::Variant),
+    /// Draw several DP seeds of one task as arm stick figures (docs/figures/dp-seeds.svg).
+    FigureDpSeeds(figure_dp_seeds::Args),
 }
 
 fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::MakeTasks(args) => make_tasks::run(&args),
         Command::Eval(args) => eval::run(&args),
+        Command::TrainDiffusion(args) => train_diffusion::run(&args),
+        Command::Ablate(variant) => ablate::run(&variant),
+        Command::FigureDpSeeds(args) => figure_dp_seeds::run(&args),
     }
 }

@@ -49,10 +49,14 @@ pub struct PlanArgs {
     /// Task set to plan: JSON (by the .json extension) or the binary EMGTASKS layout.
     #[arg(long, value_name = "FILE")]
     pub task_file: Option<PathBuf>,
-    /// Seed source: `generating` (the task's q0_seed), `home` (mid-range of the joint limits)
-    /// or `q=v1,...,v7` (radians). Default: `generating` when the task has a q0_seed, else `home`.
+    /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`
+    /// (mid-range of the joint limits) or `q=v1,...,v7` (radians). Default: `dp` when the
+    /// --weights file exists, else `generating` when the task has a q0_seed, else `home`.
     #[arg(long, value_name = "SOURCE", value_parser = SeedRequest::from_str, allow_hyphen_values = true)]
     pub seed: Option<SeedRequest>,
+    /// Diffusion-seeder weights for `--seed dp`.
+    #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_weights_path())]
+    pub weights: PathBuf,
     /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
@@ -63,6 +67,9 @@ pub struct PlanArgs {
     /// Null-space controller.
     #[arg(long, value_enum, default_value_t = ControllerKind::Classical)]
     pub controller: ControllerKind,
+    /// Policy weights for `--controller rl`.
+    #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_policy_path())]
+    pub policy: PathBuf,
 }
 
 /// The null-space controllers the CLI can run.
@@ -70,6 +77,8 @@ pub struct PlanArgs {
 pub enum ControllerKind {
     /// The classical gradient controller (Eq. 3).
     Classical,
+    /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
+    Rl,
 }
 
 impl ControllerKind {
@@ -77,13 +86,26 @@ impl ControllerKind {
     pub fn name(self) -> &'static str {
         match self {
             Self::Classical => "classical",
+            Self::Rl => "rl",
         }
     }
+}
+
+/// The PPO policy weights shipped in the workspace's `data/models/`.
+pub fn default_policy_path() -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/ppo-v1.weights")
+}
+
+/// The diffusion-seeder weights shipped in the workspace's `data/models/`.
+pub fn default_weights_path() -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/diffusion-v1.weights")
 }
 
 /// Where the rollout's seed configuration comes from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SeedRequest {
+    /// The DP seed: diffusion candidates projected onto the start pose, else `q0_seed`.
+    Dp,
     /// The task's generating configuration `q0_seed`.
     Generating,
     /// The mid-range configuration of the joint limits.
@@ -97,6 +119,7 @@ impl FromStr for SeedRequest {
 
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
+            "dp" => Ok(Self::Dp),
             "generating" => Ok(Self::Generating),
             "home" => Ok(Self::Home),
             _ => match s.strip_prefix("q=") {
@@ -105,7 +128,7 @@ impl FromStr for SeedRequest {
                     Ok(Self::Given(JointVector::from(q)))
                 }
                 None => Err(format!(
-                    "unknown seed source '{s}': use generating, home or q=v1,...,v7 (radians)"
+                    "unknown seed source '{s}': use dp, generating, home or q=v1,...,v7 (radians)"
                 )),
             },
         }

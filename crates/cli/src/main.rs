@@ -11,12 +11,15 @@
 //! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON by the `.json`
 //!   extension, else the binary `EMGTASKS` set), or nothing for the demo task: from the
 //!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n`.
-//! * Seed: `--seed generating` (the task's `q0_seed`), `home` (the mid-range configuration of
-//!   the joint limits; the robot file carries no home pose) or `q=v1,...,v7` (radians). Default:
-//!   `generating` when the task has a `q0_seed`, else `home`. A seed not already at `p0` with
-//!   its tool axis in the cone is Newton-projected onto the exact pose `(p0, n)`.
+//! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the shipped
+//!   `data/models/diffusion-v1.weights`), `generating` (the task's `q0_seed`), `home` (the
+//!   mid-range configuration of the joint limits; the robot file carries no home pose) or
+//!   `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
+//!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
+//!   cone is Newton-projected onto the exact pose `(p0, n)`.
 //! * `--config <json>`: optional `rollout` and `gains` objects; unset fields keep SPEC defaults.
-//! * `--controller classical` (the only one so far).
+//! * `--controller classical` (default) or `rl` (the PPO policy over `--policy`, default the
+//!   shipped `data/models/ppo-v1.weights`).
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv`; a task file with several
 //!   tasks gives `<stem>-00000.json/.csv`, `<stem>-00001...` and so on, each written as soon as
 //!   its task is planned. Parent directories are created.
@@ -37,7 +40,10 @@ use anyhow::{Context, Result};
 use clap::Parser;
 use emg_kinematics::Robot;
 
-use crate::args::{Cli, Command, PlanArgs};
+use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder};
+use emg_policy::{PlainPolicy, PolicyWeights};
+
+use crate::args::{Cli, Command, ControllerKind, PlanArgs, SeedRequest};
 use crate::output::{TrajectoryFile, result_paths, write_result};
 use crate::settings::Settings;
 
@@ -58,6 +64,8 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     let robot = Robot::from_urdf_file(&args.robot, &args.base_link, &args.tip_link)
         .with_context(|| format!("cannot load robot {}", args.robot.display()))?;
     let settings = Settings::load(args.config.as_deref())?;
+    let dp = load_dp_seeder(args)?;
+    let policy = load_policy(args)?;
     let tasks = tasks::requested_tasks(&robot, args)?;
     let many = tasks.len() > 1;
     let mut failures = 0;
@@ -67,7 +75,15 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         } else {
             String::new()
         };
-        match plan_and_write(&robot, args, &settings, task, many.then_some(index)) {
+        match plan_and_write(
+            &robot,
+            args,
+            &settings,
+            dp.as_ref(),
+            policy.as_ref(),
+            task,
+            many.then_some(index),
+        ) {
             Ok(report) => println!("{label}{report}"),
             Err(error) if many => {
                 failures += 1;
@@ -80,15 +96,60 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     Ok(())
 }
 
+/// The diffusion seeder: required by `--seed dp`, used by default when `--weights` exists.
+fn load_dp_seeder(args: &PlanArgs) -> Result<Option<DpSeeder>> {
+    let explicit = matches!(args.seed, Some(SeedRequest::Dp));
+    if !explicit && (args.seed.is_some() || !args.weights.exists()) {
+        return Ok(None);
+    }
+    let weights = DenoiserWeights::read(&args.weights).with_context(|| {
+        format!(
+            "--seed dp: cannot load diffusion weights {}",
+            args.weights.display()
+        )
+    })?;
+    let seeder = DpSeeder::new(&weights, DpSeedConfig::default()).with_context(|| {
+        format!(
+            "--seed dp: unusable diffusion weights {}",
+            args.weights.display()
+        )
+    })?;
+    Ok(Some(seeder))
+}
+
+/// The policy of `--controller rl`, loaded from `--policy`.
+fn load_policy(args: &PlanArgs) -> Result<Option<PlainPolicy>> {
+    if args.controller != ControllerKind::Rl {
+        return Ok(None);
+    }
+    let weights = PolicyWeights::read(&args.policy).with_context(|| {
+        format!(
+            "--controller rl: cannot load policy weights {}",
+            args.policy.display()
+        )
+    })?;
+    Ok(Some(PlainPolicy::new(&weights)))
+}
+
 /// Plans one task, writes its files and returns the lines to print.
 fn plan_and_write(
     robot: &Robot,
     args: &PlanArgs,
     settings: &Settings,
+    dp: Option<&DpSeeder>,
+    policy: Option<&PlainPolicy>,
     task: &emg_control::Task,
     index: Option<usize>,
 ) -> Result<String> {
-    let plan = plan::plan_task(robot, task, args.seed.as_ref(), args.controller, settings)?;
+    let plan = plan::plan_task(
+        robot,
+        task,
+        args.seed.as_ref(),
+        dp,
+        args.controller,
+        policy,
+        settings,
+    )?;
     let trajectory = &plan.trajectory;
     let (json_path, csv_path) = result_paths(&args.out, index);
     let file = TrajectoryFile::new(

@@ -1,7 +1,8 @@
 //! Choosing the rollout's seed and putting it exactly on the task's start pose.
 
 use anyhow::{Context, Result, bail};
-use emg_control::{SEED_POSITION_TOLERANCE_M, Task, tool_angle_deg};
+use emg_control::{ConstraintConfig, SEED_POSITION_TOLERANCE_M, Task, tool_angle_deg};
+use emg_diffusion::{DpSeedError, DpSeeder, SeedOrigin, SeedWorkspace};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
 
 use crate::args::SeedRequest;
@@ -11,23 +12,46 @@ use crate::args::SeedRequest;
 pub struct Seed {
     /// The configuration the rollout starts from.
     pub q: JointVector,
-    /// `generating`, `home` or `given`.
+    /// `dp`, `generating`, `home` or `given`.
     pub source: &'static str,
     /// Newton iterations spent projecting it onto `(p0, n)`; `None` when it was already there.
     pub projection_iterations: Option<usize>,
 }
 
-/// Picks the seed named by `request` (default: `generating` when the task has a `q0_seed`,
-/// else `home`) and, unless it already puts the TCP at `p0` with the tool axis within
-/// `theta_max_deg` of `n` and every joint within its limits, Newton-projects it onto the exact
-/// pose `(p0, n)`.
+/// Picks the seed named by `request` (default: `dp` when a diffusion seeder is loaded, else
+/// `generating` when the task has a `q0_seed`, else `home`) and, unless it already puts the TCP
+/// at `p0` with the tool axis within `theta_max_deg` of `n` and every joint within its limits,
+/// Newton-projects it onto the exact pose `(p0, n)`. The DP seed falls back to `q0_seed`
+/// (reported as `generating`); by default, a task without one then falls back to `home`.
 pub fn prepare_seed(
     robot: &Robot,
     task: &Task,
     request: Option<&SeedRequest>,
-    theta_max_deg: f64,
+    constraints: &ConstraintConfig,
+    dp: Option<&DpSeeder>,
 ) -> Result<Seed> {
+    let theta_max_deg = constraints.theta_max_deg;
+    let wants_dp = matches!(request, Some(SeedRequest::Dp)) || (request.is_none() && dp.is_some());
+    if wants_dp {
+        let seeder = dp.context("--seed dp: no diffusion weights loaded (see --weights)")?;
+        match seeder.seed(robot, task, constraints, &mut SeedWorkspace::default()) {
+            Ok(seed) => {
+                let source = match seed.origin {
+                    SeedOrigin::Diffusion => "dp",
+                    SeedOrigin::Fallback => "generating",
+                };
+                return Ok(Seed {
+                    q: seed.q,
+                    source,
+                    projection_iterations: None,
+                });
+            }
+            Err(DpSeedError::NoValidSeed { .. }) if request.is_none() => {}
+            Err(error) => return Err(error).context("--seed dp"),
+        }
+    }
     let (q, source) = match request {
+        Some(SeedRequest::Dp) => unreachable!("handled above"),
         Some(SeedRequest::Generating) => match task.q0_seed {
             Some(q) => (q, "generating"),
             None => bail!(

@@ -1,0 +1,334 @@
+//! `cargo xtask ablate <variant>`: ablations written to `docs/results/` (Tables 4 and 5).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use emg_control::{ClassicalController, RolloutConfig, Summary, Task, read_tasks, rollout_all};
+use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedOrigin, SeedWorkspace};
+use emg_seeding::LabelSet;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::{progress, workspace};
+
+/// The ablations.
+#[derive(clap::Subcommand)]
+pub enum Variant {
+    /// Classifier-free guidance scale w ∈ {0, 1, 1.5, 2, 3} (Table 4).
+    CfgScale(DpArgs),
+    /// DDIM steps ∈ {10, 20, 50, 100} (Table 5).
+    DdimSteps(DpArgs),
+}
+
+/// Options shared by the DP-seed ablations.
+#[derive(clap::Args)]
+pub struct DpArgs {
+    /// Diffusion weights.
+    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    weights: PathBuf,
+    /// Evaluation tasks (never seen in training).
+    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    tasks: PathBuf,
+    /// Labels of the evaluation tasks; their best length is the reference, when present.
+    #[arg(long, default_value_os_t = workspace::root().join("data/labels/eval-v1.labels"))]
+    reference: PathBuf,
+    /// Use only the first N tasks.
+    #[arg(long)]
+    limit: Option<usize>,
+    /// Worker threads (0 = one per core); lengths do not depend on it, seed times do (timing
+    /// is per task on one core, so keep 1 for the reported times).
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+    /// Directory of the result files.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    out_dir: PathBuf,
+    /// Robot file.
+    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    robot: PathBuf,
+}
+
+/// Runs an ablation.
+pub fn run(variant: &Variant) -> anyhow::Result<()> {
+    match variant {
+        Variant::CfgScale(args) => dp_sweep(
+            args,
+            "cfg-scale",
+            "w",
+            &[0.0, 1.0, 1.5, 2.0, 3.0],
+            |config, w| {
+                config.sample.guidance_scale = w;
+            },
+        ),
+        Variant::DdimSteps(args) => dp_sweep(
+            args,
+            "ddim-steps",
+            "DDIM steps",
+            &[10.0, 20.0, 50.0, 100.0],
+            |config, steps| {
+                config.sample.steps = steps as usize;
+            },
+        ),
+    }
+}
+
+/// Seed time statistics (ms).
+#[derive(Serialize)]
+struct TimeStats {
+    median_ms: f64,
+    p95_ms: f64,
+    mean_ms: f64,
+}
+
+/// One ablation row.
+#[derive(Serialize)]
+struct Row {
+    value: f64,
+    dp: DpSeedConfig,
+    seed_time: TimeStats,
+    tries_mean: f64,
+    fallbacks: usize,
+    path_length_m: Summary,
+    ratio_to_reference_pct: Option<Summary>,
+}
+
+#[derive(Serialize)]
+struct Baseline {
+    seed: &'static str,
+    path_length_m: Summary,
+    ratio_to_reference_pct: Option<Summary>,
+}
+
+#[derive(Serialize)]
+struct Report<'a> {
+    ablation: &'a str,
+    parameter: &'a str,
+    tasks: String,
+    task_count: usize,
+    weights: String,
+    weights_dataset: String,
+    reference: Option<String>,
+    controller: &'static str,
+    rollout: RolloutConfig,
+    baseline: Baseline,
+    rows: Vec<Row>,
+}
+
+fn dp_sweep(
+    args: &DpArgs,
+    name: &str,
+    parameter: &str,
+    values: &[f64],
+    apply: impl Fn(&mut DpSeedConfig, f64),
+) -> anyhow::Result<()> {
+    let robot = workspace::load_robot(&args.robot)?;
+    let mut tasks = read_tasks(&args.tasks, &robot)
+        .with_context(|| format!("reading {}", args.tasks.display()))?;
+    if let Some(limit) = args.limit {
+        tasks.truncate(limit);
+    }
+    if tasks.is_empty() || tasks.iter().any(|t| t.q0_seed.is_none()) {
+        bail!(
+            "{}: the ablation needs at least one task, each with its q0_seed",
+            args.tasks.display()
+        );
+    }
+    let weights = DenoiserWeights::read(&args.weights).with_context(|| {
+        format!(
+            "reading {} (train it with `cargo xtask train-diffusion`)",
+            args.weights.display()
+        )
+    })?;
+    let reference = reference_lengths(&args.reference, tasks.len())?;
+    let pool = workspace::thread_pool(args.threads)?;
+    let rollout = RolloutConfig::default();
+
+    let lengths_from = |tasks: &[Task], what: &str| -> Vec<f64> {
+        let bar = progress::bar(tasks.len() as u64, what);
+        let trajectories = pool.install(|| {
+            rollout_all(
+                &robot,
+                tasks,
+                |t| t.q0_seed.expect("seeded"),
+                ClassicalController::default,
+                &rollout,
+                &|| bar.inc(1),
+            )
+        });
+        bar.finish();
+        trajectories.iter().map(|t| t.path_length_m).collect()
+    };
+    let baseline_lengths = lengths_from(&tasks, "q0_seed");
+    let baseline = Baseline {
+        seed: "q0_seed",
+        path_length_m: summary(&baseline_lengths),
+        ratio_to_reference_pct: reference.as_ref().map(|r| ratio(&baseline_lengths, r)),
+    };
+
+    let mut rows = Vec::new();
+    for &value in values {
+        let mut dp = DpSeedConfig::default();
+        apply(&mut dp, value);
+        let seeder = DpSeeder::new(&weights, dp.clone())?;
+        let bar = progress::bar(tasks.len() as u64, "dp seeds");
+        let seeds = pool.install(|| {
+            tasks
+                .par_iter()
+                .map_init(SeedWorkspace::default, |workspace, task| {
+                    bar.inc(1);
+                    seeder.seed(&robot, task, &rollout.constraints, workspace)
+                })
+                .collect::<Result<Vec<_>, _>>()
+        })?;
+        bar.finish();
+        let seeded: Vec<Task> = tasks
+            .iter()
+            .zip(&seeds)
+            .map(|(task, seed)| Task {
+                q0_seed: Some(seed.q),
+                ..task.clone()
+            })
+            .collect();
+        let lengths = lengths_from(&seeded, "dp rollouts");
+        let mut times: Vec<f64> = seeds
+            .iter()
+            .map(|s| s.elapsed.as_secs_f64() * 1e3)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        let quantile = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+        rows.push(Row {
+            value,
+            dp,
+            seed_time: TimeStats {
+                median_ms: quantile(0.5),
+                p95_ms: quantile(0.95),
+                mean_ms: times.iter().sum::<f64>() / times.len() as f64,
+            },
+            tries_mean: seeds.iter().map(|s| s.tries as f64).sum::<f64>() / seeds.len() as f64,
+            fallbacks: seeds
+                .iter()
+                .filter(|s| s.origin == SeedOrigin::Fallback)
+                .count(),
+            path_length_m: summary(&lengths),
+            ratio_to_reference_pct: reference.as_ref().map(|r| ratio(&lengths, r)),
+        });
+    }
+    let report = Report {
+        ablation: name,
+        parameter,
+        tasks: workspace::relative(&args.tasks),
+        task_count: tasks.len(),
+        weights: workspace::relative(&args.weights),
+        weights_dataset: weights.header().dataset.clone(),
+        reference: reference
+            .as_ref()
+            .map(|_| workspace::relative(&args.reference)),
+        controller: "classical",
+        rollout,
+        baseline,
+        rows,
+    };
+    std::fs::create_dir_all(&args.out_dir)?;
+    let stem = args.out_dir.join(format!("ablate-{name}"));
+    std::fs::write(
+        stem.with_extension("json"),
+        serde_json::to_string_pretty(&report)? + "\n",
+    )?;
+    std::fs::write(stem.with_extension("md"), markdown(&report))?;
+    println!("{}", markdown(&report));
+    Ok(())
+}
+
+/// Best label length per task, when the evaluation labels exist and cover every task.
+fn reference_lengths(path: &std::path::Path, count: usize) -> anyhow::Result<Option<Vec<f64>>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let labels = LabelSet::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let lengths: Option<Vec<f64>> = (0..count)
+        .map(|i| {
+            labels
+                .get(i as u32)
+                .and_then(|t| t.labels.first())
+                .map(|l| l.length_m)
+        })
+        .collect();
+    Ok(lengths)
+}
+
+/// Per-task ratio `L / L_ref` in percent.
+fn ratio(lengths: &[f64], reference: &[f64]) -> Summary {
+    let ratios: Vec<f64> = lengths
+        .iter()
+        .zip(reference)
+        .map(|(l, r)| 100.0 * l / r.max(1e-9))
+        .collect();
+    summary(&ratios)
+}
+
+/// The summary of a non-empty sample (the task list is checked non-empty up front).
+fn summary(values: &[f64]) -> Summary {
+    Summary::of(values).expect("at least one task")
+}
+
+fn summary_cell(s: &Summary, digits: usize) -> String {
+    format!(
+        "{:.d$} / {:.d$} / {:.d$} / {:.d$}",
+        s.mean,
+        s.std,
+        s.min,
+        s.max,
+        d = digits
+    )
+}
+
+fn markdown(report: &Report) -> String {
+    let ratio_header = if report.reference.is_some() {
+        " Ratio to reference (%) mean / std / min / max |"
+    } else {
+        ""
+    };
+    let ratio_rule = if report.reference.is_some() {
+        "---|"
+    } else {
+        ""
+    };
+    let ratio_cell = |r: &Option<Summary>| {
+        r.as_ref()
+            .map_or(String::new(), |s| format!(" {} |", summary_cell(s, 1)))
+    };
+    let mut text = format!(
+        "# Ablation: {}\n\nWritten by `cargo xtask ablate {}`. Classical controller from the DP seed over {} \
+         evaluation tasks ({}, unseen in training); weights {} trained on {}. Seed time per task on one core \
+         (median / p95 / mean); tries = candidates projected; fallbacks = tasks that fell back to q0_seed.\n\n\
+         | {} | seed time (ms) median / p95 / mean | tries | fallbacks | Path length (m) mean / std / min / max |{}\n\
+         |---|---|---|---|---|{}\n",
+        report.parameter,
+        report.ablation,
+        report.task_count,
+        report.tasks,
+        report.weights,
+        report.weights_dataset,
+        report.parameter,
+        ratio_header,
+        ratio_rule
+    );
+    for row in &report.rows {
+        text += &format!(
+            "| {} | {:.3} / {:.3} / {:.3} | {:.2} | {} | {} |{}\n",
+            row.value,
+            row.seed_time.median_ms,
+            row.seed_time.p95_ms,
+            row.seed_time.mean_ms,
+            row.tries_mean,
+            row.fallbacks,
+            summary_cell(&row.path_length_m, 3),
+            ratio_cell(&row.ratio_to_reference_pct)
+        );
+    }
+    text += &format!(
+        "| q0_seed (baseline) | — | — | — | {} |{}\n",
+        summary_cell(&report.baseline.path_length_m, 3),
+        ratio_cell(&report.baseline.ratio_to_reference_pct)
+    );
+    text
+}

@@ -1,0 +1,161 @@
+//! `cargo xtask figure-dp-seeds`: several DP seeds of one task drawn as arm stick figures in two
+//! views, each labelled with the classical path length it reaches (the paper's Fig. 5).
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use emg_control::{ClassicalController, RolloutConfig, first_violation, read_tasks, rollout};
+use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
+use emg_kinematics::{DOF, PoseTarget, Vec3, project_to_pose};
+use plotters::prelude::*;
+
+use crate::workspace;
+
+/// Options of `figure-dp-seeds`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Index of the evaluation task to draw.
+    #[arg(long, default_value_t = 0)]
+    task: usize,
+    /// Candidates sampled (the IK-valid ones are drawn).
+    #[arg(long, default_value_t = 16)]
+    candidates: usize,
+    /// Diffusion weights.
+    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    weights: PathBuf,
+    /// Task set.
+    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    tasks: PathBuf,
+    /// Output SVG.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/figures/dp-seeds.svg"))]
+    out: PathBuf,
+    /// Robot file.
+    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    robot: PathBuf,
+}
+
+/// One drawn seed: its stick-figure points and the length it reaches.
+struct Drawn {
+    points: Vec<Vec3>,
+    length_m: f64,
+}
+
+/// Runs `figure-dp-seeds`.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = workspace::load_robot(&args.robot)?;
+    let tasks = read_tasks(&args.tasks, &robot)
+        .with_context(|| format!("reading {}", args.tasks.display()))?;
+    let Some(task) = tasks.get(args.task) else {
+        bail!(
+            "--task {} is past the {} tasks of {}",
+            args.task,
+            tasks.len(),
+            args.tasks.display()
+        );
+    };
+    let weights = DenoiserWeights::read(&args.weights)
+        .with_context(|| format!("reading {}", args.weights.display()))?;
+    let config = DpSeedConfig::default();
+    let seeder = DpSeeder::new(&weights, config.clone())?;
+    let candidates =
+        seeder.candidates(&robot, task, args.candidates, &mut SeedWorkspace::default())?;
+    let rollout_config = RolloutConfig::default();
+    let target = PoseTarget {
+        position: task.p0,
+        tool_axis: task.n,
+        roll_axis: None,
+    };
+    let mut drawn = Vec::new();
+    for start in &candidates {
+        let Ok((q, _)) = project_to_pose(&robot, start, &target, &config.projection) else {
+            continue;
+        };
+        let kinematics = robot.forward(&q);
+        if first_violation(&robot, task, &q, &kinematics, &rollout_config.constraints).is_some() {
+            continue;
+        }
+        let mut points = vec![Vec3::zeros()];
+        points.extend((0..DOF).map(|i| kinematics.joint_origin(i)));
+        points.push(kinematics.tcp());
+        let trajectory = rollout(
+            &robot,
+            task,
+            &q,
+            &mut ClassicalController::default(),
+            &rollout_config,
+        );
+        drawn.push(Drawn {
+            points,
+            length_m: trajectory.path_length_m,
+        });
+    }
+    if drawn.is_empty() {
+        bail!(
+            "none of the {} candidates of task {} is IK-valid; try another --task",
+            args.candidates,
+            args.task
+        );
+    }
+    if let Some(dir) = args.out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let root = SVGBackend::new(&args.out, (1100, 520)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (left, right) = root.split_horizontally(550);
+    let line_end = task.p0 + task.d * 0.8;
+    for (area, (a, b), title) in [
+        (left, (0, 2), "side view (x–z)"),
+        (right, (0, 1), "top view (x–y)"),
+    ] {
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                format!("DP seeds of evaluation task {}: {title}", args.task),
+                ("sans-serif", 16),
+            )
+            .margin(10)
+            .x_label_area_size(30)
+            .y_label_area_size(40)
+            .build_cartesian_2d(-0.9..0.9, if b == 2 { -0.2..1.3 } else { -0.9..0.9 })?;
+        chart
+            .configure_mesh()
+            .x_desc(["x", "y", "z"][a])
+            .y_desc(["x", "y", "z"][b])
+            .draw()?;
+        chart.draw_series(LineSeries::new(
+            [task.p0, line_end].iter().map(|p| (p[a], p[b])),
+            ShapeStyle::from(&RGBColor(150, 150, 150)).stroke_width(2),
+        ))?;
+        for (i, seed) in drawn.iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let series = chart.draw_series(LineSeries::new(
+                seed.points.iter().map(|p| (p[a], p[b])),
+                ShapeStyle::from(&color).stroke_width(2),
+            ))?;
+            if b == 2 {
+                series
+                    .label(format!("seed {}: L = {:.2} m", i + 1, seed.length_m))
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+            }
+            chart.draw_series(
+                seed.points
+                    .iter()
+                    .map(|p| Circle::new((p[a], p[b]), 2, color.filled())),
+            )?;
+        }
+        if b == 2 {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()?;
+        }
+    }
+    root.present()?;
+    println!(
+        "wrote {} ({} IK-valid seeds of {} candidates)",
+        workspace::relative(&args.out),
+        drawn.len(),
+        args.candidates
+    );
+    Ok(())
+}

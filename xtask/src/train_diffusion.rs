@@ -1,0 +1,298 @@
+//! `cargo xtask train-diffusion`: trains the DP denoiser on the seed labels (resumable), ships
+//! its EMA weights in `data/models/` and writes the loss curve to `docs/results/`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use emg_control::read_tasks;
+use emg_diffusion::{Backend, DiffusionConfig, TrainConfig, Trainer, TrainingSet, training_set};
+use emg_seeding::{LabelSet, hex};
+use serde::{Deserialize, Serialize};
+
+use crate::{progress, workspace};
+
+/// The Burn backends `--backend` accepts.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum BackendChoice {
+    /// Burn's pure-Rust flex backend.
+    Flex,
+    /// Burn's ndarray backend.
+    Ndarray,
+}
+
+impl From<BackendChoice> for Backend {
+    fn from(choice: BackendChoice) -> Self {
+        match choice {
+            BackendChoice::Flex => Backend::Flex,
+            BackendChoice::Ndarray => Backend::Ndarray,
+        }
+    }
+}
+
+/// Options of `train-diffusion`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// JSON run configuration (`network`, `training`); unset fields keep the shipped defaults.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Training labels.
+    #[arg(long, default_value_os_t = workspace::root().join("data/labels/train-v1.labels"))]
+    labels: PathBuf,
+    /// The task set the labels index.
+    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/train-v1.tasks"))]
+    tasks: PathBuf,
+    /// Shipped EMA weights (the run configuration is written beside them as .json).
+    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    out: PathBuf,
+    /// Checkpoint directory; a run finding one there resumes from it.
+    #[arg(long, default_value_os_t = workspace::root().join("target/diffusion-v1-checkpoint"))]
+    checkpoint: PathBuf,
+    /// Burn backend.
+    #[arg(long, value_enum, default_value_t = BackendChoice::Flex)]
+    backend: BackendChoice,
+    /// Instead of training: time this many steps on each backend and write
+    /// docs/results/diffusion-backends.md.
+    #[arg(long)]
+    measure_backends: Option<usize>,
+    /// Directory of the loss curve and the backend measurement.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    results: PathBuf,
+    /// Robot file.
+    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    robot: PathBuf,
+}
+
+/// The run configuration: the shipped network is smaller than the paper's (SPEC §6's defaults)
+/// so that a 50-step, 32-candidate DP seed stays within a couple of milliseconds on one core.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RunConfig {
+    /// Network shape.
+    pub network: DiffusionConfig,
+    /// Training hyper-parameters.
+    pub training: TrainConfig,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        Self {
+            network: DiffusionConfig {
+                width: 96,
+                hidden: 192,
+                blocks: 2,
+                time_dim: 64,
+                ..DiffusionConfig::default()
+            },
+            training: TrainConfig {
+                steps: 60_000,
+                batch_size: 256,
+                learning_rate: 1e-3,
+                ..TrainConfig::default()
+            },
+        }
+    }
+}
+
+/// What is written beside the shipped weights.
+#[derive(Serialize)]
+struct ModelCard<'a> {
+    weights: String,
+    labels: String,
+    label_task_set_sha256: String,
+    tasks: String,
+    training_pairs: usize,
+    backend: &'static str,
+    run: &'a RunConfig,
+    steps_done: usize,
+    final_loss: Option<f64>,
+    wall_seconds_this_session: f64,
+}
+
+/// Runs `train-diffusion`.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let run_config: RunConfig = match &args.config {
+        Some(path) => serde_json::from_str(
+            &std::fs::read_to_string(path)
+                .with_context(|| format!("reading {}", path.display()))?,
+        )
+        .with_context(|| format!("parsing run configuration {}", path.display()))?,
+        None => RunConfig::default(),
+    };
+    let robot = workspace::load_robot(&args.robot)?;
+    let tasks = read_tasks(&args.tasks, &robot)
+        .with_context(|| format!("reading {}", args.tasks.display()))?;
+    let labels = LabelSet::read(&args.labels).with_context(|| {
+        format!(
+            "reading {} (create it with `cargo xtask label-seeds`)",
+            args.labels.display()
+        )
+    })?;
+    let name = format!(
+        "{} (task set sha256 {})",
+        workspace::relative(&args.labels),
+        hex(labels.task_set_sha256())
+    );
+    let data = training_set(&robot, &tasks, &labels, &name)?;
+    println!(
+        "{} training pairs from {} labelled tasks",
+        data.len(),
+        labels.tasks().len()
+    );
+
+    if let Some(steps) = args.measure_backends {
+        return measure_backends(&run_config, &data, steps, &args.results);
+    }
+    let backend = Backend::from(args.backend);
+    let mut trainer = if args.checkpoint.join("state.json").exists() {
+        let trainer = Trainer::resume(
+            &args.checkpoint,
+            run_config.network.clone(),
+            run_config.training.clone(),
+            backend,
+            &data,
+        )?;
+        println!(
+            "resuming from step {} ({})",
+            trainer.step_count(),
+            args.checkpoint.display()
+        );
+        trainer
+    } else {
+        Trainer::new(
+            run_config.network.clone(),
+            run_config.training.clone(),
+            backend,
+            &data,
+        )?
+    };
+    let total = run_config.training.steps;
+    let bar = progress::bar(total as u64, "training");
+    bar.set_position(trainer.step_count() as u64);
+    let started = Instant::now();
+    let mut recent = 0.0;
+    while trainer.step_count() < total {
+        let loss = trainer.train_step(&data);
+        recent = if recent == 0.0 {
+            loss
+        } else {
+            0.98 * recent + 0.02 * loss
+        };
+        bar.inc(1);
+        if trainer.step_count() % 50 == 0 {
+            bar.set_message(format!("loss {recent:.4}"));
+        }
+        if trainer.step_count() % run_config.training.checkpoint_every_steps == 0 {
+            trainer.save_checkpoint(&args.checkpoint)?;
+            write_loss_curve(&trainer, &args.results)?;
+        }
+    }
+    bar.finish();
+    trainer.save_checkpoint(&args.checkpoint)?;
+    write_loss_curve(&trainer, &args.results)?;
+    if let Some(dir) = args.out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    trainer.ema_weights().write(&args.out)?;
+    let card = ModelCard {
+        weights: workspace::relative(&args.out),
+        labels: workspace::relative(&args.labels),
+        label_task_set_sha256: hex(labels.task_set_sha256()),
+        tasks: workspace::relative(&args.tasks),
+        training_pairs: data.len(),
+        backend: backend.name(),
+        run: &run_config,
+        steps_done: trainer.step_count(),
+        final_loss: trainer.loss_log().last().map(|row| row.loss),
+        wall_seconds_this_session: started.elapsed().as_secs_f64(),
+    };
+    std::fs::write(
+        args.out.with_extension("json"),
+        serde_json::to_string_pretty(&card)? + "\n",
+    )?;
+    println!("wrote {} and its .json", workspace::relative(&args.out));
+    Ok(())
+}
+
+/// Times `steps` training steps on each backend; writes diffusion-backends.md.
+fn measure_backends(
+    run_config: &RunConfig,
+    data: &TrainingSet,
+    steps: usize,
+    results: &Path,
+) -> anyhow::Result<()> {
+    let mut rows = String::new();
+    for backend in [Backend::Flex, Backend::Ndarray] {
+        let mut trainer = Trainer::new(
+            run_config.network.clone(),
+            run_config.training.clone(),
+            backend,
+            data,
+        )?;
+        trainer.train_step(data);
+        let started = Instant::now();
+        for _ in 0..steps {
+            trainer.train_step(data);
+        }
+        let rate = steps as f64 / started.elapsed().as_secs_f64();
+        println!("{}: {rate:.1} steps/s", backend.name());
+        rows += &format!("| {} | {rate:.1} |\n", backend.name());
+    }
+    let network = &run_config.network;
+    let text = format!(
+        "# Diffusion training speed per Burn backend\n\n\
+         Written by `cargo xtask train-diffusion --measure-backends {steps}`: optimiser steps per second \
+         (batch {}, network width {}, hidden {}, {} blocks, time embedding {}), after one warm-up step, \
+         on this machine while other jobs shared its cores.\n\n| backend | steps/s |\n|---|---|\n{rows}",
+        run_config.training.batch_size,
+        network.width,
+        network.hidden,
+        network.blocks,
+        network.time_dim
+    );
+    std::fs::create_dir_all(results)?;
+    std::fs::write(results.join("diffusion-backends.md"), text)?;
+    Ok(())
+}
+
+/// The loss log as CSV and an SVG curve.
+fn write_loss_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    std::fs::create_dir_all(results)?;
+    let log = trainer.loss_log();
+    let mut csv = String::from("step,loss\n");
+    for row in log {
+        csv += &format!("{},{}\n", row.step, row.loss);
+    }
+    std::fs::write(results.join("diffusion-training.csv"), csv)?;
+    if log.is_empty() {
+        return Ok(());
+    }
+    let path = results.join("diffusion-training.svg");
+    let root = SVGBackend::new(&path, (720, 420)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let max_step = log.last().map_or(1, |r| r.step) as f64;
+    let (low, high) = log.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+        (lo.min(r.loss), hi.max(r.loss))
+    });
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "Diffusion training loss (v-prediction MSE)",
+            ("sans-serif", 18),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..max_step, (low * 0.9).log10()..(high * 1.1).log10())?;
+    chart
+        .configure_mesh()
+        .x_desc("optimiser step")
+        .y_desc("log10 loss")
+        .draw()?;
+    chart.draw_series(LineSeries::new(
+        log.iter().map(|r| (r.step as f64, r.loss.log10())),
+        &BLUE,
+    ))?;
+    root.present()?;
+    Ok(())
+}
