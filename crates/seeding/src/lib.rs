@@ -1,23 +1,41 @@
-//! Initial configurations for extreme straight-line motion (Sec. 4.1 of the paper, SPEC §7).
+//! Initial configurations for extreme straight-line motion (Sec. 4.1 and Table 2 of the paper,
+//! SPEC §7).
 //!
 //! For one task many configurations put the pen tip at `p0` with its axis along `n`; joint limits
 //! cut that self-motion family into disconnected branches, and the branch a rollout starts on
-//! largely decides how far the line can go. This crate holds the seed-label dataset that the
-//! learning crates read: [`LabelSet`] (one [`TaskLabels`] per task, at most `K'` [`Label`]s each,
-//! longest first), stored in a compact versioned binary file.
+//! largely decides how far the line can go. This crate finds and scores those branches:
+//!
+//! * [`cone_ik_solutions`]: IK of `(p0, axis within a 5° cone of n)` from many restarts (half
+//!   biased toward the limits), with a joint margin and deduplication.
+//! * [`walk`], [`connected`], [`sample_branches`]: motion along the family (the null space of the
+//!   5-D pose constraint, [`self_motion_projector`]) to a limit or collision; branch ids.
+//! * [`heuristic_seed`]: the `q_μ` / `q_jl` seeds (null-space ascent from `q0_seed`).
+//! * [`label_task`]: one task's labels — candidates scored by classical rollouts, kept when
+//!   length-stable under small task perturbations, the top `K'` (all constants in [`LabelConfig`]).
+//! * [`LabelJob`]: resumable, sharded labelling of a task set; [`LabelSet`] is the label file the
+//!   learning crates read (`docs/labels-format.md`).
 //!
 //! ```
-//! use emg_kinematics::JointVector;
-//! use emg_seeding::{Label, LabelSet, TaskLabels};
-//! let labels = vec![Label::stored(JointVector::repeat(0.1), 0.62, 0, 0.01)];
-//! let set = LabelSet::new([7; 32], 10, 6, vec![TaskLabels { task_index: 3, labels }])?;
+//! use emg_control::Task;
+//! use emg_kinematics::{Robot, Vec3};
+//! use emg_seeding::{LabelConfig, LabelSet, label_task};
+//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let seed = robot.mid_range();
+//! let kin = robot.forward(&seed);
+//! let task = Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed))?;
+//! let mut config = LabelConfig::default();
+//! config.ik.restarts = 8;
+//! let (labels, stats) = label_task(&robot, &task, 0, &config);
+//! assert!(stats.branches >= 1 && labels.labels.len() <= config.max_labels);
+//! for label in &labels.labels {
+//!     assert!((robot.forward(&label.q).tcp() - task.p0).norm() < 1e-6);
+//! }
+//! let set = LabelSet::new([0; 32], 1, 6, vec![labels])?;
 //! let path = std::env::temp_dir().join(format!("emg-seeding-doc-{}.labels", std::process::id()));
 //! set.write(&path)?;
-//! let back = LabelSet::read(&path)?;
-//! assert_eq!(back, set);
-//! assert_eq!(back.get(3).unwrap().labels[0].length_m, f64::from(0.62f32));
+//! assert_eq!(LabelSet::read(&path)?, set);
 //! # std::fs::remove_file(&path).ok();
-//! # Ok::<(), emg_seeding::LabelError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 mod branch;
