@@ -6,7 +6,9 @@
 
 mod ablate;
 mod eval;
+mod figure_branches;
 mod figure_dp_seeds;
+mod label_seeds;
 mod make_tasks;
 mod progress;
 mod train_diffusion;
@@ -35,6 +37,10 @@ enum Command {
     Ablate(ablate::Variant),
     /// Draw several DP seeds of one task as arm stick figures (docs/figures/dp-seeds.svg).
     FigureDpSeeds(figure_dp_seeds::Args),
+    /// Label seeds across self-motion branches (data/labels/), resumable and sharded; --report writes docs/results/labels.*.
+    LabelSeeds(label_seeds::Args),
+    /// Draw one task's self-motion branches along arc length (docs/figures/self-motion-branches.svg).
+    FigureBranches(figure_branches::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -44,5 +50,7 @@ fn main() -> anyhow::Result<()> {
         Command::TrainDiffusion(args) => train_diffusion::run(&args),
         Command::Ablate(variant) => ablate::run(&variant),
         Command::FigureDpSeeds(args) => figure_dp_seeds::run(&args),
+        Command::LabelSeeds(args) => label_seeds::run(&args),
+        Command::FigureBranches(args) => figure_branches::run(&args),
     }
 }
