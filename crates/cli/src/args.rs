@@ -67,6 +67,9 @@ pub struct PlanArgs {
     /// Null-space controller.
     #[arg(long, value_enum, default_value_t = ControllerKind::Classical)]
     pub controller: ControllerKind,
+    /// Policy weights for `--controller rl`.
+    #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_policy_path())]
+    pub policy: PathBuf,
 }
 
 /// The null-space controllers the CLI can run.
@@ -74,6 +77,8 @@ pub struct PlanArgs {
 pub enum ControllerKind {
     /// The classical gradient controller (Eq. 3).
     Classical,
+    /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
+    Rl,
 }
 
 impl ControllerKind {
@@ -81,8 +86,14 @@ impl ControllerKind {
     pub fn name(self) -> &'static str {
         match self {
             Self::Classical => "classical",
+            Self::Rl => "rl",
         }
     }
+}
+
+/// The PPO policy weights shipped in the workspace's `data/models/`.
+pub fn default_policy_path() -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/ppo-v1.weights")
 }
 
 /// The diffusion-seeder weights shipped in the workspace's `data/models/`.

@@ -18,7 +18,8 @@
 //!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
 //! * `--config <json>`: optional `rollout` and `gains` objects; unset fields keep SPEC defaults.
-//! * `--controller classical` (the only one so far).
+//! * `--controller classical` (default) or `rl` (the PPO policy over `--policy`, default the
+//!   shipped `data/models/ppo-v1.weights`).
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv`; a task file with several
 //!   tasks gives `<stem>-00000.json/.csv`, `<stem>-00001...` and so on, each written as soon as
 //!   its task is planned. Parent directories are created.
@@ -40,8 +41,9 @@ use clap::Parser;
 use emg_kinematics::Robot;
 
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder};
+use emg_policy::{PlainPolicy, PolicyWeights};
 
-use crate::args::{Cli, Command, PlanArgs, SeedRequest};
+use crate::args::{Cli, Command, ControllerKind, PlanArgs, SeedRequest};
 use crate::output::{TrajectoryFile, result_paths, write_result};
 use crate::settings::Settings;
 
@@ -63,6 +65,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         .with_context(|| format!("cannot load robot {}", args.robot.display()))?;
     let settings = Settings::load(args.config.as_deref())?;
     let dp = load_dp_seeder(args)?;
+    let policy = load_policy(args)?;
     let tasks = tasks::requested_tasks(&robot, args)?;
     let many = tasks.len() > 1;
     let mut failures = 0;
@@ -77,6 +80,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
             args,
             &settings,
             dp.as_ref(),
+            policy.as_ref(),
             task,
             many.then_some(index),
         ) {
@@ -113,12 +117,27 @@ fn load_dp_seeder(args: &PlanArgs) -> Result<Option<DpSeeder>> {
     Ok(Some(seeder))
 }
 
+/// The policy of `--controller rl`, loaded from `--policy`.
+fn load_policy(args: &PlanArgs) -> Result<Option<PlainPolicy>> {
+    if args.controller != ControllerKind::Rl {
+        return Ok(None);
+    }
+    let weights = PolicyWeights::read(&args.policy).with_context(|| {
+        format!(
+            "--controller rl: cannot load policy weights {}",
+            args.policy.display()
+        )
+    })?;
+    Ok(Some(PlainPolicy::new(&weights)))
+}
+
 /// Plans one task, writes its files and returns the lines to print.
 fn plan_and_write(
     robot: &Robot,
     args: &PlanArgs,
     settings: &Settings,
     dp: Option<&DpSeeder>,
+    policy: Option<&PlainPolicy>,
     task: &emg_control::Task,
     index: Option<usize>,
 ) -> Result<String> {
@@ -128,6 +147,7 @@ fn plan_and_write(
         args.seed.as_ref(),
         dp,
         args.controller,
+        policy,
         settings,
     )?;
     let trajectory = &plan.trajectory;
