@@ -12,6 +12,7 @@ mod label_seeds;
 mod make_tasks;
 mod progress;
 mod train_diffusion;
+mod train_ppo;
 mod workspace;
 
 use clap::{Parser, Subcommand};
@@ -41,6 +42,8 @@ enum Command {
     LabelSeeds(label_seeds::Args),
     /// Draw one task's self-motion branches along arc length (docs/figures/self-motion-branches.svg).
     FigureBranches(figure_branches::Args),
+    /// Train the RL null-space controller with PPO (resumable); ship its weights in data/models/.
+    TrainPpo(train_ppo::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -51,6 +54,7 @@ fn main() -> anyhow::Result<()> {
         Command::Ablate(variant) => ablate::run(&variant),
         Command::FigureDpSeeds(args) => figure_dp_seeds::run(&args),
         Command::LabelSeeds(args) => label_seeds::run(&args),
+        Command::TrainPpo(args) => train_ppo::run(&args),
         Command::FigureBranches(args) => figure_branches::run(&args),
     }
 }

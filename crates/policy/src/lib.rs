@@ -1,0 +1,84 @@
+//! The learned null-space controller (Sec. 4.2, Eqs. 6–7; SPEC §4–5): PPO in Burn on CPU over
+//! vectorised rollouts of the shared [`emg_control::Episode`] step, exported weights, and an
+//! allocation-free plain-Rust policy forward for rollouts.
+//!
+//! * [`observe`]: the 31-value observation of Eq. 6; the action is `a ∈ (−1, 1)⁴` in `B(q)`,
+//!   scaled by `a_max` inside the shared step (Eq. 7).
+//! * [`TrainingPool`] / [`ArmEnvironment`]: episodes on training tasks, starting from their
+//!   labels or `q0_seed`; reward `clip(Δp·d / (v·Δt), 0, 1)`.
+//! * [`VecEnv`]: many [`Environment`]s stepped in parallel (rayon), thread-count independent.
+//! * [`Trainer`]: PPO with GAE, clipped objective and value loss, entropy bonus, target-KL stop,
+//!   return normalisation, truncation bootstrap; checkpoints with exact resume; any Burn
+//!   [`Backend`].
+//! * [`PolicyWeights`] / [`PlainPolicy`]: exported weights and their batch-1 forward.
+//! * [`RlController`]: the trained policy as an [`emg_control::NullSpaceController`].
+//!
+//! ```
+//! use emg_control::{RolloutConfig, Task, rollout};
+//! use emg_kinematics::{Robot, Vec3};
+//! use emg_policy::{Backend, NetworkConfig, PpoConfig, RlController, Trainer};
+//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let network = NetworkConfig { hidden: vec![8] };
+//! let trainer = Trainer::new(network, PpoConfig::default(), Backend::Flex)?;
+//! let mut controller = RlController::new(&trainer.weights());
+//! let seed = robot.mid_range();
+//! let kin = robot.forward(&seed);
+//! let task = Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed))?;
+//! let trajectory = rollout(&robot, &task, &seed, &mut controller, &RolloutConfig::default());
+//! assert!(trajectory.path_length_m > 0.0);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod advantage;
+mod config;
+mod controller;
+mod env;
+mod inference;
+mod network;
+mod observation;
+mod ppo;
+mod vec_env;
+mod weights;
+
+pub use advantage::{ReturnScaler, RunningMoments, Targets, generalised_advantages};
+pub use config::{Backend, EnvConfig, NetworkConfig, PpoConfig};
+pub use controller::RlController;
+pub use env::{ArmEnvironment, TrainingPool};
+pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
+pub use network::{ActorCritic, PolicyOutput, Trunk};
+pub use observation::{ACTION_DIM, OBSERVATION_DIM, observe};
+pub use ppo::{IterationLog, IterationTiming, Trainer};
+pub use vec_env::{Environment, EpisodeEnd, MAX_ENVS, Rollout, Transition, VecEnv, VecEnvSnapshot};
+pub use weights::{
+    PolicyWeights, WEIGHTS_FORMAT_VERSION, WeightsError, WeightsHeader, layer_shapes,
+};
+
+/// Why a configuration, a training pool or a checkpoint is unusable.
+#[derive(Debug, thiserror::Error)]
+pub enum PolicyError {
+    /// A configuration field with an unusable value.
+    #[error("field '{field}' {problem}")]
+    BadConfig {
+        /// Field.
+        field: &'static str,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A checkpoint file could not be read or written.
+    #[error("checkpoint {path}: {problem}")]
+    Checkpoint {
+        /// File.
+        path: String,
+        /// What went wrong.
+        problem: String,
+    },
+    /// A checkpoint made with other settings.
+    #[error("checkpoint was made with a different {what}; start a new run or restore the settings")]
+    ConfigMismatch {
+        /// `network config` or `PPO config`.
+        what: &'static str,
+    },
+    /// Unusable weights.
+    #[error(transparent)]
+    Weights(#[from] WeightsError),
+}
