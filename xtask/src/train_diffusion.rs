@@ -78,8 +78,8 @@ impl Default for RunConfig {
     fn default() -> Self {
         Self {
             network: DiffusionConfig {
-                width: 96,
-                hidden: 192,
+                width: 64,
+                hidden: 128,
                 blocks: 2,
                 time_dim: 64,
                 ..DiffusionConfig::default()
@@ -88,6 +88,7 @@ impl Default for RunConfig {
                 steps: 60_000,
                 batch_size: 256,
                 learning_rate: 1e-3,
+                checkpoint_every_steps: 5_000,
                 ..TrainConfig::default()
             },
         }

@@ -8,6 +8,9 @@ use emg_control::{ReferenceModel, RolloutConfig, Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, default_robot_path};
 use serde_json::Value;
 
+/// A weights path that does not exist: the default seed chain then skips the DP seed.
+const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
+
 /// A fresh, empty directory under the system temp dir, unique to this test run.
 fn temp_dir(name: &str) -> PathBuf {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
@@ -66,7 +69,8 @@ fn plan_err(args: &[&str]) -> String {
 fn demo_task_writes_documented_json_and_csv() {
     let dir = temp_dir("demo");
     let stem = dir.join("nested/demo");
-    let stdout = plan_ok(&["--out", stem.to_str().unwrap()]);
+    // Without diffusion weights the default seed is the task's generating configuration.
+    let stdout = plan_ok(&["--out", stem.to_str().unwrap(), "--weights", NO_WEIGHTS]);
     assert!(
         stdout.contains("path length") && stdout.contains("wrote"),
         "{stdout}"
@@ -129,6 +133,8 @@ fn written_trajectory_passes_the_independent_checker() {
         "0,0,-1",
         "--out",
         stem.to_str().unwrap(),
+        "--weights",
+        NO_WEIGHTS,
     ]);
     let doc = read_json(&dir.join("line.json"));
     assert_eq!(doc["seed_source"], "home");
@@ -240,6 +246,8 @@ fn task_file_with_three_tasks_gives_three_results() {
         task_file.to_str().unwrap(),
         "--out",
         stem.to_str().unwrap(),
+        "--weights",
+        NO_WEIGHTS,
     ]);
     assert_eq!(stdout.matches("path length").count(), 3, "{stdout}");
     for i in 0..3 {
@@ -276,4 +284,59 @@ fn given_seed_is_projected_and_recorded() {
     let doc = read_json(&dir.join("given.json"));
     assert_eq!(doc["seed_source"], "given");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn dp_seed_is_the_default_with_the_shipped_weights() {
+    let dir = temp_dir("dp");
+    let stem = dir.join("demo");
+    let stdout = plan_ok(&["--out", stem.to_str().unwrap()]);
+    assert!(stdout.contains("seed: dp"), "{stdout}");
+    let doc = read_json(&dir.join("demo.json"));
+    assert_eq!(doc["seed_source"], "dp");
+    let task: Task = serde_json::from_value(doc["task"].clone()).unwrap();
+    let config: RolloutConfig = serde_json::from_value(doc["config"].clone()).unwrap();
+    let trajectory: Trajectory = serde_json::from_value(doc.clone()).unwrap();
+    let checker =
+        ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip").unwrap();
+    checker
+        .check(&task, &trajectory, &config.constraints)
+        .expect("the DP-seeded trajectory passes the independent checker");
+    let explicit = plan_ok(&["--seed", "dp", "--out", stem.to_str().unwrap()]);
+    assert_eq!(explicit, stdout);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn dp_seed_with_missing_or_damaged_weights_fails_clearly() {
+    let dir = temp_dir("dp-bad");
+    let stem = dir.join("x");
+    let err = plan_err(&[
+        "--seed",
+        "dp",
+        "--weights",
+        NO_WEIGHTS,
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(
+        err.contains("cannot load diffusion weights") && err.contains(NO_WEIGHTS),
+        "{err}"
+    );
+    let shipped = std::fs::read(emg_cli_weights()).unwrap();
+    let cut = dir.join("cut.weights");
+    std::fs::write(&cut, &shipped[..shipped.len() / 2]).unwrap();
+    let err = plan_err(&[
+        "--weights",
+        cut.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(err.contains("truncated"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The shipped diffusion weights.
+fn emg_cli_weights() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/diffusion-v1.weights")
 }
