@@ -6,27 +6,43 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use emg_control::{
-    ClassicalController, ClassicalGains, ReferenceModel, RolloutConfig, Summary, Task,
-    joint_limit_histogram, read_tasks, rollout_all, termination_histogram,
+    ReferenceModel, RolloutConfig, Summary, Task, joint_limit_histogram, read_tasks, rollout_all,
+    termination_histogram,
 };
+use emg_hybrid::{BucketConfig, ControllerKind, Executor, ExecutorConfig};
+use emg_policy::{PolicyWeights, RlController};
 use serde::Serialize;
 
-use crate::{progress, workspace};
+use crate::{progress, protocol, workspace};
 
-/// Controllers `eval` can run.
-#[derive(Clone, Copy, clap::ValueEnum, Serialize)]
-#[serde(rename_all = "snake_case")]
+/// Controllers `eval --controller` can run.
+#[derive(Clone, Copy, clap::ValueEnum)]
 enum ControllerChoice {
     /// The classical null-space controller (Eq. 3).
     Classical,
+    /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
+    Rl,
+    /// Learned inside, classical near the joint limits (Sec. 4.3).
+    Hybrid,
+}
+
+impl ControllerChoice {
+    fn kind(self) -> ControllerKind {
+        match self {
+            Self::Classical => ControllerKind::Classical,
+            Self::Rl => ControllerKind::Rl,
+            Self::Hybrid => ControllerKind::Hybrid,
+        }
+    }
 }
 
 /// Options of `eval`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Controller to evaluate.
+    /// Evaluate one controller from q0_seed; without it, run the whole seed × controller
+    /// protocol (docs/results/eval.{json,md}).
     #[arg(long, value_enum)]
-    controller: ControllerChoice,
+    controller: Option<ControllerChoice>,
     /// Task set.
     #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
     tasks: PathBuf,
@@ -51,17 +67,36 @@ pub struct Args {
     /// Robot file.
     #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
     robot: PathBuf,
+    /// Policy weights of the learned controllers.
+    #[arg(long, default_value_os_t = protocol::default_policy())]
+    weights: PathBuf,
+    /// Diffusion-seeder weights (protocol).
+    #[arg(long, default_value_os_t = protocol::default_diffusion())]
+    diffusion: PathBuf,
+    /// Labels of the evaluation set, whose candidates give the reference lengths (protocol).
+    #[arg(long, default_value_os_t = workspace::root().join("data/labels/eval-v1.labels"))]
+    labels: PathBuf,
+    /// Training tasks evaluated as the "seen" set (protocol).
+    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/train-v1.tasks"))]
+    seen_tasks: PathBuf,
+    /// Labels of the training tasks (protocol).
+    #[arg(long, default_value_os_t = workspace::root().join("data/labels/train-v1.labels"))]
+    seen_labels: PathBuf,
+    /// How many training tasks form the "seen" set (protocol; 0 skips it).
+    #[arg(long, default_value_t = 1000)]
+    seen_count: usize,
 }
 
 /// The numbers of one evaluation: identical for any thread count.
 #[derive(Serialize)]
 struct EvalResult {
-    controller: ControllerChoice,
+    controller: ControllerKind,
     tasks: String,
     task_count: usize,
     seed: &'static str,
     rollout: RolloutConfig,
-    gains: ClassicalGains,
+    executor: ExecutorConfig,
+    weights: Option<String>,
     path_length_m: Summary,
     steps: Summary,
     termination: BTreeMap<String, usize>,
@@ -69,8 +104,83 @@ struct EvalResult {
     independently_checked: usize,
 }
 
-/// Runs the evaluation and writes `<name>.json` and `<name>.md`.
+/// Runs the protocol, or one controller with `--controller`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    let pool = workspace::thread_pool(args.threads)?;
+    match args.controller {
+        None => pool.install(|| run_protocol(args)),
+        Some(choice) => run_controller(args, choice.kind(), &pool),
+    }
+}
+
+/// The seed × controller protocol on the unseen evaluation set and the seen training slice.
+fn run_protocol(args: &Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+    let buckets = BucketConfig::default();
+    let mut sets = vec![protocol::evaluate_set(
+        &setup,
+        "unseen",
+        &args.tasks,
+        &args.labels,
+        args.limit,
+        &buckets,
+    )?];
+    if args.seen_count > 0 {
+        sets.push(protocol::evaluate_set(
+            &setup,
+            "seen",
+            &args.seen_tasks,
+            &args.seen_labels,
+            Some(args.seen_count),
+            &buckets,
+        )?);
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    let name = args.name.clone().unwrap_or_else(|| "eval".into());
+    std::fs::create_dir_all(&args.out_dir)?;
+    let json_path = args.out_dir.join(format!("{name}.json"));
+    let record = serde_json::json!({
+        "rollout": setup.rollout,
+        "executor": setup.executor,
+        "buckets": buckets,
+        "policy": workspace::relative(&args.weights),
+        "diffusion": workspace::relative(&args.diffusion),
+        "sets": sets,
+    });
+    std::fs::write(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
+    let mut md = format!(
+        "# Evaluation protocol: seeds × controllers\n\nWritten by `cargo xtask eval`. Do not edit by hand. \
+         Every trajectory behind these tables passed the independent checker. Unseen = the evaluation set \
+         (disjoint from every training set); seen = the first {} tasks of the training pool.\n\n",
+        args.seen_count
+    );
+    for set in &sets {
+        md += &protocol::markdown(set);
+        md += "\n";
+    }
+    md += &format!(
+        "## Run\n\nWhole protocol (seeds, references, {} rollouts per set and seed, checks): {seconds:.1} s wall on {} threads ({}).\n",
+        ControllerKind::ALL.len(),
+        rayon::current_num_threads(),
+        workspace::machine()
+    );
+    let md_path = args.out_dir.join(format!("{name}.md"));
+    std::fs::write(&md_path, md)?;
+    println!(
+        "protocol done in {seconds:.1} s; wrote {} and {}",
+        json_path.display(),
+        md_path.display()
+    );
+    Ok(())
+}
+
+/// One controller from every task's q0_seed.
+fn run_controller(
+    args: &Args,
+    kind: ControllerKind,
+    pool: &rayon::ThreadPool,
+) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
     let mut tasks = read_tasks(&args.tasks, &robot).with_context(|| {
         format!(
@@ -88,8 +198,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(gain) = args.lateral_gain {
         rollout.lateral_gain_per_s = gain;
     }
-    let gains = ClassicalGains::default();
-    let pool = workspace::thread_pool(args.threads)?;
+    let executor = ExecutorConfig::default();
+    let policy = if kind.needs_policy() {
+        Some(RlController::new(
+            &PolicyWeights::read(&args.weights).with_context(|| {
+                format!(
+                    "loading the policy (train it with `cargo xtask train-ppo`): {}",
+                    args.weights.display()
+                )
+            })?,
+        ))
+    } else {
+        None
+    };
+    let prototype = Executor::new(kind, policy.as_ref(), &executor)?;
     let seed_of = |task: &Task| task.q0_seed.expect("checked above");
 
     let bar = progress::bar(tasks.len() as u64, "rollouts");
@@ -99,7 +221,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &robot,
             &tasks,
             seed_of,
-            || ClassicalController::new(gains.clone()),
+            || prototype.clone(),
             &rollout,
             &|| bar.inc(1),
         )
@@ -147,19 +269,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .map(|t| (t.steps.len() - 1) as f64)
         .collect();
     let result = EvalResult {
-        controller: args.controller,
+        controller: kind,
         tasks: workspace::relative(&args.tasks),
         task_count: tasks.len(),
         seed: "q0_seed",
         rollout,
-        gains,
+        executor,
+        weights: policy.is_some().then(|| workspace::relative(&args.weights)),
         path_length_m: Summary::of(&lengths).context("no tasks to evaluate")?,
         steps: Summary::of(&steps).context("no tasks to evaluate")?,
         termination: termination_histogram(&trajectories),
         joint_limit_by_joint: joint_limit_histogram(&trajectories),
         independently_checked: checked,
     };
-    let name = args.name.clone().unwrap_or_else(|| "classical".into());
+    let name = args.name.clone().unwrap_or_else(|| kind.name().into());
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("{name}.json"));
     std::fs::write(&json_path, serde_json::to_string_pretty(&result)? + "\n")?;
@@ -206,7 +329,7 @@ fn markdown(
         s.max,
         result.steps.mean,
         result.steps.max,
-        name = "classical",
+        name = result.controller.name(),
         tasks = result.tasks,
         count = result.task_count,
         k_lat = result.rollout.lateral_gain_per_s,

@@ -5,12 +5,16 @@
 //!   written to `docs/results/`.
 
 mod ablate;
+mod ablate_control;
+mod bench_report;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
 mod label_seeds;
 mod make_tasks;
 mod progress;
+mod protocol;
+mod report;
 mod train_diffusion;
 mod train_ppo;
 mod workspace;
@@ -31,6 +35,10 @@ enum Command {
     MakeTasks(make_tasks::Args),
     /// Evaluate a controller over the evaluation set and write the results to docs/results/.
     Eval(eval::Args),
+    /// Regenerate docs/results.md (every table beside the paper's numbers) and its figures.
+    Report(report::Args),
+    /// Run the criterion benchmarks and write their medians to docs/results/benchmarks.md and README.md.
+    BenchReport(bench_report::Args),
     /// Train the diffusion seeder on the seed labels (resumable); ship its EMA weights in data/models/.
     TrainDiffusion(train_diffusion::Args),
     /// Ablations written to docs/results/ablate-<variant>.{json,md}.
@@ -50,6 +58,8 @@ fn main() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::MakeTasks(args) => make_tasks::run(&args),
         Command::Eval(args) => eval::run(&args),
+        Command::BenchReport(args) => bench_report::run(&args),
+        Command::Report(args) => report::run(&args),
         Command::TrainDiffusion(args) => train_diffusion::run(&args),
         Command::Ablate(variant) => ablate::run(&variant),
         Command::FigureDpSeeds(args) => figure_dp_seeds::run(&args),

@@ -9,6 +9,7 @@ use crate::boundary::BoundaryMeasure;
 use crate::switch::{HysteresisSwitch, Regime};
 
 /// Learned policy in the interior, classical controller in the boundary shell (Sec. 4.3).
+#[derive(Clone)]
 pub struct HybridController<L> {
     classical: ClassicalController,
     learned: L,

@@ -1,0 +1,430 @@
+//! The seed × controller protocol of Sec. 5 (`cargo xtask eval` without `--controller`):
+//! seeds q0_seed, q_μ, q_jl and DP; controllers classical, RL and hybrid; per-task reference
+//! lengths from the label candidates; difficulty buckets; the paper's Tables 1 and 2, on the
+//! evaluation set (tasks never seen in training) and on a slice of the training pool (seen).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use emg_control::{
+    ReferenceModel, RolloutConfig, Summary, Task, Trajectory, read_tasks, rollout_from,
+};
+use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
+use emg_hybrid::{
+    BucketConfig, CellStats, ControllerKind, Executor, ExecutorConfig, bucket_members, cell_stats,
+    count_switches,
+};
+use emg_kinematics::{JointVector, ProjectionConfig, Robot};
+use emg_policy::{PolicyWeights, RlController};
+use emg_seeding::{HeuristicConfig, HeuristicObjective, LabelSet, heuristic_seed};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::{progress, workspace};
+
+/// Where a rollout's starting configuration comes from (Table 2's rows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SeedKind {
+    /// The configuration that generated the task.
+    Q0Seed,
+    /// Directional-manipulability ascent from `q0_seed` (`q_μ`).
+    QMu,
+    /// Joint-centring ascent from `q0_seed` (`q_jl`).
+    QJl,
+    /// The diffusion seeder (DP).
+    Dp,
+}
+
+impl SeedKind {
+    /// All seeds in table order.
+    pub const ALL: [SeedKind; 4] = [Self::Q0Seed, Self::QMu, Self::QJl, Self::Dp];
+
+    /// Name for tables.
+    pub fn title(self) -> &'static str {
+        match self {
+            Self::Q0Seed => "q0_seed",
+            Self::QMu => "q_μ",
+            Self::QJl => "q_jl",
+            Self::Dp => "DP",
+        }
+    }
+}
+
+/// Everything the protocol runs with, loaded once.
+pub struct Setup {
+    /// The robot.
+    pub robot: Robot,
+    /// Its independent checker.
+    pub checker: ReferenceModel,
+    /// Rollout settings.
+    pub rollout: RolloutConfig,
+    /// Controller settings.
+    pub executor: ExecutorConfig,
+    /// The trained policy.
+    pub policy: RlController,
+    /// The diffusion seeder.
+    pub dp: DpSeeder,
+    /// Heuristic-seed settings.
+    pub heuristic: HeuristicConfig,
+    /// Projection settings of the heuristic seeds.
+    pub projection: ProjectionConfig,
+}
+
+impl Setup {
+    /// Loads the robot, the shipped policy and diffusion weights.
+    pub fn load(
+        robot_path: &Path,
+        policy_path: &Path,
+        diffusion_path: &Path,
+    ) -> anyhow::Result<Self> {
+        let robot = workspace::load_robot(robot_path)?;
+        let checker = ReferenceModel::from_urdf_file(robot_path, "link0", "pen_tip")
+            .map_err(anyhow::Error::msg)?;
+        let policy = PolicyWeights::read(policy_path)
+            .context("loading the policy (train it with `cargo xtask train-ppo`)")?;
+        let diffusion = DenoiserWeights::read(diffusion_path).context(
+            "loading the diffusion seeder (train it with `cargo xtask train-diffusion`)",
+        )?;
+        Ok(Self {
+            robot,
+            checker,
+            rollout: RolloutConfig::default(),
+            executor: ExecutorConfig::default(),
+            policy: RlController::new(&policy),
+            dp: DpSeeder::new(&diffusion, DpSeedConfig::default())?,
+            heuristic: HeuristicConfig::default(),
+            projection: ProjectionConfig::default(),
+        })
+    }
+
+    /// Seeds of `kind` for every task and their generation times (ms), in parallel.
+    pub fn seeds(
+        &self,
+        tasks: &[Task],
+        kind: SeedKind,
+    ) -> anyhow::Result<(Vec<JointVector>, Vec<f64>)> {
+        let bar = progress::bar(tasks.len() as u64, kind.title());
+        let seeds: Vec<anyhow::Result<(JointVector, f64)>> = tasks
+            .par_iter()
+            .map_init(SeedWorkspace::default, |workspace, task| {
+                let q0 = task
+                    .q0_seed
+                    .context("every evaluated task needs its q0_seed")?;
+                let seed = match kind {
+                    SeedKind::Q0Seed => (q0, 0.0),
+                    SeedKind::QMu | SeedKind::QJl => {
+                        let objective = if kind == SeedKind::QMu {
+                            HeuristicObjective::Manipulability
+                        } else {
+                            HeuristicObjective::JointCentring
+                        };
+                        let started = Instant::now();
+                        match heuristic_seed(
+                            &self.robot,
+                            task,
+                            objective,
+                            &self.heuristic,
+                            &self.projection,
+                        ) {
+                            Ok(seed) => (seed.q, seed.generation_time.as_secs_f64() * 1e3),
+                            Err(_) => (q0, started.elapsed().as_secs_f64() * 1e3),
+                        }
+                    }
+                    SeedKind::Dp => {
+                        let seed = self.dp.seed(
+                            &self.robot,
+                            task,
+                            &self.rollout.constraints,
+                            workspace,
+                        )?;
+                        (seed.q, seed.elapsed.as_secs_f64() * 1e3)
+                    }
+                };
+                bar.inc(1);
+                Ok(seed)
+            })
+            .collect();
+        bar.finish_and_clear();
+        let seeds = seeds.into_iter().collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(seeds.into_iter().unzip())
+    }
+
+    /// Rollouts of `controller` from `seeds`, every one re-checked independently.
+    pub fn rollouts(
+        &self,
+        tasks: &[Task],
+        seeds: &[JointVector],
+        controller: ControllerKind,
+        executor: &ExecutorConfig,
+        what: &str,
+    ) -> anyhow::Result<Vec<Trajectory>> {
+        let prototype = Executor::new(controller, Some(&self.policy), executor)?;
+        let bar = progress::bar(tasks.len() as u64, what);
+        let trajectories = rollout_from(
+            &self.robot,
+            tasks,
+            seeds,
+            || prototype.clone(),
+            &self.rollout,
+            &|| bar.inc(1),
+        );
+        bar.finish_and_clear();
+        self.check(tasks, &trajectories)?;
+        Ok(trajectories)
+    }
+
+    /// Runs the independent checker over every trajectory.
+    pub fn check(&self, tasks: &[Task], trajectories: &[Trajectory]) -> anyhow::Result<()> {
+        let failures: Vec<String> = tasks
+            .par_iter()
+            .zip(trajectories)
+            .enumerate()
+            .filter_map(|(i, (task, trajectory))| {
+                self.checker
+                    .check(task, trajectory, &self.rollout.constraints)
+                    .err()
+                    .map(|e| format!("task {i}: {e}"))
+            })
+            .collect();
+        if let Some(first) = failures.first() {
+            bail!(
+                "{} trajectories fail the independent check, first: {first}",
+                failures.len()
+            );
+        }
+        Ok(())
+    }
+
+    /// Reference lengths `ℓ_ref`: the longest hybrid rollout over each task's label candidates
+    /// (its `q0_seed` when it has none).
+    pub fn references(&self, tasks: &[Task], labels: &LabelSet) -> anyhow::Result<Vec<f64>> {
+        let mut owners = Vec::new();
+        let mut candidates = Vec::new();
+        for (i, task) in tasks.iter().enumerate() {
+            let found: Vec<JointVector> = labels
+                .get(i as u32)
+                .map(|t| t.labels.iter().map(|l| l.q).collect())
+                .unwrap_or_default();
+            let found = if found.is_empty() {
+                vec![task.q0_seed.context("task needs q0_seed")?]
+            } else {
+                found
+            };
+            for q in found {
+                owners.push(i);
+                candidates.push(q);
+            }
+        }
+        let candidate_tasks: Vec<Task> = owners.iter().map(|&i| tasks[i].clone()).collect();
+        let trajectories = self.rollouts(
+            &candidate_tasks,
+            &candidates,
+            ControllerKind::Hybrid,
+            &self.executor,
+            "references",
+        )?;
+        let mut references = vec![0.0f64; tasks.len()];
+        for (owner, trajectory) in owners.iter().zip(&trajectories) {
+            references[*owner] = references[*owner].max(trajectory.path_length_m);
+        }
+        Ok(references)
+    }
+}
+
+/// One cell of a table: a seed, a controller, a group of tasks.
+#[derive(Serialize)]
+pub struct Cell {
+    /// Seed source.
+    pub seed: SeedKind,
+    /// Controller.
+    pub controller: ControllerKind,
+    /// Task group (`all` or a bucket).
+    pub group: String,
+    /// Length and ratio statistics.
+    pub stats: CellStats,
+    /// Mean hand-overs per episode (hybrid only).
+    pub switches_per_episode: Option<f64>,
+}
+
+/// The protocol's numbers on one task set.
+#[derive(Serialize)]
+pub struct SetResult {
+    /// Which set: `unseen` (evaluation set) or `seen` (training pool slice).
+    pub name: String,
+    /// Task file.
+    pub tasks: String,
+    /// Tasks evaluated.
+    pub task_count: usize,
+    /// Reference lengths.
+    pub reference_m: Summary,
+    /// Tasks per bucket.
+    pub buckets: BTreeMap<String, usize>,
+    /// Seed generation time (ms) per seed source.
+    pub seed_time_ms: BTreeMap<String, Summary>,
+    /// Every cell.
+    pub cells: Vec<Cell>,
+    /// Per-task reference lengths (m), in task order.
+    pub references_m: Vec<f64>,
+    /// Per-task path lengths (m) from DP seeds, by controller name.
+    pub dp_lengths_m: BTreeMap<String, Vec<f64>>,
+}
+
+/// Runs the full protocol on `tasks` with labels `labels`.
+pub fn evaluate_set(
+    setup: &Setup,
+    name: &str,
+    tasks_path: &Path,
+    labels_path: &Path,
+    limit: Option<usize>,
+    buckets: &BucketConfig,
+) -> anyhow::Result<SetResult> {
+    let mut tasks = read_tasks(tasks_path, &setup.robot)?;
+    if let Some(limit) = limit {
+        tasks.truncate(limit);
+    }
+    let labels = LabelSet::read(labels_path).with_context(|| {
+        format!(
+            "reading {} (create it with `cargo xtask label-seeds`)",
+            labels_path.display()
+        )
+    })?;
+    println!("{name}: {} tasks", tasks.len());
+    let references = setup.references(&tasks, &labels)?;
+    let groups: Vec<(String, Vec<usize>)> =
+        std::iter::once(("all".to_string(), (0..tasks.len()).collect()))
+            .chain(
+                bucket_members(&references, buckets)
+                    .into_iter()
+                    .map(|(b, m)| (b.name().to_lowercase(), m)),
+            )
+            .collect();
+    let mut cells = Vec::new();
+    let mut seed_time_ms = BTreeMap::new();
+    let mut dp_lengths_m = BTreeMap::new();
+    for seed in SeedKind::ALL {
+        let (seeds, times) = setup.seeds(&tasks, seed)?;
+        seed_time_ms.insert(
+            seed.title().to_string(),
+            Summary::of(&times).context("no tasks")?,
+        );
+        for controller in ControllerKind::ALL {
+            let what = format!("{}+{}", seed.title(), controller.name());
+            let trajectories =
+                setup.rollouts(&tasks, &seeds, controller, &setup.executor, &what)?;
+            let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
+            if seed == SeedKind::Dp {
+                dp_lengths_m.insert(controller.name().to_string(), lengths.clone());
+            }
+            for (group, members) in &groups {
+                let Some(stats) = cell_stats(&lengths, &references, members) else {
+                    continue;
+                };
+                let switches_per_episode = (controller == ControllerKind::Hybrid).then(|| {
+                    members
+                        .iter()
+                        .map(|&i| count_switches(&trajectories[i]) as f64)
+                        .sum::<f64>()
+                        / members.len() as f64
+                });
+                cells.push(Cell {
+                    seed,
+                    controller,
+                    group: group.clone(),
+                    stats,
+                    switches_per_episode,
+                });
+            }
+        }
+    }
+    Ok(SetResult {
+        name: name.to_string(),
+        tasks: workspace::relative(tasks_path),
+        task_count: tasks.len(),
+        reference_m: Summary::of(&references).context("no tasks")?,
+        buckets: groups[1..]
+            .iter()
+            .map(|(g, m)| (g.clone(), m.len()))
+            .collect(),
+        seed_time_ms,
+        cells,
+        references_m: references,
+        dp_lengths_m,
+    })
+}
+
+/// `mean / std / min / max` with the given precision.
+pub fn four(summary: &Summary, decimals: usize) -> String {
+    format!(
+        "{:.d$} / {:.d$} / {:.d$} / {:.d$}",
+        summary.mean,
+        summary.std,
+        summary.min,
+        summary.max,
+        d = decimals
+    )
+}
+
+/// Markdown of one set's Tables 1 and 2.
+pub fn markdown(set: &SetResult) -> String {
+    let mut md = format!(
+        "### {} tasks ({}, n = {})\n\nReference length ℓ_ref (m): {}. Buckets: {}.\n\n",
+        set.name,
+        set.tasks,
+        set.task_count,
+        four(&set.reference_m, 3),
+        set.buckets
+            .iter()
+            .map(|(b, n)| format!("{b} {n}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    md += "**Table 1**: DP seed, three controllers, by difficulty.\n\n| tasks | π | path length (m) mean / std / min / max | ratio to ℓ_ref (%) mean / std / min / max | switches / episode |\n|---|---|---|---|---|\n";
+    for group in ["all", "easy", "medium", "difficult"] {
+        for cell in set
+            .cells
+            .iter()
+            .filter(|c| c.seed == SeedKind::Dp && c.group == group)
+        {
+            md += &format!(
+                "| {group} (n = {}) | {} | {} | {} | {} |\n",
+                cell.stats.length_m.count,
+                cell.controller.title(),
+                four(&cell.stats.length_m, 3),
+                four(&cell.stats.ratio_percent, 1),
+                cell.switches_per_episode
+                    .map_or("—".into(), |s| format!("{s:.2}"))
+            );
+        }
+    }
+    md += "\n**Table 2**: seeds × controllers, all tasks; t = per-task seed time (ms, mean).\n\n| π | q₀* | t (ms) | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|---|\n";
+    for controller in ControllerKind::ALL {
+        for cell in set
+            .cells
+            .iter()
+            .filter(|c| c.controller == controller && c.group == "all")
+        {
+            md += &format!(
+                "| {} | {} | {:.2} | {} | {} |\n",
+                controller.title(),
+                cell.seed.title(),
+                set.seed_time_ms[cell.seed.title()].mean,
+                four(&cell.stats.length_m, 3),
+                four(&cell.stats.ratio_percent, 1)
+            );
+        }
+    }
+    md
+}
+
+/// Default paths of the shipped models.
+pub fn default_policy() -> PathBuf {
+    workspace::root().join("data/models/ppo-v1.weights")
+}
+
+/// Default path of the shipped diffusion weights.
+pub fn default_diffusion() -> PathBuf {
+    workspace::root().join("data/models/diffusion-v1.weights")
+}

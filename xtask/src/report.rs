@@ -1,0 +1,519 @@
+//! `cargo xtask report`: regenerates `docs/results.md` from the result files of `eval` and
+//! `ablate`, beside the paper's numbers (`data/paper/tables.json`), with its figures.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use emg_control::{Task, read_tasks, rollout};
+use emg_hybrid::{ControllerKind, Executor, count_switches};
+use plotters::prelude::*;
+use serde_json::Value;
+
+use crate::protocol::{self, SeedKind, Setup};
+use crate::workspace;
+
+/// Options of `report`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory holding the result files.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    results: PathBuf,
+    /// The report to write.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/results.md"))]
+    out: PathBuf,
+    /// Directory of the figures.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/figures"))]
+    figures: PathBuf,
+    /// Robot file.
+    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    robot: PathBuf,
+}
+
+fn read(path: &Path) -> anyhow::Result<Value> {
+    let text = std::fs::read_to_string(path).with_context(|| {
+        format!(
+            "reading {} (run the command that writes it first)",
+            path.display()
+        )
+    })?;
+    Ok(serde_json::from_str(&text)?)
+}
+
+/// `mean / std / min / max` of a JSON summary or a 4-array.
+fn four(value: &Value, decimals: usize) -> String {
+    let numbers: Vec<f64> = match value {
+        Value::Array(items) => items.iter().filter_map(Value::as_f64).collect(),
+        _ => ["mean", "std", "min", "max"]
+            .iter()
+            .filter_map(|k| value[*k].as_f64())
+            .collect(),
+    };
+    numbers
+        .iter()
+        .map(|v| format!("{v:.decimals$}"))
+        .collect::<Vec<_>>()
+        .join(" / ")
+}
+
+/// Writes the report and its figures.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let paper = read(&workspace::root().join("data/paper/tables.json"))?;
+    let eval = read(&args.results.join("eval.json"))?;
+    std::fs::create_dir_all(&args.figures)?;
+    let unseen = eval["sets"]
+        .as_array()
+        .and_then(|sets| sets.iter().find(|s| s["name"] == "unseen"))
+        .context("eval.json lacks the unseen set")?;
+    let mut md = String::from(
+        "# Results\n\nWritten by `cargo xtask report` from the files in `docs/results/` (themselves written by \
+         `cargo xtask eval` and `cargo xtask ablate …`) and the paper's tables (`data/paper/tables.json`). \
+         Do not edit by hand. Ours: FR3 with pen, 10,000 evaluation tasks never seen in training; every \
+         trajectory behind every table passed the independent constraint checker.\n\n",
+    );
+    md += &table1(unseen, &paper);
+    md += &table2(unseen, &paper);
+    md += &figures(args, unseen)?;
+    md += &table3(&args.results, &paper)?;
+    md += &included(
+        &args.results,
+        "ablate-cfg-scale.md",
+        "Table 4: guidance scale",
+        &paper["table4"],
+        "w",
+    )?;
+    md += &included(
+        &args.results,
+        "ablate-ddim-steps.md",
+        "Table 5: DDIM steps",
+        &paper["table5"],
+        "steps",
+    )?;
+    md += &table6(&args.results, &paper)?;
+    if let Some(seen) = eval["sets"]
+        .as_array()
+        .and_then(|sets| sets.iter().find(|s| s["name"] == "seen"))
+    {
+        md += &format!(
+            "## Seen tasks\n\nThe same DP-seed rows on {} tasks of the training pool (seen in training):\n\n",
+            seen["task_count"]
+        );
+        md += &dp_rows(seen, "all");
+    }
+    std::fs::write(&args.out, md)?;
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+fn cells<'a>(
+    set: &'a Value,
+    seed: &'a str,
+    group: &'a str,
+) -> impl Iterator<Item = &'a Value> + 'a {
+    set["cells"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(move |c| c["seed"] == seed && c["group"] == group)
+}
+
+fn dp_rows(set: &Value, group: &str) -> String {
+    let mut md = String::from("| π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|\n");
+    for cell in cells(set, "dp", group) {
+        md += &format!(
+            "| {} | {} | {} |\n",
+            cell["controller"].as_str().unwrap_or(""),
+            four(&cell["stats"]["length_m"], 3),
+            four(&cell["stats"]["ratio_percent"], 1)
+        );
+    }
+    md + "\n"
+}
+
+fn table1(set: &Value, paper: &Value) -> String {
+    let mut md = String::from(
+        "## Table 1: three controllers from DP seeds, by difficulty\n\n\
+         | tasks | π | ours: path length (m) | paper | ours: ratio to ℓ_ref (%) | paper |\n|---|---|---|---|---|---|\n",
+    );
+    for group in ["all", "easy", "medium", "difficult"] {
+        for cell in cells(set, "dp", group) {
+            let controller = cell["controller"].as_str().unwrap_or("");
+            let theirs = &paper["table1"][group][controller];
+            md += &format!(
+                "| {group} (ours n = {}, paper n = {}) | {controller} | {} | {} | {} | {} |\n",
+                cell["stats"]["length_m"]["count"],
+                paper["table1_counts"][group],
+                four(&cell["stats"]["length_m"], 3),
+                four(&theirs[0], 2),
+                four(&cell["stats"]["ratio_percent"], 1),
+                four(&theirs[1], 1)
+            );
+        }
+    }
+    let mean = |controller: &str| {
+        cells(set, "dp", "all")
+            .find(|c| c["controller"] == controller)
+            .and_then(|c| c["stats"]["length_m"]["mean"].as_f64())
+            .unwrap_or(f64::NAN)
+    };
+    let ratio = cells(set, "dp", "all")
+        .find(|c| c["controller"] == "hybrid")
+        .and_then(|c| c["stats"]["ratio_percent"]["mean"].as_f64())
+        .unwrap_or(f64::NAN);
+    md += &format!(
+        "\nHybrid + DP vs Classical + DP: **{:+.1} %** mean path length (paper +27 %, goal ≥ +35 %); \
+         Hybrid + DP reaches **{ratio:.1} %** of ℓ_ref on average (paper 90.6 %, goal ≥ 92 %). \
+         RL + DP vs Classical + DP: {:+.1} %.\n\n",
+        100.0 * (mean("hybrid") / mean("classical") - 1.0),
+        100.0 * (mean("rl") / mean("classical") - 1.0),
+    );
+    md
+}
+
+fn table2(set: &Value, paper: &Value) -> String {
+    let mut md = String::from(
+        "## Table 2: seeds × controllers (all tasks)\n\nt = mean per-task seed time on this machine (ms; the paper's on its own hardware).\n\n\
+         | π | q₀* | ours t (ms) | paper t | ours: path length (m) | paper | ours: ratio (%) | paper |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for controller in ControllerKind::ALL {
+        for seed in SeedKind::ALL {
+            let key = serde_json::to_value(seed).unwrap_or_default();
+            let Some(cell) = cells(set, key.as_str().unwrap_or(""), "all")
+                .find(|c| c["controller"] == controller.name())
+            else {
+                continue;
+            };
+            let theirs = &paper["table2"][controller.name()][key.as_str().unwrap_or("")];
+            let time = set["seed_time_ms"][seed.title()]["mean"]
+                .as_f64()
+                .unwrap_or(f64::NAN);
+            let paper_cell = |i: usize, d: usize| {
+                if theirs.is_null() {
+                    "—".into()
+                } else {
+                    four(&theirs[i], d)
+                }
+            };
+            md += &format!(
+                "| {} | {} | {time:.2} | {} | {} | {} | {} | {} |\n",
+                controller.title(),
+                seed.title(),
+                theirs[0].as_f64().map_or("—".into(), |t| format!("{t:.2}")),
+                four(&cell["stats"]["length_m"], 3),
+                paper_cell(1, 2),
+                four(&cell["stats"]["ratio_percent"], 1),
+                paper_cell(2, 1)
+            );
+        }
+    }
+    md + "\n"
+}
+
+fn table3(results: &Path, paper: &Value) -> anyhow::Result<String> {
+    let ours = read(&results.join("ablate-classical-weights.json"))?;
+    let mut md = String::from(
+        "## Table 3: classical secondary-objective weights (from q0_seed)\n\nOurs (all 39 settings):\n\n\
+         | k_μ | k_jl | k_θ | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|---|\n",
+    );
+    for row in ours["rows"].as_array().into_iter().flatten() {
+        let s = &row["setting"];
+        md += &format!(
+            "| {} | {} | {} | {} | {} |\n",
+            s["k_mu"],
+            s["k_jl"],
+            s["k_theta"],
+            four(&row["stats"]["length_m"], 3),
+            four(&row["stats"]["ratio_percent"], 1)
+        );
+    }
+    md += "\nPaper (representative rows):\n\n| k_μ | k_jl | k_θ | path length (m) | ratio (%) |\n|---|---|---|---|---|\n";
+    for row in paper["table3"].as_array().into_iter().flatten() {
+        md += &format!(
+            "| {} | {} | {} | {} | {} |\n",
+            row["k_mu"],
+            row["k_jl"],
+            row["k_theta"],
+            four(&row["length"], 2),
+            four(&row["ratio"], 1)
+        );
+    }
+    Ok(md + "\n")
+}
+
+fn included(
+    results: &Path,
+    file: &str,
+    title: &str,
+    paper: &Value,
+    key: &str,
+) -> anyhow::Result<String> {
+    let text = std::fs::read_to_string(results.join(file))
+        .with_context(|| format!("reading {file} (run the matching `cargo xtask ablate`)"))?;
+    let body: String = text
+        .lines()
+        .skip_while(|l| l.starts_with('#') || l.trim().is_empty())
+        .collect::<Vec<_>>()
+        .join("\n");
+    let mut md = format!(
+        "## {title}\n\nOurs (`docs/results/{file}`):\n\n{body}\n\nPaper:\n\n| {key} | t (ms) | path length (m) | ratio (%) |\n|---|---|---|---|\n"
+    );
+    for row in paper.as_array().into_iter().flatten() {
+        md += &format!(
+            "| {} | {} | {} | {} |\n",
+            row[key],
+            row["t_ms"],
+            four(&row["length"], 3),
+            four(&row["ratio"], 1)
+        );
+    }
+    Ok(md + "\n")
+}
+
+fn table6(results: &Path, paper: &Value) -> anyhow::Result<String> {
+    let ours = read(&results.join("ablate-switching.json"))?;
+    let mut md = String::from(
+        "## Table 6: switching thresholds and boundary measure (DP seeds, hybrid)\n\n\
+         | measure | (τ_enter, τ_exit) | ours: switches | paper | ours: path length (m) | paper | ours: ratio (%) | paper |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for row in ours["rows"].as_array().into_iter().flatten() {
+        let s = &row["setting"];
+        let theirs = paper["table6"].as_array().into_iter().flatten().find(|p| {
+            s["measure"]["kind"] == "joint_limits"
+                && p["tau_enter"] == s["tau_enter"]
+                && p["tau_exit"] == s["tau_exit"]
+        });
+        md += &format!(
+            "| {} | ({}, {}) | {:.2} | {} | {} | {} | {} | {} |\n",
+            s["measure"]["kind"].as_str().unwrap_or(""),
+            s["tau_enter"],
+            s["tau_exit"],
+            row["switches_per_episode"].as_f64().unwrap_or(0.0),
+            theirs.map_or("—".into(), |p| format!("{}", p["switches"])),
+            four(&row["stats"]["length_m"], 3),
+            theirs.map_or("—".into(), |p| four(&p["length"], 3)),
+            four(&row["stats"]["ratio_percent"], 1),
+            theirs.map_or("—".into(), |p| four(&p["ratio"], 1)),
+        );
+    }
+    Ok(md + "\n")
+}
+
+fn figures(args: &Args, set: &Value) -> anyhow::Result<String> {
+    let numbers = |v: &Value| -> Vec<f64> {
+        v.as_array()
+            .into_iter()
+            .flatten()
+            .filter_map(Value::as_f64)
+            .collect()
+    };
+    let references = numbers(&set["references_m"]);
+    histogram(
+        &args.figures.join("reference-lengths.svg"),
+        "reference length ℓ_ref (m)",
+        &[("ℓ_ref", &references)],
+        &[0.45, 0.80],
+    )?;
+    let per_controller: Vec<(&str, Vec<f64>)> = ControllerKind::ALL
+        .iter()
+        .map(|c| (c.title(), numbers(&set["dp_lengths_m"][c.name()])))
+        .collect();
+    let series: Vec<(&str, &[f64])> = per_controller
+        .iter()
+        .map(|(n, v)| (*n, v.as_slice()))
+        .collect();
+    histogram(
+        &args.figures.join("path-lengths.svg"),
+        "path length from DP seeds (m)",
+        &series,
+        &[],
+    )?;
+    trace(args)?;
+    Ok("## Figures\n\n\
+        ![reference lengths](figures/reference-lengths.svg)\n\n*Reference lengths ℓ_ref over the evaluation set; \
+        dashed lines: the 0.45 m and 0.80 m bucket thresholds.*\n\n\
+        ![path lengths](figures/path-lengths.svg)\n\n*Path-length distributions from DP seeds per controller.*\n\n\
+        ![hybrid trace](figures/hybrid-trace.svg)\n\n*A representative task under the hybrid controller: progress \
+        along the line (top) and joint 6 (bottom) coloured by the acting controller; dashed lines: the joint-6 \
+        values where ρ reaches τ_enter and τ_exit.*\n\n"
+        .into())
+}
+
+fn histogram(
+    path: &Path,
+    x_label: &str,
+    series: &[(&str, &[f64])],
+    marks: &[f64],
+) -> anyhow::Result<()> {
+    let max = series
+        .iter()
+        .flat_map(|(_, v)| v.iter().copied())
+        .fold(0.0f64, f64::max)
+        .max(0.1);
+    let bins = 40usize;
+    let width = max / bins as f64;
+    let counts: Vec<Vec<usize>> = series
+        .iter()
+        .map(|(_, values)| {
+            let mut c = vec![0usize; bins];
+            for v in values.iter() {
+                c[((v / width) as usize).min(bins - 1)] += 1;
+            }
+            c
+        })
+        .collect();
+    let top = counts.iter().flatten().copied().max().unwrap_or(1) as f64 * 1.1;
+    let root = SVGBackend::new(path, (800, 420)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..max, 0.0..top)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc("tasks")
+        .draw()?;
+    for (k, ((name, _), c)) in series.iter().zip(&counts).enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let points: Vec<(f64, f64)> = c
+            .iter()
+            .enumerate()
+            .flat_map(|(b, &n)| {
+                [
+                    (b as f64 * width, n as f64),
+                    ((b + 1) as f64 * width, n as f64),
+                ]
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                points,
+                ShapeStyle::from(&color).stroke_width(2),
+            ))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+    }
+    for &m in marks {
+        chart.draw_series(DashedLineSeries::new(
+            vec![(m, 0.0), (m, top)],
+            6,
+            4,
+            ShapeStyle::from(&BLACK.mix(0.6)),
+        ))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// The first evaluation task (of the first 300) whose DP + hybrid rollout hands over at least
+/// twice, drawn over time.
+fn trace(args: &Args) -> anyhow::Result<()> {
+    let setup = Setup::load(
+        &args.robot,
+        &protocol::default_policy(),
+        &protocol::default_diffusion(),
+    )?;
+    let mut tasks: Vec<Task> = read_tasks(
+        &workspace::root().join("data/tasks/eval-v1.tasks"),
+        &setup.robot,
+    )?;
+    tasks.truncate(300);
+    let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
+    let prototype = Executor::new(ControllerKind::Hybrid, Some(&setup.policy), &setup.executor)?;
+    let mut chosen = None;
+    for (task, seed) in tasks.iter().zip(&seeds) {
+        let trajectory = rollout(
+            &setup.robot,
+            task,
+            seed,
+            &mut prototype.clone(),
+            &setup.rollout,
+        );
+        if count_switches(&trajectory) >= 2 && trajectory.path_length_m > 0.3 {
+            chosen = Some((task.clone(), trajectory));
+            break;
+        }
+    }
+    let (task, trajectory) =
+        chosen.context("no representative task with switches among the first 300")?;
+    let limits = setup.robot.limits();
+    let (mid, half) = (limits.mid()[5], limits.half_range()[5]);
+    let path = args.figures.join("hybrid-trace.svg");
+    let root = SVGBackend::new(&path, (800, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (upper, lower) = root.split_vertically(260);
+    let end = trajectory.steps.last().map_or(1.0, |s| s.time_s).max(0.1);
+    let colour = |c: Option<emg_control::ActingController>| match c {
+        Some(emg_control::ActingController::Learned) => RGBColor(31, 119, 180),
+        _ => RGBColor(214, 39, 40),
+    };
+    let progress: Vec<(f64, f64, RGBColor)> = trajectory
+        .steps
+        .iter()
+        .map(|s| (s.time_s, task.progress(&s.tcp), colour(s.controller)))
+        .collect();
+    let mut top = ChartBuilder::on(&upper)
+        .caption(
+            format!(
+                "hybrid from DP seed: {:.2} m; blue = RL, red = classical",
+                trajectory.path_length_m
+            ),
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..end, 0.0..trajectory.path_length_m.max(0.05) * 1.05)?;
+    top.configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("progress along d (m)")
+        .draw()?;
+    top.draw_series(progress.windows(2).map(|w| {
+        PathElement::new(
+            vec![(w[0].0, w[0].1), (w[1].0, w[1].1)],
+            ShapeStyle::from(&w[0].2).stroke_width(3),
+        )
+    }))?;
+    let q6: Vec<(f64, f64, RGBColor)> = trajectory
+        .steps
+        .iter()
+        .map(|s| (s.time_s, s.q[5], colour(s.controller)))
+        .collect();
+    let mut bottom = ChartBuilder::on(&lower)
+        .margin(10)
+        .x_label_area_size(30)
+        .y_label_area_size(50)
+        .build_cartesian_2d(0.0..end, limits.lower[5]..limits.upper[5])?;
+    bottom
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("q6 (rad)")
+        .draw()?;
+    bottom.draw_series(q6.windows(2).map(|w| {
+        PathElement::new(
+            vec![(w[0].0, w[0].1), (w[1].0, w[1].1)],
+            ShapeStyle::from(&w[0].2).stroke_width(3),
+        )
+    }))?;
+    for tau in [
+        setup.executor.switch.tau_enter,
+        setup.executor.switch.tau_exit,
+    ] {
+        for sign in [-1.0, 1.0] {
+            let q = mid + sign * tau * half;
+            bottom.draw_series(DashedLineSeries::new(
+                vec![(0.0, q), (end, q)],
+                6,
+                4,
+                ShapeStyle::from(&BLACK.mix(0.5)),
+            ))?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
