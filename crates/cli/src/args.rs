@@ -65,9 +65,9 @@ pub struct PlanArgs {
     #[arg(long, value_name = "STEM", default_value = "trajectory")]
     pub out: PathBuf,
     /// Null-space controller.
-    #[arg(long, value_enum, default_value_t = ControllerKind::Classical)]
+    #[arg(long, value_enum, default_value_t = ControllerKind::Hybrid)]
     pub controller: ControllerKind,
-    /// Policy weights for `--controller rl`.
+    /// Policy weights of `--controller rl` and `hybrid`.
     #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_policy_path())]
     pub policy: PathBuf,
 }
@@ -79,14 +79,17 @@ pub enum ControllerKind {
     Classical,
     /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
     Rl,
+    /// The learned policy inside, the classical controller near the joint limits (Sec. 4.3).
+    Hybrid,
 }
 
 impl ControllerKind {
-    /// Name written to result files.
-    pub fn name(self) -> &'static str {
+    /// The executor's controller of this choice.
+    pub fn kind(self) -> emg_hybrid::ControllerKind {
         match self {
-            Self::Classical => "classical",
-            Self::Rl => "rl",
+            Self::Classical => emg_hybrid::ControllerKind::Classical,
+            Self::Rl => emg_hybrid::ControllerKind::Rl,
+            Self::Hybrid => emg_hybrid::ControllerKind::Hybrid,
         }
     }
 }

@@ -17,9 +17,11 @@
 //!   `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
 //!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
-//! * `--config <json>`: optional `rollout` and `gains` objects; unset fields keep SPEC defaults.
-//! * `--controller classical` (default) or `rl` (the PPO policy over `--policy`, default the
-//!   shipped `data/models/ppo-v1.weights`).
+//! * `--config <json>`: optional `rollout`, `gains`, `switch` (`tau_enter`, `tau_exit`) and
+//!   `measure` objects; unset fields keep SPEC defaults.
+//! * `--controller hybrid` (default: the PPO policy over `--policy`, default the shipped
+//!   `data/models/ppo-v1.weights`, inside; the classical controller near the joint limits),
+//!   `rl` or `classical`.
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv`; a task file with several
 //!   tasks gives `<stem>-00000.json/.csv`, `<stem>-00001...` and so on, each written as soon as
 //!   its task is planned. Parent directories are created.
@@ -41,9 +43,9 @@ use clap::Parser;
 use emg_kinematics::Robot;
 
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder};
-use emg_policy::{PlainPolicy, PolicyWeights};
+use emg_policy::{PolicyWeights, RlController};
 
-use crate::args::{Cli, Command, ControllerKind, PlanArgs, SeedRequest};
+use crate::args::{Cli, Command, PlanArgs, SeedRequest};
 use crate::output::{TrajectoryFile, result_paths, write_result};
 use crate::settings::Settings;
 
@@ -117,18 +119,19 @@ fn load_dp_seeder(args: &PlanArgs) -> Result<Option<DpSeeder>> {
     Ok(Some(seeder))
 }
 
-/// The policy of `--controller rl`, loaded from `--policy`.
-fn load_policy(args: &PlanArgs) -> Result<Option<PlainPolicy>> {
-    if args.controller != ControllerKind::Rl {
+/// The policy of `--controller rl` and `hybrid`, loaded from `--policy`.
+fn load_policy(args: &PlanArgs) -> Result<Option<RlController>> {
+    if !args.controller.kind().needs_policy() {
         return Ok(None);
     }
     let weights = PolicyWeights::read(&args.policy).with_context(|| {
         format!(
-            "--controller rl: cannot load policy weights {}",
+            "--controller {}: cannot load policy weights {}",
+            args.controller.kind().name(),
             args.policy.display()
         )
     })?;
-    Ok(Some(PlainPolicy::new(&weights)))
+    Ok(Some(RlController::new(&weights)))
 }
 
 /// Plans one task, writes its files and returns the lines to print.
@@ -137,7 +140,7 @@ fn plan_and_write(
     args: &PlanArgs,
     settings: &Settings,
     dp: Option<&DpSeeder>,
-    policy: Option<&PlainPolicy>,
+    policy: Option<&RlController>,
     task: &emg_control::Task,
     index: Option<usize>,
 ) -> Result<String> {
@@ -157,7 +160,7 @@ fn plan_and_write(
         robot.joint_names(),
         task,
         plan.seed.source,
-        args.controller.name(),
+        args.controller.kind().name(),
         &settings.rollout,
         &settings.gains,
         trajectory,

@@ -1,10 +1,11 @@
 //! Planning one task: seed it, build the requested controller and run the shared rollout.
 
-use anyhow::{Context, Result};
-use emg_control::{ClassicalController, NullSpaceController, Task, Trajectory, rollout};
+use anyhow::Result;
+use emg_control::{Task, Trajectory, rollout};
 use emg_diffusion::DpSeeder;
+use emg_hybrid::Executor;
 use emg_kinematics::Robot;
-use emg_policy::{PlainPolicy, RlController};
+use emg_policy::RlController;
 
 use crate::args::{ControllerKind, SeedRequest};
 use crate::seed::{Seed, prepare_seed};
@@ -19,23 +20,6 @@ pub struct Plan {
     pub trajectory: Trajectory,
 }
 
-/// The controller named on the command line, configured from `settings` (`policy`: the loaded
-/// weights of `rl`).
-pub fn controller(
-    kind: ControllerKind,
-    settings: &Settings,
-    policy: Option<&PlainPolicy>,
-) -> Result<Box<dyn NullSpaceController>> {
-    Ok(match kind {
-        ControllerKind::Classical => Box::new(ClassicalController::new(settings.gains.clone())),
-        ControllerKind::Rl => Box::new(RlController::from_policy(
-            policy
-                .context("--controller rl needs policy weights")?
-                .clone(),
-        )),
-    })
-}
-
 /// Seeds `task` and rolls out a fresh controller of `kind` from that seed.
 pub fn plan_task(
     robot: &Robot,
@@ -43,11 +27,11 @@ pub fn plan_task(
     seed: Option<&SeedRequest>,
     dp: Option<&DpSeeder>,
     kind: ControllerKind,
-    policy: Option<&PlainPolicy>,
+    policy: Option<&RlController>,
     settings: &Settings,
 ) -> Result<Plan> {
     let seed = prepare_seed(robot, task, seed, &settings.rollout.constraints, dp)?;
-    let mut controller = controller(kind, settings, policy)?;
-    let trajectory = rollout(robot, task, &seed.q, controller.as_mut(), &settings.rollout);
+    let mut controller = Executor::new(kind.kind(), policy, &settings.executor())?;
+    let trajectory = rollout(robot, task, &seed.q, &mut controller, &settings.rollout);
     Ok(Plan { seed, trajectory })
 }

@@ -1,9 +1,10 @@
-//! The optional `--config` file: rollout settings and controller gains.
+//! The optional `--config` file: rollout settings, controller gains and the hybrid switch.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
 use emg_control::{ClassicalGains, RolloutConfig};
+use emg_hybrid::{BoundaryMeasure, ExecutorConfig, SwitchConfig};
 use serde::{Deserialize, Serialize};
 
 /// Contents of a `--config` JSON file; every field is optional and defaults to SPEC values.
@@ -14,9 +15,22 @@ pub struct Settings {
     pub rollout: RolloutConfig,
     /// Gains of the classical controller.
     pub gains: ClassicalGains,
+    /// Hysteresis thresholds of the hybrid switch.
+    pub switch: SwitchConfig,
+    /// Boundary measure of the hybrid switch.
+    pub measure: BoundaryMeasure,
 }
 
 impl Settings {
+    /// The controllers' settings.
+    pub fn executor(&self) -> ExecutorConfig {
+        ExecutorConfig {
+            gains: self.gains.clone(),
+            switch: self.switch.clone(),
+            measure: self.measure.clone(),
+        }
+    }
+
     /// Reads a config file, or the defaults when none is given.
     pub fn load(path: Option<&Path>) -> Result<Self> {
         let Some(path) = path else {

@@ -81,7 +81,7 @@ fn demo_task_writes_documented_json_and_csv() {
     let doc = read_json(&json_path);
     assert_eq!(doc["format"], "emg-trajectory/1");
     assert_eq!(doc["seed_source"], "generating");
-    assert_eq!(doc["controller"], "classical");
+    assert_eq!(doc["controller"], "hybrid", "the default controller is the hybrid");
     assert_eq!(doc["joint_names"].as_array().unwrap().len(), 7);
     assert!(doc["robot"].as_str().unwrap().ends_with("fr3_pen.urdf"));
     for field in ["p0", "d", "n", "q0_seed"] {
@@ -96,7 +96,11 @@ fn demo_task_writes_documented_json_and_csv() {
     }
     assert_eq!(steps[0]["q"].as_array().unwrap().len(), 7);
     assert_eq!(steps[0]["tcp"].as_array().unwrap().len(), 3);
-    assert_eq!(steps[0]["controller"], "classical");
+    assert!(
+        steps[0]["controller"] == "learned" || steps[0]["controller"] == "classical",
+        "{}",
+        steps[0]["controller"]
+    );
     let reason = doc["termination"]["reason"].as_str().unwrap();
     assert!(["violation", "invalid_start", "step_cap"].contains(&reason));
     if reason == "violation" {
@@ -114,7 +118,7 @@ fn demo_task_writes_documented_json_and_csv() {
     assert_eq!(rows.len(), steps.len());
     assert!(rows.iter().all(|r| r.split(',').count() == 14));
     let first: Vec<&str> = rows[0].split(',').collect();
-    assert_eq!(first[13], "classical");
+    assert_eq!(first[13], steps[0]["controller"].as_str().unwrap());
     let q1: f64 = first[1].parse().unwrap();
     assert_eq!(q1, steps[0]["q"][0].as_f64().unwrap());
     std::fs::remove_dir_all(&dir).ok();
