@@ -81,7 +81,10 @@ fn demo_task_writes_documented_json_and_csv() {
     let doc = read_json(&json_path);
     assert_eq!(doc["format"], "emg-trajectory/1");
     assert_eq!(doc["seed_source"], "generating");
-    assert_eq!(doc["controller"], "hybrid", "the default controller is the hybrid");
+    assert_eq!(
+        doc["controller"], "hybrid",
+        "the default controller is the hybrid"
+    );
     assert_eq!(doc["joint_names"].as_array().unwrap().len(), 7);
     assert!(doc["robot"].as_str().unwrap().ends_with("fr3_pen.urdf"));
     for field in ["p0", "d", "n", "q0_seed"] {
