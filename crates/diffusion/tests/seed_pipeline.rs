@@ -49,7 +49,9 @@ fn weights() -> DenoiserWeights {
     trainer.ema_weights().clone()
 }
 
-fn seeder(first_batch: usize) -> DpSeeder {
+/// A seeder over `weights`; both seeders of a comparison share one set of weights, since Burn's
+/// random generator is process-wide and tests training in parallel would make two trainings differ.
+fn seeder(weights: &DenoiserWeights, first_batch: usize) -> DpSeeder {
     let config = DpSeedConfig {
         sample: SampleConfig {
             steps: 5,
@@ -58,14 +60,15 @@ fn seeder(first_batch: usize) -> DpSeeder {
         first_batch,
         ..DpSeedConfig::default()
     };
-    DpSeeder::new(&weights(), config).unwrap()
+    DpSeeder::new(weights, config).unwrap()
 }
 
 #[test]
 fn seeds_are_valid_or_the_fallback_and_independent_of_batching() {
     let robot = robot();
     let constraints = RolloutConfig::default().constraints;
-    let (one, all) = (seeder(1), seeder(32));
+    let weights = weights();
+    let (one, all) = (seeder(&weights, 1), seeder(&weights, 32));
     let mut workspace = SeedWorkspace::default();
     for task in tasks(&robot) {
         let seed = one
