@@ -3,9 +3,11 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{ClassicalController, RolloutConfig, Summary, Task, read_tasks, rollout_all};
+use emg_control::{ReferenceModel, RolloutConfig, Summary, Task, read_tasks, rollout_all};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedOrigin, SeedWorkspace};
+use emg_hybrid::{Executor, ExecutorConfig};
 use emg_kinematics::ProjectionConfig;
+use emg_policy::{PolicyWeights, RlController};
 use emg_seeding::{HeuristicConfig, HeuristicObjective, LabelSet, heuristic_seed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -47,6 +49,12 @@ pub struct DpArgs {
     /// Directory of the result files.
     #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
     out_dir: PathBuf,
+    /// Controller that rolls out from the seeds.
+    #[arg(long, value_enum, default_value_t = crate::eval::ControllerChoice::Hybrid)]
+    controller: crate::eval::ControllerChoice,
+    /// Policy weights of the learned controllers.
+    #[arg(long, default_value_os_t = crate::protocol::default_policy())]
+    policy: PathBuf,
     /// Robot file.
     #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
     robot: PathBuf,
@@ -149,20 +157,50 @@ fn dp_sweep(
     let pool = workspace::thread_pool(args.threads)?;
     let rollout = RolloutConfig::default();
 
-    let lengths_from = |tasks: &[Task], what: &str| -> Vec<f64> {
+    let kind = args.controller.kind();
+    let policy = if kind.needs_policy() {
+        Some(RlController::new(
+            &PolicyWeights::read(&args.policy).with_context(|| {
+                format!(
+                    "reading {} (train it with `cargo xtask train-ppo`)",
+                    args.policy.display()
+                )
+            })?,
+        ))
+    } else {
+        None
+    };
+    let prototype = Executor::new(kind, policy.as_ref(), &ExecutorConfig::default())?;
+    let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip")
+        .map_err(anyhow::Error::msg)?;
+    let lengths_from = |tasks: &[Task], what: &str| -> anyhow::Result<Vec<f64>> {
         let bar = progress::bar(tasks.len() as u64, what);
         let trajectories = pool.install(|| {
             rollout_all(
                 &robot,
                 tasks,
                 |t| t.q0_seed.expect("seeded"),
-                ClassicalController::default,
+                || prototype.clone(),
                 &rollout,
                 &|| bar.inc(1),
             )
         });
         bar.finish();
-        trajectories.iter().map(|t| t.path_length_m).collect()
+        let failures = pool.install(|| {
+            tasks
+                .par_iter()
+                .zip(&trajectories)
+                .filter(|(task, trajectory)| {
+                    checker
+                        .check(task, trajectory, &rollout.constraints)
+                        .is_err()
+                })
+                .count()
+        });
+        if failures > 0 {
+            bail!("{failures} trajectories fail the independent check");
+        }
+        Ok(trajectories.iter().map(|t| t.path_length_m).collect())
     };
     let mut baselines = Vec::new();
     for (seed, objective) in [
@@ -198,7 +236,7 @@ fn dp_sweep(
                 seeded
             }
         };
-        let lengths = lengths_from(&seeded, seed);
+        let lengths = lengths_from(&seeded, seed)?;
         baselines.push(Baseline {
             seed,
             path_length_m: summary(&lengths),
@@ -230,7 +268,7 @@ fn dp_sweep(
                 ..task.clone()
             })
             .collect();
-        let lengths = lengths_from(&seeded, "dp rollouts");
+        let lengths = lengths_from(&seeded, "dp rollouts")?;
         let mut times: Vec<f64> = seeds
             .iter()
             .map(|s| s.elapsed.as_secs_f64() * 1e3)
@@ -264,7 +302,7 @@ fn dp_sweep(
         reference: reference
             .as_ref()
             .map(|_| workspace::relative(&args.reference)),
-        controller: "classical",
+        controller: kind.name(),
         rollout,
         baselines,
         rows,
@@ -344,13 +382,14 @@ fn markdown(report: &Report) -> String {
             .map_or(String::new(), |s| format!(" {} |", summary_cell(s, 1)))
     };
     let mut text = format!(
-        "# Ablation: {}\n\nWritten by `cargo xtask ablate {}`. Classical controller from the DP seed over {} \
-         evaluation tasks ({}, unseen in training); weights {} trained on {}. Seed time per task on one core \
+        "# Ablation: {}\n\nWritten by `cargo xtask ablate {}`. The {} controller from the DP seed over {} \
+         evaluation tasks (every trajectory passed the independent checker) ({}, unseen in training); weights {} trained on {}. Seed time per task on one core \
          (median / p95 / mean; the machine was shared with other jobs); tries = candidates projected; fallbacks = tasks that fell back to q0_seed.\n\n\
          | {} | seed time (ms) median / p95 / mean | tries | fallbacks | Path length (m) mean / std / min / max |{}\n\
          |---|---|---|---|---|{}\n",
         report.parameter,
         report.ablation,
+        report.controller,
         report.task_count,
         report.tasks,
         report.weights,

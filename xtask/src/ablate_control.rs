@@ -141,7 +141,8 @@ fn prepare(args: &ControlArgs) -> anyhow::Result<(Setup, Vec<emg_control::Task>,
     }
     let labels = LabelSet::read(&args.labels)
         .with_context(|| format!("reading {}", args.labels.display()))?;
-    let references = setup.references(&tasks, &labels)?;
+    let indices: Vec<usize> = (0..tasks.len()).collect();
+    let references = setup.references(&tasks, &indices, &labels)?;
     Ok((setup, tasks, references))
 }
 

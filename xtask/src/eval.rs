@@ -17,7 +17,7 @@ use crate::{progress, protocol, workspace};
 
 /// Controllers `eval --controller` can run.
 #[derive(Clone, Copy, clap::ValueEnum)]
-enum ControllerChoice {
+pub enum ControllerChoice {
     /// The classical null-space controller (Eq. 3).
     Classical,
     /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
@@ -27,7 +27,8 @@ enum ControllerChoice {
 }
 
 impl ControllerChoice {
-    fn kind(self) -> ControllerKind {
+    /// The executor's controller of this choice.
+    pub fn kind(self) -> ControllerKind {
         match self {
             Self::Classical => ControllerKind::Classical,
             Self::Rl => ControllerKind::Rl,
@@ -85,6 +86,13 @@ pub struct Args {
     /// How many training tasks form the "seen" set (protocol; 0 skips it).
     #[arg(long, default_value_t = 1000)]
     seen_count: usize,
+    /// Run only the tasks with `index % n == i` (protocol) and write their per-task outcomes to
+    /// `<out-dir>/eval-shards/`; join them with `--merge n`.
+    #[arg(long, value_name = "i/n", conflicts_with = "merge")]
+    shard: Option<emg_seeding::Shard>,
+    /// Join the outcomes of shards `0/n … (n−1)/n` into the tables (protocol).
+    #[arg(long, value_name = "n")]
+    merge: Option<usize>,
 }
 
 /// The numbers of one evaluation: identical for any thread count.
@@ -113,36 +121,81 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 }
 
-/// The seed × controller protocol on the unseen evaluation set and the seen training slice.
+/// The seed × controller protocol on the unseen evaluation set and the seen training slice: the
+/// whole run, one shard of it, or the merge of all shards (same tables as the whole run).
 fn run_protocol(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
-    let setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
-    let buckets = BucketConfig::default();
-    let mut sets = vec![protocol::evaluate_set(
-        &setup,
-        "unseen",
-        &args.tasks,
-        &args.labels,
-        args.limit,
-        &buckets,
-    )?];
-    if args.seen_count > 0 {
-        sets.push(protocol::evaluate_set(
-            &setup,
-            "seen",
-            &args.seen_tasks,
-            &args.seen_labels,
-            Some(args.seen_count),
-            &buckets,
-        )?);
-    }
-    let seconds = started.elapsed().as_secs_f64();
     let name = args.name.clone().unwrap_or_else(|| "eval".into());
+    let shard_dir = args.out_dir.join("eval-shards");
+    let shard_path = |i: usize, n: usize| shard_dir.join(format!("{name}-shard-{i}-of-{n}.json"));
+    let raw_sets = match args.merge {
+        Some(n) => {
+            anyhow::ensure!(n > 0, "--merge needs the number of shards (at least 1)");
+            let mut shards = Vec::new();
+            for i in 0..n {
+                let path = shard_path(i, n);
+                let text = std::fs::read_to_string(&path).with_context(|| {
+                    format!(
+                        "reading {} (run `cargo xtask eval --shard {i}/{n}`)",
+                        path.display()
+                    )
+                })?;
+                shards.push(serde_json::from_str::<Vec<protocol::RawSet>>(&text)?);
+            }
+            let mut merged = Vec::new();
+            while !shards[0].is_empty() {
+                let parts = shards.iter_mut().map(|sets| sets.remove(0)).collect();
+                merged.push(protocol::merge_sets(parts)?);
+            }
+            merged
+        }
+        None => {
+            let setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            let shard = args.shard.map(|s| (s.index, s.count));
+            let mut sets = vec![protocol::run_set(
+                &setup,
+                "unseen",
+                &args.tasks,
+                &args.labels,
+                args.limit,
+                shard,
+            )?];
+            if args.seen_count > 0 {
+                sets.push(protocol::run_set(
+                    &setup,
+                    "seen",
+                    &args.seen_tasks,
+                    &args.seen_labels,
+                    Some(args.seen_count),
+                    shard,
+                )?);
+            }
+            if let Some(s) = args.shard {
+                std::fs::create_dir_all(&shard_dir)?;
+                let path = shard_path(s.index, s.count);
+                std::fs::write(&path, serde_json::to_string(&sets)?)?;
+                println!(
+                    "shard {}/{} done; wrote {}",
+                    s.index,
+                    s.count,
+                    path.display()
+                );
+                return Ok(());
+            }
+            sets
+        }
+    };
+    let buckets = BucketConfig::default();
+    let sets = raw_sets
+        .iter()
+        .map(|raw| protocol::summarize(raw, &buckets))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let seconds = started.elapsed().as_secs_f64();
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("{name}.json"));
     let record = serde_json::json!({
-        "rollout": setup.rollout,
-        "executor": setup.executor,
+        "rollout": emg_control::RolloutConfig::default(),
+        "executor": ExecutorConfig::default(),
         "buckets": buckets,
         "policy": workspace::relative(&args.weights),
         "diffusion": workspace::relative(&args.diffusion),
@@ -159,19 +212,20 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
         md += &protocol::markdown(set);
         md += "\n";
     }
-    md += &format!(
-        "## Run\n\nWhole protocol (seeds, references, {} rollouts per set and seed, checks): {seconds:.1} s wall on {} threads ({}).\n",
-        ControllerKind::ALL.len(),
-        rayon::current_num_threads(),
-        workspace::machine()
-    );
+    md += &match args.merge {
+        Some(n) => format!(
+            "## Run\n\nMerged from {n} shards (`cargo xtask eval --shard i/{n}`, then `--merge {n}`).\n"
+        ),
+        None => format!(
+            "## Run\n\nWhole protocol (seeds, references, {} rollouts per set and seed, checks): {seconds:.1} s wall on {} threads ({}).\n",
+            ControllerKind::ALL.len(),
+            rayon::current_num_threads(),
+            workspace::machine()
+        ),
+    };
     let md_path = args.out_dir.join(format!("{name}.md"));
     std::fs::write(&md_path, md)?;
-    println!(
-        "protocol done in {seconds:.1} s; wrote {} and {}",
-        json_path.display(),
-        md_path.display()
-    );
+    println!("wrote {} and {}", json_path.display(), md_path.display());
     Ok(())
 }
 

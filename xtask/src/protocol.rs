@@ -20,7 +20,7 @@ use emg_kinematics::{JointVector, ProjectionConfig, Robot};
 use emg_policy::{PolicyWeights, RlController};
 use emg_seeding::{HeuristicConfig, HeuristicObjective, LabelSet, heuristic_seed};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
@@ -41,6 +41,16 @@ pub enum SeedKind {
 impl SeedKind {
     /// All seeds in table order.
     pub const ALL: [SeedKind; 4] = [Self::Q0Seed, Self::QMu, Self::QJl, Self::Dp];
+
+    /// Name in result files (`q0_seed`, `q_mu`, `q_jl`, `dp`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Q0Seed => "q0_seed",
+            Self::QMu => "q_mu",
+            Self::QJl => "q_jl",
+            Self::Dp => "dp",
+        }
+    }
 
     /// Name for tables.
     pub fn title(self) -> &'static str {
@@ -199,13 +209,18 @@ impl Setup {
     }
 
     /// Reference lengths `ℓ_ref`: the longest hybrid rollout over each task's label candidates
-    /// (its `q0_seed` when it has none).
-    pub fn references(&self, tasks: &[Task], labels: &LabelSet) -> anyhow::Result<Vec<f64>> {
+    /// (its `q0_seed` when it has none); `indices[i]` is task `i`'s index in the labelled set.
+    pub fn references(
+        &self,
+        tasks: &[Task],
+        indices: &[usize],
+        labels: &LabelSet,
+    ) -> anyhow::Result<Vec<f64>> {
         let mut owners = Vec::new();
         let mut candidates = Vec::new();
         for (i, task) in tasks.iter().enumerate() {
             let found: Vec<JointVector> = labels
-                .get(i as u32)
+                .get(indices[i] as u32)
                 .map(|t| t.labels.iter().map(|l| l.q).collect())
                 .unwrap_or_default();
             let found = if found.is_empty() {
@@ -272,18 +287,98 @@ pub struct SetResult {
     pub dp_lengths_m: BTreeMap<String, Vec<f64>>,
 }
 
-/// Runs the full protocol on `tasks` with labels `labels`.
-pub fn evaluate_set(
+/// Per-task outcomes of the protocol on a task set (or one shard of it), in task order: what
+/// shards write and what the tables are computed from.
+#[derive(Serialize, Deserialize)]
+pub struct RawSet {
+    /// Which set: `unseen` or `seen`.
+    pub name: String,
+    /// Task file.
+    pub tasks: String,
+    /// Indices of the evaluated tasks in the task file.
+    pub indices: Vec<usize>,
+    /// Reference lengths (m).
+    #[serde(with = "exact")]
+    pub references_m: Vec<f64>,
+    /// Seed generation time (ms) per task, by seed name.
+    #[serde(with = "exact_map")]
+    pub seed_times_ms: BTreeMap<String, Vec<f64>>,
+    /// Path length (m) per task, by `seed/controller`.
+    #[serde(with = "exact_map")]
+    pub lengths_m: BTreeMap<String, Vec<f64>>,
+    /// Hand-overs per task of the hybrid controller, by seed name.
+    #[serde(with = "exact_map")]
+    pub switches: BTreeMap<String, Vec<f64>>,
+}
+
+/// Shard files store values as their IEEE-754 bits, so a merge reproduces a whole run exactly.
+mod exact {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(values: &[f64], s: S) -> Result<S::Ok, S::Error> {
+        values
+            .iter()
+            .map(|v| v.to_bits())
+            .collect::<Vec<u64>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        Ok(Vec::<u64>::deserialize(d)?
+            .into_iter()
+            .map(f64::from_bits)
+            .collect())
+    }
+}
+
+/// [`exact`] for maps of value lists.
+mod exact_map {
+    use std::collections::BTreeMap;
+
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(
+        map: &BTreeMap<String, Vec<f64>>,
+        s: S,
+    ) -> Result<S::Ok, S::Error> {
+        map.iter()
+            .map(|(k, v)| {
+                (
+                    k.clone(),
+                    v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>(),
+                )
+            })
+            .collect::<BTreeMap<_, _>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<BTreeMap<String, Vec<f64>>, D::Error> {
+        Ok(BTreeMap::<String, Vec<u64>>::deserialize(d)?
+            .into_iter()
+            .map(|(k, v)| (k, v.into_iter().map(f64::from_bits).collect()))
+            .collect())
+    }
+}
+
+fn cell_key(seed: SeedKind, controller: ControllerKind) -> String {
+    format!("{}/{}", seed.name(), controller.name())
+}
+
+/// Runs the protocol on the tasks of `tasks_path` (the first `limit`; those with
+/// `index % n == i` for `shard = Some((i, n))`), labels `labels_path`.
+pub fn run_set(
     setup: &Setup,
     name: &str,
     tasks_path: &Path,
     labels_path: &Path,
     limit: Option<usize>,
-    buckets: &BucketConfig,
-) -> anyhow::Result<SetResult> {
-    let mut tasks = read_tasks(tasks_path, &setup.robot)?;
+    shard: Option<(usize, usize)>,
+) -> anyhow::Result<RawSet> {
+    let mut all = read_tasks(tasks_path, &setup.robot)?;
     if let Some(limit) = limit {
-        tasks.truncate(limit);
+        all.truncate(limit);
     }
     let labels = LabelSet::read(labels_path).with_context(|| {
         format!(
@@ -291,12 +386,99 @@ pub fn evaluate_set(
             labels_path.display()
         )
     })?;
+    let indices: Vec<usize> = (0..all.len())
+        .filter(|i| shard.is_none_or(|(k, n)| i % n == k))
+        .collect();
+    let tasks: Vec<Task> = indices.iter().map(|&i| all[i].clone()).collect();
     println!("{name}: {} tasks", tasks.len());
-    let references = setup.references(&tasks, &labels)?;
+    let references_m = setup.references(&tasks, &indices, &labels)?;
+    let mut raw = RawSet {
+        name: name.to_string(),
+        tasks: workspace::relative(tasks_path),
+        indices,
+        references_m,
+        seed_times_ms: BTreeMap::new(),
+        lengths_m: BTreeMap::new(),
+        switches: BTreeMap::new(),
+    };
+    for seed in SeedKind::ALL {
+        let (seeds, times) = setup.seeds(&tasks, seed)?;
+        raw.seed_times_ms.insert(seed.name().to_string(), times);
+        for controller in ControllerKind::ALL {
+            let what = format!("{}+{}", seed.title(), controller.name());
+            let trajectories =
+                setup.rollouts(&tasks, &seeds, controller, &setup.executor, &what)?;
+            if controller == ControllerKind::Hybrid {
+                let switches = trajectories
+                    .iter()
+                    .map(|t| count_switches(t) as f64)
+                    .collect();
+                raw.switches.insert(seed.name().to_string(), switches);
+            }
+            let lengths = trajectories.iter().map(|t| t.path_length_m).collect();
+            raw.lengths_m.insert(cell_key(seed, controller), lengths);
+        }
+    }
+    Ok(raw)
+}
+
+/// Joins shards of one set into the set in task order; every task must appear exactly once.
+pub fn merge_sets(parts: Vec<RawSet>) -> anyhow::Result<RawSet> {
+    let mut parts = parts.into_iter();
+    let mut merged = parts.next().context("no shards to merge")?;
+    let mut order: Vec<(usize, usize, usize)> = (0..merged.indices.len())
+        .map(|k| (merged.indices[k], 0, k))
+        .collect();
+    let mut rest = Vec::new();
+    for (p, part) in parts.enumerate() {
+        anyhow::ensure!(
+            part.name == merged.name && part.tasks == merged.tasks,
+            "shard of {} ({}) does not belong to {} ({})",
+            part.name,
+            part.tasks,
+            merged.name,
+            merged.tasks
+        );
+        order.extend((0..part.indices.len()).map(|k| (part.indices[k], p + 1, k)));
+        rest.push(part);
+    }
+    order.sort_unstable();
+    for (position, (index, _, _)) in order.iter().enumerate() {
+        anyhow::ensure!(
+            *index == position,
+            "{}: task {position} is missing or repeated across the shards",
+            merged.name
+        );
+    }
+    let sources: Vec<&RawSet> = std::iter::once(&merged).chain(&rest).collect();
+    let pick = |get: &dyn Fn(&RawSet) -> &Vec<f64>| -> Vec<f64> {
+        order.iter().map(|&(_, p, k)| get(sources[p])[k]).collect()
+    };
+    let references_m = pick(&|r| &r.references_m);
+    let remap = |map: &BTreeMap<String, Vec<f64>>,
+                 field: fn(&RawSet) -> &BTreeMap<String, Vec<f64>>| {
+        map.keys()
+            .map(|key| (key.clone(), pick(&|r| &field(r)[key])))
+            .collect::<BTreeMap<_, _>>()
+    };
+    let seed_times_ms = remap(&merged.seed_times_ms, |r| &r.seed_times_ms);
+    let lengths_m = remap(&merged.lengths_m, |r| &r.lengths_m);
+    let switches = remap(&merged.switches, |r| &r.switches);
+    merged.indices = (0..order.len()).collect();
+    merged.references_m = references_m;
+    merged.seed_times_ms = seed_times_ms;
+    merged.lengths_m = lengths_m;
+    merged.switches = switches;
+    Ok(merged)
+}
+
+/// The tables of one set from its per-task outcomes.
+pub fn summarize(raw: &RawSet, buckets: &BucketConfig) -> anyhow::Result<SetResult> {
+    let references = &raw.references_m;
     let groups: Vec<(String, Vec<usize>)> =
-        std::iter::once(("all".to_string(), (0..tasks.len()).collect()))
+        std::iter::once(("all".to_string(), (0..references.len()).collect()))
             .chain(
-                bucket_members(&references, buckets)
+                bucket_members(references, buckets)
                     .into_iter()
                     .map(|(b, m)| (b.name().to_lowercase(), m)),
             )
@@ -305,29 +487,22 @@ pub fn evaluate_set(
     let mut seed_time_ms = BTreeMap::new();
     let mut dp_lengths_m = BTreeMap::new();
     for seed in SeedKind::ALL {
-        let (seeds, times) = setup.seeds(&tasks, seed)?;
         seed_time_ms.insert(
             seed.title().to_string(),
-            Summary::of(&times).context("no tasks")?,
+            Summary::of(&raw.seed_times_ms[seed.name()]).context("no tasks")?,
         );
         for controller in ControllerKind::ALL {
-            let what = format!("{}+{}", seed.title(), controller.name());
-            let trajectories =
-                setup.rollouts(&tasks, &seeds, controller, &setup.executor, &what)?;
-            let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
+            let lengths = &raw.lengths_m[&cell_key(seed, controller)];
             if seed == SeedKind::Dp {
                 dp_lengths_m.insert(controller.name().to_string(), lengths.clone());
             }
             for (group, members) in &groups {
-                let Some(stats) = cell_stats(&lengths, &references, members) else {
+                let Some(stats) = cell_stats(lengths, references, members) else {
                     continue;
                 };
                 let switches_per_episode = (controller == ControllerKind::Hybrid).then(|| {
-                    members
-                        .iter()
-                        .map(|&i| count_switches(&trajectories[i]) as f64)
-                        .sum::<f64>()
-                        / members.len() as f64
+                    let switches = &raw.switches[seed.name()];
+                    members.iter().map(|&i| switches[i]).sum::<f64>() / members.len() as f64
                 });
                 cells.push(Cell {
                     seed,
@@ -340,17 +515,17 @@ pub fn evaluate_set(
         }
     }
     Ok(SetResult {
-        name: name.to_string(),
-        tasks: workspace::relative(tasks_path),
-        task_count: tasks.len(),
-        reference_m: Summary::of(&references).context("no tasks")?,
+        name: raw.name.clone(),
+        tasks: raw.tasks.clone(),
+        task_count: references.len(),
+        reference_m: Summary::of(references).context("no tasks")?,
         buckets: groups[1..]
             .iter()
             .map(|(g, m)| (g.clone(), m.len()))
             .collect(),
         seed_time_ms,
         cells,
-        references_m: references,
+        references_m: references.clone(),
         dp_lengths_m,
     })
 }
