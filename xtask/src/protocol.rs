@@ -603,3 +603,54 @@ pub fn default_policy() -> PathBuf {
 pub fn default_diffusion() -> PathBuf {
     workspace::root().join("data/models/diffusion-v1.weights")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn raw(indices: Vec<usize>, scale: f64) -> RawSet {
+        let values = |offset: f64| {
+            indices
+                .iter()
+                .map(|&i| offset + i as f64 * scale)
+                .collect::<Vec<_>>()
+        };
+        RawSet {
+            name: "unseen".into(),
+            tasks: "tasks".into(),
+            references_m: values(1.0),
+            seed_times_ms: [("dp".to_string(), values(0.5))].into(),
+            lengths_m: [("dp/hybrid".to_string(), values(0.25))].into(),
+            switches: [("dp".to_string(), values(0.0))].into(),
+            indices,
+        }
+    }
+
+    #[test]
+    fn merged_shards_equal_the_whole_set_bit_for_bit() {
+        let whole = raw((0..7).collect(), 0.1);
+        let shards = vec![
+            raw(vec![1, 4], 0.1),
+            raw(vec![0, 3, 6], 0.1),
+            raw(vec![2, 5], 0.1),
+        ];
+        let text = serde_json::to_string(&shards).unwrap();
+        let shards: Vec<RawSet> = serde_json::from_str(&text).unwrap();
+        let merged = merge_sets(shards).unwrap();
+        assert_eq!(
+            serde_json::to_string(&merged).unwrap(),
+            serde_json::to_string(&whole).unwrap()
+        );
+    }
+
+    #[test]
+    fn a_missing_or_repeated_task_is_refused() {
+        let error = merge_sets(vec![raw(vec![0, 2], 1.0), raw(vec![2, 3], 1.0)])
+            .err()
+            .unwrap();
+        assert!(
+            error.to_string().contains("task 1 is missing or repeated"),
+            "{error}"
+        );
+    }
+}
