@@ -11,7 +11,8 @@
 //! * [`tool_alignment_gradient`]: the gradient of `z(q)·n`.
 //! * [`damped_pseudo_inverse`]: `J⁺` with variable damping (Eq. 2 of the paper).
 //! * [`null_space_basis`] and [`task_aligned_basis`]: `N` and the Gram–Schmidt basis `B(q)`.
-//! * [`Robot::self_collision`]: capsule distances between bodies at least three links apart.
+//! * [`Robot::first_collision`] and [`Robot::min_clearance`]: capsule clearances between bodies at
+//!   least three links apart.
 //! * [`project_to_pose`]: Newton projection onto an exact `(p0, n[, roll])` pose within limits.
 //!
 //! ```
