@@ -7,7 +7,6 @@ use emg_control::{ReferenceModel, RolloutConfig, Summary, Task, read_tasks, roll
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedOrigin, SeedWorkspace};
 use emg_hybrid::{Executor, ExecutorConfig};
 use emg_kinematics::ProjectionConfig;
-use emg_policy::{PolicyWeights, RlController};
 use emg_seeding::{HeuristicConfig, HeuristicObjective, LabelSet, heuristic_seed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -159,14 +158,7 @@ fn dp_sweep(
 
     let kind = args.controller.kind();
     let policy = if kind.needs_policy() {
-        Some(RlController::new(
-            &PolicyWeights::read(&args.policy).with_context(|| {
-                format!(
-                    "reading {} (train it with `cargo xtask train-ppo`)",
-                    args.policy.display()
-                )
-            })?,
-        ))
+        Some(crate::protocol::load_policy(&args.policy)?)
     } else {
         None
     };
@@ -186,20 +178,14 @@ fn dp_sweep(
             )
         });
         bar.finish();
-        let failures = pool.install(|| {
-            tasks
-                .par_iter()
-                .zip(&trajectories)
-                .filter(|(task, trajectory)| {
-                    checker
-                        .check(task, trajectory, &rollout.constraints)
-                        .is_err()
-                })
-                .count()
-        });
-        if failures > 0 {
-            bail!("{failures} trajectories fail the independent check");
-        }
+        pool.install(|| {
+            crate::protocol::check_trajectories(
+                &checker,
+                tasks,
+                &trajectories,
+                &rollout.constraints,
+            )
+        })?;
         Ok(trajectories.iter().map(|t| t.path_length_m).collect())
     };
     let mut baselines = Vec::new();

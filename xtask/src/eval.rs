@@ -10,7 +10,6 @@ use emg_control::{
     termination_histogram,
 };
 use emg_hybrid::{BucketConfig, ControllerKind, Executor, ExecutorConfig};
-use emg_policy::{PolicyWeights, RlController};
 use serde::Serialize;
 
 use crate::{progress, protocol, workspace};
@@ -254,14 +253,7 @@ fn run_controller(
     }
     let executor = ExecutorConfig::default();
     let policy = if kind.needs_policy() {
-        Some(RlController::new(
-            &PolicyWeights::read(&args.weights).with_context(|| {
-                format!(
-                    "loading the policy (train it with `cargo xtask train-ppo`): {}",
-                    args.weights.display()
-                )
-            })?,
-        ))
+        Some(protocol::load_policy(&args.weights)?)
     } else {
         None
     };
@@ -288,31 +280,10 @@ fn run_controller(
     if !args.no_check {
         let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip")
             .map_err(anyhow::Error::msg)?;
-        let bar = progress::bar(tasks.len() as u64, "checking");
         let started = Instant::now();
-        let failures: Vec<String> = pool.install(|| {
-            use rayon::prelude::*;
-            tasks
-                .par_iter()
-                .zip(&trajectories)
-                .enumerate()
-                .filter_map(|(i, (task, trajectory))| {
-                    bar.inc(1);
-                    checker
-                        .check(task, trajectory, &rollout.constraints)
-                        .err()
-                        .map(|e| format!("task {i}: {e}"))
-                })
-                .collect()
-        });
-        bar.finish();
-        if !failures.is_empty() {
-            bail!(
-                "{} trajectories fail the independent check, first: {}",
-                failures.len(),
-                failures[0]
-            );
-        }
+        pool.install(|| {
+            protocol::check_trajectories(&checker, &tasks, &trajectories, &rollout.constraints)
+        })?;
         checked = tasks.len();
         check_seconds = Some(started.elapsed().as_secs_f64());
     }

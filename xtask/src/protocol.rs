@@ -9,7 +9,8 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use emg_control::{
-    ReferenceModel, RolloutConfig, Summary, Task, Trajectory, read_tasks, rollout_from,
+    ConstraintConfig, ReferenceModel, RolloutConfig, Summary, Task, Trajectory, read_tasks,
+    rollout_from,
 };
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
 use emg_hybrid::{
@@ -93,8 +94,6 @@ impl Setup {
         let robot = workspace::load_robot(robot_path)?;
         let checker = ReferenceModel::from_urdf_file(robot_path, "link0", "pen_tip")
             .map_err(anyhow::Error::msg)?;
-        let policy = PolicyWeights::read(policy_path)
-            .context("loading the policy (train it with `cargo xtask train-ppo`)")?;
         let diffusion = DenoiserWeights::read(diffusion_path).context(
             "loading the diffusion seeder (train it with `cargo xtask train-diffusion`)",
         )?;
@@ -103,7 +102,7 @@ impl Setup {
             checker,
             rollout: RolloutConfig::default(),
             executor: ExecutorConfig::default(),
-            policy: RlController::new(&policy),
+            policy: load_policy(policy_path)?,
             dp: DpSeeder::new(&diffusion, DpSeedConfig::default())?,
             heuristic: HeuristicConfig::default(),
             projection: ProjectionConfig::default(),
@@ -188,24 +187,12 @@ impl Setup {
 
     /// Runs the independent checker over every trajectory.
     pub fn check(&self, tasks: &[Task], trajectories: &[Trajectory]) -> anyhow::Result<()> {
-        let failures: Vec<String> = tasks
-            .par_iter()
-            .zip(trajectories)
-            .enumerate()
-            .filter_map(|(i, (task, trajectory))| {
-                self.checker
-                    .check(task, trajectory, &self.rollout.constraints)
-                    .err()
-                    .map(|e| format!("task {i}: {e}"))
-            })
-            .collect();
-        if let Some(first) = failures.first() {
-            bail!(
-                "{} trajectories fail the independent check, first: {first}",
-                failures.len()
-            );
-        }
-        Ok(())
+        check_trajectories(
+            &self.checker,
+            tasks,
+            trajectories,
+            &self.rollout.constraints,
+        )
     }
 
     /// Reference lengths `ℓ_ref`: the longest hybrid rollout over each task's label candidates
@@ -247,6 +234,45 @@ impl Setup {
         }
         Ok(references)
     }
+}
+
+/// Re-checks every trajectory with the independent checker (in parallel); fails naming the first
+/// offending task.
+pub fn check_trajectories(
+    checker: &ReferenceModel,
+    tasks: &[Task],
+    trajectories: &[Trajectory],
+    constraints: &ConstraintConfig,
+) -> anyhow::Result<()> {
+    let failures: Vec<String> = tasks
+        .par_iter()
+        .zip(trajectories)
+        .enumerate()
+        .filter_map(|(i, (task, trajectory))| {
+            checker
+                .check(task, trajectory, constraints)
+                .err()
+                .map(|e| format!("task {i}: {e}"))
+        })
+        .collect();
+    if let Some(first) = failures.first() {
+        bail!(
+            "{} trajectories fail the independent check, first: {first}",
+            failures.len()
+        );
+    }
+    Ok(())
+}
+
+/// Loads the trained policy as a controller.
+pub fn load_policy(path: &Path) -> anyhow::Result<RlController> {
+    let weights = PolicyWeights::read(path).with_context(|| {
+        format!(
+            "loading the policy {} (train it with `cargo xtask train-ppo`)",
+            path.display()
+        )
+    })?;
+    Ok(RlController::new(&weights))
 }
 
 /// One cell of a table: a seed, a controller, a group of tasks.
