@@ -4,12 +4,12 @@
 //! File layout: the magic `EMGDIFFW`, a `u32` format version, a `u32` header length, the JSON
 //! [`WeightsHeader`], a `u64` value count, then the values in the order of [`parameter_layout`].
 
-use std::io::Write;
 use std::path::Path;
 
 use burn::module::Param;
 use burn::nn::{LayerNorm, Linear};
 use burn::tensor::{Device, Tensor, TensorData};
+use emg_learning::container::{self, ContainerError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::DiffusionConfig;
@@ -300,68 +300,31 @@ impl DenoiserWeights {
 
     /// The file bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let header = serde_json::to_vec(&self.header).expect("header serialises");
-        let mut bytes = Vec::with_capacity(24 + header.len() + 4 * self.values.len());
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&WEIGHTS_FORMAT_VERSION.to_le_bytes());
-        bytes.extend_from_slice(&(header.len() as u32).to_le_bytes());
-        bytes.extend_from_slice(&header);
-        bytes.extend_from_slice(&(self.values.len() as u64).to_le_bytes());
-        for v in &self.values {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        bytes
+        container::encode(MAGIC, WEIGHTS_FORMAT_VERSION, &self.header, &self.values)
     }
 
     /// Parses file bytes, rejecting truncated, padded or mismatched content with a clear error.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, WeightsError> {
-        let mut cursor = Cursor { bytes, at: 0 };
-        if cursor.take(8, "header")? != MAGIC {
-            return Err(WeightsError::BadMagic);
-        }
-        let version = u32::from_le_bytes(cursor.take(4, "header")?.try_into().expect("4 bytes"));
-        if version != WEIGHTS_FORMAT_VERSION {
-            return Err(WeightsError::UnsupportedVersion { found: version });
-        }
-        let header_len =
-            u32::from_le_bytes(cursor.take(4, "header")?.try_into().expect("4 bytes")) as usize;
-        let header: WeightsHeader = serde_json::from_slice(cursor.take(header_len, "header")?)
-            .map_err(|e| WeightsError::BadHeader(e.to_string()))?;
-        let count =
-            u64::from_le_bytes(cursor.take(8, "header")?.try_into().expect("8 bytes")) as usize;
-        let expected: usize = parameter_layout(&header.config)
-            .iter()
-            .map(TensorSpec::len)
-            .sum();
-        if count != expected {
-            return Err(WeightsError::CountMismatch {
-                expected,
-                found: count,
-            });
-        }
-        let values = cursor
-            .take(4 * count, "values")?
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect();
-        let rest = bytes.len() - cursor.at;
-        if rest != 0 {
-            return Err(WeightsError::TrailingBytes(rest));
-        }
+        let (header, values) = container::decode_checked(
+            bytes,
+            MAGIC,
+            WEIGHTS_FORMAT_VERSION,
+            |h: &WeightsHeader| {
+                parameter_layout(&h.config)
+                    .iter()
+                    .map(TensorSpec::len)
+                    .sum()
+            },
+        )?;
         Self::new(header, values)
     }
 
     /// Writes the file (to a temporary sibling first, so an interrupted write loses nothing).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        let io = |source| WeightsError::Io {
+        container::write_atomically(path, &self.to_bytes()).map_err(|source| WeightsError::Io {
             path: path.display().to_string(),
             source,
-        };
-        let partial = path.with_extension("partial");
-        let mut file = std::fs::File::create(&partial).map_err(io)?;
-        file.write_all(&self.to_bytes()).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&partial, path).map_err(io)
+        })
     }
 
     /// Reads a weights file.
@@ -371,27 +334,6 @@ impl DenoiserWeights {
             source,
         })?;
         Self::from_bytes(&bytes)
-    }
-}
-
-struct Cursor<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> Cursor<'a> {
-    fn take(&mut self, n: usize, part: &'static str) -> Result<&'a [u8], WeightsError> {
-        let end = self.at + n;
-        if end > self.bytes.len() {
-            return Err(WeightsError::Truncated {
-                part,
-                expected: end,
-                found: self.bytes.len(),
-            });
-        }
-        let slice = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(slice)
     }
 }
 
@@ -423,4 +365,27 @@ fn visit_parameters(model: &Denoiser, mut f: impl FnMut(&TensorData)) {
     norm(&model.output_norm, &mut f);
     linear(&model.head, &mut f);
     f(&model.null_condition.val().into_data());
+}
+
+impl From<ContainerError> for WeightsError {
+    fn from(error: ContainerError) -> Self {
+        match error {
+            ContainerError::BadMagic => Self::BadMagic,
+            ContainerError::UnsupportedVersion { found, .. } => Self::UnsupportedVersion { found },
+            ContainerError::Truncated {
+                part,
+                expected,
+                found,
+            } => Self::Truncated {
+                part,
+                expected,
+                found,
+            },
+            ContainerError::BadHeader(message) => Self::BadHeader(message),
+            ContainerError::CountMismatch { expected, found } => {
+                Self::CountMismatch { expected, found }
+            }
+            ContainerError::TrailingBytes(rest) => Self::TrailingBytes(rest),
+        }
+    }
 }

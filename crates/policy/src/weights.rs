@@ -5,12 +5,12 @@
 //! [`WeightsHeader`], a `u64` value count, then the values layer by layer in the order of
 //! [`layer_shapes`], each layer its weight (`[in, out]`, row-major) then its bias (`[out]`).
 
-use std::io::Write;
 use std::path::Path;
 
 use burn::module::Param;
 use burn::nn::Linear;
 use burn::tensor::{Device, Tensor, TensorData};
+use emg_learning::container::{self, ContainerError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::NetworkConfig;
@@ -240,63 +240,26 @@ impl PolicyWeights {
 
     /// The file's bytes.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let header = serde_json::to_vec(&self.header).expect("header serialises");
-        let mut bytes = Vec::with_capacity(24 + header.len() + 4 * self.values.len());
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&WEIGHTS_FORMAT_VERSION.to_le_bytes());
-        bytes.extend_from_slice(&(header.len() as u32).to_le_bytes());
-        bytes.extend_from_slice(&header);
-        bytes.extend_from_slice(&(self.values.len() as u64).to_le_bytes());
-        for v in &self.values {
-            bytes.extend_from_slice(&v.to_le_bytes());
-        }
-        bytes
+        container::encode(MAGIC, WEIGHTS_FORMAT_VERSION, &self.header, &self.values)
     }
 
     /// Parses a file's bytes, with a clear error for a truncated or mismatched file.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, WeightsError> {
-        let mut cursor = Cursor { bytes, at: 0 };
-        if cursor.take(8, "header")? != MAGIC {
-            return Err(WeightsError::BadMagic);
-        }
-        let version = u32::from_le_bytes(cursor.array::<4>("header")?);
-        if version != WEIGHTS_FORMAT_VERSION {
-            return Err(WeightsError::UnsupportedVersion { found: version });
-        }
-        let header_len = u32::from_le_bytes(cursor.array::<4>("header")?) as usize;
-        let header: WeightsHeader = serde_json::from_slice(cursor.take(header_len, "header")?)
-            .map_err(|e| WeightsError::BadHeader(e.to_string()))?;
-        let count = u64::from_le_bytes(cursor.array::<8>("header")?) as usize;
-        let expected = value_count(&header.network);
-        if count != expected {
-            return Err(WeightsError::CountMismatch {
-                expected,
-                found: count,
-            });
-        }
-        let values = cursor
-            .take(4 * count, "values")?
-            .chunks_exact(4)
-            .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
-            .collect();
-        let rest = bytes.len() - cursor.at;
-        if rest != 0 {
-            return Err(WeightsError::TrailingBytes(rest));
-        }
+        let (header, values) = container::decode_checked(
+            bytes,
+            MAGIC,
+            WEIGHTS_FORMAT_VERSION,
+            |h: &WeightsHeader| value_count(&h.network),
+        )?;
         Self::new(header, values)
     }
 
     /// Writes the file (via a `.partial` sibling renamed into place).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        let io = |source| WeightsError::Io {
+        container::write_atomically(path, &self.to_bytes()).map_err(|source| WeightsError::Io {
             path: path.display().to_string(),
             source,
-        };
-        let partial = path.with_extension("partial");
-        let mut file = std::fs::File::create(&partial).map_err(io)?;
-        file.write_all(&self.to_bytes()).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&partial, path).map_err(io)
+        })
     }
 
     /// Reads a file written by [`PolicyWeights::write`].
@@ -319,27 +282,25 @@ fn layers(model: &ActorCritic) -> impl Iterator<Item = &Linear> {
         .chain([&model.value])
 }
 
-struct Cursor<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> Cursor<'a> {
-    fn take(&mut self, n: usize, part: &'static str) -> Result<&'a [u8], WeightsError> {
-        let end = self.at + n;
-        if end > self.bytes.len() {
-            return Err(WeightsError::Truncated {
+impl From<ContainerError> for WeightsError {
+    fn from(error: ContainerError) -> Self {
+        match error {
+            ContainerError::BadMagic => Self::BadMagic,
+            ContainerError::UnsupportedVersion { found, .. } => Self::UnsupportedVersion { found },
+            ContainerError::Truncated {
                 part,
-                expected: end,
-                found: self.bytes.len(),
-            });
+                expected,
+                found,
+            } => Self::Truncated {
+                part,
+                expected,
+                found,
+            },
+            ContainerError::BadHeader(message) => Self::BadHeader(message),
+            ContainerError::CountMismatch { expected, found } => {
+                Self::CountMismatch { expected, found }
+            }
+            ContainerError::TrailingBytes(rest) => Self::TrailingBytes(rest),
         }
-        let slice = &self.bytes[self.at..end];
-        self.at = end;
-        Ok(slice)
-    }
-
-    fn array<const N: usize>(&mut self, part: &'static str) -> Result<[u8; N], WeightsError> {
-        Ok(self.take(N, part)?.try_into().expect("N bytes"))
     }
 }

@@ -1,0 +1,22 @@
+//! Pieces shared by the learned crates (`emg-policy`, `emg-diffusion`):
+//!
+//! - [`Backend`]: the Burn CPU backend training runs on, chosen at run time by the tensor device;
+//! - [`container`]: the versioned binary container their weights files use — 8 magic bytes, a
+//!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
+//!   values as little-endian `f32` — with strict truncation and trailing-byte checks and an
+//!   atomic write through a `.partial` sibling.
+//!
+//! ```
+//! use emg_learning::container::{decode, encode};
+//!
+//! let bytes = encode(b"EXAMPLE!", 3, &vec![2_usize, 2], &[1.0, -2.0, 0.5, 4.0]);
+//! let (header, values): (Vec<usize>, Vec<f32>) = decode(&bytes, b"EXAMPLE!", 3).unwrap();
+//! assert_eq!(header, [2, 2]);
+//! assert_eq!(values, [1.0, -2.0, 0.5, 4.0]);
+//! ```
+
+mod backend;
+pub mod container;
+
+pub use backend::Backend;
+pub use container::ContainerError;
