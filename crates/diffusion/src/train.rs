@@ -4,7 +4,7 @@
 //! Every random choice of step `k` comes from its own ChaCha stream of the configured seed, so
 //! a run resumed from a checkpoint continues the very same loss curve.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use burn::grad_clipping::GradientClippingConfig;
 use burn::module::Module;
@@ -298,10 +298,7 @@ impl Trainer {
             path: path.display().to_string(),
             problem,
         };
-        let staging = sibling(dir, "partial");
-        let previous = sibling(dir, "previous");
-        let _ = std::fs::remove_dir_all(&staging);
-        std::fs::create_dir_all(&staging).map_err(|e| fail(&staging, e.to_string()))?;
+        let staging = emg_learning::checkpoint::stage(dir).map_err(|e| fail(dir, e.to_string()))?;
         self.model
             .clone()
             .save_file(staging.join("model.bpk"))
@@ -322,13 +319,7 @@ impl Trainer {
         let json = serde_json::to_string_pretty(&state).expect("state serialises");
         std::fs::write(staging.join("state.json"), json)
             .map_err(|e| fail(&staging, e.to_string()))?;
-        let _ = std::fs::remove_dir_all(&previous);
-        if dir.exists() {
-            std::fs::rename(dir, &previous).map_err(|e| fail(dir, e.to_string()))?;
-        }
-        std::fs::rename(&staging, dir).map_err(|e| fail(dir, e.to_string()))?;
-        let _ = std::fs::remove_dir_all(&previous);
-        Ok(())
+        emg_learning::checkpoint::publish(dir).map_err(|e| fail(dir, e.to_string()))
     }
 
     /// Steps done.
@@ -491,10 +482,4 @@ fn check_shapes(network: &DiffusionConfig, data: &TrainingSet) -> Result<(), Tra
         });
     }
     Ok(())
-}
-
-fn sibling(dir: &Path, suffix: &str) -> PathBuf {
-    let mut name = dir.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".{suffix}"));
-    dir.with_file_name(name)
 }

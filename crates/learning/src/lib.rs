@@ -4,7 +4,8 @@
 //! - [`container`]: the versioned binary container their weights files use — 8 magic bytes, a
 //!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
 //!   values as little-endian `f32` — with strict truncation and trailing-byte checks and an
-//!   atomic write through a `.partial` sibling.
+//!   atomic write through a `.partial` sibling;
+//! - [`checkpoint`]: checkpoint directories written into a staging sibling and swapped in whole.
 //!
 //! ```
 //! use emg_learning::container::{decode, encode};
@@ -16,6 +17,7 @@
 //! ```
 
 mod backend;
+pub mod checkpoint;
 pub mod container;
 
 pub use backend::Backend;

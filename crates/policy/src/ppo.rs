@@ -7,7 +7,7 @@
 //! and the in-flight episodes are stored as replayable records, so a run resumed from a
 //! checkpoint continues the very same learning curve.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use burn::grad_clipping::GradientClippingConfig;
@@ -213,10 +213,7 @@ impl Trainer {
             path: path.display().to_string(),
             problem,
         };
-        let staging = sibling(dir, "partial");
-        let previous = sibling(dir, "previous");
-        let _ = std::fs::remove_dir_all(&staging);
-        std::fs::create_dir_all(&staging).map_err(|e| fail(&staging, e.to_string()))?;
+        let staging = emg_learning::checkpoint::stage(dir).map_err(|e| fail(dir, e.to_string()))?;
         self.model
             .clone()
             .save_file(staging.join("model.bpk"))
@@ -236,13 +233,7 @@ impl Trainer {
         let json = serde_json::to_string(&state).expect("state serialises");
         std::fs::write(staging.join("state.json"), json)
             .map_err(|e| fail(&staging, e.to_string()))?;
-        let _ = std::fs::remove_dir_all(&previous);
-        if dir.exists() {
-            std::fs::rename(dir, &previous).map_err(|e| fail(dir, e.to_string()))?;
-        }
-        std::fs::rename(&staging, dir).map_err(|e| fail(dir, e.to_string()))?;
-        let _ = std::fs::remove_dir_all(&previous);
-        Ok(())
+        emg_learning::checkpoint::publish(dir).map_err(|e| fail(dir, e.to_string()))
     }
 
     /// Iterations done.
@@ -493,10 +484,4 @@ impl UpdateStats {
         self.entropy += step.entropy;
         self.last_kl = step.approx_kl;
     }
-}
-
-fn sibling(dir: &Path, suffix: &str) -> PathBuf {
-    let mut name = dir.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".{suffix}"));
-    dir.with_file_name(name)
 }

@@ -1,0 +1,29 @@
+//! Checkpoint directories: a staged checkpoint replaces the old one whole, and the staging and
+//! previous siblings are gone afterwards.
+
+use emg_learning::checkpoint::{publish, stage};
+
+#[test]
+fn a_published_checkpoint_replaces_the_previous_one() {
+    let root = std::env::temp_dir().join(format!("emg-learning-checkpoint-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let dir = root.join("run");
+    for (round, name) in [(1, "first.txt"), (2, "second.txt")] {
+        let staging = stage(&dir).unwrap();
+        assert!(staging.is_dir() && std::fs::read_dir(&staging).unwrap().next().is_none());
+        std::fs::write(staging.join(name), format!("{round}")).unwrap();
+        publish(&dir).unwrap();
+        assert_eq!(
+            std::fs::read_to_string(dir.join(name)).unwrap(),
+            format!("{round}")
+        );
+        assert!(!staging.exists());
+        assert!(!root.join("run.previous").exists());
+    }
+    assert!(
+        !dir.join("first.txt").exists(),
+        "the old checkpoint is replaced, not merged"
+    );
+    std::fs::remove_dir_all(&root).unwrap();
+}
