@@ -251,11 +251,8 @@ impl Trainer {
             path: path.display().to_string(),
             problem,
         };
-        let state_path = dir.join("state.json");
-        let text = std::fs::read_to_string(&state_path)
-            .map_err(|e| read_error(&state_path, e.to_string()))?;
-        let state: CheckpointState =
-            serde_json::from_str(&text).map_err(|e| read_error(&state_path, e.to_string()))?;
+        let state: CheckpointState = emg_learning::checkpoint::read_state(dir)
+            .map_err(|e| read_error(Path::new(&e.path), e.problem))?;
         if state.network != network {
             return Err(TrainError::ConfigMismatch {
                 what: "network config",
@@ -316,9 +313,8 @@ impl Trainer {
             window_loss_sum: self.window_loss_sum,
             window_steps: self.window_steps,
         };
-        let json = serde_json::to_string_pretty(&state).expect("state serialises");
-        std::fs::write(staging.join("state.json"), json)
-            .map_err(|e| fail(&staging, e.to_string()))?;
+        emg_learning::checkpoint::write_state(&staging, &state)
+            .map_err(|e| fail(Path::new(&e.path), e.problem))?;
         emg_learning::checkpoint::publish(dir).map_err(|e| fail(dir, e.to_string()))
     }
 

@@ -3,6 +3,43 @@
 
 use std::path::{Path, PathBuf};
 
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+/// Name of the JSON run state inside a checkpoint directory.
+const STATE_FILE: &str = "state.json";
+
+/// A checkpoint file that could not be read or written.
+#[derive(Debug, thiserror::Error)]
+#[error("checkpoint {path}: {problem}")]
+pub struct CheckpointError {
+    /// The file or directory concerned.
+    pub path: String,
+    /// What went wrong.
+    pub problem: String,
+}
+
+fn error(path: &Path, problem: impl ToString) -> CheckpointError {
+    CheckpointError {
+        path: path.display().to_string(),
+        problem: problem.to_string(),
+    }
+}
+
+/// Writes the run state (everything but the tensors) into a staging directory as JSON.
+pub fn write_state<T: Serialize>(staging: &Path, state: &T) -> Result<(), CheckpointError> {
+    let path = staging.join(STATE_FILE);
+    let json = serde_json::to_string(state).map_err(|e| error(&path, e))?;
+    std::fs::write(&path, json).map_err(|e| error(&path, e))
+}
+
+/// Reads the run state of checkpoint `dir`.
+pub fn read_state<T: DeserializeOwned>(dir: &Path) -> Result<T, CheckpointError> {
+    let path = dir.join(STATE_FILE);
+    let text = std::fs::read_to_string(&path).map_err(|e| error(&path, e))?;
+    serde_json::from_str(&text).map_err(|e| error(&path, e))
+}
+
 /// `dir` with `.suffix` appended to its last component.
 fn sibling(dir: &Path, suffix: &str) -> PathBuf {
     let mut name = dir.file_name().unwrap_or_default().to_os_string();

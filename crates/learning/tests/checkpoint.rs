@@ -27,3 +27,19 @@ fn a_published_checkpoint_replaces_the_previous_one() {
     );
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+#[test]
+fn run_state_round_trips_and_a_missing_state_names_its_file() {
+    use emg_learning::checkpoint::{read_state, write_state};
+    let root = std::env::temp_dir().join(format!("emg-learning-state-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let dir = root.join("run");
+    let staging = stage(&dir).unwrap();
+    write_state(&staging, &(7_u64, vec![0.25_f64, -1.5])).unwrap();
+    publish(&dir).unwrap();
+    let state: (u64, Vec<f64>) = read_state(&dir).unwrap();
+    assert_eq!(state, (7, vec![0.25, -1.5]));
+    let error = read_state::<u64>(&root.join("missing")).unwrap_err();
+    assert!(error.to_string().contains("state.json"), "{error}");
+    std::fs::remove_dir_all(&root).unwrap();
+}
