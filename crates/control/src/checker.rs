@@ -29,6 +29,7 @@ struct ReferenceJoint {
     axis: Option<Unit<Vector3<f64>>>,
     lower: f64,
     upper: f64,
+    velocity: f64,
 }
 
 /// The robot as the checker sees it, built straight from the URDF file.
@@ -80,6 +81,7 @@ impl ReferenceModel {
                 axis: revolute.then(|| Unit::new_normalize(Vector3::from(joint.axis.xyz.0))),
                 lower: joint.limit.lower,
                 upper: joint.limit.upper,
+                velocity: joint.limit.velocity,
             });
         }
         for (chain_index, name) in link_names.iter().enumerate() {
@@ -150,6 +152,15 @@ impl ReferenceModel {
             .collect()
     }
 
+    /// Velocity limits (rad/s) of the revolute joints in order, as the file states them.
+    pub fn velocity_limits(&self) -> Vec<f64> {
+        self.joints
+            .iter()
+            .filter(|j| j.axis.is_some())
+            .map(|j| j.velocity)
+            .collect()
+    }
+
     /// Smallest clearance (m) over capsule pairs at least three links apart, with their links.
     pub fn min_clearance(&self, q: &[f64]) -> (f64, String, String) {
         let frames = self.link_frames(q);
@@ -179,7 +190,8 @@ impl ReferenceModel {
 
     /// Verifies every recorded step of `trajectory` against the constraints and its own
     /// records: joint limits, TCP and tool angle as recorded, line tolerance, tool cone, no
-    /// self-collision, monotone timestamps, the reported path length, and that a rejected step
+    /// self-collision, increasing timestamps, joint speeds within the velocity limits (when the
+    /// constraints enforce them), the reported path length, and that a rejected step
     /// really breaks the constraint it is blamed on.
     pub fn check(
         &self,
@@ -188,6 +200,7 @@ impl ReferenceModel {
         constraints: &ConstraintConfig,
     ) -> Result<(), CheckFailure> {
         let limits = self.limits();
+        let velocity_limits = self.velocity_limits();
         let fail = |step: usize, problem: String| Err(CheckFailure { step, problem });
         if trajectory.steps.is_empty() {
             return fail(0, "the trajectory holds no step, not even its seed".into());
@@ -247,8 +260,27 @@ impl ReferenceModel {
             if !step.time_s.is_finite() {
                 return fail(k, format!("timestamp {} is not finite", step.time_s));
             }
-            if k > 0 && within(step.time_s, trajectory.steps[k - 1].time_s) {
-                return fail(k, "timestamps do not increase".into());
+            if k > 0 {
+                let previous = &trajectory.steps[k - 1];
+                if within(step.time_s, previous.time_s) {
+                    return fail(k, "timestamps do not increase".into());
+                }
+                if let Some(fraction) = constraints.velocity_limit_fraction {
+                    let elapsed = step.time_s - previous.time_s;
+                    for (i, limit) in velocity_limits.iter().enumerate() {
+                        let speed = (step.q[i] - previous.q[i]).abs() / elapsed;
+                        let allowed = fraction.get() * limit;
+                        if !within(speed, allowed * (1.0 + SLACK)) {
+                            return fail(
+                                k,
+                                format!(
+                                    "joint {} moves at {speed} rad/s, above {allowed} rad/s",
+                                    i + 1
+                                ),
+                            );
+                        }
+                    }
+                }
             }
         }
         if let Some(last) = trajectory.steps.last() {

@@ -13,6 +13,10 @@ pub struct ConstraintConfig {
     pub theta_max_deg: f64,
     /// Smallest clearance between checked capsule pairs (m); 0 means "not touching".
     pub collision_margin_m: f64,
+    /// Joint speeds stay within this fraction of the robot file's velocity limits; `None` (JSON
+    /// `null`) leaves joint speeds unbounded, as the paper's runs do. Steps that would be faster
+    /// are slowed down in time, not changed in shape (see [`crate::Episode`]).
+    pub velocity_limit_fraction: Option<VelocityLimitFraction>,
 }
 
 impl Default for ConstraintConfig {
@@ -21,7 +25,49 @@ impl Default for ConstraintConfig {
             line_tolerance_m: 0.02,
             theta_max_deg: 30.0,
             collision_margin_m: 0.0,
+            velocity_limit_fraction: Some(VelocityLimitFraction::FULL),
         }
+    }
+}
+
+/// A fraction in `(0, 1]` of the joint-velocity limits; reading any other value is an error that
+/// names the field.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "f64", into = "f64")]
+pub struct VelocityLimitFraction(f64);
+
+impl VelocityLimitFraction {
+    /// The whole limit.
+    pub const FULL: Self = Self(1.0);
+
+    /// `fraction` if it lies in `(0, 1]`.
+    pub fn new(fraction: f64) -> Result<Self, String> {
+        if fraction > 0.0 && fraction <= 1.0 {
+            Ok(Self(fraction))
+        } else {
+            Err(format!(
+                "velocity_limit_fraction must be in (0, 1], got {fraction}"
+            ))
+        }
+    }
+
+    /// The fraction as a number.
+    pub fn get(self) -> f64 {
+        self.0
+    }
+}
+
+impl TryFrom<f64> for VelocityLimitFraction {
+    type Error = String;
+
+    fn try_from(fraction: f64) -> Result<Self, String> {
+        Self::new(fraction)
+    }
+}
+
+impl From<VelocityLimitFraction> for f64 {
+    fn from(fraction: VelocityLimitFraction) -> f64 {
+        fraction.0
     }
 }
 

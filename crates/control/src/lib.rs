@@ -36,7 +36,7 @@ mod task_file;
 
 pub use checker::{CheckFailure, ReferenceModel};
 pub use classical::ClassicalController;
-pub use config::{ClassicalGains, ConstraintConfig, RolloutConfig};
+pub use config::{ClassicalGains, ConstraintConfig, RolloutConfig, VelocityLimitFraction};
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
 pub use evaluation::{

@@ -12,7 +12,8 @@ use crate::task::Task;
 /// One recorded step of a trajectory.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepRecord {
-    /// Time since the start (s).
+    /// Time since the start (s): `Δt` per step, more for steps slowed to honour the joint-velocity
+    /// limits.
     pub time_s: f64,
     /// Joint configuration (rad).
     pub q: JointVector,
@@ -102,12 +103,18 @@ pub enum StepOutcome {
 /// Each step: build the [`StepContext`] at `q_t` ([`Episode::context`]), choose an action, and
 /// [`Episode::apply`] it: clip to `[−1, 1]⁴`, integrate `q̇ = J⁺ẋ + a_max B a` for `Δt`, and
 /// accept `q_{t+1}` only if it holds every constraint.
+///
+/// Joint-velocity limits are honoured by time scaling: a step whose `q̇` would exceed
+/// `fraction · v_max,i` on some joint keeps its shape but lasts `Δt · max_i |q̇_i| / (fraction ·
+/// v_max,i)` instead of `Δt`, so the line progress slows for that step and the recorded
+/// timestamps are the real ones. The geometric path is the same with limits on or off.
 #[derive(Clone, Debug)]
 pub struct Episode<'a> {
     robot: &'a Robot,
     task: &'a Task,
     config: &'a RolloutConfig,
     q: JointVector,
+    time_s: f64,
     kinematics: Kinematics,
     previous_action: NullAction,
     steps: Vec<StepRecord>,
@@ -128,6 +135,7 @@ impl<'a> Episode<'a> {
             task,
             config,
             q: *seed,
+            time_s: 0.0,
             kinematics,
             previous_action: NullAction::zeros(),
             steps: Vec::with_capacity(config.max_steps + 1),
@@ -170,7 +178,8 @@ impl<'a> Episode<'a> {
     ) -> StepOutcome {
         debug_assert!(self.termination.is_none(), "apply after the episode ended");
         let action = action.map(|a| a.clamp(-1.0, 1.0));
-        let next = self.q + context.joint_velocity(&action) * self.config.dt_s;
+        let velocity = context.joint_velocity(&action);
+        let next = self.q + velocity * self.config.dt_s;
         self.record(Some(acting));
         let next_kinematics = self.robot.forward(&next);
         if let Some(violation) = first_violation(
@@ -187,6 +196,7 @@ impl<'a> Episode<'a> {
             return StepOutcome::Terminated;
         }
         let progress_m = (next_kinematics.tcp() - self.kinematics.tcp()).dot(&self.task.d);
+        self.time_s += self.step_duration(&velocity);
         self.q = next;
         self.kinematics = next_kinematics;
         self.previous_action = action;
@@ -230,10 +240,23 @@ impl<'a> Episode<'a> {
         }
     }
 
+    /// How long a step at joint velocity `velocity` lasts: `Δt`, stretched so that no joint
+    /// exceeds its share of the velocity limit.
+    fn step_duration(&self, velocity: &JointVector) -> f64 {
+        let Some(fraction) = self.config.constraints.velocity_limit_fraction else {
+            return self.config.dt_s;
+        };
+        let limits = &self.robot.limits().velocity;
+        let stretch = (0..velocity.len())
+            .map(|i| velocity[i].abs() / (fraction.get() * limits[i]))
+            .fold(1.0, f64::max);
+        self.config.dt_s * stretch
+    }
+
     fn record(&mut self, controller: Option<ActingController>) {
         let kinematics = &self.kinematics;
         self.steps.push(StepRecord {
-            time_s: self.steps.len() as f64 * self.config.dt_s,
+            time_s: self.time_s,
             q: self.q,
             tcp: kinematics.tcp(),
             tool_angle_deg: tool_angle_deg(&kinematics.tool_axis(), &self.task.n),

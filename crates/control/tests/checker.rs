@@ -493,6 +493,7 @@ fn checker_rejects_a_colliding_configuration() {
         line_tolerance_m: 100.0,
         theta_max_deg: 180.0,
         collision_margin_m: 0.0,
+        ..ConstraintConfig::default()
     };
     checker
         .check(&task, &original, &loose)
