@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{ReferenceModel, RolloutConfig, Summary, Task, read_tasks, rollout_all};
+use emg_control::{RolloutConfig, Summary, Task, read_tasks, rollout_all};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedOrigin, SeedWorkspace};
 use emg_hybrid::{Executor, ExecutorConfig};
 use emg_kinematics::ProjectionConfig;
@@ -163,8 +163,7 @@ fn dp_sweep(
         None
     };
     let prototype = Executor::new(kind, policy.as_ref(), &ExecutorConfig::default())?;
-    let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip")
-        .map_err(anyhow::Error::msg)?;
+    let checker = workspace::load_checker(&args.robot, &robot)?;
     let lengths_from = |tasks: &[Task], what: &str| -> anyhow::Result<Vec<f64>> {
         let bar = progress::bar(tasks.len() as u64, what);
         let trajectories = pool.install(|| {

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use emg_control::{
-    ReferenceModel, RolloutConfig, Summary, Task, joint_limit_histogram, read_tasks, rollout_all,
+    RolloutConfig, Summary, Task, joint_limit_histogram, read_tasks, rollout_all,
     termination_histogram,
 };
 use emg_hybrid::{BucketConfig, ControllerKind, Executor, ExecutorConfig};
@@ -278,8 +278,7 @@ fn run_controller(
     let mut check_seconds = None;
     let mut checked = 0;
     if !args.no_check {
-        let checker = ReferenceModel::from_urdf_file(&args.robot, "link0", "pen_tip")
-            .map_err(anyhow::Error::msg)?;
+        let checker = workspace::load_checker(&args.robot, &robot)?;
         let started = Instant::now();
         pool.install(|| {
             protocol::check_trajectories(&checker, &tasks, &trajectories, &rollout.constraints)

@@ -92,8 +92,7 @@ impl Setup {
         diffusion_path: &Path,
     ) -> anyhow::Result<Self> {
         let robot = workspace::load_robot(robot_path)?;
-        let checker = ReferenceModel::from_urdf_file(robot_path, "link0", "pen_tip")
-            .map_err(anyhow::Error::msg)?;
+        let checker = workspace::load_checker(robot_path, &robot)?;
         let diffusion = DenoiserWeights::read(diffusion_path).context(
             "loading the diffusion seeder (train it with `cargo xtask train-diffusion`)",
         )?;

@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use emg_control::ReferenceModel;
 use emg_kinematics::Robot;
 
 /// The workspace root (parent of `xtask/`).
@@ -23,10 +24,16 @@ pub fn relative(path: &Path) -> String {
         .to_string()
 }
 
-/// Loads the robot file (base `link0`, tip `pen_tip`).
+/// Loads a robot file whose links form one chain (base = its root link, tip = its leaf).
 pub fn load_robot(path: &Path) -> anyhow::Result<Robot> {
-    Robot::from_urdf_file(path, "link0", "pen_tip")
-        .with_context(|| format!("loading robot {}", path.display()))
+    Robot::from_chain_file(path).with_context(|| format!("loading robot {}", path.display()))
+}
+
+/// The independent checker of `robot`, read again from its file.
+pub fn load_checker(path: &Path, robot: &Robot) -> anyhow::Result<ReferenceModel> {
+    ReferenceModel::from_urdf_file(path, robot.base_link(), robot.tip_link())
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("loading the checker's model of {}", path.display()))
 }
 
 /// Builds a rayon pool with `threads` threads (0 = one per core).

@@ -63,6 +63,16 @@ pub enum RobotError {
         /// Its URDF type.
         kind: String,
     },
+    /// The file's links do not form one unbranched chain, so its base and tip must be named.
+    #[error(
+        "cannot tell the chain's ends: the file has root links [{roots}] and leaf links [{leaves}]; name the base and tip links"
+    )]
+    AmbiguousChain {
+        /// Links that are no joint's child.
+        roots: String,
+        /// Links that are no joint's parent.
+        leaves: String,
+    },
     /// The chain does not have exactly [`DOF`] revolute joints.
     #[error(
         "the chain from '{base}' to '{tip}' has {found} revolute joints; exactly {DOF} are required"
@@ -153,6 +163,8 @@ pub(crate) struct JointFrame {
 #[derive(Clone, Debug)]
 pub struct Robot {
     pub(crate) name: String,
+    pub(crate) base_link: String,
+    pub(crate) tip_link: String,
     pub(crate) joint_names: Vec<String>,
     pub(crate) joints: [JointFrame; DOF],
     pub(crate) tcp_offset: JointFrame,
@@ -182,6 +194,24 @@ impl Robot {
             source,
         })?;
         Self::from_urdf_str(&text, base_link, tip_link)
+    }
+
+    /// Reads a URDF file whose links form one chain: from its root link to its only leaf link.
+    pub fn from_chain_file(path: impl AsRef<Path>) -> Result<Self, RobotError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_chain_str(&text)
+    }
+
+    /// Reads URDF text whose links form one chain: from its root link to its only leaf link.
+    pub fn from_chain_str(text: &str) -> Result<Self, RobotError> {
+        let urdf =
+            urdf_rs::read_from_string(text).map_err(|e| RobotError::Malformed(e.to_string()))?;
+        let (base, tip) = chain_ends(&urdf)?;
+        Self::from_urdf_str(text, &base, &tip)
     }
 
     /// Reads the chain from `base_link` to `tip_link` of URDF text.
@@ -252,6 +282,8 @@ impl Robot {
             + offset.translation.vector.norm();
         Ok(Self {
             name: urdf.name.clone(),
+            base_link: base_link.into(),
+            tip_link: tip_link.into(),
             joint_names,
             joints,
             tcp_offset: JointFrame {
@@ -273,6 +305,16 @@ impl Robot {
     /// The robot's name from the file.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Name of the chain's base link (the frame every position is expressed in).
+    pub fn base_link(&self) -> &str {
+        &self.base_link
+    }
+
+    /// Name of the chain's tip link (the TCP frame).
+    pub fn tip_link(&self) -> &str {
+        &self.tip_link
     }
 
     /// Names of the seven revolute joints, base to tip.
@@ -308,6 +350,28 @@ impl Robot {
 }
 
 /// The joints from `base` down to `tip`, in order, checking the chain is serial.
+/// The root and the leaf of a file whose links form one unbranched chain.
+fn chain_ends(urdf: &urdf_rs::Robot) -> Result<(String, String), RobotError> {
+    let is_child = |name: &str| urdf.joints.iter().any(|j| j.child.link == name);
+    let is_parent = |name: &str| urdf.joints.iter().any(|j| j.parent.link == name);
+    let names = |keep: &dyn Fn(&str) -> bool| {
+        urdf.links
+            .iter()
+            .map(|l| l.name.as_str())
+            .filter(|name| keep(name))
+            .collect::<Vec<_>>()
+    };
+    let roots = names(&|name| !is_child(name));
+    let leaves = names(&|name| !is_parent(name));
+    match (roots.as_slice(), leaves.as_slice()) {
+        ([root], [leaf]) => Ok((root.to_string(), leaf.to_string())),
+        _ => Err(RobotError::AmbiguousChain {
+            roots: roots.join(", "),
+            leaves: leaves.join(", "),
+        }),
+    }
+}
+
 fn chain_joints<'a>(
     urdf: &'a urdf_rs::Robot,
     base: &str,
