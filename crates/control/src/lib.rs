@@ -1,5 +1,6 @@
 //! Straight-line tasks, their constraints, the one rollout loop every controller shares, the
-//! classical null-space controller, an independent trajectory checker and the task population.
+//! classical null-space controller, an independent trajectory checker, trajectory files a robot
+//! stack can replay, and the task population.
 //!
 //! A controller implements [`NullSpaceController`]: at each step it sees a [`StepContext`]
 //! (kinematics, gradients, the basis `B(q)`, `ρ(q)`) and returns an action `a ∈ [−1, 1]⁴`;
@@ -28,6 +29,7 @@ mod config;
 mod constraints;
 mod controller;
 mod evaluation;
+mod joint_trajectory;
 mod rollout;
 mod sampler;
 mod step;
@@ -41,6 +43,12 @@ pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
 pub use evaluation::{
     Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram,
+};
+pub use joint_trajectory::{
+    CSV_HEADER, DECLARED_VELOCITY_TOLERANCE, GAP_ROUNDING_NOISE_NS, JOINT_TRAJECTORY_FORMAT,
+    JointSamples, JointTrajectory, JointTrajectoryError, JointTrajectoryPoint, ReplayError,
+    ReplayReport, TimeFromStart, VELOCITY_LIMIT_SLACK, check_joint_names, check_replay,
+    point_velocities, read_csv, times_from_start, trajectory_csv,
 };
 pub use rollout::{Episode, StepOutcome, StepRecord, Termination, Trajectory, rollout};
 pub use sampler::{SamplerConfig, TaskSampler, candidate};
