@@ -1,0 +1,66 @@
+//! A self-contained HTML motion viewer: one page that animates a planned straight-line motion.
+//!
+//! [`render_html`] turns a robot, its task, the rollout and the constraints it was planned under
+//! into a single HTML document with inline CSS, inline JavaScript and the motion as an inline
+//! JSON blob; it references nothing outside itself, so it opens from disk without a network.
+//! The page draws on a Canvas 2D (no WebGL) with its own perspective projection:
+//!
+//! * the arm as its collision capsules, the joint origins and the pen highlighted;
+//! * the task line `p0 + s·d` with its start and its lateral tolerance, the tool cone of
+//!   half-angle `θ_max` around `n` at the TCP, the current tool axis and the TCP trace so far;
+//! * a timeline coloured by the controller that acted at each step, play/pause, scrubbing,
+//!   playback speed, mouse-drag orbit and wheel zoom; time, path progress, tool angle and `ρ`
+//!   as text. Playback follows the recorded (possibly non-uniform) timestamps in real time.
+//!
+//! Forward kinematics runs here, once per recorded step; the page only interpolates the world
+//! points between steps by time. Once its first frame is drawn the page sets
+//! `document.body.dataset.status = "rendered"`; an uncaught error or rejection sets it to
+//! `"error: <message>"` instead.
+//!
+//! ```
+//! use emg_control::{ClassicalController, RolloutConfig, Task, rollout};
+//! use emg_kinematics::{Robot, Vec3};
+//! use emg_viewer::{ViewerInput, render_html};
+//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let seed = robot.mid_range();
+//! let kin = robot.forward(&seed);
+//! let task = Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed))?;
+//! let config = RolloutConfig { max_steps: 20, ..RolloutConfig::default() };
+//! let trajectory = rollout(&robot, &task, &seed, &mut ClassicalController::default(), &config);
+//! let page = render_html(&ViewerInput {
+//!     robot: &robot,
+//!     task: &task,
+//!     trajectory: &trajectory,
+//!     constraints: &config.constraints,
+//!     title: "demo line",
+//! });
+//! assert!(page.starts_with("<!DOCTYPE html>"));
+//! assert!(page.contains("<title>demo line</title>"));
+//! assert!(page.contains(r#""theta_max_deg":30.0"#));
+//! assert_eq!(page.matches(r#""controller":"classical""#).count(), 20);
+//! assert!(!page.contains("http://") && !page.contains("https://"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod page;
+mod scene;
+
+pub use page::render_html;
+
+use emg_control::{ConstraintConfig, Task, Trajectory};
+use emg_kinematics::Robot;
+
+/// Everything one viewer page shows: the arm, its task, the planned motion and its limits.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewerInput<'a> {
+    /// The arm that moves (its capsules are drawn).
+    pub robot: &'a Robot,
+    /// The straight-line task `(p0, d, n)`.
+    pub task: &'a Task,
+    /// The planned rollout; its timestamps drive the playback.
+    pub trajectory: &'a Trajectory,
+    /// The constraints it was planned under (line tolerance and tool-cone half-angle are drawn).
+    pub constraints: &'a ConstraintConfig,
+    /// Page title and heading (plain text; escaped as needed).
+    pub title: &'a str,
+}

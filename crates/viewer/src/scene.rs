@@ -1,0 +1,160 @@
+//! The data blob a page animates: world-frame geometry of every recorded step.
+
+use emg_control::{ActingController, StepRecord};
+use emg_kinematics::{DOF, Vec3};
+use serde::Serialize;
+
+use crate::ViewerInput;
+
+/// Metres (and unit-vector components) are written to 10 µm: far below a pixel, and it keeps the
+/// page small.
+const LENGTH_SCALE: f64 = 1e5;
+/// Seconds are written to 1 µs.
+const TIME_SCALE: f64 = 1e6;
+/// Degrees and `ρ` are written to 1e-4.
+const VALUE_SCALE: f64 = 1e4;
+
+/// The page's whole input, serialised as JSON.
+#[derive(Debug, Serialize)]
+pub(crate) struct Scene<'a> {
+    title: &'a str,
+    robot: &'a str,
+    task: SceneTask,
+    constraints: SceneConstraints,
+    capsules: Vec<SceneCapsule<'a>>,
+    path_length_m: f64,
+    termination: String,
+    steps: Vec<SceneStep>,
+}
+
+#[derive(Debug, Serialize)]
+struct SceneTask {
+    p0: [f64; 3],
+    d: [f64; 3],
+    n: [f64; 3],
+}
+
+#[derive(Debug, Serialize)]
+struct SceneConstraints {
+    line_tolerance_m: f64,
+    theta_max_deg: f64,
+}
+
+/// One capsule of the arm; its end points per step are in [`SceneStep::capsules`].
+#[derive(Debug, Serialize)]
+struct SceneCapsule<'a> {
+    link: &'a str,
+    radius: f64,
+    /// Part of the pen (the last link with capsules, after the last joint): drawn highlighted.
+    pen: bool,
+}
+
+/// One recorded step in world coordinates.
+#[derive(Debug, Serialize)]
+struct SceneStep {
+    t: f64,
+    /// Progress `(p − p0)·d` along the line (m).
+    s: f64,
+    /// Lateral distance of the TCP from the line (m).
+    lateral: f64,
+    tool_angle_deg: f64,
+    rho: f64,
+    controller: Option<ActingController>,
+    /// Base origin, then the origin of every joint, then the TCP.
+    joints: Vec<[f64; 3]>,
+    tool_axis: [f64; 3],
+    /// Both end points `[x0, y0, z0, x1, y1, z1]` of every capsule, in capsule order.
+    capsules: Vec<[f64; 6]>,
+}
+
+impl<'a> Scene<'a> {
+    /// Runs forward kinematics on every step of the input's trajectory.
+    pub(crate) fn new(input: &ViewerInput<'a>) -> Self {
+        let ViewerInput {
+            robot,
+            task,
+            trajectory,
+            constraints,
+            title,
+        } = *input;
+        // The pen: the capsules of the chain's last link that has any, on the last segment.
+        let tip_link = robot
+            .capsules()
+            .iter()
+            .filter(|c| c.segment == DOF)
+            .map(|c| c.chain_index)
+            .max();
+        let capsules = robot
+            .capsules()
+            .iter()
+            .map(|c| SceneCapsule {
+                link: &c.link,
+                radius: c.radius,
+                pen: c.segment == DOF && Some(c.chain_index) == tip_link,
+            })
+            .collect();
+        let steps = trajectory
+            .steps
+            .iter()
+            .map(|step| scene_step(input, step))
+            .collect();
+        Self {
+            title,
+            robot: robot.name(),
+            task: SceneTask {
+                p0: point(&task.p0),
+                d: point(&task.d),
+                n: point(&task.n),
+            },
+            constraints: SceneConstraints {
+                line_tolerance_m: constraints.line_tolerance_m,
+                theta_max_deg: constraints.theta_max_deg,
+            },
+            capsules,
+            path_length_m: length(trajectory.path_length_m),
+            termination: trajectory.termination.to_string(),
+            steps,
+        }
+    }
+}
+
+fn scene_step(input: &ViewerInput<'_>, step: &StepRecord) -> SceneStep {
+    let kin = input.robot.forward(&step.q);
+    let tcp = kin.tcp();
+    let mut joints = Vec::with_capacity(DOF + 2);
+    joints.push(point(&kin.segment_point(0, &Vec3::zeros())));
+    joints.extend((0..DOF).map(|i| point(&kin.joint_origin(i))));
+    joints.push(point(&tcp));
+    let capsules = input
+        .robot
+        .capsules()
+        .iter()
+        .map(|c| {
+            let [a, b] = [&c.start, &c.end].map(|p| point(&kin.segment_point(c.segment, p)));
+            [a[0], a[1], a[2], b[0], b[1], b[2]]
+        })
+        .collect();
+    SceneStep {
+        t: round(step.time_s, TIME_SCALE),
+        s: length(input.task.progress(&tcp)),
+        lateral: length(input.task.lateral_error(&tcp).norm()),
+        tool_angle_deg: round(step.tool_angle_deg, VALUE_SCALE),
+        rho: round(step.rho, VALUE_SCALE),
+        controller: step.controller,
+        joints,
+        tool_axis: point(&kin.tool_axis()),
+        capsules,
+    }
+}
+
+fn point(p: &Vec3) -> [f64; 3] {
+    [length(p.x), length(p.y), length(p.z)]
+}
+
+fn length(x: f64) -> f64 {
+    round(x, LENGTH_SCALE)
+}
+
+fn round(x: f64, scale: f64) -> f64 {
+    (x * scale).round() / scale
+}
