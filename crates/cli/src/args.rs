@@ -20,6 +20,47 @@ pub struct Cli {
 pub enum Command {
     /// Plan straight-line motions: seed, roll out a controller, write the trajectories.
     Plan(PlanArgs),
+    /// Verify a trajectory file (emg-trajectory/1 JSON, emg-joint-trajectory/1 JSON or the CSV)
+    /// with the independent checker; exit status 1 names the point and the constraint.
+    #[command(visible_alias = "replay")]
+    Check(CheckArgs),
+}
+
+/// Options of `emg check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json` or `<stem>.csv`.
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// Robot description (URDF). Default: the file's `robot` field (a JSON file, or the
+    /// --task-from file for a CSV), else the FR3-with-pen file shipped in data/robots/.
+    #[arg(long, value_name = "URDF")]
+    pub robot: Option<PathBuf>,
+    /// Base link of the kinematic chain.
+    #[arg(long, default_value = "link0")]
+    pub base_link: String,
+    /// Tip link of the chain (the TCP; its z-axis is the tool axis).
+    #[arg(long, default_value = "pen_tip")]
+    pub tip_link: String,
+    /// Take the task (and, without --config, the constraints) from this emg-trajectory/1 or
+    /// emg-joint-trajectory/1 file instead of FILE (a CSV carries none).
+    #[arg(long, value_name = "JSON", conflicts_with = "p0")]
+    pub task_from: Option<PathBuf>,
+    /// Task start position p0 (m), as x,y,z, instead of the file's task. Needs --d and --n.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["d", "n"])]
+    pub p0: Option<[f64; 3]>,
+    /// Task motion direction d, as x,y,z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "n"])]
+    pub d: Option<[f64; 3]>,
+    /// Task-plane normal n, as x,y,z.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "d"])]
+    pub n: Option<[f64; 3]>,
+    /// JSON file as for `plan --config`: its `rollout.constraints` replace the file's.
+    #[arg(long, value_name = "JSON")]
+    pub config: Option<PathBuf>,
 }
 
 /// Options of `emg plan`.
@@ -60,8 +101,8 @@ pub struct PlanArgs {
     /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
-    /// Output path stem: writes STEM.json and STEM.csv (STEM-00000.json/.csv, ... for a task
-    /// file holding several tasks).
+    /// Output path stem: writes STEM.json, STEM.csv and STEM.joint_trajectory.json
+    /// (STEM-00000.json, ... for a task file holding several tasks).
     #[arg(long, value_name = "STEM", default_value = "trajectory")]
     pub out: PathBuf,
     /// Null-space controller.

@@ -4,6 +4,7 @@
 //! emg plan                                   # built-in demo task → trajectory.json, trajectory.csv
 //! emg plan --p0 0.4,0.1,0.3 --d 0,1,0 --n 0,0,-1 --seed home --out runs/line
 //! emg plan --task-file tasks.json --config plan.json --out runs/set   # runs/set-00000.json, ...
+//! emg check runs/line.joint_trajectory.json  # verify a file with the independent checker
 //! ```
 //!
 //! * Robot: `--robot <urdf>` (default: the FR3-with-pen file in `data/robots/`), `--base-link`
@@ -22,14 +23,19 @@
 //! * `--controller hybrid` (default: the PPO policy over `--policy`, default the shipped
 //!   `data/models/ppo-v1.weights`, inside; the classical controller near the joint limits),
 //!   `rl` or `classical`.
-//! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv`; a task file with several
-//!   tasks gives `<stem>-00000.json/.csv`, `<stem>-00001...` and so on, each written as soon as
-//!   its task is planned. Parent directories are created.
+//! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv` +
+//!   `<stem>.joint_trajectory.json`; a task file with several tasks gives `<stem>-00000.json`,
+//!   ... and so on, each written as soon as its task is planned. Parent directories are created.
 //!
-//! The file layout is documented in `docs/trajectory-format.md`. Errors go to stderr with a
+//! `emg check <FILE>` (alias `replay`) reads any of the three files back and verifies it with
+//! the independent checker (`--robot`, `--task-from`, `--p0/--d/--n`, `--config` as needed).
+//!
+//! The file layouts are documented in `docs/trajectory-format.md` and
+//! `docs/joint-trajectory-format.md`. Errors go to stderr with a
 //! nonzero exit status; with several tasks a failing task is reported and the rest still run.
 
 mod args;
+mod check;
 mod output;
 mod plan;
 mod seed;
@@ -46,12 +52,15 @@ use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder};
 use emg_policy::{PolicyWeights, RlController};
 
 use crate::args::{Cli, Command, PlanArgs, SeedRequest};
-use crate::output::{TrajectoryFile, result_paths, write_result};
+use crate::output::{
+    TrajectoryFile, joint_trajectory_path, result_paths, write_joint_trajectory, write_result,
+};
 use crate::settings::Settings;
 
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Command::Plan(args) => run_plan(&args),
+        Command::Check(args) => check::run_check(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -166,6 +175,16 @@ fn plan_and_write(
         trajectory,
     );
     write_result(&file, &json_path, &csv_path)?;
+    let joint_path = joint_trajectory_path(&args.out, index);
+    let joint_file = emg_control::JointTrajectory::new(
+        &file.robot,
+        robot.joint_names(),
+        task,
+        &settings.rollout.constraints,
+        trajectory,
+    )
+    .context("cannot build the joint trajectory")?;
+    write_joint_trajectory(&joint_file, &joint_path)?;
     let steps = trajectory.steps.len() - 1;
     let duration = trajectory.steps.last().map_or(0.0, |s| s.time_s);
     let projected = match plan.seed.projection_iterations {
@@ -174,11 +193,12 @@ fn plan_and_write(
     };
     Ok(format!(
         "path length {:.4} m, {steps} steps, {duration:.2} s; ended: {}\n  \
-         seed: {}{projected}\n  wrote {} and {}",
+         seed: {}{projected}\n  wrote {}, {} and {}",
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,
         json_path.display(),
-        csv_path.display()
+        csv_path.display(),
+        joint_path.display()
     ))
 }

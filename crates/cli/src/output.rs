@@ -1,12 +1,15 @@
-//! The result files: `<stem>.json` (format `emg-trajectory/1`) and `<stem>.csv`.
-//! The layout is documented in `docs/trajectory-format.md`.
+//! The result files: `<stem>.json` (format `emg-trajectory/1`), `<stem>.csv` and
+//! `<stem>.joint_trajectory.json` (format `emg-joint-trajectory/1`). The layouts are documented
+//! in `docs/trajectory-format.md` and `docs/joint-trajectory-format.md`.
 
 use std::ffi::OsString;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use emg_control::{ClassicalGains, RolloutConfig, StepRecord, Task, Termination, Trajectory};
+use emg_control::{
+    ClassicalGains, JointTrajectory, RolloutConfig, StepRecord, Task, Termination, Trajectory,
+    trajectory_csv,
+};
 use serde::Serialize;
 
 /// Value of the `format` field of every trajectory file this build writes.
@@ -71,16 +74,26 @@ impl<'a> TrajectoryFile<'a> {
 /// The `.json` and `.csv` paths for `stem`: `<stem>.json`, or `<stem>-00007.json` for task 7
 /// of a multi-task run (`index = Some(7)`).
 pub fn result_paths(stem: &Path, index: Option<usize>) -> (PathBuf, PathBuf) {
-    let mut base = OsString::from(stem.as_os_str());
+    (
+        suffixed(stem, index, ".json"),
+        suffixed(stem, index, ".csv"),
+    )
+}
+
+/// The joint-trajectory path for `stem` by the same rule: `<stem>.joint_trajectory.json`, or
+/// `<stem>-00007.joint_trajectory.json` for task 7 of a multi-task run.
+pub fn joint_trajectory_path(stem: &Path, index: Option<usize>) -> PathBuf {
+    suffixed(stem, index, ".joint_trajectory.json")
+}
+
+/// `stem`, then `-iiiii` for task `index`, then `ext`, appended as text.
+fn suffixed(stem: &Path, index: Option<usize>, ext: &str) -> PathBuf {
+    let mut name = OsString::from(stem.as_os_str());
     if let Some(i) = index {
-        base.push(format!("-{i:05}"));
+        name.push(format!("-{i:05}"));
     }
-    let with = |ext: &str| {
-        let mut name = base.clone();
-        name.push(ext);
-        PathBuf::from(name)
-    };
-    (with(".json"), with(".csv"))
+    name.push(ext);
+    PathBuf::from(name)
 }
 
 /// Writes `file` as JSON to `json_path` and its steps as CSV to `csv_path`, creating parent
@@ -89,26 +102,14 @@ pub fn write_result(file: &TrajectoryFile<'_>, json_path: &Path, csv_path: &Path
     let mut json = serde_json::to_string(file).context("cannot serialise the trajectory")?;
     json.push('\n');
     write_atomic(json_path, &json)?;
-    write_atomic(csv_path, &csv(file.steps))
+    write_atomic(csv_path, &trajectory_csv(file.steps))
 }
 
-/// The CSV table of `steps`: header `time_s,q1..q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller`.
-pub fn csv(steps: &[StepRecord]) -> String {
-    let mut out = String::from(
-        "time_s,q1,q2,q3,q4,q5,q6,q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller\n",
-    );
-    for step in steps {
-        let mut row = vec![step.time_s];
-        row.extend(step.q.iter());
-        row.extend(step.tcp.iter());
-        row.extend([step.tool_angle_deg, step.rho]);
-        for value in row {
-            let _ = write!(out, "{value:?},");
-        }
-        out.push_str(step.controller.map_or("", |c| c.name()));
-        out.push('\n');
-    }
-    out
+/// Writes `file` as JSON to `path` (temporary name, then renamed into place).
+pub fn write_joint_trajectory(file: &JointTrajectory, path: &Path) -> Result<()> {
+    let mut json = file.to_json();
+    json.push('\n');
+    write_atomic(path, &json)
 }
 
 fn write_atomic(path: &Path, contents: &str) -> Result<()> {

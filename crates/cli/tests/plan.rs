@@ -115,13 +115,14 @@ fn demo_task_writes_documented_json_and_csv() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "time_s,q1,q2,q3,q4,q5,q6,q7,tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller"
+        "time_s,q1,q2,q3,q4,q5,q6,q7,qd1,qd2,qd3,qd4,qd5,qd6,qd7,\
+         tcp_x,tcp_y,tcp_z,tool_angle_deg,rho,controller"
     );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), steps.len());
-    assert!(rows.iter().all(|r| r.split(',').count() == 14));
+    assert!(rows.iter().all(|r| r.split(',').count() == 21));
     let first: Vec<&str> = rows[0].split(',').collect();
-    assert_eq!(first[13], steps[0]["controller"].as_str().unwrap());
+    assert_eq!(first[20], steps[0]["controller"].as_str().unwrap());
     let q1: f64 = first[1].parse().unwrap();
     assert_eq!(q1, steps[0]["q"][0].as_f64().unwrap());
     std::fs::remove_dir_all(&dir).ok();

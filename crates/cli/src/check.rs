@@ -1,0 +1,322 @@
+//! `emg check`: read a trajectory file back and verify it with the independent checker.
+//!
+//! Reads `emg-trajectory/1` JSON, `emg-joint-trajectory/1` JSON or the CSV (told apart by the
+//! content: JSON starts with `{`, and its `format` field names the layout), resolves the robot,
+//! the task and the constraints, and runs [`emg_control::check_replay`]. The layouts and what is
+//! verified are documented in `docs/joint-trajectory-format.md`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+use emg_control::{
+    ConstraintConfig, JOINT_TRAJECTORY_FORMAT, JointSamples, JointTrajectory, ReferenceModel,
+    ReplayError, ReplayReport, RolloutConfig, Task, Trajectory, check_joint_names, check_replay,
+    read_csv,
+};
+use emg_kinematics::{Robot, Vec3};
+use serde_json::Value;
+
+use crate::args::CheckArgs;
+use crate::output::TRAJECTORY_FORMAT;
+use crate::settings::Settings;
+
+/// What a trajectory file holds, by layout.
+enum Contents {
+    /// `emg-trajectory/1`: the rollout as recorded.
+    Rollout(RolloutFile),
+    /// `emg-joint-trajectory/1`.
+    Joint(JointTrajectory),
+    /// The CSV: times, positions and declared velocities only.
+    Csv(JointSamples),
+}
+
+/// The parts of an `emg-trajectory/1` file the check reads.
+struct RolloutFile {
+    robot: String,
+    joint_names: Vec<String>,
+    task: Task,
+    constraints: ConstraintConfig,
+    trajectory: Trajectory,
+}
+
+/// Task and constraints a JSON file carries, with the robot it names.
+struct Carried {
+    robot: String,
+    task: Task,
+    constraints: ConstraintConfig,
+}
+
+impl Contents {
+    /// Reads `path`; errors name the file, the field or CSV cell, and what is wrong.
+    fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let contents = if text.trim_start().starts_with('{') {
+            read_json(&text)
+        } else {
+            read_csv(&text).map(Self::Csv).map_err(anyhow::Error::from)
+        };
+        contents.with_context(|| format!("{} is not a readable trajectory file", path.display()))
+    }
+
+    fn layout(&self) -> &'static str {
+        match self {
+            Self::Rollout(_) => TRAJECTORY_FORMAT,
+            Self::Joint(_) => JOINT_TRAJECTORY_FORMAT,
+            Self::Csv(_) => "CSV",
+        }
+    }
+
+    /// Task, constraints and robot the file carries (none for a CSV).
+    fn carried(&self) -> Option<Carried> {
+        match self {
+            Self::Rollout(file) => Some(Carried {
+                robot: file.robot.clone(),
+                task: file.task.clone(),
+                constraints: file.constraints.clone(),
+            }),
+            Self::Joint(file) => Some(Carried {
+                robot: file.robot.clone(),
+                task: file.task.clone(),
+                constraints: file.constraints.clone(),
+            }),
+            Self::Csv(_) => None,
+        }
+    }
+
+    fn joint_names(&self) -> Option<&[String]> {
+        match self {
+            Self::Rollout(file) => Some(&file.joint_names),
+            Self::Joint(file) => Some(&file.joint_names),
+            Self::Csv(_) => None,
+        }
+    }
+
+    fn samples(&self) -> JointSamples {
+        match self {
+            Self::Rollout(file) => JointSamples::from_steps(&file.trajectory.steps),
+            Self::Joint(file) => file.samples(),
+            Self::Csv(samples) => samples.clone(),
+        }
+    }
+}
+
+/// A JSON trajectory file of either layout, by its `format` field.
+fn read_json(text: &str) -> Result<Contents> {
+    let doc: Value = serde_json::from_str(text).context("not valid JSON")?;
+    let format = doc
+        .get("format")
+        .context("field 'format' is missing")?
+        .as_str()
+        .with_context(|| format!("field 'format' is {}, expected a string", doc["format"]))?;
+    match format {
+        TRAJECTORY_FORMAT => read_rollout(&doc).map(Contents::Rollout),
+        JOINT_TRAJECTORY_FORMAT => Ok(Contents::Joint(JointTrajectory::from_json(text)?)),
+        other => bail!(
+            "field 'format' is {other:?}, expected {TRAJECTORY_FORMAT:?} or \
+             {JOINT_TRAJECTORY_FORMAT:?}"
+        ),
+    }
+}
+
+/// The parts of an `emg-trajectory/1` document the check needs.
+fn read_rollout(doc: &Value) -> Result<RolloutFile> {
+    let field = |name: &str| {
+        doc.get(name)
+            .with_context(|| format!("field '{name}' is missing"))
+    };
+    let robot = field("robot")?
+        .as_str()
+        .context("field 'robot' is not a string")?
+        .to_string();
+    let joint_names = serde_json::from_value(field("joint_names")?.clone())
+        .context("field 'joint_names' is not an array of strings")?;
+    let task = serde_json::from_value(field("task")?.clone()).context("field 'task'")?;
+    let config: RolloutConfig =
+        serde_json::from_value(field("config")?.clone()).context("field 'config'")?;
+    for name in ["steps", "termination", "path_length_m"] {
+        field(name)?;
+    }
+    let trajectory = serde_json::from_value(doc.clone())
+        .context("fields 'steps', 'termination', 'path_length_m'")?;
+    Ok(RolloutFile {
+        robot,
+        joint_names,
+        task,
+        constraints: config.constraints,
+        trajectory,
+    })
+}
+
+/// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
+pub fn run_check(args: &CheckArgs) -> Result<()> {
+    let file = &args.file;
+    let contents = Contents::read(file)?;
+    let carried = contents.carried();
+    let task_from = match args.task_from.as_deref() {
+        Some(path) => Some((path, read_task_from(path)?)),
+        None => None,
+    };
+
+    let robot_path = match (&args.robot, &task_from, &carried) {
+        (Some(path), _, _) => path.clone(),
+        (None, _, Some(c)) => named_robot(&c.robot, file)?,
+        (None, Some((path, c)), None) => named_robot(&c.robot, path)?,
+        (None, None, None) => emg_kinematics::default_robot_path(),
+    };
+    let robot = Robot::from_urdf_file(&robot_path, &args.base_link, &args.tip_link)
+        .with_context(|| format!("cannot load robot {}", robot_path.display()))?;
+    let model = ReferenceModel::from_urdf_file(&robot_path, &args.base_link, &args.tip_link)
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("the checker cannot load robot {}", robot_path.display()))?;
+
+    let (task, task_origin) = match (args.p0, args.d, args.n, &task_from, &carried) {
+        (Some(p0), Some(d), Some(n), _, _) => (
+            Task::new(&robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), None)
+                .context("invalid task given on the command line")?,
+            "--p0/--d/--n".to_string(),
+        ),
+        (_, _, _, Some((path, c)), _) => (
+            validated(&robot, &c.task)
+                .with_context(|| format!("field 'task' of {}", path.display()))?,
+            format!("--task-from {}", path.display()),
+        ),
+        (_, _, _, None, Some(c)) => (
+            validated(&robot, &c.task)
+                .with_context(|| format!("field 'task' of {}", file.display()))?,
+            "the file".to_string(),
+        ),
+        _ => bail!(
+            "{} is a CSV file, which carries no task: give --task-from <emg-trajectory JSON> or \
+             --p0 x,y,z --d x,y,z --n x,y,z",
+            file.display()
+        ),
+    };
+    let (constraints, constraints_origin) = match (&args.config, &carried, &task_from) {
+        (Some(path), _, _) => (
+            Settings::load(Some(path))?.rollout.constraints,
+            format!("--config {}", path.display()),
+        ),
+        (None, Some(c), _) => (c.constraints.clone(), "the file".to_string()),
+        (None, None, Some((path, c))) => (
+            c.constraints.clone(),
+            format!("--task-from {}", path.display()),
+        ),
+        (None, None, None) => (ConstraintConfig::default(), "the defaults".to_string()),
+    };
+
+    if let Some(names) = contents.joint_names() {
+        check_joint_names(names, robot.joint_names())
+            .with_context(|| format!("{} does not hold up", file.display()))?;
+    }
+    let samples = contents.samples();
+    // The recorded trajectory is verified as recorded (its TCP, tool angles, path length and
+    // end) only against its own task: its tool angles are measured from that task's normal.
+    let own_task = args.p0.is_none() && task_from.is_none();
+    let recorded = match &contents {
+        Contents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
+        _ => None,
+    };
+    let report = match check_replay(&model, &task, &constraints, &samples, recorded) {
+        Ok(report) => report,
+        Err(ReplayError::Point { point, problem }) => {
+            let at = samples
+                .time_s
+                .get(point)
+                .map_or(String::new(), |t| format!(" (t = {t} s)"));
+            bail!(
+                "{} does not hold up: point {point} of {}{at}: {problem}",
+                file.display(),
+                samples.len()
+            );
+        }
+        Err(error) => bail!("{} does not hold up: {error}", file.display()),
+    };
+
+    println!(
+        "{}: {}, robot {}",
+        file.display(),
+        contents.layout(),
+        robot_path.display()
+    );
+    println!(
+        "  task from {task_origin}; constraints from {constraints_origin}: {}",
+        describe(&constraints)
+    );
+    print_report(&report);
+    println!(
+        "  {}",
+        match recorded {
+            Some(trajectory) => format!("recorded end verified: {}", trajectory.termination),
+            None => "not verifiable from this file: why the motion ended".to_string(),
+        }
+    );
+    println!("OK");
+    Ok(())
+}
+
+/// Task and constraints of a `--task-from` file (either JSON layout).
+fn read_task_from(path: &Path) -> Result<Carried> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let contents = read_json(&text)
+        .with_context(|| format!("--task-from {}: not a trajectory JSON file", path.display()))?;
+    contents
+        .carried()
+        .with_context(|| format!("--task-from {}: carries no task", path.display()))
+}
+
+/// The robot file a trajectory file names; it must exist (paths are as given to `emg plan`,
+/// relative to the working directory).
+fn named_robot(robot: &str, file: &Path) -> Result<PathBuf> {
+    let path = PathBuf::from(robot);
+    anyhow::ensure!(
+        path.is_file(),
+        "field 'robot' of {} names {robot}, which is not a file here; give --robot <URDF>",
+        file.display()
+    );
+    Ok(path)
+}
+
+/// `task` validated by [`Task::new`] (a validated task comes back bit for bit).
+fn validated(robot: &Robot, task: &Task) -> Result<Task> {
+    Ok(Task::new(robot, task.p0, task.d, task.n, task.q0_seed)?)
+}
+
+fn describe(constraints: &ConstraintConfig) -> String {
+    let speeds = match constraints.velocity_limit_fraction {
+        Some(fraction) => format!("joint speeds ≤ {} × limit", fraction.get()),
+        None => "joint speeds not limited".to_string(),
+    };
+    format!(
+        "line {} mm, cone {}°, clearance ≥ {} mm, {speeds}",
+        constraints.line_tolerance_m * 1e3,
+        constraints.theta_max_deg,
+        constraints.collision_margin_m * 1e3
+    )
+}
+
+fn print_report(report: &ReplayReport) {
+    println!(
+        "  {} points, {:.3} s, path length {:.4} m",
+        report.points, report.duration_s, report.path_length_m
+    );
+    let peaks: Vec<String> = report
+        .peak_speed_fraction
+        .iter()
+        .map(|f| format!("{f:.3}"))
+        .collect();
+    println!("  peak joint speed / limit: {}", peaks.join(" "));
+    let (clearance, a, b) = &report.min_clearance;
+    println!(
+        "  max line deviation {:.3} mm, max tool angle {:.2}°, min clearance {:.1} mm ({a}, {b})",
+        report.max_line_deviation_m * 1e3,
+        report.max_tool_angle_deg,
+        clearance * 1e3
+    );
+    if let Some(error) = report.max_declared_velocity_error {
+        println!(
+            "  declared velocities agree with positions and times (largest difference {error:.1e} rad/s)"
+        );
+    }
+}

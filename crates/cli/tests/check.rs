@@ -1,0 +1,364 @@
+//! End-to-end tests of `emg check`: plan a real task with the binary, verify each of the three
+//! files it writes, then tamper with them and expect exit status 1 naming the point and the
+//! constraint.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde_json::Value;
+
+/// Velocity-limit fraction of the planned task: low enough that many steps are slowed, so the
+/// times are not uniform.
+const FRACTION: f64 = 0.05;
+
+/// A fresh, empty directory under the system temp dir, unique to this test run.
+fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!(
+        "emg-check-{name}-{}-{nanos}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+fn emg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(args)
+        .output()
+        .expect("run emg")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Plans the demo task with the classical controller from its generating configuration (no
+/// model to load) and returns the output stem.
+fn plan(dir: &Path) -> PathBuf {
+    let config = dir.join("plan.json");
+    std::fs::write(
+        &config,
+        format!(r#"{{"rollout": {{"constraints": {{"velocity_limit_fraction": {FRACTION}}}}}}}"#),
+    )
+    .unwrap();
+    let stem = dir.join("demo");
+    let output = emg(&[
+        "plan",
+        "--controller",
+        "classical",
+        "--seed",
+        "generating",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    assert!(stdout.contains("demo.joint_trajectory.json"), "{stdout}");
+    stem
+}
+
+fn with_ext(stem: &Path, ext: &str) -> PathBuf {
+    PathBuf::from(format!("{}{ext}", stem.display()))
+}
+
+/// Runs `emg check` with `args`, asserting success; returns stdout.
+fn check_ok(args: &[&str]) -> String {
+    let output = emg(&[&["check"], args].concat());
+    assert!(
+        output.status.success(),
+        "emg check {args:?} failed: {}",
+        text(&output.stderr)
+    );
+    let stdout = text(&output.stdout);
+    assert!(stdout.trim_end().ends_with("OK"), "{stdout}");
+    stdout
+}
+
+/// Runs `emg check` with `args`, asserting exit status 1; returns stderr.
+fn check_err(args: &[&str]) -> String {
+    let output = emg(&[&["check"], args].concat());
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "emg check {args:?} should fail with status 1: {}",
+        text(&output.stdout)
+    );
+    text(&output.stderr)
+}
+
+fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Writes `doc` next to the original and returns the path as a string.
+fn write_json(dir: &Path, name: &str, doc: &Value) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn every_file_of_a_plan_passes_and_tampering_is_caught() {
+    let dir = temp_dir("files");
+    let stem = plan(&dir);
+    let json = with_ext(&stem, ".json");
+    let csv = with_ext(&stem, ".csv");
+    let joint = with_ext(&stem, ".joint_trajectory.json");
+
+    let out = check_ok(&[json.to_str().unwrap()]);
+    assert!(
+        out.contains("emg-trajectory/1") && out.contains("recorded end verified"),
+        "{out}"
+    );
+    let out = check_ok(&[joint.to_str().unwrap()]);
+    assert!(out.contains("emg-joint-trajectory/1"), "{out}");
+    assert!(out.contains("declared velocities agree"), "{out}");
+    assert!(
+        out.contains("not verifiable from this file: why the motion ended"),
+        "{out}"
+    );
+    // The slowed steps run at the limit fraction: the peak is reported as such.
+    assert!(out.contains(&format!("{FRACTION:.3}")), "{out}");
+    let points = read_json(&joint)["points"].as_array().unwrap().len();
+    assert!(out.contains(&format!("{points} points")), "{out}");
+    // `replay` is an alias.
+    let output = emg(&["replay", joint.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+
+    // The CSV carries no task: it comes from --task-from or --p0/--d/--n.
+    let err = check_err(&[csv.to_str().unwrap()]);
+    assert!(
+        err.contains("carries no task") && err.contains("--task-from"),
+        "{err}"
+    );
+    let out = check_ok(&[csv.to_str().unwrap(), "--task-from", json.to_str().unwrap()]);
+    assert!(
+        out.contains("CSV") && out.contains("declared velocities agree"),
+        "{out}"
+    );
+    let task = &read_json(&json)["task"];
+    let vec3 = |field: &str| {
+        let v: Vec<String> = task[field]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| format!("{:?}", x.as_f64().unwrap()))
+            .collect();
+        v.join(",")
+    };
+    let (p0, d, n) = (vec3("p0"), vec3("d"), vec3("n"));
+    check_ok(&[csv.to_str().unwrap(), "--p0", &p0, "--d", &d, "--n", &n]);
+
+    // Timestamps are non-uniform (slowed steps) and on the nanosecond grid.
+    let good = read_json(&joint);
+    let seconds = |point: &Value| {
+        let t = &point["time_from_start"];
+        t["sec"].as_f64().unwrap() + t["nanosec"].as_f64().unwrap() / 1e9
+    };
+    let pts = good["points"].as_array().unwrap();
+    let gaps: Vec<f64> = pts
+        .windows(2)
+        .map(|w| seconds(&w[1]) - seconds(&w[0]))
+        .collect();
+    assert!(gaps.iter().any(|g| (g - 0.05).abs() > 1e-3), "{gaps:?}");
+    let k = pts.len() / 2;
+
+    let tamper = |name: &str, edit: &dyn Fn(&mut Value)| {
+        let mut doc = good.clone();
+        edit(&mut doc);
+        check_err(&[&write_json(&dir, name, &doc)])
+    };
+    let err = tamper("limit.json", &|doc| {
+        doc["points"][k]["positions"][0] = 2.9.into();
+    });
+    assert!(
+        err.contains(&format!("point {k} of")) && err.contains("joint 1 = 2.9 outside"),
+        "{err}"
+    );
+    let err = tamper("line.json", &|doc| {
+        let q = doc["points"][k]["positions"][1].as_f64().unwrap();
+        doc["points"][k]["positions"][1] = (q + 0.1).into();
+    });
+    assert!(
+        err.contains(&format!("point {k} of")) && err.contains("off the line"),
+        "{err}"
+    );
+    let err = tamper("fast.json", &|doc| {
+        // The gap before point k shrinks to a hundredth.
+        let gap_ns = ((seconds(&pts[k]) - seconds(&pts[k - 1])) * 1e9).round() as u64;
+        let start = (seconds(&pts[k - 1]) * 1e9).round() as u64 + gap_ns / 100;
+        doc["points"][k]["time_from_start"] =
+            serde_json::json!({"sec": start / 1_000_000_000, "nanosec": start % 1_000_000_000});
+    });
+    assert!(
+        err.contains(&format!("point {k} of")) && err.contains("rad/s, above"),
+        "{err}"
+    );
+    let err = tamper("names.json", &|doc| {
+        doc["joint_names"][2] = "fr3_joint9".into();
+    });
+    assert!(
+        err.contains("joint_names") && err.contains("same order"),
+        "{err}"
+    );
+    let err = tamper("order.json", &|doc| {
+        let names = doc["joint_names"].as_array_mut().unwrap();
+        names.swap(0, 1);
+    });
+    assert!(
+        err.contains("joint_names") && err.contains("fr3_joint2"),
+        "{err}"
+    );
+    let err = tamper("declared.json", &|doc| {
+        let v = doc["points"][k]["velocities"][3].as_f64().unwrap();
+        doc["points"][k]["velocities"][3] = (v + 0.001).into();
+    });
+    assert!(
+        err.contains(&format!("point {k} of")) && err.contains("declared velocity of joint 4"),
+        "{err}"
+    );
+    let err = tamper("declared-fast.json", &|doc| {
+        doc["points"][k]["velocities"][0] = 1.0.into();
+    });
+    assert!(
+        err.contains("declared velocity of joint 1") && err.contains("× its limit"),
+        "{err}"
+    );
+
+    // A too-fast step in the CSV: the time of point k moves close to point k - 1.
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let mut lines: Vec<String> = table.lines().map(str::to_string).collect();
+    let time = |line: &str| line.split(',').next().unwrap().parse::<f64>().unwrap();
+    let (before, at) = (time(&lines[k]), time(&lines[k + 1]));
+    let rest = lines[k + 1].split_once(',').unwrap().1.to_string();
+    lines[k + 1] = format!("{:?},{rest}", before + (at - before) / 100.0);
+    let fast_csv = dir.join("fast.csv");
+    std::fs::write(&fast_csv, lines.join("\n")).unwrap();
+    let err = check_err(&[
+        fast_csv.to_str().unwrap(),
+        "--task-from",
+        json.to_str().unwrap(),
+    ]);
+    assert!(
+        err.contains(&format!("point {k} of")) && err.contains("rad/s, above"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn malformed_files_name_the_file_and_the_field() {
+    let dir = temp_dir("malformed");
+    let stem = plan(&dir);
+    let joint = read_json(&with_ext(&stem, ".joint_trajectory.json"));
+
+    let mut doc = joint.clone();
+    doc["format"] = "emg-joint-trajectory/2".into();
+    let path = write_json(&dir, "format.json", &doc);
+    let err = check_err(&[&path]);
+    assert!(
+        err.contains(&path)
+            && err.contains("field 'format'")
+            && err.contains("emg-joint-trajectory/2"),
+        "{err}"
+    );
+
+    let mut doc = joint.clone();
+    doc["points"][3]["positions"].as_array_mut().unwrap().pop();
+    let path = write_json(&dir, "count.json", &doc);
+    let err = check_err(&[&path]);
+    assert!(
+        err.contains(&path) && err.contains("'points[3].positions' has 6 values, expected 7"),
+        "{err}"
+    );
+
+    let mut doc = joint.clone();
+    doc["joint_names"].as_array_mut().unwrap().pop();
+    let err = check_err(&[&write_json(&dir, "names.json", &doc)]);
+    assert!(
+        err.contains("'joint_names' has 6 entries, expected 7"),
+        "{err}"
+    );
+
+    let mut doc = read_json(&with_ext(&stem, ".json"));
+    doc.as_object_mut().unwrap().remove("task");
+    let err = check_err(&[&write_json(&dir, "notask.json", &doc)]);
+    assert!(err.contains("field 'task' is missing"), "{err}");
+
+    let table = std::fs::read_to_string(with_ext(&stem, ".csv")).unwrap();
+    let mut lines: Vec<String> = table.lines().map(str::to_string).collect();
+    let mut cells: Vec<String> = lines[4].split(',').map(str::to_string).collect();
+    cells[3] = "abc".into();
+    lines[4] = cells.join(",");
+    let bad_csv = dir.join("bad.csv");
+    std::fs::write(&bad_csv, lines.join("\n")).unwrap();
+    let err = check_err(&[
+        bad_csv.to_str().unwrap(),
+        "--task-from",
+        &with_ext(&stem, ".json").to_string_lossy(),
+    ]);
+    assert!(
+        err.contains(bad_csv.to_str().unwrap())
+            && err.contains("CSV line 5, column 4 ('q3'): 'abc' is not a finite number"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_task_set_writes_one_joint_trajectory_per_task() {
+    let dir = temp_dir("set");
+    let robot = emg_kinematics::Robot::from_urdf_file(
+        emg_kinematics::default_robot_path(),
+        "link0",
+        "pen_tip",
+    )
+    .unwrap();
+    let mid = robot.mid_range();
+    let tasks: Vec<Value> = [
+        mid,
+        mid + emg_kinematics::JointVector::from([0.3, 0.2, -0.2, 0.3, 0.1, -0.2, 0.4]),
+    ]
+    .iter()
+    .map(|q| {
+        let kin = robot.forward(q);
+        let n = kin.tool_axis();
+        let y = emg_kinematics::Vec3::y();
+        let d = (y - n * y.dot(&n)).normalize();
+        serde_json::json!({
+            "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(),
+            "q0_seed": q.as_slice(),
+        })
+    })
+    .collect();
+    let task_file = dir.join("tasks.json");
+    std::fs::write(&task_file, Value::from(tasks).to_string()).unwrap();
+    let stem = dir.join("out/set");
+    let output = emg(&[
+        "plan",
+        "--task-file",
+        task_file.to_str().unwrap(),
+        "--controller",
+        "classical",
+        "--seed",
+        "generating",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    for i in 0..2 {
+        let path = dir.join(format!("out/set-{i:05}.joint_trajectory.json"));
+        check_ok(&[path.to_str().unwrap()]);
+    }
+    assert!(!dir.join("out/set.joint_trajectory.json").exists());
+    assert!(!dir.join("out/set-00002.joint_trajectory.json").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
