@@ -105,6 +105,10 @@ pub struct PlanArgs {
     /// (STEM-00000.json, ... for a task file holding several tasks).
     #[arg(long, value_name = "STEM", default_value = "trajectory")]
     pub out: PathBuf,
+    /// Also write a self-contained HTML page that animates the planned motion in 3D (for a
+    /// task file holding several tasks: PATH-00000.html, ..., the extension kept).
+    #[arg(long, value_name = "PATH")]
+    pub html: Option<PathBuf>,
     /// Null-space controller.
     #[arg(long, value_enum, default_value_t = ControllerKind::Hybrid)]
     pub controller: ControllerKind,

@@ -26,6 +26,8 @@
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv` +
 //!   `<stem>.joint_trajectory.json`; a task file with several tasks gives `<stem>-00000.json`,
 //!   ... and so on, each written as soon as its task is planned. Parent directories are created.
+//! * `--html <path>`: also a self-contained HTML page that animates the motion in 3D
+//!   (`<path without extension>-00000.html`, ... for several tasks).
 //!
 //! `emg check <FILE>` (alias `replay`) reads any of the three files back and verifies it with
 //! the independent checker (`--robot`, `--task-from`, `--p0/--d/--n`, `--config` as needed).
@@ -53,7 +55,8 @@ use emg_policy::{PolicyWeights, RlController};
 
 use crate::args::{Cli, Command, PlanArgs, SeedRequest};
 use crate::output::{
-    TrajectoryFile, joint_trajectory_path, result_paths, write_joint_trajectory, write_result,
+    TrajectoryFile, html_path, joint_trajectory_path, result_paths, write_html,
+    write_joint_trajectory, write_result,
 };
 use crate::settings::Settings;
 
@@ -185,6 +188,7 @@ fn plan_and_write(
     )
     .context("cannot build the joint trajectory")?;
     write_joint_trajectory(&joint_file, &joint_path)?;
+    let viewer = write_viewer(robot, args, settings, task, trajectory, index)?;
     let steps = trajectory.steps.len() - 1;
     let duration = trajectory.steps.last().map_or(0.0, |s| s.time_s);
     let projected = match plan.seed.projection_iterations {
@@ -193,7 +197,7 @@ fn plan_and_write(
     };
     Ok(format!(
         "path length {:.4} m, {steps} steps, {duration:.2} s; ended: {}\n  \
-         seed: {}{projected}\n  wrote {}, {} and {}",
+         seed: {}{projected}\n  wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,
@@ -201,4 +205,34 @@ fn plan_and_write(
         csv_path.display(),
         joint_path.display()
     ))
+}
+
+/// Writes the `--html` viewer page of one planned task; returns the line to print (empty without
+/// `--html`).
+fn write_viewer(
+    robot: &Robot,
+    args: &PlanArgs,
+    settings: &Settings,
+    task: &emg_control::Task,
+    trajectory: &emg_control::Trajectory,
+    index: Option<usize>,
+) -> Result<String> {
+    let Some(html) = &args.html else {
+        return Ok(String::new());
+    };
+    let path = html_path(html, index);
+    let name = path
+        .file_stem()
+        .unwrap_or(path.as_os_str())
+        .to_string_lossy();
+    let title = format!("{name}: {} controller", args.controller.kind().name());
+    let page = emg_viewer::render_html(&emg_viewer::ViewerInput {
+        robot,
+        task,
+        trajectory,
+        constraints: &settings.rollout.constraints,
+        title: &title,
+    });
+    write_html(&path, &page)?;
+    Ok(format!("\n  wrote {}", path.display()))
 }

@@ -112,6 +112,23 @@ pub fn write_joint_trajectory(file: &JointTrajectory, path: &Path) -> Result<()>
     write_atomic(path, &json)
 }
 
+/// The viewer page path for `--html <path>`: `path` itself, or for task 7 of a multi-task run
+/// `path` without its extension, then `-00007`, then the extension (`.html` when it has none).
+pub fn html_path(path: &Path, index: Option<usize>) -> PathBuf {
+    let Some(i) = index else {
+        return path.to_path_buf();
+    };
+    let mut name = OsString::from(path.with_extension("").as_os_str());
+    name.push(format!("-{i:05}."));
+    name.push(path.extension().unwrap_or("html".as_ref()));
+    PathBuf::from(name)
+}
+
+/// Writes the viewer page `html` to `path`, creating parent directories, via a temporary name.
+pub fn write_html(path: &Path, html: &str) -> Result<()> {
+    write_atomic(path, html)
+}
+
 fn write_atomic(path: &Path, contents: &str) -> Result<()> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         std::fs::create_dir_all(parent)

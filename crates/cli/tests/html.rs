@@ -1,0 +1,174 @@
+//! `emg plan --html`: the viewer page is written beside the trajectory files, one per task.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use emg_kinematics::{JointVector, Robot, default_robot_path};
+use serde_json::Value;
+
+/// A weights path that does not exist: the default seed chain then skips the DP seed.
+const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
+
+/// A fresh, empty directory under the system temp dir, unique to this test run.
+fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!(
+        "emg-cli-html-{name}-{}-{nanos}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+/// Runs `emg plan` with the classical controller and `args`, asserting success; returns stdout.
+fn plan_ok(args: &[&str]) -> String {
+    let output: Output = Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(["plan", "--controller", "classical", "--weights", NO_WEIGHTS])
+        .args(args)
+        .output()
+        .expect("run emg");
+    assert!(
+        output.status.success(),
+        "emg plan {args:?} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn read(path: &std::path::Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The files directly inside `dir`, sorted.
+fn listing(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|entry| entry.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn html_page_holds_the_planned_motion() {
+    let dir = temp_dir("single");
+    let stem = dir.join("demo");
+    let page_path = dir.join("pages/demo.html");
+    let stdout = plan_ok(&[
+        "--seed",
+        "home",
+        "--out",
+        stem.to_str().unwrap(),
+        "--html",
+        page_path.to_str().unwrap(),
+    ]);
+    assert!(
+        stdout.contains(&format!("wrote {}", page_path.display())),
+        "the page is reported: {stdout}"
+    );
+    let page = read(&page_path);
+    assert!(page.starts_with("<!DOCTYPE html>"));
+    assert!(page.contains("<title>demo: classical controller</title>"));
+    assert!(!page.contains("http://") && !page.contains("https://"));
+    let trajectory: Value = serde_json::from_str(&read(&dir.join("demo.json"))).unwrap();
+    let steps = trajectory["steps"].as_array().unwrap();
+    assert!(steps.len() > 10, "a real motion: {} steps", steps.len());
+    let acting = steps
+        .iter()
+        .filter(|s| s["controller"] == "classical")
+        .count();
+    assert_eq!(
+        page.matches(r#""controller":"classical""#).count(),
+        acting,
+        "one entry per recorded step"
+    );
+    assert_eq!(
+        listing(&dir.join("pages")),
+        ["demo.html"],
+        "no .partial is left"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn html_pages_follow_the_per_task_suffix_rule() {
+    let dir = temp_dir("set");
+    let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
+    let mid = robot.mid_range();
+    let tasks: Vec<Value> = [
+        mid,
+        mid + JointVector::from([0.3, 0.2, -0.2, 0.3, 0.1, -0.2, 0.4]),
+    ]
+    .iter()
+    .map(|q| {
+        let kin = robot.forward(q);
+        let n = kin.tool_axis();
+        let y = emg_kinematics::Vec3::y();
+        let d = (y - n * y.dot(&n)).normalize();
+        serde_json::json!({
+            "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(), "q0_seed": q.as_slice(),
+        })
+    })
+    .collect();
+    let task_file = dir.join("tasks.json");
+    std::fs::write(&task_file, serde_json::to_string(&tasks).unwrap()).unwrap();
+    let task_file = task_file.to_str().unwrap();
+    let out = dir.join("out/set");
+    let out = out.to_str().unwrap();
+
+    let with_extension = dir.join("view/set.html");
+    let stdout = plan_ok(&[
+        "--task-file",
+        task_file,
+        "--out",
+        out,
+        "--html",
+        with_extension.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        listing(&dir.join("view")),
+        ["set-00000.html", "set-00001.html"]
+    );
+    for i in 0..2 {
+        let page = dir.join(format!("view/set-{i:05}.html"));
+        assert!(
+            stdout.contains(&format!("wrote {}", page.display())),
+            "{stdout}"
+        );
+        assert!(read(&page).contains(&format!("<title>set-{i:05}: classical controller</title>")));
+    }
+
+    let without_extension = dir.join("bare/set");
+    plan_ok(&[
+        "--task-file",
+        task_file,
+        "--out",
+        out,
+        "--html",
+        without_extension.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        listing(&dir.join("bare")),
+        ["set-00000.html", "set-00001.html"]
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn no_page_without_html() {
+    let dir = temp_dir("none");
+    let stdout = plan_ok(&[
+        "--seed",
+        "home",
+        "--out",
+        dir.join("demo").to_str().unwrap(),
+    ]);
+    assert!(!stdout.contains(".html"), "{stdout}");
+    assert!(listing(&dir).iter().all(|name| !name.ends_with(".html")));
+    std::fs::remove_dir_all(&dir).ok();
+}
