@@ -435,3 +435,37 @@ fn controls_scrub_orbit_and_zoom_without_errors() {
         "scrubbing to the end shows the full duration"
     );
 }
+
+#[test]
+fn a_motion_of_only_the_seed_renders() {
+    let Some(browser) = browser() else { return };
+    let dir = temp_dir("dom-seed-only");
+    let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
+        .expect("the FR3 robot file loads");
+    let seed = robot.mid_range();
+    let kin = robot.forward(&seed);
+    let task =
+        Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed)).expect("a valid task");
+    let config = RolloutConfig {
+        max_steps: 0,
+        ..RolloutConfig::default()
+    };
+    let trajectory = rollout(
+        &robot,
+        &task,
+        &seed,
+        &mut ClassicalController::default(),
+        &config,
+    );
+    assert_eq!(trajectory.steps.len(), 1, "only the seed");
+    let page = render_html(&ViewerInput {
+        robot: &robot,
+        task: &task,
+        trajectory: &trajectory,
+        constraints: &config.constraints,
+        title: "seed only",
+    });
+    if let Err(problems) = page_problems(&dump_dom(&browser, &dir, &page)) {
+        panic!("a one-step motion did not render cleanly:\n{problems}");
+    }
+}
