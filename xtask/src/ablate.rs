@@ -30,13 +30,13 @@ pub enum Variant {
 #[derive(clap::Args)]
 pub struct DpArgs {
     /// Diffusion weights.
-    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    #[arg(long, default_value_os_t = workspace::data("models/diffusion-v1.weights"))]
     weights: PathBuf,
     /// Evaluation tasks (never seen in training).
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
     /// Labels of the evaluation tasks; their best length is the reference, when present.
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/eval-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/eval-v1.labels"))]
     reference: PathBuf,
     /// Use only the first N tasks.
     #[arg(long)]
@@ -46,7 +46,7 @@ pub struct DpArgs {
     #[arg(long, default_value_t = 1)]
     threads: usize,
     /// Directory of the result files.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Controller that rolls out from the seeds.
     #[arg(long, value_enum, default_value_t = crate::eval::ControllerChoice::Hybrid)]
@@ -55,7 +55,7 @@ pub struct DpArgs {
     #[arg(long, default_value_os_t = crate::protocol::default_policy())]
     policy: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

@@ -20,10 +20,10 @@ use crate::workspace;
 #[derive(clap::Args)]
 pub struct ControlArgs {
     /// Evaluation tasks.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
     /// Labels of the evaluation tasks (reference lengths).
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/eval-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/eval-v1.labels"))]
     labels: PathBuf,
     /// Use only the first N tasks.
     #[arg(long)]
@@ -38,10 +38,10 @@ pub struct ControlArgs {
     #[arg(long, default_value_os_t = protocol::default_diffusion())]
     diffusion: PathBuf,
     /// Directory of the result files.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

@@ -44,7 +44,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     controller: Option<ControllerChoice>,
     /// Task set.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
     /// Evaluate only the first N tasks.
     #[arg(long)]
@@ -62,10 +62,10 @@ pub struct Args {
     #[arg(long)]
     name: Option<String>,
     /// Directory of the result files.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
     /// Policy weights of the learned controllers.
     #[arg(long, default_value_os_t = protocol::default_policy())]
@@ -74,13 +74,13 @@ pub struct Args {
     #[arg(long, default_value_os_t = protocol::default_diffusion())]
     diffusion: PathBuf,
     /// Labels of the evaluation set, whose candidates give the reference lengths (protocol).
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/eval-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/eval-v1.labels"))]
     labels: PathBuf,
     /// Training tasks evaluated as the "seen" set (protocol).
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/train-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/train-v1.tasks"))]
     seen_tasks: PathBuf,
     /// Labels of the training tasks (protocol).
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/train-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/train-v1.labels"))]
     seen_labels: PathBuf,
     /// How many training tasks form the "seen" set (protocol; 0 skips it).
     #[arg(long, default_value_t = 1000)]

@@ -34,13 +34,13 @@ pub struct Args {
     #[arg(long, default_value_t = 400)]
     max_steps: usize,
     /// Task set.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
     /// Output SVG.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/figures/self-motion-branches.svg"))]
+    #[arg(long, default_value_os_t = workspace::figure("self-motion-branches.svg"))]
     out: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

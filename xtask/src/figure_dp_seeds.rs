@@ -21,16 +21,16 @@ pub struct Args {
     #[arg(long, default_value_t = 16)]
     candidates: usize,
     /// Diffusion weights.
-    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    #[arg(long, default_value_os_t = workspace::data("models/diffusion-v1.weights"))]
     weights: PathBuf,
     /// Task set.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/eval-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
     /// Output SVG.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/figures/dp-seeds.svg"))]
+    #[arg(long, default_value_os_t = workspace::figure("dp-seeds.svg"))]
     out: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

@@ -64,19 +64,19 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     threads: usize,
     /// Journal directory (one subdirectory per set).
-    #[arg(long, default_value_os_t = workspace::root().join("target/label-journal"))]
+    #[arg(long, default_value_os_t = workspace::scratch("label-journal"))]
     journal_dir: PathBuf,
     /// Task-set directory.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks"))]
     tasks_dir: PathBuf,
     /// Label directory.
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels"))]
     out_dir: PathBuf,
     /// Report directory.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     results_dir: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

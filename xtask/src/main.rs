@@ -3,6 +3,11 @@
 //! * `cargo xtask make-tasks`: the evaluation set and the training pool in `data/tasks/`.
 //! * `cargo xtask eval --controller classical`: path-length statistics over the evaluation set,
 //!   written to `docs/results/`.
+//!
+//! Every command takes `--robot <fr3|iiwa14|URDF>` (default `fr3`). The robot selects the
+//! defaults of every other path: the FR3's files live at the top of `data/`, `docs/results/` and
+//! `docs/figures/`; another shipped robot's under `<dir>/iiwa14/`; any other robot file's under
+//! `<dir>/custom/<file stem>/`. Explicit path options still override each default.
 
 mod ablate;
 mod ablate_control;
@@ -55,6 +60,7 @@ enum Command {
 }
 
 fn main() -> anyhow::Result<()> {
+    workspace::select_robot(&std::env::args().collect::<Vec<_>>());
     match Cli::parse().command {
         Command::MakeTasks(args) => make_tasks::run(&args),
         Command::Eval(args) => eval::run(&args),

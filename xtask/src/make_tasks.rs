@@ -27,10 +27,10 @@ pub struct Args {
     #[arg(long, default_value_t = SamplerConfig::default().seed)]
     seed: u64,
     /// Output directory.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks"))]
     out_dir: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

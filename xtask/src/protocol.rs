@@ -621,12 +621,12 @@ pub fn markdown(set: &SetResult) -> String {
 
 /// Default paths of the shipped models.
 pub fn default_policy() -> PathBuf {
-    workspace::root().join("data/models/ppo-v1.weights")
+    workspace::data("models/ppo-v1.weights")
 }
 
 /// Default path of the shipped diffusion weights.
 pub fn default_diffusion() -> PathBuf {
-    workspace::root().join("data/models/diffusion-v1.weights")
+    workspace::data("models/diffusion-v1.weights")
 }
 
 #[cfg(test)]

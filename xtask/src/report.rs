@@ -16,7 +16,7 @@ use crate::workspace;
 #[derive(clap::Args)]
 pub struct Args {
     /// Directory holding the result files.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     results: PathBuf,
     /// The report to write.
     #[arg(long, default_value_os_t = workspace::root().join("docs/results.md"))]
@@ -25,7 +25,7 @@ pub struct Args {
     #[arg(long, default_value_os_t = workspace::root().join("docs/figures"))]
     figures: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 
@@ -418,10 +418,7 @@ fn trace(args: &Args) -> anyhow::Result<()> {
         &protocol::default_policy(),
         &protocol::default_diffusion(),
     )?;
-    let mut tasks: Vec<Task> = read_tasks(
-        &workspace::root().join("data/tasks/eval-v1.tasks"),
-        &setup.robot,
-    )?;
+    let mut tasks: Vec<Task> = read_tasks(&workspace::data("tasks/eval-v1.tasks"), &setup.robot)?;
     tasks.truncate(300);
     let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
     let prototype = Executor::new(ControllerKind::Hybrid, Some(&setup.policy), &setup.executor)?;

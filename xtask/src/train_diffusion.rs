@@ -37,16 +37,16 @@ pub struct Args {
     #[arg(long)]
     config: Option<PathBuf>,
     /// Training labels.
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/train-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/train-v1.labels"))]
     labels: PathBuf,
     /// The task set the labels index.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/train-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/train-v1.tasks"))]
     tasks: PathBuf,
     /// Shipped EMA weights (the run configuration is written beside them as .json).
-    #[arg(long, default_value_os_t = workspace::root().join("data/models/diffusion-v1.weights"))]
+    #[arg(long, default_value_os_t = workspace::data("models/diffusion-v1.weights"))]
     out: PathBuf,
     /// Checkpoint directory; a run finding one there resumes from it.
-    #[arg(long, default_value_os_t = workspace::root().join("target/diffusion-v1-checkpoint"))]
+    #[arg(long, default_value_os_t = workspace::scratch("diffusion-v1-checkpoint"))]
     checkpoint: PathBuf,
     /// Burn backend.
     #[arg(long, value_enum, default_value_t = BackendChoice::Flex)]
@@ -56,10 +56,10 @@ pub struct Args {
     #[arg(long)]
     measure_backends: Option<usize>,
     /// Directory of the loss curve and the backend measurement.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     results: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

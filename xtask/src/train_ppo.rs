@@ -41,16 +41,16 @@ pub struct Args {
     #[arg(long)]
     config: Option<PathBuf>,
     /// Training task pool.
-    #[arg(long, default_value_os_t = workspace::root().join("data/tasks/train-v1.tasks"))]
+    #[arg(long, default_value_os_t = workspace::data("tasks/train-v1.tasks"))]
     tasks: PathBuf,
     /// Seed labels of the training pool (starting configurations); used when the file exists.
-    #[arg(long, default_value_os_t = workspace::root().join("data/labels/train-v1.labels"))]
+    #[arg(long, default_value_os_t = workspace::data("labels/train-v1.labels"))]
     labels: PathBuf,
     /// Shipped weights (the run configuration is written beside them as .json).
-    #[arg(long, default_value_os_t = workspace::root().join("data/models/ppo-v1.weights"))]
+    #[arg(long, default_value_os_t = workspace::data("models/ppo-v1.weights"))]
     out: PathBuf,
     /// Checkpoint directory; a run finding one there resumes from it.
-    #[arg(long, default_value_os_t = workspace::root().join("target/ppo-v1-checkpoint"))]
+    #[arg(long, default_value_os_t = workspace::scratch("ppo-v1-checkpoint"))]
     checkpoint: PathBuf,
     /// Iterations between checkpoints.
     #[arg(long, default_value_t = 25)]
@@ -69,10 +69,10 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     threads: usize,
     /// Directory of the learning curve and the backend measurement.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/results"))]
+    #[arg(long, default_value_os_t = workspace::results_dir())]
     results: PathBuf,
     /// Robot file.
-    #[arg(long, default_value_os_t = emg_kinematics::default_robot_path())]
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
 }
 

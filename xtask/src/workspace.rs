@@ -1,6 +1,7 @@
 //! Paths and shared loading of the workspace's data.
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use anyhow::Context;
 use emg_control::ReferenceModel;
@@ -12,6 +13,102 @@ pub fn root() -> PathBuf {
         .parent()
         .expect("xtask lives inside the workspace")
         .to_path_buf()
+}
+
+/// The robots shipped in `data/robots/`: selection name, robot file, and the directory under
+/// `data/` (and under `docs/results/`) that holds its task sets, labels, models and results.
+/// The FR3, the paper's arm, keeps the top-level layout.
+const SHIPPED_ROBOTS: [(&str, &str, &str); 2] = [
+    ("fr3", "fr3_pen.urdf", ""),
+    ("iiwa14", "iiwa14_pen.urdf", "iiwa14"),
+];
+
+/// Where one robot's files live: its robot file, data, results and scratch directories.
+#[derive(Clone, Debug)]
+pub struct RobotLayout {
+    /// Robot file.
+    pub urdf: PathBuf,
+    /// Sub-directory name of its data and results (empty for the FR3's top-level layout).
+    subdir: String,
+}
+
+static LAYOUT: OnceLock<RobotLayout> = OnceLock::new();
+
+/// The robot file of `--robot` (a shipped robot's name or a URDF path).
+pub fn robot_file(value: &str) -> Result<PathBuf, String> {
+    Ok(layout_of(value).urdf)
+}
+
+/// The layout of `--robot` (a shipped robot's name or a URDF path): a shipped robot's own, or
+/// `custom/<file stem>` directories for any other robot file.
+fn layout_of(value: &str) -> RobotLayout {
+    let robots = root().join("data/robots");
+    let canonical = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
+    for (name, file, subdir) in SHIPPED_ROBOTS {
+        let urdf = canonical(&robots.join(file));
+        if value == name || canonical(Path::new(value)) == urdf {
+            return RobotLayout {
+                urdf,
+                subdir: subdir.into(),
+            };
+        }
+    }
+    let urdf = PathBuf::from(value);
+    let stem = urdf
+        .file_stem()
+        .map_or_else(|| "robot".into(), |s| s.to_string_lossy().into_owned());
+    RobotLayout {
+        urdf,
+        subdir: format!("custom/{stem}"),
+    }
+}
+
+/// Selects the robot whose files the commands' defaults point at, from the `--robot` value in
+/// the command line (the FR3 when there is none). Call once, before parsing the arguments.
+pub fn select_robot(args: &[String]) {
+    let value = args.iter().enumerate().find_map(|(i, arg)| {
+        arg.strip_prefix("--robot=")
+            .map(str::to_string)
+            .or_else(|| {
+                (arg == "--robot")
+                    .then(|| args.get(i + 1).cloned())
+                    .flatten()
+            })
+    });
+    let layout = layout_of(value.as_deref().unwrap_or("fr3"));
+    LAYOUT.set(layout).expect("the robot is selected once");
+}
+
+fn layout() -> &'static RobotLayout {
+    LAYOUT.get_or_init(|| layout_of("fr3"))
+}
+
+/// The selected robot's file (the default of every `--robot`).
+pub fn default_robot() -> PathBuf {
+    layout().urdf.clone()
+}
+
+/// `relative` inside the selected robot's data directory (`data/` for the FR3).
+pub fn data(relative: &str) -> PathBuf {
+    root().join("data").join(&layout().subdir).join(relative)
+}
+
+/// The selected robot's results directory (`docs/results/` for the FR3).
+pub fn results_dir() -> PathBuf {
+    root().join("docs/results").join(&layout().subdir)
+}
+
+/// `name` inside the selected robot's figure directory (`docs/figures/` for the FR3).
+pub fn figure(name: &str) -> PathBuf {
+    root()
+        .join("docs/figures")
+        .join(&layout().subdir)
+        .join(name)
+}
+
+/// `name` inside the selected robot's scratch directory under `target/` (journals, checkpoints).
+pub fn scratch(name: &str) -> PathBuf {
+    root().join("target").join(&layout().subdir).join(name)
 }
 
 /// Path relative to the workspace root, for records that must not depend on the checkout place.
