@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use anyhow::Context;
 use emg_control::ReferenceModel;
-use emg_kinematics::Robot;
+use emg_kinematics::{Robot, ShippedRobot};
 
 /// The workspace root (parent of `xtask/`).
 pub fn root() -> PathBuf {
@@ -15,20 +15,12 @@ pub fn root() -> PathBuf {
         .to_path_buf()
 }
 
-/// The robots shipped in `data/robots/`: selection name, robot file, and the directory under
-/// `data/` (and under `docs/results/`) that holds its task sets, labels, models and results.
-/// The FR3, the paper's arm, keeps the top-level layout.
-const SHIPPED_ROBOTS: [(&str, &str, &str); 2] = [
-    ("fr3", "fr3_pen.urdf", ""),
-    ("iiwa14", "iiwa14_pen.urdf", "iiwa14"),
-];
-
-/// Where one robot's files live: its robot file, data, results and scratch directories.
+/// Where one robot's files live: its robot file and the sub-directory of its data, results,
+/// figures and scratch files (empty for the FR3's top-level layout).
 #[derive(Clone, Debug)]
 pub struct RobotLayout {
     /// Robot file.
     pub urdf: PathBuf,
-    /// Sub-directory name of its data and results (empty for the FR3's top-level layout).
     subdir: String,
 }
 
@@ -42,16 +34,12 @@ pub fn robot_file(value: &str) -> Result<PathBuf, String> {
 /// The layout of `--robot` (a shipped robot's name or a URDF path): a shipped robot's own, or
 /// `custom/<file stem>` directories for any other robot file.
 fn layout_of(value: &str) -> RobotLayout {
-    let robots = root().join("data/robots");
-    let canonical = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
-    for (name, file, subdir) in SHIPPED_ROBOTS {
-        let urdf = canonical(&robots.join(file));
-        if value == name || canonical(Path::new(value)) == urdf {
-            return RobotLayout {
-                urdf,
-                subdir: subdir.into(),
-            };
-        }
+    let shipped = ShippedRobot::by_name(value).or_else(|| ShippedRobot::by_path(Path::new(value)));
+    if let Some(robot) = shipped {
+        return RobotLayout {
+            urdf: robot.path(),
+            subdir: robot.data_subdir().into(),
+        };
     }
     let urdf = PathBuf::from(value);
     let stem = urdf

@@ -32,16 +32,17 @@ pub struct CheckArgs {
     /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json` or `<stem>.csv`.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// Robot description (URDF). Default: the file's `robot` field (a JSON file, or the
-    /// --task-from file for a CSV), else the FR3-with-pen file shipped in data/robots/.
-    #[arg(long, value_name = "URDF")]
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`) or a robot file (URDF). Default: the
+    /// file's `robot` field (a JSON file, or the --task-from file for a CSV), else `fr3`.
+    #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot)]
     pub robot: Option<PathBuf>,
-    /// Base link of the kinematic chain.
-    #[arg(long, default_value = "link0")]
-    pub base_link: String,
-    /// Tip link of the chain (the TCP; its z-axis is the tool axis).
-    #[arg(long, default_value = "pen_tip")]
-    pub tip_link: String,
+    /// Base link of the kinematic chain (default: the file's root link).
+    #[arg(long, requires = "tip_link")]
+    pub base_link: Option<String>,
+    /// Tip link of the chain, the TCP whose z-axis is the tool axis (default: the file's only
+    /// leaf link).
+    #[arg(long, requires = "base_link")]
+    pub tip_link: Option<String>,
     /// Take the task (and, without --config, the constraints) from this emg-trajectory/1 or
     /// emg-joint-trajectory/1 file instead of FILE (a CSV carries none).
     #[arg(long, value_name = "JSON", conflicts_with = "p0")]
@@ -66,15 +67,18 @@ pub struct CheckArgs {
 /// Options of `emg plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Robot description (URDF). Defaults to the FR3-with-pen file shipped in data/robots/.
-    #[arg(long, value_name = "URDF", default_value_os_t = emg_kinematics::default_robot_path())]
+    /// Robot: a shipped robot's name (`fr3`, the default, or `iiwa14`) or a robot file (URDF)
+    /// of any 7-DoF serial arm.
+    #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot,
+          default_value = "fr3")]
     pub robot: PathBuf,
-    /// Base link of the kinematic chain.
-    #[arg(long, default_value = "link0")]
-    pub base_link: String,
-    /// Tip link of the chain (the TCP; its z-axis is the tool axis).
-    #[arg(long, default_value = "pen_tip")]
-    pub tip_link: String,
+    /// Base link of the kinematic chain (default: the file's root link).
+    #[arg(long, requires = "tip_link")]
+    pub base_link: Option<String>,
+    /// Tip link of the chain, the TCP whose z-axis is the tool axis (default: the file's only
+    /// leaf link).
+    #[arg(long, requires = "base_link")]
+    pub tip_link: Option<String>,
     /// Task start position p0 (m), as x,y,z. Needs --d and --n.
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
           requires_all = ["d", "n"], conflicts_with = "task_file")]
@@ -95,9 +99,9 @@ pub struct PlanArgs {
     /// --weights file exists, else `generating` when the task has a q0_seed, else `home`.
     #[arg(long, value_name = "SOURCE", value_parser = SeedRequest::from_str, allow_hyphen_values = true)]
     pub seed: Option<SeedRequest>,
-    /// Diffusion-seeder weights for `--seed dp`.
-    #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_weights_path())]
-    pub weights: PathBuf,
+    /// Diffusion-seeder weights for `--seed dp` (default: those shipped for a shipped robot).
+    #[arg(long, value_name = "WEIGHTS")]
+    pub weights: Option<PathBuf>,
     /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
@@ -112,9 +116,10 @@ pub struct PlanArgs {
     /// Null-space controller.
     #[arg(long, value_enum, default_value_t = ControllerKind::Hybrid)]
     pub controller: ControllerKind,
-    /// Policy weights of `--controller rl` and `hybrid`.
-    #[arg(long, value_name = "WEIGHTS", default_value_os_t = default_policy_path())]
-    pub policy: PathBuf,
+    /// Policy weights of `--controller rl` and `hybrid` (default: those shipped for a shipped
+    /// robot).
+    #[arg(long, value_name = "WEIGHTS")]
+    pub policy: Option<PathBuf>,
 }
 
 /// The null-space controllers the CLI can run.
@@ -139,14 +144,20 @@ impl ControllerKind {
     }
 }
 
-/// The PPO policy weights shipped in the workspace's `data/models/`.
-pub fn default_policy_path() -> PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/ppo-v1.weights")
-}
+impl PlanArgs {
+    /// The diffusion-seeder weights: `--weights`, else those shipped for the robot (if any).
+    pub fn weights_path(&self) -> Option<PathBuf> {
+        self.weights
+            .clone()
+            .or_else(|| crate::robot::shipped_model(&self.robot, "diffusion-v1.weights"))
+    }
 
-/// The diffusion-seeder weights shipped in the workspace's `data/models/`.
-pub fn default_weights_path() -> PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/diffusion-v1.weights")
+    /// The policy weights: `--policy`, else those shipped for the robot (if any).
+    pub fn policy_path(&self) -> Option<PathBuf> {
+        self.policy
+            .clone()
+            .or_else(|| crate::robot::shipped_model(&self.robot, "ppo-v1.weights"))
+    }
 }
 
 /// Where the rollout's seed configuration comes from.

@@ -9,9 +9,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use emg_control::{
-    ConstraintConfig, JOINT_TRAJECTORY_FORMAT, JointSamples, JointTrajectory, ReferenceModel,
-    ReplayError, ReplayReport, RolloutConfig, Task, Trajectory, check_joint_names, check_replay,
-    read_csv,
+    ConstraintConfig, JOINT_TRAJECTORY_FORMAT, JointSamples, JointTrajectory, ReplayError,
+    ReplayReport, RolloutConfig, Task, Trajectory, check_joint_names, check_replay, read_csv,
 };
 use emg_kinematics::{Robot, Vec3};
 use serde_json::Value;
@@ -164,11 +163,12 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         (None, Some((path, c)), None) => named_robot(&c.robot, path)?,
         (None, None, None) => emg_kinematics::default_robot_path(),
     };
-    let robot = Robot::from_urdf_file(&robot_path, &args.base_link, &args.tip_link)
-        .with_context(|| format!("cannot load robot {}", robot_path.display()))?;
-    let model = ReferenceModel::from_urdf_file(&robot_path, &args.base_link, &args.tip_link)
-        .map_err(anyhow::Error::msg)
-        .with_context(|| format!("the checker cannot load robot {}", robot_path.display()))?;
+    let robot = crate::robot::load_robot(
+        &robot_path,
+        args.base_link.as_deref(),
+        args.tip_link.as_deref(),
+    )?;
+    let model = crate::robot::load_checker(&robot_path, &robot)?;
 
     let (task, task_origin) = match (args.p0, args.d, args.n, &task_from, &carried) {
         (Some(p0), Some(d), Some(n), _, _) => (

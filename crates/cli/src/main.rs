@@ -40,6 +40,7 @@ mod args;
 mod check;
 mod output;
 mod plan;
+mod robot;
 mod seed;
 mod settings;
 mod tasks;
@@ -75,8 +76,11 @@ fn main() -> ExitCode {
 }
 
 fn run_plan(args: &PlanArgs) -> Result<()> {
-    let robot = Robot::from_urdf_file(&args.robot, &args.base_link, &args.tip_link)
-        .with_context(|| format!("cannot load robot {}", args.robot.display()))?;
+    let robot = robot::load_robot(
+        &args.robot,
+        args.base_link.as_deref(),
+        args.tip_link.as_deref(),
+    )?;
     let settings = Settings::load(args.config.as_deref())?;
     let dp = load_dp_seeder(args)?;
     let policy = load_policy(args)?;
@@ -113,21 +117,22 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
 /// The diffusion seeder: required by `--seed dp`, used by default when `--weights` exists.
 fn load_dp_seeder(args: &PlanArgs) -> Result<Option<DpSeeder>> {
     let explicit = matches!(args.seed, Some(SeedRequest::Dp));
-    if !explicit && (args.seed.is_some() || !args.weights.exists()) {
-        return Ok(None);
-    }
-    let weights = DenoiserWeights::read(&args.weights).with_context(|| {
+    let path = match args.weights_path() {
+        Some(path) if explicit || (args.seed.is_none() && path.exists()) => path,
+        None if explicit => anyhow::bail!(
+            "--seed dp: no diffusion weights are shipped for robot {}; pass --weights",
+            args.robot.display()
+        ),
+        _ => return Ok(None),
+    };
+    let weights = DenoiserWeights::read(&path).with_context(|| {
         format!(
             "--seed dp: cannot load diffusion weights {}",
-            args.weights.display()
+            path.display()
         )
     })?;
-    let seeder = DpSeeder::new(&weights, DpSeedConfig::default()).with_context(|| {
-        format!(
-            "--seed dp: unusable diffusion weights {}",
-            args.weights.display()
-        )
-    })?;
+    let seeder = DpSeeder::new(&weights, DpSeedConfig::default())
+        .with_context(|| format!("--seed dp: unusable diffusion weights {}", path.display()))?;
     Ok(Some(seeder))
 }
 
@@ -136,11 +141,18 @@ fn load_policy(args: &PlanArgs) -> Result<Option<RlController>> {
     if !args.controller.kind().needs_policy() {
         return Ok(None);
     }
-    let weights = PolicyWeights::read(&args.policy).with_context(|| {
+    let Some(path) = args.policy_path() else {
+        anyhow::bail!(
+            "--controller {}: no policy is shipped for robot {}; pass --policy or use --controller classical",
+            args.controller.kind().name(),
+            args.robot.display()
+        );
+    };
+    let weights = PolicyWeights::read(&path).with_context(|| {
         format!(
             "--controller {}: cannot load policy weights {}",
             args.controller.kind().name(),
-            args.policy.display()
+            path.display()
         )
     })?;
     Ok(Some(RlController::new(&weights)))

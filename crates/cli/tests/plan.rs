@@ -348,3 +348,59 @@ fn dp_seed_with_missing_or_damaged_weights_fails_clearly() {
 fn emg_cli_weights() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/models/diffusion-v1.weights")
 }
+
+/// `--robot iiwa14` plans on the second shipped arm: its own file and joint names, a demo task
+/// away from its stretched-out (singular) mid-range configuration, a trajectory its checker
+/// accepts. A robot file that is not shipped has no default models, and the error says what to
+/// pass instead.
+#[test]
+fn robot_by_name_and_by_file() {
+    let dir = temp_dir("iiwa");
+    let stem = dir.join("iiwa");
+    plan_ok(&[
+        "--robot",
+        "iiwa14",
+        "--controller",
+        "classical",
+        "--seed",
+        "generating",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    let doc = read_json(&dir.join("iiwa.json"));
+    let robot_path = PathBuf::from(doc["robot"].as_str().unwrap());
+    assert!(robot_path.ends_with("iiwa14_pen.urdf"), "{robot_path:?}");
+    assert_eq!(doc["joint_names"][6], "iiwa_joint_7");
+    assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{doc}");
+    let robot = Robot::from_chain_file(&robot_path).unwrap();
+    let task: Task = serde_json::from_value(doc["task"].clone()).unwrap();
+    let config: RolloutConfig = serde_json::from_value(doc["config"].clone()).unwrap();
+    let trajectory: Trajectory = serde_json::from_value(doc).unwrap();
+    let checker = ReferenceModel::from_urdf_file(&robot_path, "iiwa_link_0", "pen_tip").unwrap();
+    checker
+        .check(&task, &trajectory, &config.constraints)
+        .expect("the iiwa plan holds every constraint");
+    let mid = robot.forward(&robot.mid_range());
+    assert!(
+        (mid.tcp() - task.p0).norm() > 0.1,
+        "the demo avoids the stretched-out pose"
+    );
+
+    let copy = dir.join("my_arm.urdf");
+    std::fs::copy(&robot_path, &copy).unwrap();
+    let message = plan_err(&[
+        "--robot",
+        copy.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(message.contains("--policy"), "{message}");
+    plan_ok(&[
+        "--robot",
+        copy.to_str().unwrap(),
+        "--controller",
+        "classical",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+}

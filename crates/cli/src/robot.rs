@@ -1,0 +1,82 @@
+//! `--robot`: a shipped robot by name or any 7-DoF robot file, its chain ends, and the models
+//! shipped for it.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use emg_control::ReferenceModel;
+use emg_kinematics::{Robot, SHIPPED_ROBOTS, ShippedRobot};
+
+/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`) gives its file, anything else is a
+/// path to a robot file.
+pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
+    if value.is_empty() {
+        let names: Vec<_> = SHIPPED_ROBOTS.iter().map(|r| r.name).collect();
+        return Err(format!(
+            "give a robot file or one of the shipped robots: {}",
+            names.join(", ")
+        ));
+    }
+    Ok(ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), ShippedRobot::path))
+}
+
+/// Loads the robot file: the chain between `base` and `tip` when both are named, else from the
+/// file's root link to its only leaf link.
+pub fn load_robot(path: &Path, base: Option<&str>, tip: Option<&str>) -> Result<Robot> {
+    let robot = match (base, tip) {
+        (Some(base), Some(tip)) => Robot::from_urdf_file(path, base, tip),
+        (None, None) => Robot::from_chain_file(path),
+        _ => anyhow::bail!("name both --base-link and --tip-link, or neither"),
+    };
+    robot.with_context(|| format!("cannot load robot {}", path.display()))
+}
+
+/// The independent checker's model of the same chain, read again from the file.
+pub fn load_checker(path: &Path, robot: &Robot) -> Result<ReferenceModel> {
+    ReferenceModel::from_urdf_file(path, robot.base_link(), robot.tip_link())
+        .map_err(anyhow::Error::msg)
+        .with_context(|| format!("the checker cannot load robot {}", path.display()))
+}
+
+/// Model file `name` (e.g. `ppo-v1.weights`) shipped for the robot file `robot`, when that file
+/// is one of the shipped robots.
+pub fn shipped_model(robot: &Path, name: &str) -> Option<PathBuf> {
+    ShippedRobot::by_path(robot).map(|r| r.data_dir().join("models").join(name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_select_shipped_files_and_paths_pass_through() {
+        for robot in SHIPPED_ROBOTS {
+            let path = parse_robot(robot.name).unwrap();
+            assert_eq!(path, robot.path());
+            assert!(path.exists(), "{}", path.display());
+            let model = shipped_model(&path, "ppo-v1.weights").unwrap();
+            assert!(model.starts_with(robot.data_dir()));
+        }
+        assert_eq!(
+            parse_robot("my/arm.urdf").unwrap(),
+            PathBuf::from("my/arm.urdf")
+        );
+        assert_eq!(
+            shipped_model(Path::new("my/arm.urdf"), "ppo-v1.weights"),
+            None
+        );
+        assert!(parse_robot("").unwrap_err().contains("iiwa14"));
+    }
+
+    #[test]
+    fn chain_ends_are_found_or_named_together() {
+        let path = parse_robot("iiwa14").unwrap();
+        let found = load_robot(&path, None, None).unwrap();
+        assert_eq!(
+            (found.base_link(), found.tip_link()),
+            ("iiwa_link_0", "pen_tip")
+        );
+        let error = load_robot(&path, Some("iiwa_link_0"), None).unwrap_err();
+        assert!(error.to_string().contains("--tip-link"), "{error}");
+    }
+}
