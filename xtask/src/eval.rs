@@ -12,6 +12,7 @@ use emg_control::{
 use emg_hybrid::{BucketConfig, ControllerKind, Executor, ExecutorConfig};
 use serde::Serialize;
 
+use crate::velocity_limits::{self, VelocityLimits};
 use crate::{progress, protocol, workspace};
 
 /// Controllers `eval --controller` can run.
@@ -92,6 +93,14 @@ pub struct Args {
     /// Join the outcomes of shards `0/n … (n−1)/n` into the tables (protocol).
     #[arg(long, value_name = "n")]
     merge: Option<usize>,
+    /// Joint-velocity limits of the robot file: `on` (steps that would be too fast are slowed
+    /// down in time) or `off` (unbounded joint speeds, the paper's setting).
+    #[arg(long, value_enum, default_value_t = VelocityLimits::On)]
+    velocity_limits: VelocityLimits,
+    /// Instead of the protocol: DP seeds × every controller with the velocity limits off and on,
+    /// path length and duration compared (docs/results/velocity-limits.{json,md}).
+    #[arg(long, conflicts_with_all = ["controller", "shard", "merge"])]
+    compare_velocity_limits: bool,
 }
 
 /// The numbers of one evaluation: identical for any thread count.
@@ -114,6 +123,12 @@ struct EvalResult {
 /// Runs the protocol, or one controller with `--controller`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let pool = workspace::thread_pool(args.threads)?;
+    if args.compare_velocity_limits {
+        return pool.install(|| {
+            let mut setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            velocity_limits::run(&mut setup, &args.tasks, args.limit, &args.out_dir)
+        });
+    }
     match args.controller {
         None => pool.install(|| run_protocol(args)),
         Some(choice) => run_controller(args, choice.kind(), &pool),
@@ -149,7 +164,8 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
             merged
         }
         None => {
-            let setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            let mut setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            args.velocity_limits.apply(&mut setup.rollout.constraints);
             let shard = args.shard.map(|s| (s.index, s.count));
             let mut sets = vec![protocol::run_set(
                 &setup,
@@ -192,8 +208,10 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
     let seconds = started.elapsed().as_secs_f64();
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("{name}.json"));
+    let mut rollout = RolloutConfig::default();
+    args.velocity_limits.apply(&mut rollout.constraints);
     let record = serde_json::json!({
-        "rollout": emg_control::RolloutConfig::default(),
+        "rollout": rollout,
         "executor": ExecutorConfig::default(),
         "buckets": buckets,
         "policy": workspace::relative(&args.weights),
@@ -248,6 +266,7 @@ fn run_controller(
         bail!("every evaluation task needs its q0_seed");
     }
     let mut rollout = RolloutConfig::default();
+    args.velocity_limits.apply(&mut rollout.constraints);
     if let Some(gain) = args.lateral_gain {
         rollout.lateral_gain_per_s = gain;
     }

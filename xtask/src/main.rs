@@ -22,6 +22,7 @@ mod protocol;
 mod report;
 mod train_diffusion;
 mod train_ppo;
+mod velocity_limits;
 mod workspace;
 
 use clap::{Parser, Subcommand};

@@ -1,0 +1,209 @@
+//! `cargo xtask eval --compare-velocity-limits`: DP seeds × every controller on the evaluation
+//! set with the joint-velocity limits off (the paper's runs) and on (time scaling), and how path
+//! length and duration change (`docs/results/velocity-limits.{json,md}`).
+
+use std::path::Path;
+
+use anyhow::Context;
+use emg_control::{ConstraintConfig, Summary, Trajectory, VelocityLimitFraction, read_tasks};
+use emg_hybrid::ControllerKind;
+use serde::Serialize;
+
+use crate::protocol::{SeedKind, Setup, four};
+use crate::workspace;
+
+/// `eval --velocity-limits`: whether rollouts honour the robot file's joint-velocity limits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VelocityLimits {
+    /// Steps that would be too fast are slowed down in time (the default).
+    On,
+    /// Joint speeds are not bounded (the paper's setting).
+    Off,
+}
+
+impl VelocityLimits {
+    /// The constraint setting of this choice.
+    pub fn apply(self, constraints: &mut ConstraintConfig) {
+        constraints.velocity_limit_fraction = match self {
+            Self::On => Some(VelocityLimitFraction::FULL),
+            Self::Off => None,
+        };
+    }
+}
+
+/// One controller's runs with the limits off and on.
+#[derive(Serialize)]
+struct Comparison {
+    controller: ControllerKind,
+    off: Timing,
+    on: Timing,
+    /// Tasks whose path length differs between the two runs.
+    tasks_with_other_path_length: usize,
+    /// Tasks whose unlimited run exceeds some joint's velocity limit.
+    tasks_over_the_limits_when_off: usize,
+    /// Tasks with at least one slowed step when on.
+    tasks_slowed_when_on: usize,
+    /// Steps slowed when on, over all steps.
+    slowed_step_fraction: f64,
+    /// Duration on / duration off, per task with at least one step.
+    duration_ratio: Summary,
+}
+
+/// Path length and duration of one set of runs.
+#[derive(Serialize)]
+struct Timing {
+    path_length_m: Summary,
+    duration_s: Summary,
+    /// Largest joint speed as a fraction of that joint's limit, per task with at least one step.
+    peak_speed_ratio: Summary,
+}
+
+fn duration(trajectory: &Trajectory) -> f64 {
+    trajectory.steps.last().map_or(0.0, |s| s.time_s)
+}
+
+/// Largest `|Δq_i| / Δt / v_max,i` over the steps of `trajectory` (0 for a seed alone).
+fn peak_speed_ratio(trajectory: &Trajectory, limits: &[f64]) -> f64 {
+    trajectory
+        .steps
+        .windows(2)
+        .flat_map(|pair| {
+            let elapsed = pair[1].time_s - pair[0].time_s;
+            limits
+                .iter()
+                .enumerate()
+                .map(move |(i, v)| (pair[1].q[i] - pair[0].q[i]).abs() / elapsed / v)
+        })
+        .fold(0.0, f64::max)
+}
+
+fn timing(trajectories: &[Trajectory], limits: &[f64]) -> anyhow::Result<Timing> {
+    let moving: Vec<&Trajectory> = trajectories.iter().filter(|t| t.steps.len() > 1).collect();
+    let summary = |values: Vec<f64>| Summary::of(&values).context("no task moved at all");
+    Ok(Timing {
+        path_length_m: summary(trajectories.iter().map(|t| t.path_length_m).collect())?,
+        duration_s: summary(trajectories.iter().map(duration).collect())?,
+        peak_speed_ratio: summary(moving.iter().map(|t| peak_speed_ratio(t, limits)).collect())?,
+    })
+}
+
+/// Runs the comparison on the first `limit` tasks (all without a limit) and writes its files.
+pub fn run(
+    setup: &mut Setup,
+    tasks_path: &Path,
+    limit: Option<usize>,
+    out_dir: &Path,
+) -> anyhow::Result<()> {
+    let mut tasks = read_tasks(tasks_path, &setup.robot)?;
+    if let Some(limit) = limit {
+        tasks.truncate(limit);
+    }
+    let limits: Vec<f64> = setup.robot.limits().velocity.iter().copied().collect();
+    let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
+    let executor = setup.executor.clone();
+    let mut comparisons = Vec::new();
+    for controller in ControllerKind::ALL {
+        let mut runs = Vec::new();
+        for choice in [VelocityLimits::Off, VelocityLimits::On] {
+            choice.apply(&mut setup.rollout.constraints);
+            let what = format!("DP+{} ({choice:?})", controller.name());
+            runs.push(setup.rollouts(&tasks, &seeds, controller, &executor, &what)?);
+        }
+        let (off, on) = (&runs[0], &runs[1]);
+        let ratios: Vec<f64> = off
+            .iter()
+            .zip(on)
+            .filter(|(a, _)| duration(a) > 0.0)
+            .map(|(a, b)| duration(b) / duration(a))
+            .collect();
+        let dt = setup.rollout.dt_s;
+        let slowed = |t: &Trajectory| {
+            t.steps
+                .windows(2)
+                .filter(|p| p[1].time_s - p[0].time_s > dt * (1.0 + 1e-9))
+                .count()
+        };
+        let steps: usize = on.iter().map(|t| t.steps.len() - 1).sum();
+        let slowed_steps: usize = on.iter().map(slowed).sum();
+        comparisons.push(Comparison {
+            controller,
+            off: timing(off, &limits)?,
+            on: timing(on, &limits)?,
+            tasks_with_other_path_length: off
+                .iter()
+                .zip(on)
+                .filter(|(a, b)| a.path_length_m != b.path_length_m)
+                .count(),
+            tasks_over_the_limits_when_off: off
+                .iter()
+                .filter(|t| peak_speed_ratio(t, &limits) > 1.0 + 1e-9)
+                .count(),
+            tasks_slowed_when_on: on.iter().filter(|t| slowed(t) > 0).count(),
+            slowed_step_fraction: slowed_steps as f64 / steps.max(1) as f64,
+            duration_ratio: Summary::of(&ratios).context("no task moved at all")?,
+        });
+    }
+    VelocityLimits::On.apply(&mut setup.rollout.constraints);
+
+    std::fs::create_dir_all(out_dir)?;
+    let json_path = out_dir.join("velocity-limits.json");
+    let record = serde_json::json!({
+        "robot": setup.robot.name(),
+        "tasks": workspace::relative(tasks_path),
+        "task_count": tasks.len(),
+        "seed": "dp",
+        "velocity_limits_rad_per_s": limits,
+        "controllers": comparisons,
+    });
+    std::fs::write(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
+    let md_path = out_dir.join("velocity-limits.md");
+    std::fs::write(
+        &md_path,
+        markdown(setup, &comparisons, tasks.len(), tasks_path),
+    )?;
+    println!("wrote {} and {}", json_path.display(), md_path.display());
+    Ok(())
+}
+
+fn markdown(setup: &Setup, rows: &[Comparison], count: usize, tasks_path: &Path) -> String {
+    let mut md = format!(
+        "# Joint-velocity limits: off vs on\n\nWritten by `cargo xtask eval --compare-velocity-limits`. \
+         Do not edit by hand. Robot `{}`, {count} tasks of `{}`, DP seeds, every trajectory re-checked \
+         by the independent checker (joint speeds included when the limits are on). With the limits on, \
+         a step that would move some joint faster than the robot file's velocity limit keeps its shape \
+         and lasts longer (time scaling), so the path is the same and only the timing changes.\n\n\
+         | controller | path length off (m) | path length on (m) | tasks with another length | duration off (s) | duration on (s) | duration on/off | tasks over the limits when off | tasks slowed when on | steps slowed | peak speed/limit off | peak speed/limit on |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        setup.robot.name(),
+        workspace::relative(tasks_path),
+    );
+    for row in rows {
+        md += &format!(
+            "| {} | {:.4} | {:.4} | {} | {:.3} | {:.3} | mean {:.4}, max {:.3} | {} | {} | {:.2} % | mean {:.3}, max {:.2} | mean {:.3}, max {:.3} |\n",
+            row.controller.title(),
+            row.off.path_length_m.mean,
+            row.on.path_length_m.mean,
+            row.tasks_with_other_path_length,
+            row.off.duration_s.mean,
+            row.on.duration_s.mean,
+            row.duration_ratio.mean,
+            row.duration_ratio.max,
+            row.tasks_over_the_limits_when_off,
+            row.tasks_slowed_when_on,
+            100.0 * row.slowed_step_fraction,
+            row.off.peak_speed_ratio.mean,
+            row.off.peak_speed_ratio.max,
+            row.on.peak_speed_ratio.mean,
+            row.on.peak_speed_ratio.max,
+        );
+    }
+    md += &format!(
+        "\nPath length with the limits on (m, mean / std / min / max): {}.\n",
+        rows.iter()
+            .map(|r| format!("{} {}", r.controller.title(), four(&r.on.path_length_m, 3)))
+            .collect::<Vec<_>>()
+            .join("; ")
+    );
+    md
+}
