@@ -47,21 +47,29 @@ pub struct CheckArgs {
     /// emg-joint-trajectory/1 file instead of FILE (a CSV carries none).
     #[arg(long, value_name = "JSON", conflicts_with = "p0")]
     pub task_from: Option<PathBuf>,
-    /// Task start position p0 (m), as x,y,z, instead of the file's task. Needs --d and --n.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["d", "n"])]
-    pub p0: Option<[f64; 3]>,
-    /// Task motion direction d, as x,y,z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["p0", "n"])]
-    pub d: Option<[f64; 3]>,
-    /// Task-plane normal n, as x,y,z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["p0", "d"])]
-    pub n: Option<[f64; 3]>,
+    /// A task given on the command line instead of the file's.
+    #[command(flatten)]
+    pub line: TaskLineArgs,
     /// JSON file as for `plan --config`: its `rollout.constraints` replace the file's.
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
+}
+
+/// A task line on the command line: all three of `--p0`, `--d` and `--n`, or none.
+#[derive(Debug, Args)]
+pub struct TaskLineArgs {
+    /// Task start position p0 (m), as x,y,z. Needs --d and --n.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["d", "n"])]
+    pub p0: Option<[f64; 3]>,
+    /// Task motion direction d, as x,y,z (normalised; must be perpendicular to n).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "n"])]
+    pub d: Option<[f64; 3]>,
+    /// Task-plane normal n, as x,y,z (normalised; the tool axis must stay near it).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
+          requires_all = ["p0", "d"])]
+    pub n: Option<[f64; 3]>,
 }
 
 /// Options of `emg plan`.
@@ -79,20 +87,11 @@ pub struct PlanArgs {
     /// leaf link).
     #[arg(long, requires = "base_link")]
     pub tip_link: Option<String>,
-    /// Task start position p0 (m), as x,y,z. Needs --d and --n.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["d", "n"], conflicts_with = "task_file")]
-    pub p0: Option<[f64; 3]>,
-    /// Task motion direction d, as x,y,z (normalised; must be perpendicular to n).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["p0", "n"])]
-    pub d: Option<[f64; 3]>,
-    /// Task-plane normal n, as x,y,z (normalised); the tool axis must stay near it.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true,
-          requires_all = ["p0", "d"])]
-    pub n: Option<[f64; 3]>,
+    /// A task given on the command line.
+    #[command(flatten)]
+    pub line: TaskLineArgs,
     /// Task set to plan: JSON (by the .json extension) or the binary EMGTASKS layout.
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "p0")]
     pub task_file: Option<PathBuf>,
     /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`
     /// (mid-range of the joint limits) or `q=v1,...,v7` (radians). Default: `dp` when the

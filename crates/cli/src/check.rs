@@ -170,7 +170,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     )?;
     let model = crate::robot::load_checker(&robot_path, &robot)?;
 
-    let (task, task_origin) = match (args.p0, args.d, args.n, &task_from, &carried) {
+    let (task, task_origin) = match (args.line.p0, args.line.d, args.line.n, &task_from, &carried) {
         (Some(p0), Some(d), Some(n), _, _) => (
             Task::new(&robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), None)
                 .context("invalid task given on the command line")?,
@@ -212,7 +212,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     let samples = contents.samples();
     // The recorded trajectory is verified as recorded (its TCP, tool angles, path length and
     // end) only against its own task: its tool angles are measured from that task's normal.
-    let own_task = args.p0.is_none() && task_from.is_none();
+    let own_task = args.line.p0.is_none() && task_from.is_none();
     let recorded = match &contents {
         Contents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
         _ => None,

@@ -18,7 +18,7 @@ pub fn requested_tasks(robot: &Robot, args: &PlanArgs) -> Result<Vec<Task>> {
         );
         return Ok(tasks);
     }
-    match (args.p0, args.d, args.n) {
+    match (args.line.p0, args.line.d, args.line.n) {
         (Some(p0), Some(d), Some(n)) => {
             let task = Task::new(robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), None)
                 .context("invalid task given on the command line")?;

@@ -2,41 +2,17 @@
 //! files it writes, then tamper with them and expect exit status 1 naming the point and the
 //! constraint.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::Value;
+
+use common::{emg, read_json, temp_dir, text};
 
 /// Velocity-limit fraction of the planned task: low enough that many steps are slowed, so the
 /// times are not uniform.
 const FRACTION: f64 = 0.05;
-
-/// A fresh, empty directory under the system temp dir, unique to this test run.
-fn temp_dir(name: &str) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "emg-check-{name}-{}-{nanos}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
-}
-
-fn emg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emg"))
-        .args(args)
-        .output()
-        .expect("run emg")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
 
 /// Plans the demo task with the classical controller from its generating configuration (no
 /// model to load) and returns the output stem.
@@ -92,10 +68,6 @@ fn check_err(args: &[&str]) -> String {
         text(&output.stdout)
     );
     text(&output.stderr)
-}
-
-fn read_json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 /// Writes `doc` next to the original and returns the path as a string.

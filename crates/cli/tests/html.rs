@@ -1,29 +1,13 @@
 //! `emg plan --html`: the viewer page is written beside the trajectory files, one per task.
 
-use std::path::PathBuf;
+mod common;
+
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use emg_kinematics::{JointVector, Robot, default_robot_path};
 use serde_json::Value;
 
-/// A weights path that does not exist: the default seed chain then skips the DP seed.
-const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
-
-/// A fresh, empty directory under the system temp dir, unique to this test run.
-fn temp_dir(name: &str) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "emg-cli-html-{name}-{}-{nanos}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
-}
+use common::{NO_WEIGHTS, read, temp_dir};
 
 /// Runs `emg plan` with the classical controller and `args`, asserting success; returns stdout.
 fn plan_ok(args: &[&str]) -> String {
@@ -38,10 +22,6 @@ fn plan_ok(args: &[&str]) -> String {
         String::from_utf8_lossy(&output.stderr)
     );
     String::from_utf8_lossy(&output.stdout).into_owned()
-}
-
-fn read(path: &std::path::Path) -> String {
-    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// The files directly inside `dir`, sorted.

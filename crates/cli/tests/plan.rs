@@ -1,45 +1,18 @@
 //! End-to-end tests of `emg plan`: run the built binary and read back what it wrote.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::process::Output;
 
 use emg_control::{ReferenceModel, RolloutConfig, Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, default_robot_path};
 use serde_json::Value;
 
-/// A weights path that does not exist: the default seed chain then skips the DP seed.
-const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
-
-/// A fresh, empty directory under the system temp dir, unique to this test run.
-fn temp_dir(name: &str) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "emg-cli-{name}-{}-{nanos}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
-}
-
-fn emg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_emg"))
-        .args(args)
-        .output()
-        .expect("run emg")
-}
+use common::{NO_WEIGHTS, emg, read_json, temp_dir, text};
 
 fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn read_json(path: &Path) -> Value {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).expect("valid JSON")
+    text(&output.stderr)
 }
 
 /// Runs `emg plan` with `args`, asserting success.

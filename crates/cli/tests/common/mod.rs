@@ -1,0 +1,50 @@
+//! Helpers shared by the end-to-end tests of the `emg` binary: fresh temp directories, running
+//! the binary, and reading what it wrote.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use serde_json::Value;
+
+/// A weights path that does not exist: the default seed chain then skips the DP seed.
+pub const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
+
+/// A fresh, empty directory under the system temp dir, unique to this test run.
+pub fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    let dir = std::env::temp_dir().join(format!(
+        "emg-cli-{name}-{}-{nanos}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    std::fs::create_dir_all(&dir).expect("create temp dir");
+    dir
+}
+
+/// Runs the built `emg` binary with `args`.
+pub fn emg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(args)
+        .output()
+        .expect("run emg")
+}
+
+/// Bytes of a captured stream as text.
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A file's text; panics naming the file.
+pub fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A JSON file's contents.
+pub fn read_json(path: &Path) -> Value {
+    serde_json::from_str(&read(path)).expect("valid JSON")
+}
