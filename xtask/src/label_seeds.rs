@@ -254,6 +254,7 @@ struct SeedRow {
 /// The labelling report.
 #[derive(Serialize)]
 struct Report {
+    labels_dir: String,
     threads: usize,
     throughput_tasks: usize,
     throughput_seconds: f64,
@@ -277,7 +278,10 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
     let tasks = read_tasks(&task_path, robot)?;
     let labels = LabelSet::read(&args.out_dir.join("eval-v1.labels"))?;
     if labels.task_set_sha256() != &task_set_sha256(&task_path)? || !labels.is_complete() {
-        bail!("data/labels/eval-v1.labels does not label the current evaluation set completely");
+        bail!(
+            "{} does not label the current evaluation set completely",
+            args.out_dir.join("eval-v1.labels").display()
+        );
     }
 
     let sample = &tasks[..args.throughput_tasks.min(tasks.len())];
@@ -365,6 +369,7 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
     let report = Report {
+        labels_dir: workspace::relative(&args.out_dir),
         threads: rayon::current_num_threads(),
         throughput_tasks: sample.len(),
         throughput_seconds,
@@ -399,10 +404,11 @@ fn classical_length(
 }
 
 fn markdown(report: &Report) -> String {
-    let mut md = String::from(
+    let mut md = format!(
         "# Seed labels: branches, best branch vs q0_seed, heuristic seeds\n\n\
-         Written by `cargo xtask label-seeds --report` from data/labels/*.manifest.json and a fresh \
+         Written by `cargo xtask label-seeds --report` from {}/*.manifest.json and a fresh \
          run on the evaluation set. Do not edit by hand.\n\n",
+        report.labels_dir
     );
     md += &format!(
         "## Throughput\n\nLabelling {} evaluation tasks afresh: {:.1} s wall on {} threads = **{:.1} tasks/s**.\n\n",

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use emg_control::{Task, read_tasks, rollout};
 use emg_hybrid::{ControllerKind, Executor, count_switches};
+use emg_kinematics::SHIPPED_ROBOTS;
 use plotters::prelude::*;
 use serde_json::Value;
 
@@ -99,6 +100,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
         md += &dp_rows(seen, "all");
     }
+    md += &velocity_limits(&args.results)?;
+    md += &other_arms(&args.results)?;
     std::fs::write(&args.out, md)?;
     println!("wrote {}", args.out.display());
     Ok(())
@@ -167,6 +170,77 @@ fn table1(set: &Value, paper: &Value) -> String {
         100.0 * (mean("rl") / mean("classical") - 1.0),
     );
     md
+}
+
+/// The velocity-limit comparisons (`eval --compare-velocity-limits`) of every shipped robot.
+fn velocity_limits(results: &Path) -> anyhow::Result<String> {
+    let mut md = String::from(
+        "## Beyond the paper: joint-velocity limits\n\nThe paper's runs ignore the joint-velocity \
+         limits; ours honour them by time scaling (a too-fast step keeps its shape and lasts longer).\n\n",
+    );
+    for robot in SHIPPED_ROBOTS {
+        let file = Path::new(robot.data_subdir()).join("velocity-limits.md");
+        let text = std::fs::read_to_string(results.join(&file)).with_context(|| {
+            format!(
+                "reading docs/results/{} (run `cargo xtask eval --robot {} --compare-velocity-limits`)",
+                file.display(),
+                robot.name
+            )
+        })?;
+        let body: Vec<&str> = text.lines().filter(|l| l.starts_with('|')).collect();
+        md += &format!(
+            "`{}` (`docs/results/{}`):\n\n{}\n\n",
+            robot.name,
+            file.display(),
+            body.join("\n")
+        );
+    }
+    Ok(md)
+}
+
+/// Table 1 of every shipped robot other than the FR3, from its own `eval.json`.
+fn other_arms(results: &Path) -> anyhow::Result<String> {
+    let mut md = String::new();
+    for robot in &SHIPPED_ROBOTS[1..] {
+        let file = Path::new(robot.data_subdir()).join("eval.json");
+        let eval = read(&results.join(&file))
+            .with_context(|| format!("run `cargo xtask eval --robot {}` first", robot.name))?;
+        let unseen = eval["sets"]
+            .as_array()
+            .and_then(|sets| sets.iter().find(|s| s["name"] == "unseen"))
+            .with_context(|| format!("docs/results/{} lacks the unseen set", file.display()))?;
+        md += &format!(
+            "## Second arm: `{}`, Table 1\n\nThe whole pipeline on the second shipped arm (its own task sets, labels, \
+             diffusion seeder and policy; `docs/results/{}`), {} unseen tasks:\n\n\
+             | tasks | π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|\n",
+            robot.name,
+            file.display(),
+            unseen["task_count"]
+        );
+        for group in ["all", "easy", "medium", "difficult"] {
+            for cell in cells(unseen, "dp", group) {
+                md += &format!(
+                    "| {group} (n = {}) | {} | {} | {} |\n",
+                    cell["stats"]["length_m"]["count"],
+                    cell["controller"].as_str().unwrap_or(""),
+                    four(&cell["stats"]["length_m"], 3),
+                    four(&cell["stats"]["ratio_percent"], 1)
+                );
+            }
+        }
+        let mean = |controller: &str| {
+            cells(unseen, "dp", "all")
+                .find(|c| c["controller"] == controller)
+                .and_then(|c| c["stats"]["length_m"]["mean"].as_f64())
+                .unwrap_or(f64::NAN)
+        };
+        md += &format!(
+            "\nHybrid + DP vs Classical + DP: **{:+.1} %** mean path length; RL + DP vs Classical + DP: {:+.1} %.\n\n",
+            100.0 * (mean("hybrid") / mean("classical") - 1.0),
+            100.0 * (mean("rl") / mean("classical") - 1.0),
+        );
+    }
+    Ok(md)
 }
 
 fn table2(set: &Value, paper: &Value) -> String {
