@@ -136,9 +136,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     );
     let data = training_set(&robot, &tasks, &labels, &name)?;
     println!(
-        "{} training pairs from {} labelled tasks",
+        "{} training pairs from {} labelled tasks; mirror augmentation {}",
         data.len(),
-        labels.tasks().len()
+        labels.tasks().len(),
+        if data.has_mirror() {
+            "on"
+        } else {
+            "off (the robot is not mirror-symmetric)"
+        }
     );
 
     if let Some(steps) = args.measure_backends {

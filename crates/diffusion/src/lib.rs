@@ -42,7 +42,7 @@ mod train;
 mod weights;
 
 pub use config::{Backend, DiffusionConfig, SampleConfig, TrainConfig};
-pub use dataset::{MIRROR_CONDITION_SIGNS, MIRROR_JOINT_SIGNS, training_set};
+pub use dataset::{MIRROR_CONDITION_SIGNS, MIRROR_JOINT_SIGNS, has_mirror_symmetry, training_set};
 pub use embedding::sinusoidal_embedding;
 pub use forward::{ForwardScratch, PlainDenoiser};
 pub use model::{Denoiser, DenoiserInput, ResidualBlock};

@@ -51,7 +51,7 @@ pub enum TrainError {
     },
 }
 
-/// A sign flip that maps a training pair onto an equally valid one (the FR3's xz-plane symmetry,
+/// A sign flip that maps a training pair onto an equally valid one (an arm's xz-plane symmetry,
 /// SPEC §6): condition and sample are multiplied element-wise by these signs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Mirror {
@@ -121,6 +121,11 @@ impl TrainingSet {
             mirror: None,
             name: name.to_string(),
         })
+    }
+
+    /// Whether the mirror augmentation is on.
+    pub fn has_mirror(&self) -> bool {
+        self.mirror.is_some()
     }
 
     /// Adds the mirror augmentation.
