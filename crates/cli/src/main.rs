@@ -1,4 +1,4 @@
-//! `emg`: plan extreme straight-line motions for a 7-DoF arm holding a pen (Franka FR3).
+//! `emg`: plan extreme straight-line motions for a 7-DoF arm holding a pen.
 //!
 //! ```text
 //! emg plan                                   # built-in demo task → trajectory.json, trajectory.csv
@@ -7,21 +7,23 @@
 //! emg check runs/line.joint_trajectory.json  # verify a file with the independent checker
 //! ```
 //!
-//! * Robot: `--robot <urdf>` (default: the FR3-with-pen file in `data/robots/`), `--base-link`
-//!   (`link0`), `--tip-link` (`pen_tip`).
+//! * Robot: `--robot fr3` (the default), `--robot iiwa14`, or `--robot <urdf>` for any 7-DoF
+//!   serial arm; the chain runs from the file's root link to its only leaf unless `--base-link`
+//!   and `--tip-link` name its ends. A shipped robot brings its own trained models.
 //! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON by the `.json`
 //!   extension, else the binary `EMGTASKS` set), or nothing for the demo task: from the
-//!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n`.
-//! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the shipped
-//!   `data/models/diffusion-v1.weights`), `generating` (the task's `q0_seed`), `home` (the
+//!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n` (the
+//!   first task of the robot's task population when that configuration is near a singularity).
+//! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the robot's shipped
+//!   `diffusion-v1.weights`), `generating` (the task's `q0_seed`), `home` (the
 //!   mid-range configuration of the joint limits; the robot file carries no home pose) or
 //!   `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
 //!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
 //! * `--config <json>`: optional `rollout`, `gains`, `switch` (`tau_enter`, `tau_exit`) and
 //!   `measure` objects; unset fields keep SPEC defaults.
-//! * `--controller hybrid` (default: the PPO policy over `--policy`, default the shipped
-//!   `data/models/ppo-v1.weights`, inside; the classical controller near the joint limits),
+//! * `--controller hybrid` (default: the PPO policy over `--policy`, default the robot's shipped
+//!   `ppo-v1.weights`, inside; the classical controller near the joint limits),
 //!   `rl` or `classical`.
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv` +
 //!   `<stem>.joint_trajectory.json`; a task file with several tasks gives `<stem>-00000.json`,
