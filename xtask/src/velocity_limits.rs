@@ -1,6 +1,7 @@
 //! `cargo xtask eval --compare-velocity-limits`: DP seeds × every controller on the evaluation
-//! set with the joint-velocity limits off (the paper's runs) and on (time scaling), and how path
-//! length and duration change (`docs/results/velocity-limits.{json,md}`).
+//! set with the joint-velocity limits off (the paper's runs) and at the full, half and a quarter of
+//! them (time scaling), and how path length and duration change
+//! (`docs/results/velocity-limits.{json,md}`).
 
 use std::path::Path;
 
@@ -32,21 +33,32 @@ impl VelocityLimits {
     }
 }
 
-/// One controller's runs with the limits off and on.
+/// Fractions of the velocity limits compared with the unlimited runs: the full limits, and a cell
+/// run at half and a quarter of them.
+const FRACTIONS: [f64; 3] = [1.0, 0.5, 0.25];
+
+/// One controller's runs with the limits off and at each of [`FRACTIONS`].
 #[derive(Serialize)]
 struct Comparison {
     controller: ControllerKind,
     off: Timing,
-    on: Timing,
-    /// Tasks whose path length differs between the two runs.
-    tasks_with_other_path_length: usize,
     /// Tasks whose unlimited run exceeds some joint's velocity limit.
     tasks_over_the_limits_when_off: usize,
-    /// Tasks with at least one slowed step when on.
-    tasks_slowed_when_on: usize,
-    /// Steps slowed when on, over all steps.
+    limited: Vec<Limited>,
+}
+
+/// The runs at one fraction of the velocity limits, against the unlimited runs.
+#[derive(Serialize)]
+struct Limited {
+    fraction: f64,
+    timing: Timing,
+    /// Tasks whose path length differs from the unlimited run's.
+    tasks_with_other_path_length: usize,
+    /// Tasks with at least one slowed step.
+    tasks_slowed: usize,
+    /// Slowed steps over all steps.
     slowed_step_fraction: f64,
-    /// Duration on / duration off, per task with at least one step.
+    /// Duration limited / duration unlimited, per task with at least one step.
     duration_ratio: Summary,
 }
 
@@ -55,7 +67,8 @@ struct Comparison {
 struct Timing {
     path_length_m: Summary,
     duration_s: Summary,
-    /// Largest joint speed as a fraction of that joint's limit, per task with at least one step.
+    /// Largest joint speed as a fraction of that joint's full limit, per task with at least one
+    /// step.
     peak_speed_ratio: Summary,
 }
 
@@ -102,46 +115,59 @@ pub fn run(
     let limits: Vec<f64> = setup.robot.limits().velocity.iter().copied().collect();
     let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
     let executor = setup.executor.clone();
+    let dt = setup.rollout.dt_s;
     let mut comparisons = Vec::new();
     for controller in ControllerKind::ALL {
-        let mut runs = Vec::new();
-        for choice in [VelocityLimits::Off, VelocityLimits::On] {
-            choice.apply(&mut setup.rollout.constraints);
-            let what = format!("DP+{} ({choice:?})", controller.name());
-            runs.push(setup.rollouts(&tasks, &seeds, controller, &executor, &what)?);
-        }
-        let (off, on) = (&runs[0], &runs[1]);
-        let ratios: Vec<f64> = off
-            .iter()
-            .zip(on)
-            .filter(|(a, _)| duration(a) > 0.0)
-            .map(|(a, b)| duration(b) / duration(a))
-            .collect();
-        let dt = setup.rollout.dt_s;
-        let slowed = |t: &Trajectory| {
-            t.steps
-                .windows(2)
-                .filter(|p| p[1].time_s - p[0].time_s > dt * (1.0 + 1e-9))
-                .count()
+        let mut run = |fraction: Option<f64>| -> anyhow::Result<Vec<Trajectory>> {
+            setup.rollout.constraints.velocity_limit_fraction = fraction
+                .map(VelocityLimitFraction::new)
+                .transpose()
+                .map_err(anyhow::Error::msg)?;
+            let what = match fraction {
+                None => format!("DP+{} (no limits)", controller.name()),
+                Some(f) => format!("DP+{} ({f} × limits)", controller.name()),
+            };
+            setup.rollouts(&tasks, &seeds, controller, &executor, &what)
         };
-        let steps: usize = on.iter().map(|t| t.steps.len() - 1).sum();
-        let slowed_steps: usize = on.iter().map(slowed).sum();
+        let off = run(None)?;
+        let mut limited = Vec::new();
+        for fraction in FRACTIONS {
+            let on = run(Some(fraction))?;
+            let ratios: Vec<f64> = off
+                .iter()
+                .zip(&on)
+                .filter(|(a, _)| duration(a) > 0.0)
+                .map(|(a, b)| duration(b) / duration(a))
+                .collect();
+            let slowed = |t: &Trajectory| {
+                t.steps
+                    .windows(2)
+                    .filter(|p| p[1].time_s - p[0].time_s > dt * (1.0 + 1e-9))
+                    .count()
+            };
+            let steps: usize = on.iter().map(|t| t.steps.len() - 1).sum();
+            let slowed_steps: usize = on.iter().map(slowed).sum();
+            limited.push(Limited {
+                fraction,
+                timing: timing(&on, &limits)?,
+                tasks_with_other_path_length: off
+                    .iter()
+                    .zip(&on)
+                    .filter(|(a, b)| a.path_length_m != b.path_length_m)
+                    .count(),
+                tasks_slowed: on.iter().filter(|t| slowed(t) > 0).count(),
+                slowed_step_fraction: slowed_steps as f64 / steps.max(1) as f64,
+                duration_ratio: Summary::of(&ratios).context("no task moved at all")?,
+            });
+        }
         comparisons.push(Comparison {
             controller,
-            off: timing(off, &limits)?,
-            on: timing(on, &limits)?,
-            tasks_with_other_path_length: off
-                .iter()
-                .zip(on)
-                .filter(|(a, b)| a.path_length_m != b.path_length_m)
-                .count(),
             tasks_over_the_limits_when_off: off
                 .iter()
                 .filter(|t| peak_speed_ratio(t, &limits) > 1.0 + 1e-9)
                 .count(),
-            tasks_slowed_when_on: on.iter().filter(|t| slowed(t) > 0).count(),
-            slowed_step_fraction: slowed_steps as f64 / steps.max(1) as f64,
-            duration_ratio: Summary::of(&ratios).context("no task moved at all")?,
+            off: timing(&off, &limits)?,
+            limited,
         });
     }
     VelocityLimits::On.apply(&mut setup.rollout.constraints);
@@ -171,37 +197,54 @@ fn markdown(setup: &Setup, rows: &[Comparison], count: usize, tasks_path: &Path)
         "# Joint-velocity limits: off vs on\n\nWritten by `cargo xtask eval --compare-velocity-limits`. \
          Do not edit by hand. Robot `{}`, {count} tasks of `{}`, DP seeds, every trajectory re-checked \
          by the independent checker (joint speeds included when the limits are on). With the limits on, \
-         a step that would move some joint faster than the robot file's velocity limit keeps its shape \
-         and lasts longer (time scaling), so the path is the same and only the timing changes.\n\n\
-         | controller | path length off (m) | path length on (m) | tasks with another length | duration off (s) | duration on (s) | duration on/off | tasks over the limits when off | tasks slowed when on | steps slowed | peak speed/limit off | peak speed/limit on |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         a step that would move some joint faster than the allowed fraction of the robot file's velocity \
+         limit keeps its shape and lasts longer (time scaling), so the path is the same and only the \
+         timing changes. Rows: no limits (the paper's setting), the full limits (the default), and a \
+         cell run at half and at a quarter of them.\n\n\
+         | controller | velocity limits | path length (m) | tasks with another length | duration (s) | duration / unlimited | tasks slowed | steps slowed | peak joint speed / full limit |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
         setup.robot.name(),
         workspace::relative(tasks_path),
     );
     for row in rows {
+        let peak = |t: &Timing| {
+            format!(
+                "mean {:.3}, max {:.3}",
+                t.peak_speed_ratio.mean, t.peak_speed_ratio.max
+            )
+        };
         md += &format!(
-            "| {} | {:.4} | {:.4} | {} | {:.3} | {:.3} | mean {:.4}, max {:.3} | {} | {} | {:.2} % | mean {:.3}, max {:.2} | mean {:.3}, max {:.3} |\n",
+            "| {} | none | {:.4} | — | {:.3} | — | — | — | {} ({} tasks above 1) |\n",
             row.controller.title(),
             row.off.path_length_m.mean,
-            row.on.path_length_m.mean,
-            row.tasks_with_other_path_length,
             row.off.duration_s.mean,
-            row.on.duration_s.mean,
-            row.duration_ratio.mean,
-            row.duration_ratio.max,
+            peak(&row.off),
             row.tasks_over_the_limits_when_off,
-            row.tasks_slowed_when_on,
-            100.0 * row.slowed_step_fraction,
-            row.off.peak_speed_ratio.mean,
-            row.off.peak_speed_ratio.max,
-            row.on.peak_speed_ratio.mean,
-            row.on.peak_speed_ratio.max,
         );
+        for on in &row.limited {
+            md += &format!(
+                "| {} | {} × | {:.4} | {} | {:.3} | mean {:.4}, max {:.3} | {} | {:.2} % | {} |\n",
+                row.controller.title(),
+                on.fraction,
+                on.timing.path_length_m.mean,
+                on.tasks_with_other_path_length,
+                on.timing.duration_s.mean,
+                on.duration_ratio.mean,
+                on.duration_ratio.max,
+                on.tasks_slowed,
+                100.0 * on.slowed_step_fraction,
+                peak(&on.timing),
+            );
+        }
     }
     md += &format!(
-        "\nPath length with the limits on (m, mean / std / min / max): {}.\n",
+        "\nPath length with the full limits (m, mean / std / min / max): {}.\n",
         rows.iter()
-            .map(|r| format!("{} {}", r.controller.title(), four(&r.on.path_length_m, 3)))
+            .map(|r| format!(
+                "{} {}",
+                r.controller.title(),
+                four(&r.limited[0].timing.path_length_m, 3)
+            ))
             .collect::<Vec<_>>()
             .join("; ")
     );
