@@ -42,7 +42,7 @@ pub struct WeightsHeader {
 #[derive(Debug, thiserror::Error)]
 pub enum WeightsError {
     /// The file could not be read or written.
-    #[error("weights file {path}: {source}")]
+    #[error("cannot access weights file {path}")]
     Io {
         /// File.
         path: String,
