@@ -526,11 +526,14 @@ window.addEventListener("unhandledrejection", function (event) {
   speedSelect.addEventListener("change", () => {
     previousNow = null;
   });
+  // Scrubbing redraws at once, so the scene and the read-out follow the bar without waiting for
+  // the next animation frame.
   scrub.addEventListener("input", () => {
     scrubbing = true;
     current = Math.min(duration, Math.max(0, Number(scrub.value)));
     previousNow = null;
-    dirty = true;
+    draw();
+    dirty = false;
   });
   scrub.addEventListener("change", () => {
     scrubbing = false;
