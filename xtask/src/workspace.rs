@@ -17,10 +17,9 @@ pub fn root() -> PathBuf {
 
 /// Where one robot's files live: its robot file and the sub-directory of its data, results,
 /// figures and scratch files (empty for the FR3's top-level layout).
-#[derive(Clone, Debug)]
-pub struct RobotLayout {
-    /// Robot file.
-    pub urdf: PathBuf,
+#[derive(Clone, Debug, PartialEq)]
+struct RobotLayout {
+    urdf: PathBuf,
     subdir: String,
 }
 
@@ -54,17 +53,19 @@ fn layout_of(value: &str) -> RobotLayout {
 /// Selects the robot whose files the commands' defaults point at, from the `--robot` value in
 /// the command line (the FR3 when there is none). Call once, before parsing the arguments.
 pub fn select_robot(args: &[String]) {
-    let value = args.iter().enumerate().find_map(|(i, arg)| {
-        arg.strip_prefix("--robot=")
-            .map(str::to_string)
-            .or_else(|| {
-                (arg == "--robot")
-                    .then(|| args.get(i + 1).cloned())
-                    .flatten()
-            })
-    });
-    let layout = layout_of(value.as_deref().unwrap_or("fr3"));
+    let layout = layout_of(robot_value(args).unwrap_or("fr3"));
     LAYOUT.set(layout).expect("the robot is selected once");
+}
+
+/// The value of `--robot X` or `--robot=X` in `args`, if any.
+fn robot_value(args: &[String]) -> Option<&str> {
+    args.iter().enumerate().find_map(|(i, arg)| {
+        arg.strip_prefix("--robot=").or_else(|| {
+            (arg == "--robot")
+                .then(|| args.get(i + 1).map(String::as_str))
+                .flatten()
+        })
+    })
 }
 
 fn layout() -> &'static RobotLayout {
@@ -142,4 +143,35 @@ pub fn machine() -> String {
         "{model}, {} cores",
         std::thread::available_parallelism().map_or(0, |n| n.get())
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn robot_values_pick_shipped_or_custom_layouts() {
+        let args = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        assert_eq!(
+            robot_value(&args(&["xtask", "eval", "--robot", "iiwa14"])),
+            Some("iiwa14")
+        );
+        assert_eq!(
+            robot_value(&args(&["xtask", "eval", "--robot=fr3"])),
+            Some("fr3")
+        );
+        assert_eq!(robot_value(&args(&["xtask", "eval"])), None);
+        let iiwa = layout_of("iiwa14");
+        assert_eq!(iiwa.subdir, "iiwa14");
+        assert!(iiwa.urdf.ends_with("data/robots/iiwa14_pen.urdf") && iiwa.urdf.exists());
+        let by_path = layout_of(iiwa.urdf.to_str().unwrap());
+        assert_eq!(
+            by_path, iiwa,
+            "the shipped file by path is the shipped robot"
+        );
+        assert_eq!(layout_of("fr3").subdir, "");
+        let custom = layout_of("arms/my_arm.urdf");
+        assert_eq!(custom.subdir, "custom/my_arm");
+        assert_eq!(custom.urdf, PathBuf::from("arms/my_arm.urdf"));
+    }
 }
