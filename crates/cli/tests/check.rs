@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
-use common::{emg, read_json, temp_dir, text};
+use common::{emg, read_json, task_json, temp_dir, text};
 
 /// Velocity-limit fraction of the planned task: low enough that many steps are slowed, so the
 /// times are not uniform.
@@ -300,16 +300,7 @@ fn a_task_set_writes_one_joint_trajectory_per_task() {
         mid + emg_kinematics::JointVector::from([0.3, 0.2, -0.2, 0.3, 0.1, -0.2, 0.4]),
     ]
     .iter()
-    .map(|q| {
-        let kin = robot.forward(q);
-        let n = kin.tool_axis();
-        let y = emg_kinematics::Vec3::y();
-        let d = (y - n * y.dot(&n)).normalize();
-        serde_json::json!({
-            "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(),
-            "q0_seed": q.as_slice(),
-        })
-    })
+    .map(|q| task_json(&robot, q))
     .collect();
     let task_file = dir.join("tasks.json");
     std::fs::write(&task_file, Value::from(tasks).to_string()).unwrap();

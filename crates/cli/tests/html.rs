@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 use emg_kinematics::{JointVector, Robot, default_robot_path};
 use serde_json::Value;
 
-use common::{NO_WEIGHTS, read, temp_dir};
+use common::{NO_WEIGHTS, read, task_json, temp_dir};
 
 /// Runs `emg plan` with the classical controller and `args`, asserting success; returns stdout.
 fn plan_ok(args: &[&str]) -> String {
@@ -85,15 +85,7 @@ fn html_pages_follow_the_per_task_suffix_rule() {
         mid + JointVector::from([0.3, 0.2, -0.2, 0.3, 0.1, -0.2, 0.4]),
     ]
     .iter()
-    .map(|q| {
-        let kin = robot.forward(q);
-        let n = kin.tool_axis();
-        let y = emg_kinematics::Vec3::y();
-        let d = (y - n * y.dot(&n)).normalize();
-        serde_json::json!({
-            "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(), "q0_seed": q.as_slice(),
-        })
-    })
+    .map(|q| task_json(&robot, q))
     .collect();
     let task_file = dir.join("tasks.json");
     std::fs::write(&task_file, serde_json::to_string(&tasks).unwrap()).unwrap();

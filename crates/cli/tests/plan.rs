@@ -9,7 +9,7 @@ use emg_control::{ReferenceModel, RolloutConfig, Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, default_robot_path};
 use serde_json::Value;
 
-use common::{NO_WEIGHTS, emg, read_json, temp_dir, text};
+use common::{NO_WEIGHTS, emg, read_json, task_json, temp_dir, text};
 
 fn stderr(output: &Output) -> String {
     text(&output.stderr)
@@ -206,15 +206,9 @@ fn task_file_with_three_tasks_gives_three_results() {
         .iter()
         .enumerate()
         .map(|(i, q)| {
-            let kin = robot.forward(q);
-            let n = kin.tool_axis();
-            let y = emg_kinematics::Vec3::y();
-            let d = (y - n * y.dot(&n)).normalize();
-            let mut task = serde_json::json!({
-                "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(),
-            });
-            if i != 2 {
-                task["q0_seed"] = serde_json::json!(q.as_slice());
+            let mut task = task_json(&robot, q);
+            if i == 2 {
+                task.as_object_mut().unwrap().remove("q0_seed");
             }
             task
         })

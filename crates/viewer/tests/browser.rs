@@ -314,13 +314,18 @@ fn screenshot_check_fails_when_the_page_draws_nothing() {
     let dir = temp_dir("screenshot-blank");
     // Without steps the script stops before drawing anything.
     let (_, page) = planned_page();
-    let broken = page.replacen(r#""steps":["#, r#""steps":[],"unused":["#, 1);
+    let broken = without_steps(&page);
     assert_ne!(broken, page, "the data blob holds the steps");
     let (_, _, pixels) = screenshot(&browser, &dir, &broken);
     assert!(
         blank_screenshot_problem(&pixels).is_some(),
         "a page that draws nothing passed the screenshot check"
     );
+}
+
+/// `page` with its motion data emptied of steps (the steps moved to an unused member).
+fn without_steps(page: &str) -> String {
+    page.replacen(r#""steps":["#, r#""steps":[],"unused":["#, 1)
 }
 
 #[test]
@@ -339,7 +344,7 @@ fn status_check_catches_an_error_in_the_viewer_script() {
     let Some(browser) = browser() else { return };
     let dir = temp_dir("dom-broken-data");
     let (_, page) = planned_page();
-    let broken = page.replacen(r#""steps":["#, r#""steps":[],"unused":["#, 1);
+    let broken = without_steps(&page);
     let run = dump_dom(&browser, &dir, &broken);
     let problems = page_problems(&run).expect_err("a page whose script throws passed the check");
     assert!(

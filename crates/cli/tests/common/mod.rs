@@ -48,3 +48,15 @@ pub fn read(path: &Path) -> String {
 pub fn read_json(path: &Path) -> Value {
     serde_json::from_str(&read(path)).expect("valid JSON")
 }
+
+/// A task (JSON, as in a task file) from configuration `q`: `p0` = its TCP, `n` = its tool axis,
+/// `d` = +y made perpendicular to `n`, and `q0_seed` = `q`.
+pub fn task_json(robot: &emg_kinematics::Robot, q: &emg_kinematics::JointVector) -> Value {
+    let kin = robot.forward(q);
+    let n = kin.tool_axis();
+    let y = emg_kinematics::Vec3::y();
+    let d = (y - n * y.dot(&n)).normalize();
+    serde_json::json!({
+        "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(), "q0_seed": q.as_slice(),
+    })
+}
