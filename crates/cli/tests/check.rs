@@ -79,7 +79,8 @@ fn write_json(dir: &Path, name: &str, doc: &Value) -> String {
 
 #[test]
 fn every_file_of_a_plan_passes_and_tampering_is_caught() {
-    let dir = temp_dir("files");
+    let tmp = temp_dir("files");
+    let dir = tmp.path();
     let stem = plan(&dir);
     let json = with_ext(&stem, ".json");
     let csv = with_ext(&stem, ".csv");
@@ -228,7 +229,8 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
 
 #[test]
 fn malformed_files_name_the_file_and_the_field() {
-    let dir = temp_dir("malformed");
+    let tmp = temp_dir("malformed");
+    let dir = tmp.path();
     let stem = plan(&dir);
     let joint = read_json(&with_ext(&stem, ".joint_trajectory.json"));
 
@@ -287,7 +289,8 @@ fn malformed_files_name_the_file_and_the_field() {
 
 #[test]
 fn a_task_set_writes_one_joint_trajectory_per_task() {
-    let dir = temp_dir("set");
+    let tmp = temp_dir("set");
+    let dir = tmp.path();
     let robot = emg_kinematics::Robot::from_urdf_file(
         emg_kinematics::default_robot_path(),
         "link0",

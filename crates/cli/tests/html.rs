@@ -36,7 +36,8 @@ fn listing(dir: &std::path::Path) -> Vec<String> {
 
 #[test]
 fn html_page_holds_the_planned_motion() {
-    let dir = temp_dir("single");
+    let tmp = temp_dir("single");
+    let dir = tmp.path();
     let stem = dir.join("demo");
     let page_path = dir.join("pages/demo.html");
     let stdout = plan_ok(&[
@@ -77,7 +78,8 @@ fn html_page_holds_the_planned_motion() {
 
 #[test]
 fn html_pages_follow_the_per_task_suffix_rule() {
-    let dir = temp_dir("set");
+    let tmp = temp_dir("set");
+    let dir = tmp.path();
     let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
     let mid = robot.mid_range();
     let tasks: Vec<Value> = [
@@ -133,7 +135,8 @@ fn html_pages_follow_the_per_task_suffix_rule() {
 
 #[test]
 fn no_page_without_html() {
-    let dir = temp_dir("none");
+    let tmp = temp_dir("none");
+    let dir = tmp.path();
     let stdout = plan_ok(&[
         "--seed",
         "home",

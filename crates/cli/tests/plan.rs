@@ -40,7 +40,8 @@ fn plan_err(args: &[&str]) -> String {
 
 #[test]
 fn demo_task_writes_documented_json_and_csv() {
-    let dir = temp_dir("demo");
+    let tmp = temp_dir("demo");
+    let dir = tmp.path();
     let stem = dir.join("nested/demo");
     // Without diffusion weights the default seed is the task's generating configuration.
     let stdout = plan_ok(&["--out", stem.to_str().unwrap(), "--weights", NO_WEIGHTS]);
@@ -103,7 +104,8 @@ fn demo_task_writes_documented_json_and_csv() {
 
 #[test]
 fn written_trajectory_passes_the_independent_checker() {
-    let dir = temp_dir("check");
+    let tmp = temp_dir("check");
+    let dir = tmp.path();
     let stem = dir.join("line");
     plan_ok(&[
         "--p0",
@@ -142,7 +144,8 @@ fn written_trajectory_passes_the_independent_checker() {
 
 #[test]
 fn bad_inputs_fail_naming_the_field() {
-    let dir = temp_dir("bad");
+    let tmp = temp_dir("bad");
+    let dir = tmp.path();
     let out = dir.join("never");
     let out = out.to_str().unwrap();
 
@@ -194,7 +197,8 @@ fn bad_inputs_fail_naming_the_field() {
 
 #[test]
 fn task_file_with_three_tasks_gives_three_results() {
-    let dir = temp_dir("set");
+    let tmp = temp_dir("set");
+    let dir = tmp.path();
     let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
     let mid = robot.mid_range();
     let configs = [
@@ -241,7 +245,8 @@ fn task_file_with_three_tasks_gives_three_results() {
 
 #[test]
 fn given_seed_is_projected_and_recorded() {
-    let dir = temp_dir("given");
+    let tmp = temp_dir("given");
+    let dir = tmp.path();
     let stem = dir.join("given");
     let stdout = plan_ok(&[
         "--p0",
@@ -263,7 +268,8 @@ fn given_seed_is_projected_and_recorded() {
 
 #[test]
 fn dp_seed_is_the_default_with_the_shipped_weights() {
-    let dir = temp_dir("dp");
+    let tmp = temp_dir("dp");
+    let dir = tmp.path();
     let stem = dir.join("demo");
     let stdout = plan_ok(&["--out", stem.to_str().unwrap()]);
     assert!(stdout.contains("seed: dp"), "{stdout}");
@@ -284,7 +290,8 @@ fn dp_seed_is_the_default_with_the_shipped_weights() {
 
 #[test]
 fn dp_seed_with_missing_or_damaged_weights_fails_clearly() {
-    let dir = temp_dir("dp-bad");
+    let tmp = temp_dir("dp-bad");
+    let dir = tmp.path();
     let stem = dir.join("x");
     let err = plan_err(&[
         "--seed",
@@ -322,7 +329,8 @@ fn emg_cli_weights() -> PathBuf {
 /// pass instead.
 #[test]
 fn robot_by_name_and_by_file() {
-    let dir = temp_dir("iiwa");
+    let tmp = temp_dir("iiwa");
+    let dir = tmp.path();
     let stem = dir.join("iiwa");
     plan_ok(&[
         "--robot",

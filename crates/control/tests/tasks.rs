@@ -179,26 +179,22 @@ fn valid_input_is_normalised_and_made_perpendicular() {
     assert!((task.lateral_error(&p) - (-(side * 0.01 + n * 0.02))).norm() < 1e-15);
 }
 
-/// A unique path in the temporary directory, removed on drop.
-struct TempFile(PathBuf);
+/// A path inside a fresh temporary directory, which is removed on drop.
+struct TempFile {
+    path: PathBuf,
+    _dir: tempfile::TempDir,
+}
 
 impl TempFile {
     fn new(name: &str) -> Self {
-        use std::sync::atomic::{AtomicUsize, Ordering};
-        static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let unique = format!(
-            "emg-control-test-{}-{}-{}",
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed),
-            name
-        );
-        Self(std::env::temp_dir().join(unique))
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
+        let dir = tempfile::Builder::new()
+            .prefix("emg-control-test-")
+            .tempdir()
+            .expect("create temp dir");
+        Self {
+            path: dir.path().join(name),
+            _dir: dir,
+        }
     }
 }
 
@@ -227,11 +223,11 @@ fn binary_task_sets_round_trip_bit_for_bit() {
     let robot = robot();
     let set = sample_set(&robot);
     let file = TempFile::new("roundtrip.tasks");
-    write_task_set(&file.0, &set).unwrap();
-    let bytes = std::fs::read(&file.0).unwrap();
+    write_task_set(&file.path, &set).unwrap();
+    let bytes = std::fs::read(&file.path).unwrap();
     assert_eq!(bytes.len(), 24 + set.len() * 16 * 8);
     assert_eq!(&bytes[..8], b"EMGTASKS");
-    let back = read_tasks(&file.0, &robot).unwrap();
+    let back = read_tasks(&file.path, &robot).unwrap();
     assert_eq!(back.len(), set.len());
     for (i, (a, b)) in set.iter().zip(&back).enumerate() {
         assert_eq!(
@@ -253,8 +249,8 @@ fn binary_task_sets_round_trip_bit_for_bit() {
     }
     assert!(back[3].q0_seed.is_none());
     // An empty set round-trips too.
-    write_task_set(&file.0, &[]).unwrap();
-    assert!(read_tasks(&file.0, &robot).unwrap().is_empty());
+    write_task_set(&file.path, &[]).unwrap();
+    assert!(read_tasks(&file.path, &robot).unwrap().is_empty());
 }
 
 fn format_error(result: Result<Vec<Task>, TaskFileError>) -> String {
@@ -269,51 +265,51 @@ fn damaged_binary_files_are_refused() {
     let robot = robot();
     let set: Vec<Task> = tasks(&robot, 3).into_iter().map(|(_, t)| t).collect();
     let file = TempFile::new("damaged.tasks");
-    write_task_set(&file.0, &set).unwrap();
-    let good = std::fs::read(&file.0).unwrap();
+    write_task_set(&file.path, &set).unwrap();
+    let good = std::fs::read(&file.path).unwrap();
 
     for cut in [8, 1, good.len() - 24 - 1] {
-        std::fs::write(&file.0, &good[..good.len() - cut]).unwrap();
-        let m = format_error(read_tasks(&file.0, &robot));
+        std::fs::write(&file.path, &good[..good.len() - cut]).unwrap();
+        let m = format_error(read_tasks(&file.path, &robot));
         assert!(m.contains("truncated"), "cut {cut}: {m}");
         assert!(
-            m.contains(&file.0.display().to_string()),
+            m.contains(&file.path.display().to_string()),
             "the path is named: {m}"
         );
     }
     // Cut inside the header, after the magic.
     for keep in [12, 20] {
-        std::fs::write(&file.0, &good[..keep]).unwrap();
-        let m = format_error(read_tasks(&file.0, &robot));
+        std::fs::write(&file.path, &good[..keep]).unwrap();
+        let m = format_error(read_tasks(&file.path, &robot));
         assert!(m.contains("truncated"), "header cut to {keep} bytes: {m}");
     }
     let mut padded = good.clone();
     padded.extend_from_slice(&[0; 8]);
-    std::fs::write(&file.0, &padded).unwrap();
-    assert!(format_error(read_tasks(&file.0, &robot)).contains("padded"));
+    std::fs::write(&file.path, &padded).unwrap();
+    assert!(format_error(read_tasks(&file.path, &robot)).contains("padded"));
 
     let mut foreign = good.clone();
     foreign[..8].copy_from_slice(b"NOTTASKS");
-    std::fs::write(&file.0, &foreign).unwrap();
-    assert!(format_error(read_tasks(&file.0, &robot)).contains("EMGTASKS"));
-    std::fs::write(&file.0, b"").unwrap();
-    format_error(read_tasks(&file.0, &robot));
+    std::fs::write(&file.path, &foreign).unwrap();
+    assert!(format_error(read_tasks(&file.path, &robot)).contains("EMGTASKS"));
+    std::fs::write(&file.path, b"").unwrap();
+    format_error(read_tasks(&file.path, &robot));
 
     let mut version = good.clone();
     version[8..12].copy_from_slice(&7u32.to_le_bytes());
-    std::fs::write(&file.0, &version).unwrap();
-    let m = format_error(read_tasks(&file.0, &robot));
+    std::fs::write(&file.path, &version).unwrap();
+    let m = format_error(read_tasks(&file.path, &robot));
     assert!(m.contains("version 7"), "{m}");
 
     let mut width = good.clone();
     width[12..16].copy_from_slice(&15u32.to_le_bytes());
-    std::fs::write(&file.0, &width).unwrap();
-    assert!(format_error(read_tasks(&file.0, &robot)).contains("15 values per task"));
+    std::fs::write(&file.path, &width).unwrap();
+    assert!(format_error(read_tasks(&file.path, &robot)).contains("15 values per task"));
 
     let mut count = good.clone();
     count[16..24].copy_from_slice(&u64::MAX.to_le_bytes());
-    std::fs::write(&file.0, &count).unwrap();
-    format_error(read_tasks(&file.0, &robot));
+    std::fs::write(&file.path, &count).unwrap();
+    format_error(read_tasks(&file.path, &robot));
 
     // A binary record holding an invalid task is reported with its index.
     let mut invalid = good.clone();
@@ -321,8 +317,8 @@ fn damaged_binary_files_are_refused() {
     for k in 0..3 {
         invalid[record + 24 + 8 * k..record + 32 + 8 * k].copy_from_slice(&0f64.to_le_bytes());
     }
-    std::fs::write(&file.0, &invalid).unwrap();
-    match read_tasks(&file.0, &robot) {
+    std::fs::write(&file.path, &invalid).unwrap();
+    match read_tasks(&file.path, &robot) {
         Err(TaskFileError::Task {
             index: 2,
             source: TaskError::ZeroVector { field: "d" },
@@ -333,7 +329,7 @@ fn damaged_binary_files_are_refused() {
 
     let missing = TempFile::new("missing.tasks");
     assert!(matches!(
-        read_tasks(&missing.0, &robot),
+        read_tasks(&missing.path, &robot),
         Err(TaskFileError::Io { .. })
     ));
 }
@@ -353,13 +349,13 @@ fn json_task_files() {
 
     // A list, and a single object, both read.
     let list = serde_json::json!([spec(p0, d, Some(q)), spec(p0 + d * 0.01, d * 2.0, None)]);
-    std::fs::write(&file.0, list.to_string()).unwrap();
-    let read = read_tasks(&file.0, &robot).unwrap();
+    std::fs::write(&file.path, list.to_string()).unwrap();
+    let read = read_tasks(&file.path, &robot).unwrap();
     assert_eq!(read.len(), 2);
     assert_eq!(read[0].q0_seed, Some(q));
     assert!(read[1].q0_seed.is_none() && (read[1].d.norm() - 1.0).abs() < 1e-15);
-    std::fs::write(&file.0, spec(p0, d, None).to_string()).unwrap();
-    assert_eq!(read_tasks(&file.0, &robot).unwrap().len(), 1);
+    std::fs::write(&file.path, spec(p0, d, None).to_string()).unwrap();
+    assert_eq!(read_tasks(&file.path, &robot).unwrap().len(), 1);
 
     // One invalid task: its index and field are named.
     let cases = [
@@ -378,8 +374,8 @@ fn json_task_files() {
             bad,
             spec(p0, d, None)
         ]);
-        std::fs::write(&file.0, list.to_string()).unwrap();
-        match read_tasks(&file.0, &robot) {
+        std::fs::write(&file.path, list.to_string()).unwrap();
+        match read_tasks(&file.path, &robot) {
             Err(e @ TaskFileError::Task { index: 2, .. }) => {
                 let m = e.to_string();
                 assert!(m.contains("task 2") && m.contains(field), "{m}");
@@ -395,19 +391,19 @@ fn json_task_files() {
         serde_json::json!([spec(p0, d, None), extra.clone()]).to_string(),
         extra.to_string(),
     ] {
-        std::fs::write(&file.0, &text).unwrap();
-        let m = format_error(read_tasks(&file.0, &robot));
+        std::fs::write(&file.path, &text).unwrap();
+        let m = format_error(read_tasks(&file.path, &robot));
         assert!(m.contains("speed"), "unknown key not named: {m}");
     }
     // A missing field and a wrong length are reported as format errors naming the field.
     let mut missing = spec(p0, d, None);
     missing.as_object_mut().unwrap().remove("n");
-    std::fs::write(&file.0, serde_json::json!([missing]).to_string()).unwrap();
-    assert!(format_error(read_tasks(&file.0, &robot)).contains("`n`"));
+    std::fs::write(&file.path, serde_json::json!([missing]).to_string()).unwrap();
+    assert!(format_error(read_tasks(&file.path, &robot)).contains("`n`"));
     let mut short = spec(p0, d, None);
     short["q0_seed"] = serde_json::json!([0.0, 1.0]);
-    std::fs::write(&file.0, serde_json::json!([short]).to_string()).unwrap();
-    format_error(read_tasks(&file.0, &robot));
-    std::fs::write(&file.0, "not json").unwrap();
-    format_error(read_tasks(&file.0, &robot));
+    std::fs::write(&file.path, serde_json::json!([short]).to_string()).unwrap();
+    format_error(read_tasks(&file.path, &robot));
+    std::fs::write(&file.path, "not json").unwrap();
+    format_error(read_tasks(&file.path, &robot));
 }

@@ -113,7 +113,8 @@ fn resumed_run_continues_the_same_loss_curve() {
     for _ in 0..12 {
         straight.train_step(&data);
     }
-    let dir = std::env::temp_dir().join(format!("emg-diffusion-resume-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("checkpoint");
     let mut first = Trainer::new(tiny(), training(12), Backend::Flex, &data).unwrap();
     for _ in 0..6 {
         first.train_step(&data);
@@ -207,10 +208,8 @@ fn damaged_or_mismatched_weights_files_give_clear_errors() {
         "weights field 'config.data_dim' is 3, but 7 is required"
     );
 
-    let path = std::env::temp_dir().join(format!(
-        "emg-diffusion-weights-{}.weights",
-        std::process::id()
-    ));
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("denoiser.weights");
     weights.write(&path).unwrap();
     assert_eq!(DenoiserWeights::read(&path).unwrap(), weights);
     std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();

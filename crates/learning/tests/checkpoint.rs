@@ -5,9 +5,8 @@ use emg_learning::checkpoint::{publish, stage};
 
 #[test]
 fn a_published_checkpoint_replaces_the_previous_one() {
-    let root = std::env::temp_dir().join(format!("emg-learning-checkpoint-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
-    std::fs::create_dir_all(&root).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
     let dir = root.join("run");
     for (round, name) in [(1, "first.txt"), (2, "second.txt")] {
         let staging = stage(&dir).unwrap();
@@ -25,14 +24,13 @@ fn a_published_checkpoint_replaces_the_previous_one() {
         !dir.join("first.txt").exists(),
         "the old checkpoint is replaced, not merged"
     );
-    std::fs::remove_dir_all(&root).unwrap();
 }
 
 #[test]
 fn run_state_round_trips_and_a_missing_state_names_its_file() {
     use emg_learning::checkpoint::{read_state, write_state};
-    let root = std::env::temp_dir().join(format!("emg-learning-state-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path();
     let dir = root.join("run");
     let staging = stage(&dir).unwrap();
     write_state(&staging, &(7_u64, vec![0.25_f64, -1.5])).unwrap();
@@ -41,5 +39,4 @@ fn run_state_round_trips_and_a_missing_state_names_its_file() {
     assert_eq!(state, (7, vec![0.25, -1.5]));
     let error = read_state::<u64>(&root.join("missing")).unwrap_err();
     assert!(error.to_string().contains("state.json"), "{error}");
-    std::fs::remove_dir_all(&root).unwrap();
 }

@@ -124,14 +124,12 @@ fn bad_header_and_count_mismatch_are_rejected() {
 
 #[test]
 fn write_atomically_replaces_the_file_and_leaves_no_partial() {
-    let dir = std::env::temp_dir().join(format!("emg-learning-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("w.weights");
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("w.weights");
     write_atomically(&path, b"first").unwrap();
     write_atomically(&path, b"second").unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), b"second");
     assert!(!path.with_extension("partial").exists());
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

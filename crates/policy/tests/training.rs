@@ -91,7 +91,8 @@ fn a_resumed_run_continues_the_same_curve() {
         straight.iterate(&mut envs).unwrap();
     }
 
-    let dir = std::env::temp_dir().join(format!("emg-policy-resume-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("checkpoint");
     let mut first = Trainer::new(network.clone(), ppo.clone(), Backend::Flex).unwrap();
     let mut envs = first.start_envs(pool.environments(16)).unwrap();
     for _ in 0..2 {

@@ -87,12 +87,10 @@ fn plain_forward_agrees_with_burn_on_ndarray() {
 #[test]
 fn weights_round_trip_through_a_file() {
     let weights = trained_weights(Backend::Flex);
-    let dir = std::env::temp_dir().join(format!("emg-policy-weights-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("policy.weights");
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("policy.weights");
     weights.write(&path).unwrap();
     assert_eq!(PolicyWeights::read(&path).unwrap(), weights);
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

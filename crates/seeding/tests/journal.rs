@@ -33,10 +33,11 @@ fn label_file(dir: &std::path::Path, runs: &[(Shard, Option<usize>)], threads: u
 
 #[test]
 fn interrupted_sharded_and_threaded_runs_equal_the_single_run() {
-    let single = label_file(&temporary_dir("single"), &[(Shard::WHOLE, None)], 1);
+    let single = label_file(temporary_dir("single").path(), &[(Shard::WHOLE, None)], 1);
 
     // Interrupted after one chunk, then after one more, then resumed to the end.
-    let dir = temporary_dir("resumed");
+    let tmp = temporary_dir("resumed");
+    let dir = tmp.path();
     {
         let (robot, config) = (robot(), small_config());
         let tasks = eval_tasks(&robot, TASKS);
@@ -52,7 +53,7 @@ fn interrupted_sharded_and_threaded_runs_equal_the_single_run() {
     assert_eq!(single, resumed, "resumed run differs from the single run");
 
     let sharded = label_file(
-        &temporary_dir("sharded"),
+        temporary_dir("sharded").path(),
         &[
             ("1/3".parse().unwrap(), None),
             ("0/3".parse().unwrap(), None),
@@ -68,7 +69,8 @@ fn journal_of_another_config_is_refused_and_shards_parse() {
     let (robot, config) = (robot(), small_config());
     let tasks = eval_tasks(&robot, 3);
     let sha = task_set_sha256(&eval_path()).unwrap();
-    let dir = temporary_dir("refused");
+    let tmp = temporary_dir("refused");
+    let dir = tmp.path();
     LabelJob::new(&robot, &tasks, sha, &config, &dir, CHUNK).unwrap();
     let mut other = config.clone();
     other.seed += 1;

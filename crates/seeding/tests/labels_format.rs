@@ -24,23 +24,24 @@ fn sample_set(indices: &[u32]) -> LabelSet {
     LabelSet::new([5; 32], 20, 6, tasks).expect("valid set")
 }
 
-fn temporary(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("emg-seeding-format-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+/// A path named `name` inside a fresh temporary directory, which is removed on drop.
+fn temporary(name: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    (dir, path)
 }
 
 #[test]
 fn round_trip_is_exact() {
     let set = sample_set(&[0, 1, 2, 3, 7, 19]);
-    let path = temporary("round.labels");
+    let (_tmp, path) = temporary("round.labels");
     set.write(&path).unwrap();
     let back = LabelSet::read(&path).unwrap();
     assert_eq!(back, set);
     assert_eq!(back.get(7), set.get(7));
     assert!(back.get(4).is_none());
     assert!(!back.is_complete());
-    let again = temporary("round-again.labels");
+    let (_tmp_again, again) = temporary("round-again.labels");
     back.write(&again).unwrap();
     assert_eq!(
         std::fs::read(&path).unwrap(),
@@ -58,7 +59,7 @@ fn merged_parts_equal_one_write() {
         sample_set(&[5, 6, 7, 8, 9]),
     ];
     let merged = LabelSet::merge(parts).unwrap();
-    let (a, b) = (temporary("whole.labels"), temporary("merged.labels"));
+    let ((_tmp_a, a), (_tmp_b, b)) = (temporary("whole.labels"), temporary("merged.labels"));
     whole.write(&a).unwrap();
     merged.write(&b).unwrap();
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
@@ -110,7 +111,7 @@ fn bad_sets_and_files_are_rejected_by_name() {
     );
     assert!(nan.unwrap_err().to_string().contains("'q' is not finite"));
 
-    let path = temporary("corrupt.labels");
+    let (_tmp, path) = temporary("corrupt.labels");
     sample_set(&[1, 2, 3]).write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
     std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
@@ -135,7 +136,7 @@ fn bad_sets_and_files_are_rejected_by_name() {
             .contains("version 9")
     );
     assert!(matches!(
-        LabelSet::read(&temporary("missing.labels")),
+        LabelSet::read(&temporary("missing.labels").1),
         Err(LabelError::Io { .. })
     ));
 }

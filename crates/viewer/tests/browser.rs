@@ -55,19 +55,12 @@ fn browser() -> Option<PathBuf> {
     found
 }
 
-/// A fresh directory under the system temp dir.
-fn temp_dir(name: &str) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "emg-viewer-{name}-{}-{nanos}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
+/// A fresh directory under the system temp dir, removed when dropped.
+fn temp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("emg-viewer-{name}-"))
+        .tempdir()
+        .expect("create temp dir")
 }
 
 /// A classical rollout of a line along +y from the mid-range configuration, and its page.
@@ -296,7 +289,8 @@ fn the_planned_motion_has_many_steps() {
 #[test]
 fn screenshot_shows_the_arm() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("screenshot");
+    let tmp = temp_dir("screenshot");
+    let dir = tmp.path();
     let (_, page) = planned_page();
     let (width, height, pixels) = screenshot(&browser, &dir, &page);
     assert_eq!((width, height), (1000, 700), "screenshot size");
@@ -311,7 +305,8 @@ fn screenshot_shows_the_arm() {
 #[test]
 fn screenshot_check_fails_when_the_page_draws_nothing() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("screenshot-blank");
+    let tmp = temp_dir("screenshot-blank");
+    let dir = tmp.path();
     // Without steps the script stops before drawing anything.
     let (_, page) = planned_page();
     let broken = without_steps(&page);
@@ -331,7 +326,8 @@ fn without_steps(page: &str) -> String {
 #[test]
 fn page_reports_rendered_with_a_silent_console() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("dom");
+    let tmp = temp_dir("dom");
+    let dir = tmp.path();
     let (_, page) = planned_page();
     let run = dump_dom(&browser, &dir, &page);
     if let Err(problems) = page_problems(&run) {
@@ -342,7 +338,8 @@ fn page_reports_rendered_with_a_silent_console() {
 #[test]
 fn status_check_catches_an_error_in_the_viewer_script() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("dom-broken-data");
+    let tmp = temp_dir("dom-broken-data");
+    let dir = tmp.path();
     let (_, page) = planned_page();
     let broken = without_steps(&page);
     let run = dump_dom(&browser, &dir, &broken);
@@ -360,7 +357,8 @@ fn status_check_catches_an_error_in_the_viewer_script() {
 #[test]
 fn console_check_catches_errors_thrown_after_the_first_frame() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("dom-late-error");
+    let tmp = temp_dir("dom-late-error");
+    let dir = tmp.path();
     let (_, page) = planned_page();
     let thrown = with_extra_script(
         &page,
@@ -388,7 +386,8 @@ fn console_check_catches_errors_thrown_after_the_first_frame() {
 #[test]
 fn controls_scrub_orbit_and_zoom_without_errors() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("dom-controls");
+    let tmp = temp_dir("dom-controls");
+    let dir = tmp.path();
     let (trajectory, page) = planned_page();
     // Drive every control, then record what the read-out shows at the end of the motion.
     let exercise = r#"
@@ -443,7 +442,8 @@ fn controls_scrub_orbit_and_zoom_without_errors() {
 #[test]
 fn a_motion_of_only_the_seed_renders() {
     let Some(browser) = browser() else { return };
-    let dir = temp_dir("dom-seed-only");
+    let tmp = temp_dir("dom-seed-only");
+    let dir = tmp.path();
     let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
         .expect("the FR3 robot file loads");
     let seed = robot.mid_range();

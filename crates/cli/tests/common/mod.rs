@@ -2,28 +2,21 @@
 //! the binary, and reading what it wrote.
 #![allow(dead_code)]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::Value;
+use tempfile::TempDir;
 
 /// A weights path that does not exist: the default seed chain then skips the DP seed.
 pub const NO_WEIGHTS: &str = "/nonexistent/diffusion.weights";
 
-/// A fresh, empty directory under the system temp dir, unique to this test run.
-pub fn temp_dir(name: &str) -> PathBuf {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "emg-cli-{name}-{}-{nanos}-{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    std::fs::create_dir_all(&dir).expect("create temp dir");
-    dir
+/// A fresh, empty directory under the system temp dir, removed when dropped.
+pub fn temp_dir(name: &str) -> TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("emg-cli-{name}-"))
+        .tempdir()
+        .expect("create temp dir")
 }
 
 /// Runs the built `emg` binary with `args`.

@@ -38,10 +38,10 @@ pub fn small_config() -> LabelConfig {
     config
 }
 
-/// A fresh temporary directory for one test.
-pub fn temporary_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("emg-seeding-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temporary directory");
-    dir
+/// A fresh temporary directory for one test, removed when dropped.
+pub fn temporary_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("emg-seeding-{name}-"))
+        .tempdir()
+        .expect("temporary directory")
 }
