@@ -81,7 +81,7 @@ fn write_json(dir: &Path, name: &str, doc: &Value) -> String {
 fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     let tmp = temp_dir("files");
     let dir = tmp.path();
-    let stem = plan(&dir);
+    let stem = plan(dir);
     let json = with_ext(&stem, ".json");
     let csv = with_ext(&stem, ".csv");
     let joint = with_ext(&stem, ".joint_trajectory.json");
@@ -147,7 +147,7 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     let tamper = |name: &str, edit: &dyn Fn(&mut Value)| {
         let mut doc = good.clone();
         edit(&mut doc);
-        check_err(&[&write_json(&dir, name, &doc)])
+        check_err(&[&write_json(dir, name, &doc)])
     };
     let err = tamper("limit.json", &|doc| {
         doc["points"][k]["positions"][0] = 2.9.into();
@@ -224,19 +224,19 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
         err.contains(&format!("point {k} of")) && err.contains("rad/s, above"),
         "{err}"
     );
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
 fn malformed_files_name_the_file_and_the_field() {
     let tmp = temp_dir("malformed");
     let dir = tmp.path();
-    let stem = plan(&dir);
+    let stem = plan(dir);
     let joint = read_json(&with_ext(&stem, ".joint_trajectory.json"));
 
     let mut doc = joint.clone();
     doc["format"] = "emg-joint-trajectory/2".into();
-    let path = write_json(&dir, "format.json", &doc);
+    let path = write_json(dir, "format.json", &doc);
     let err = check_err(&[&path]);
     assert!(
         err.contains(&path)
@@ -247,7 +247,7 @@ fn malformed_files_name_the_file_and_the_field() {
 
     let mut doc = joint.clone();
     doc["points"][3]["positions"].as_array_mut().unwrap().pop();
-    let path = write_json(&dir, "count.json", &doc);
+    let path = write_json(dir, "count.json", &doc);
     let err = check_err(&[&path]);
     assert!(
         err.contains(&path) && err.contains("'points[3].positions' has 6 values, expected 7"),
@@ -256,7 +256,7 @@ fn malformed_files_name_the_file_and_the_field() {
 
     let mut doc = joint.clone();
     doc["joint_names"].as_array_mut().unwrap().pop();
-    let err = check_err(&[&write_json(&dir, "names.json", &doc)]);
+    let err = check_err(&[&write_json(dir, "names.json", &doc)]);
     assert!(
         err.contains("'joint_names' has 6 entries, expected 7"),
         "{err}"
@@ -264,7 +264,7 @@ fn malformed_files_name_the_file_and_the_field() {
 
     let mut doc = read_json(&with_ext(&stem, ".json"));
     doc.as_object_mut().unwrap().remove("task");
-    let err = check_err(&[&write_json(&dir, "notask.json", &doc)]);
+    let err = check_err(&[&write_json(dir, "notask.json", &doc)]);
     assert!(err.contains("field 'task' is missing"), "{err}");
 
     let table = std::fs::read_to_string(with_ext(&stem, ".csv")).unwrap();
@@ -284,7 +284,7 @@ fn malformed_files_name_the_file_and_the_field() {
             && err.contains("CSV line 5, column 4 ('q3'): 'abc' is not a finite number"),
         "{err}"
     );
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -326,5 +326,5 @@ fn a_task_set_writes_one_joint_trajectory_per_task() {
     }
     assert!(!dir.join("out/set.joint_trajectory.json").exists());
     assert!(!dir.join("out/set-00002.joint_trajectory.json").exists());
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(dir).ok();
 }

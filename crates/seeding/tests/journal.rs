@@ -42,14 +42,14 @@ fn interrupted_sharded_and_threaded_runs_equal_the_single_run() {
         let (robot, config) = (robot(), small_config());
         let tasks = eval_tasks(&robot, TASKS);
         let sha = task_set_sha256(&eval_path()).unwrap();
-        let job = LabelJob::new(&robot, &tasks, sha, &config, &dir, CHUNK).unwrap();
+        let job = LabelJob::new(&robot, &tasks, sha, &config, dir, CHUNK).unwrap();
         let first = job.run(Shard::WHOLE, Some(1), &|_| {}).unwrap();
         assert_eq!((first.chunks_done, first.chunks_left), (1, 3));
         assert!(job.merge().is_err(), "an incomplete journal must not merge");
         let second = job.run(Shard::WHOLE, Some(1), &|_| {}).unwrap();
         assert_eq!((second.chunks_skipped, second.chunks_left), (1, 2));
     }
-    let resumed = label_file(&dir, &[(Shard::WHOLE, None)], 2);
+    let resumed = label_file(dir, &[(Shard::WHOLE, None)], 2);
     assert_eq!(single, resumed, "resumed run differs from the single run");
 
     let sharded = label_file(
@@ -71,10 +71,10 @@ fn journal_of_another_config_is_refused_and_shards_parse() {
     let sha = task_set_sha256(&eval_path()).unwrap();
     let tmp = temporary_dir("refused");
     let dir = tmp.path();
-    LabelJob::new(&robot, &tasks, sha, &config, &dir, CHUNK).unwrap();
+    LabelJob::new(&robot, &tasks, sha, &config, dir, CHUNK).unwrap();
     let mut other = config.clone();
     other.seed += 1;
-    let error = LabelJob::new(&robot, &tasks, sha, &other, &dir, CHUNK)
+    let error = LabelJob::new(&robot, &tasks, sha, &other, dir, CHUNK)
         .err()
         .unwrap();
     assert!(error.to_string().contains("another task set"), "{error}");

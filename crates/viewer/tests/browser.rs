@@ -292,7 +292,7 @@ fn screenshot_shows_the_arm() {
     let tmp = temp_dir("screenshot");
     let dir = tmp.path();
     let (_, page) = planned_page();
-    let (width, height, pixels) = screenshot(&browser, &dir, &page);
+    let (width, height, pixels) = screenshot(&browser, dir, &page);
     assert_eq!((width, height), (1000, 700), "screenshot size");
     if let Some(problem) = blank_screenshot_problem(&pixels) {
         panic!(
@@ -311,7 +311,7 @@ fn screenshot_check_fails_when_the_page_draws_nothing() {
     let (_, page) = planned_page();
     let broken = without_steps(&page);
     assert_ne!(broken, page, "the data blob holds the steps");
-    let (_, _, pixels) = screenshot(&browser, &dir, &broken);
+    let (_, _, pixels) = screenshot(&browser, dir, &broken);
     assert!(
         blank_screenshot_problem(&pixels).is_some(),
         "a page that draws nothing passed the screenshot check"
@@ -329,7 +329,7 @@ fn page_reports_rendered_with_a_silent_console() {
     let tmp = temp_dir("dom");
     let dir = tmp.path();
     let (_, page) = planned_page();
-    let run = dump_dom(&browser, &dir, &page);
+    let run = dump_dom(&browser, dir, &page);
     if let Err(problems) = page_problems(&run) {
         panic!("the viewer page did not run cleanly:\n{problems}");
     }
@@ -342,7 +342,7 @@ fn status_check_catches_an_error_in_the_viewer_script() {
     let dir = tmp.path();
     let (_, page) = planned_page();
     let broken = without_steps(&page);
-    let run = dump_dom(&browser, &dir, &broken);
+    let run = dump_dom(&browser, dir, &broken);
     let problems = page_problems(&run).expect_err("a page whose script throws passed the check");
     assert!(
         problems.contains("error: Uncaught Error: the motion data holds no steps"),
@@ -364,21 +364,21 @@ fn console_check_catches_errors_thrown_after_the_first_frame() {
         &page,
         "setTimeout(() => { throw new Error('deliberate'); }, 100);",
     );
-    let problems = page_problems(&dump_dom(&browser, &dir, &thrown))
+    let problems = page_problems(&dump_dom(&browser, dir, &thrown))
         .expect_err("a page that throws after rendering passed the check");
     assert!(
         problems.contains("error: Uncaught Error: deliberate"),
         "{problems}"
     );
     let rejected = with_extra_script(&page, "Promise.reject(new Error('deliberate rejection'));");
-    let problems = page_problems(&dump_dom(&browser, &dir, &rejected))
+    let problems = page_problems(&dump_dom(&browser, dir, &rejected))
         .expect_err("a page with an unhandled rejection passed the check");
     assert!(
         problems.contains("error: unhandled rejection: deliberate rejection"),
         "{problems}"
     );
     let logged = with_extra_script(&page, "console.error('quiet');");
-    let problems = page_problems(&dump_dom(&browser, &dir, &logged))
+    let problems = page_problems(&dump_dom(&browser, dir, &logged))
         .expect_err("a page that logs a console error passed the check");
     assert!(problems.contains("\"quiet\""), "{problems}");
 }
@@ -411,7 +411,7 @@ fn controls_scrub_orbit_and_zoom_without_errors() {
         document.body.dataset.step = document.getElementById("r-step").textContent;
         document.body.dataset.time = document.getElementById("r-time").textContent;
     "#;
-    let run = dump_dom(&browser, &dir, &with_extra_script(&page, exercise));
+    let run = dump_dom(&browser, dir, &with_extra_script(&page, exercise));
     if let Err(problems) = page_problems(&run) {
         panic!("driving the controls broke the page:\n{problems}");
     }
@@ -469,7 +469,7 @@ fn a_motion_of_only_the_seed_renders() {
         constraints: &config.constraints,
         title: "seed only",
     });
-    if let Err(problems) = page_problems(&dump_dom(&browser, &dir, &page)) {
+    if let Err(problems) = page_problems(&dump_dom(&browser, dir, &page)) {
         panic!("a one-step motion did not render cleanly:\n{problems}");
     }
 }
