@@ -224,7 +224,6 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
         err.contains(&format!("point {k} of")) && err.contains("rad/s, above"),
         "{err}"
     );
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -284,7 +283,6 @@ fn malformed_files_name_the_file_and_the_field() {
             && err.contains("CSV line 5, column 4 ('q3'): 'abc' is not a finite number"),
         "{err}"
     );
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -326,5 +324,4 @@ fn a_task_set_writes_one_joint_trajectory_per_task() {
     }
     assert!(!dir.join("out/set.joint_trajectory.json").exists());
     assert!(!dir.join("out/set-00002.joint_trajectory.json").exists());
-    std::fs::remove_dir_all(dir).ok();
 }

@@ -73,7 +73,6 @@ fn html_page_holds_the_planned_motion() {
         ["demo.html"],
         "no .partial is left"
     );
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -130,7 +129,6 @@ fn html_pages_follow_the_per_task_suffix_rule() {
         listing(&dir.join("bare")),
         ["set-00000.html", "set-00001.html"]
     );
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -145,5 +143,4 @@ fn no_page_without_html() {
     ]);
     assert!(!stdout.contains(".html"), "{stdout}");
     assert!(listing(dir).iter().all(|name| !name.ends_with(".html")));
-    std::fs::remove_dir_all(dir).ok();
 }

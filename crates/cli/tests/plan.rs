@@ -99,7 +99,6 @@ fn demo_task_writes_documented_json_and_csv() {
     assert_eq!(first[20], steps[0]["controller"].as_str().unwrap());
     let q1: f64 = first[1].parse().unwrap();
     assert_eq!(q1, steps[0]["q"][0].as_f64().unwrap());
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -139,7 +138,6 @@ fn written_trajectory_passes_the_independent_checker() {
     // The seed was projected onto the exact start pose.
     let (tcp, _) = checker.tcp_pose(trajectory.steps[0].q.as_slice());
     assert!((tcp - task.p0).norm() < 1e-8);
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -192,7 +190,6 @@ fn bad_inputs_fail_naming_the_field() {
     );
 
     assert!(!dir.join("never.json").exists());
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -240,7 +237,6 @@ fn task_file_with_three_tasks_gives_three_results() {
     }
     assert!(!dir.join("out/set.json").exists());
     assert!(!dir.join("out/set-00003.json").exists());
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -263,7 +259,6 @@ fn given_seed_is_projected_and_recorded() {
     assert!(stdout.contains("projected"), "{stdout}");
     let doc = read_json(&dir.join("given.json"));
     assert_eq!(doc["seed_source"], "given");
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -285,7 +280,6 @@ fn dp_seed_is_the_default_with_the_shipped_weights() {
         .expect("the DP-seeded trajectory passes the independent checker");
     let explicit = plan_ok(&["--seed", "dp", "--out", stem.to_str().unwrap()]);
     assert_eq!(explicit, stdout);
-    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
@@ -315,7 +309,6 @@ fn dp_seed_with_missing_or_damaged_weights_fails_clearly() {
         stem.to_str().unwrap(),
     ]);
     assert!(err.contains("truncated"), "{err}");
-    std::fs::remove_dir_all(dir).ok();
 }
 
 /// The shipped diffusion weights.

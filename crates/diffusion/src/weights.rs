@@ -43,43 +43,12 @@ pub enum WeightsError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// The file does not start with the weights magic.
-    #[error("not a denoiser weights file (missing the EMGDIFFW magic)")]
-    BadMagic,
-    /// The file was written by another layout version.
+    /// The bytes are not a well-formed denoiser weights file of this layout version (the cause
+    /// says what is wrong: magic, version, truncation, header, value count, trailing bytes).
     #[error(
-        "weights format version {found} is not supported (this build reads {WEIGHTS_FORMAT_VERSION})"
+        "not a valid denoiser weights file (EMGDIFFW, format version {WEIGHTS_FORMAT_VERSION})"
     )]
-    UnsupportedVersion {
-        /// Version in the file.
-        found: u32,
-    },
-    /// The file ends before the part named.
-    #[error(
-        "weights file is truncated: it ends inside the {part} ({expected} bytes needed, {found} present)"
-    )]
-    Truncated {
-        /// `header` or `values`.
-        part: &'static str,
-        /// Bytes needed.
-        expected: usize,
-        /// Bytes present.
-        found: usize,
-    },
-    /// The JSON header does not parse.
-    #[error("weights header is not valid: {0}")]
-    BadHeader(String),
-    /// The value count does not match the network shape of the header.
-    #[error("weights hold {found} values but the header's network shape needs {expected}")]
-    CountMismatch {
-        /// Values the shape needs.
-        expected: usize,
-        /// Values the file declares.
-        found: usize,
-    },
-    /// Bytes follow the last value.
-    #[error("weights file has {0} unexpected bytes after the values")]
-    TrailingBytes(usize),
+    Format(#[from] ContainerError),
     /// The network shape differs from what the caller needs.
     #[error("weights field 'config.{field}' is {found}, but {expected} is required")]
     ShapeMismatch {
@@ -164,10 +133,10 @@ impl DenoiserWeights {
         let layout = parameter_layout(&header.config);
         let expected: usize = layout.iter().map(TensorSpec::len).sum();
         if values.len() != expected {
-            return Err(WeightsError::CountMismatch {
+            return Err(WeightsError::Format(ContainerError::CountMismatch {
                 expected,
                 found: values.len(),
-            });
+            }));
         }
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             let mut start = 0;
@@ -365,27 +334,4 @@ fn visit_parameters(model: &Denoiser, mut f: impl FnMut(&TensorData)) {
     norm(&model.output_norm, &mut f);
     linear(&model.head, &mut f);
     f(&model.null_condition.val().into_data());
-}
-
-impl From<ContainerError> for WeightsError {
-    fn from(error: ContainerError) -> Self {
-        match error {
-            ContainerError::BadMagic => Self::BadMagic,
-            ContainerError::UnsupportedVersion { found, .. } => Self::UnsupportedVersion { found },
-            ContainerError::Truncated {
-                part,
-                expected,
-                found,
-            } => Self::Truncated {
-                part,
-                expected,
-                found,
-            },
-            ContainerError::BadHeader(message) => Self::BadHeader(message),
-            ContainerError::CountMismatch { expected, found } => {
-                Self::CountMismatch { expected, found }
-            }
-            ContainerError::TrailingBytes(rest) => Self::TrailingBytes(rest),
-        }
-    }
 }

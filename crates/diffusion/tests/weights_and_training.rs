@@ -4,8 +4,8 @@
 use burn::module::Module;
 use burn::tensor::{Tensor, TensorData};
 use emg_diffusion::{
-    Backend, DenoiserInput, DenoiserWeights, DiffusionConfig, ForwardScratch, PlainDenoiser,
-    TrainConfig, Trainer, TrainingSet, WeightsError, sinusoidal_embedding,
+    Backend, ContainerError, DenoiserInput, DenoiserWeights, DiffusionConfig, ForwardScratch,
+    PlainDenoiser, TrainConfig, Trainer, TrainingSet, WeightsError, sinusoidal_embedding,
 };
 
 fn tiny() -> DiffusionConfig {
@@ -160,7 +160,6 @@ fn resumed_run_continues_the_same_loss_curve() {
             .to_string()
             .contains("training config")
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -174,22 +173,33 @@ fn damaged_or_mismatched_weights_files_give_clear_errors() {
     for cut in [0, 5, 12, 40, bytes.len() / 2, bytes.len() - 1] {
         let error = DenoiserWeights::from_bytes(&bytes[..cut]).unwrap_err();
         assert!(
-            matches!(error, WeightsError::Truncated { .. }),
+            matches!(
+                error,
+                WeightsError::Format(ContainerError::Truncated { .. })
+            ),
             "cut at {cut}: {error}"
         );
-        assert!(error.to_string().contains("truncated"));
+        assert!(
+            error
+                .to_string()
+                .contains("not a valid denoiser weights file")
+        );
+        let cause = std::error::Error::source(&error)
+            .expect("the container error")
+            .to_string();
+        assert!(cause.contains("truncated"), "{cause}");
     }
     let mut padded = bytes.clone();
     padded.push(0);
     assert!(matches!(
         DenoiserWeights::from_bytes(&padded),
-        Err(WeightsError::TrailingBytes(1))
+        Err(WeightsError::Format(ContainerError::TrailingBytes(1)))
     ));
     let mut bad_magic = bytes.clone();
     bad_magic[0] = b'X';
     assert!(matches!(
         DenoiserWeights::from_bytes(&bad_magic),
-        Err(WeightsError::BadMagic)
+        Err(WeightsError::Format(ContainerError::BadMagic))
     ));
 
     // A header whose network shape does not fit the values.
@@ -197,7 +207,10 @@ fn damaged_or_mismatched_weights_files_give_clear_errors() {
     header.config.width = 17;
     let error = DenoiserWeights::new(header, weights.values().to_vec()).unwrap_err();
     assert!(
-        matches!(error, WeightsError::CountMismatch { .. }),
+        matches!(
+            error,
+            WeightsError::Format(ContainerError::CountMismatch { .. })
+        ),
         "{error}"
     );
 
@@ -215,7 +228,10 @@ fn damaged_or_mismatched_weights_files_give_clear_errors() {
     std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
     assert!(matches!(
         DenoiserWeights::read(&path),
-        Err(WeightsError::Truncated { part: "values", .. })
+        Err(WeightsError::Format(ContainerError::Truncated {
+            part: "values",
+            ..
+        }))
     ));
     std::fs::remove_file(&path).ok();
     let missing = DenoiserWeights::read(&path).unwrap_err();

@@ -43,6 +43,7 @@ mod weights;
 pub use advantage::{ReturnScaler, RunningMoments, Targets, generalised_advantages};
 pub use config::{Backend, EnvConfig, NetworkConfig, PpoConfig};
 pub use controller::RlController;
+pub use emg_learning::container::ContainerError;
 pub use env::{ArmEnvironment, TrainingPool};
 pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
 pub use network::{ActorCritic, PolicyOutput, Trunk};

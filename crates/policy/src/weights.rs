@@ -49,43 +49,10 @@ pub enum WeightsError {
         /// Cause.
         source: std::io::Error,
     },
-    /// The file does not start with the magic bytes.
-    #[error("not a policy weights file (missing the EMGPPOWT magic)")]
-    BadMagic,
-    /// A layout version this build cannot read.
-    #[error(
-        "weights format version {found} is not supported (this build reads {WEIGHTS_FORMAT_VERSION})"
-    )]
-    UnsupportedVersion {
-        /// Version in the file.
-        found: u32,
-    },
-    /// The file ends early.
-    #[error(
-        "weights file is truncated: it ends inside the {part} ({expected} bytes needed, {found} present)"
-    )]
-    Truncated {
-        /// `header` or `values`.
-        part: &'static str,
-        /// Bytes needed.
-        expected: usize,
-        /// Bytes present.
-        found: usize,
-    },
-    /// The JSON header does not parse.
-    #[error("weights header is not valid: {0}")]
-    BadHeader(String),
-    /// The value count disagrees with the header's network shape.
-    #[error("weights hold {found} values but the header's network shape needs {expected}")]
-    CountMismatch {
-        /// Values the shape needs.
-        expected: usize,
-        /// Values present.
-        found: usize,
-    },
-    /// Bytes after the values.
-    #[error("weights file has {0} unexpected bytes after the values")]
-    TrailingBytes(usize),
+    /// The bytes are not a well-formed policy weights file of this layout version (the cause
+    /// says what is wrong: magic, version, truncation, header, value count, trailing bytes).
+    #[error("not a valid policy weights file (EMGPPOWT, format version {WEIGHTS_FORMAT_VERSION})")]
+    Format(#[from] ContainerError),
     /// A header field disagrees with what this build uses.
     #[error("weights field '{field}' is {found}, but {expected} is required")]
     ShapeMismatch {
@@ -147,16 +114,16 @@ impl PolicyWeights {
             }
         }
         if let Some(width) = header.network.hidden.iter().position(|&w| w == 0) {
-            return Err(WeightsError::BadHeader(format!(
+            return Err(WeightsError::Format(ContainerError::BadHeader(format!(
                 "network.hidden[{width}] is 0; every hidden layer needs a positive width"
-            )));
+            ))));
         }
         let expected = value_count(&header.network);
         if values.len() != expected {
-            return Err(WeightsError::CountMismatch {
+            return Err(WeightsError::Format(ContainerError::CountMismatch {
                 expected,
                 found: values.len(),
-            });
+            }));
         }
         if let Some(index) = values.iter().position(|v| !v.is_finite()) {
             return Err(WeightsError::NotFinite(index));
@@ -280,27 +247,4 @@ fn layers(model: &ActorCritic) -> impl Iterator<Item = &Linear> {
         .chain([&model.mean, &model.log_std])
         .chain(&model.critic.layers)
         .chain([&model.value])
-}
-
-impl From<ContainerError> for WeightsError {
-    fn from(error: ContainerError) -> Self {
-        match error {
-            ContainerError::BadMagic => Self::BadMagic,
-            ContainerError::UnsupportedVersion { found, .. } => Self::UnsupportedVersion { found },
-            ContainerError::Truncated {
-                part,
-                expected,
-                found,
-            } => Self::Truncated {
-                part,
-                expected,
-                found,
-            },
-            ContainerError::BadHeader(message) => Self::BadHeader(message),
-            ContainerError::CountMismatch { expected, found } => {
-                Self::CountMismatch { expected, found }
-            }
-            ContainerError::TrailingBytes(rest) => Self::TrailingBytes(rest),
-        }
-    }
 }

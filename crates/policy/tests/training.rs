@@ -148,5 +148,4 @@ fn a_resumed_run_continues_the_same_curve() {
         .err()
         .expect("a changed configuration is refused");
     assert!(error.to_string().contains("PPO config"), "{error}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -3,8 +3,8 @@
 
 use burn::tensor::{Tensor, TensorData};
 use emg_policy::{
-    ACTION_DIM, Backend, NetworkConfig, OBSERVATION_DIM, PlainPolicy, PolicyWeights, PpoConfig,
-    Trainer, WeightsError,
+    ACTION_DIM, Backend, ContainerError, NetworkConfig, OBSERVATION_DIM, PlainPolicy,
+    PolicyWeights, PpoConfig, Trainer, WeightsError,
 };
 
 fn trained_weights(backend: Backend) -> PolicyWeights {
@@ -98,13 +98,27 @@ fn a_truncated_file_is_refused_with_a_clear_error() {
     let bytes = trained_weights(Backend::Flex).to_bytes();
     let error = PolicyWeights::from_bytes(&bytes[..bytes.len() - 6]).unwrap_err();
     assert!(
-        matches!(error, WeightsError::Truncated { part: "values", .. }),
+        matches!(
+            error,
+            WeightsError::Format(ContainerError::Truncated { part: "values", .. })
+        ),
         "{error}"
     );
-    assert!(error.to_string().contains("truncated"), "{error}");
+    assert!(
+        error
+            .to_string()
+            .contains("not a valid policy weights file")
+    );
+    let cause = std::error::Error::source(&error)
+        .expect("the container error")
+        .to_string();
+    assert!(cause.contains("truncated"), "{cause}");
     let error = PolicyWeights::from_bytes(&bytes[..10]).unwrap_err();
     assert!(
-        matches!(error, WeightsError::Truncated { part: "header", .. }),
+        matches!(
+            error,
+            WeightsError::Format(ContainerError::Truncated { part: "header", .. })
+        ),
         "{error}"
     );
 }
@@ -115,7 +129,10 @@ fn a_mismatched_file_is_refused_with_a_clear_error() {
     let error =
         PolicyWeights::new(weights.header().clone(), weights.values()[1..].to_vec()).unwrap_err();
     assert!(
-        matches!(error, WeightsError::CountMismatch { .. }),
+        matches!(
+            error,
+            WeightsError::Format(ContainerError::CountMismatch { .. })
+        ),
         "{error}"
     );
     let mut header = weights.header().clone();
@@ -126,7 +143,7 @@ fn a_mismatched_file_is_refused_with_a_clear_error() {
     bytes[0] = b'X';
     assert!(matches!(
         PolicyWeights::from_bytes(&bytes),
-        Err(WeightsError::BadMagic)
+        Err(WeightsError::Format(ContainerError::BadMagic))
     ));
     let mut values = weights.values().to_vec();
     values[3] = f32::NAN;
