@@ -1,9 +1,10 @@
 //! The control step allocates nothing: building a step's context, choosing the classical action,
 //! integrating the joint velocity and checking every constraint run with zero heap allocations
-//! (counted by a global allocator wrapper).
+//! (counted by a global allocator wrapper, per thread: the test harness's own threads may
+//! allocate meanwhile).
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use emg_control::{
     ClassicalController, NullAction, NullSpaceController, RolloutConfig, SamplerConfig,
@@ -13,11 +14,19 @@ use emg_kinematics::Robot;
 
 struct CountingAllocator;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Heap allocations made by the current thread.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
 
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        // `try_with`: the thread's counter may already be gone while the thread exits.
+        let _ = ALLOCATIONS.try_with(|count| count.set(count.get() + 1));
         unsafe { System.alloc(layout) }
     }
 
@@ -38,11 +47,18 @@ fn classical_control_step_and_constraint_check_do_not_allocate() {
         .filter_map(|i| candidate(&robot, &SamplerConfig::default(), i))
         .collect();
     assert!(tasks.len() > 20);
+    let counted = allocations();
+    std::hint::black_box(Box::new(1_u64));
+    assert_eq!(
+        allocations(),
+        counted + 1,
+        "the counter sees this thread's allocations"
+    );
     let mut controller = ClassicalController::default();
     let mut steps = 0;
     for task in &tasks {
         let mut q = task.q0_seed.expect("sampled tasks keep their seed");
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         for step in 0..20 {
             let kinematics = robot.forward(&q);
             let context = StepContext::new(
@@ -64,11 +80,7 @@ fn classical_control_step_and_constraint_check_do_not_allocate() {
             }
             q = next;
         }
-        assert_eq!(
-            ALLOCATIONS.load(Ordering::SeqCst),
-            before,
-            "the control step allocated"
-        );
+        assert_eq!(allocations(), before, "the control step allocated");
     }
     assert!(steps > 200, "only {steps} steps exercised");
 }
