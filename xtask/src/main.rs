@@ -11,6 +11,7 @@
 
 mod ablate;
 mod ablate_control;
+mod backend_choice;
 mod bench_report;
 mod eval;
 mod figure_branches;

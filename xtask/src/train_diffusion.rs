@@ -10,25 +10,8 @@ use emg_diffusion::{Backend, DiffusionConfig, TrainConfig, Trainer, TrainingSet,
 use emg_seeding::{LabelSet, hex};
 use serde::{Deserialize, Serialize};
 
+use crate::backend_choice::BackendChoice;
 use crate::{progress, workspace};
-
-/// The Burn backends `--backend` accepts.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum BackendChoice {
-    /// Burn's pure-Rust flex backend.
-    Flex,
-    /// Burn's ndarray backend.
-    Ndarray,
-}
-
-impl From<BackendChoice> for Backend {
-    fn from(choice: BackendChoice) -> Self {
-        match choice {
-            BackendChoice::Flex => Backend::Flex,
-            BackendChoice::Ndarray => Backend::Ndarray,
-        }
-    }
-}
 
 /// Options of `train-diffusion`.
 #[derive(clap::Args)]

@@ -13,25 +13,8 @@ use emg_policy::{
 use emg_seeding::LabelSet;
 use serde::{Deserialize, Serialize};
 
+use crate::backend_choice::BackendChoice;
 use crate::{progress, workspace};
-
-/// The Burn backends `--backend` accepts.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum BackendChoice {
-    /// Burn's pure-Rust flex backend.
-    Flex,
-    /// Burn's ndarray backend.
-    Ndarray,
-}
-
-impl From<BackendChoice> for Backend {
-    fn from(choice: BackendChoice) -> Self {
-        match choice {
-            BackendChoice::Flex => Backend::Flex,
-            BackendChoice::Ndarray => Backend::Ndarray,
-        }
-    }
-}
 
 /// Options of `train-ppo`.
 #[derive(clap::Args)]
