@@ -44,6 +44,7 @@ mod weights;
 pub use config::{Backend, DiffusionConfig, SampleConfig, TrainConfig};
 pub use dataset::{MIRROR_CONDITION_SIGNS, MIRROR_JOINT_SIGNS, has_mirror_symmetry, training_set};
 pub use embedding::sinusoidal_embedding;
+pub use emg_learning::checkpoint::CheckpointError;
 pub use emg_learning::container::ContainerError;
 pub use forward::{ForwardScratch, PlainDenoiser};
 pub use model::{Denoiser, DenoiserInput, ResidualBlock};

@@ -10,6 +10,7 @@ use burn::grad_clipping::GradientClippingConfig;
 use burn::module::Module;
 use burn::optim::{AdamWConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
+use emg_learning::checkpoint::{self, CheckpointError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
@@ -33,13 +34,8 @@ pub enum TrainError {
         problem: String,
     },
     /// A checkpoint file could not be read or written.
-    #[error("checkpoint {path}: {problem}")]
-    Checkpoint {
-        /// File.
-        path: String,
-        /// What went wrong.
-        problem: String,
-    },
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
     /// The EMA weights of a checkpoint are unusable.
     #[error(transparent)]
     Weights(#[from] WeightsError),
@@ -252,12 +248,7 @@ impl Trainer {
         backend: Backend,
         data: &TrainingSet,
     ) -> Result<Self, TrainError> {
-        let read_error = |path: &Path, problem: String| TrainError::Checkpoint {
-            path: path.display().to_string(),
-            problem,
-        };
-        let state: CheckpointState = emg_learning::checkpoint::read_state(dir)
-            .map_err(|e| read_error(Path::new(&e.path), e.problem))?;
+        let state: CheckpointState = checkpoint::read_state(dir)?;
         if state.network != network {
             return Err(TrainError::ConfigMismatch {
                 what: "network config",
@@ -276,15 +267,8 @@ impl Trainer {
             return Err(TrainError::ConfigMismatch { what: "data set" });
         }
         let mut trainer = Self::new(network, training, backend, data)?;
-        let model_path = dir.join("model.bpk");
-        trainer.model = trainer
-            .model
-            .try_load_file(&model_path)
-            .map_err(|e| read_error(&model_path, e.to_string()))?;
-        let optimizer_path = dir.join("optimizer.bpk");
-        trainer.optimizer = optimizer(&trainer.training)
-            .load(&optimizer_path)
-            .map_err(|e| read_error(&optimizer_path, e.to_string()))?;
+        (trainer.model, trainer.optimizer) =
+            checkpoint::read_training(dir, trainer.model, optimizer(&trainer.training))?;
         trainer.ema = DenoiserWeights::read(&dir.join("ema.weights"))?;
         trainer.step = state.step;
         trainer.log = state.log;
@@ -296,18 +280,8 @@ impl Trainer {
     /// Writes a checkpoint into `dir` (built beside it and swapped in, so a stop mid-write keeps
     /// the previous checkpoint).
     pub fn save_checkpoint(&self, dir: &Path) -> Result<(), TrainError> {
-        let fail = |path: &Path, problem: String| TrainError::Checkpoint {
-            path: path.display().to_string(),
-            problem,
-        };
-        let staging = emg_learning::checkpoint::stage(dir).map_err(|e| fail(dir, e.to_string()))?;
-        self.model
-            .clone()
-            .save_file(staging.join("model.bpk"))
-            .map_err(|e| fail(&staging, e.to_string()))?;
-        self.optimizer
-            .save(staging.join("optimizer.bpk"))
-            .map_err(|e| fail(&staging, e.to_string()))?;
+        let staging = checkpoint::stage(dir)?;
+        checkpoint::write_training(&staging, &self.model, &self.optimizer)?;
         self.ema.write(&staging.join("ema.weights"))?;
         let state = CheckpointState {
             network: self.network.clone(),
@@ -318,9 +292,8 @@ impl Trainer {
             window_loss_sum: self.window_loss_sum,
             window_steps: self.window_steps,
         };
-        emg_learning::checkpoint::write_state(&staging, &state)
-            .map_err(|e| fail(Path::new(&e.path), e.problem))?;
-        emg_learning::checkpoint::publish(dir).map_err(|e| fail(dir, e.to_string()))
+        checkpoint::write_state(&staging, &state)?;
+        Ok(checkpoint::publish(dir)?)
     }
 
     /// Steps done.

@@ -1,13 +1,21 @@
 //! Checkpoint directories replaced atomically: files are written into a staging sibling that is
 //! swapped in only when complete, so a stop at any moment leaves a whole checkpoint behind.
+//!
+//! A checkpoint holds a Burn model's parameters, its optimizer's state and the run state (JSON).
 
 use std::path::{Path, PathBuf};
 
+use burn::module::Module;
+use burn::optim::ModuleOptimizer;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
 /// Name of the JSON run state inside a checkpoint directory.
 const STATE_FILE: &str = "state.json";
+/// Name of the model's parameters inside a checkpoint directory.
+const MODEL_FILE: &str = "model.bpk";
+/// Name of the optimizer's state inside a checkpoint directory.
+const OPTIMIZER_FILE: &str = "optimizer.bpk";
 
 /// A checkpoint file that could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +48,35 @@ pub fn read_state<T: DeserializeOwned>(dir: &Path) -> Result<T, CheckpointError>
     serde_json::from_str(&text).map_err(|e| error(&path, e))
 }
 
+/// Writes a model's parameters and its optimizer's state into a staging directory.
+pub fn write_training<M: Module>(
+    staging: &Path,
+    model: &M,
+    optimizer: &ModuleOptimizer,
+) -> Result<(), CheckpointError> {
+    let path = staging.join(MODEL_FILE);
+    model
+        .clone()
+        .save_file(&path)
+        .map_err(|e| error(&path, e))?;
+    let path = staging.join(OPTIMIZER_FILE);
+    optimizer.save(&path).map_err(|e| error(&path, e))
+}
+
+/// Loads what [`write_training`] wrote into checkpoint `dir` into `model` and `optimizer`
+/// (fresh ones of the checkpoint's shape and settings) and returns them.
+pub fn read_training<M: Module>(
+    dir: &Path,
+    model: M,
+    optimizer: ModuleOptimizer,
+) -> Result<(M, ModuleOptimizer), CheckpointError> {
+    let path = dir.join(MODEL_FILE);
+    let model = model.try_load_file(&path).map_err(|e| error(&path, e))?;
+    let path = dir.join(OPTIMIZER_FILE);
+    let optimizer = optimizer.load(&path).map_err(|e| error(&path, e))?;
+    Ok((model, optimizer))
+}
+
 /// `dir` with `.suffix` appended to its last component.
 fn sibling(dir: &Path, suffix: &str) -> PathBuf {
     let mut name = dir.file_name().unwrap_or_default().to_os_string();
@@ -49,22 +86,22 @@ fn sibling(dir: &Path, suffix: &str) -> PathBuf {
 
 /// Creates an empty staging directory (`<dir>.partial`) for the next checkpoint of `dir` and
 /// returns its path.
-pub fn stage(dir: &Path) -> std::io::Result<PathBuf> {
+pub fn stage(dir: &Path) -> Result<PathBuf, CheckpointError> {
     let staging = sibling(dir, "partial");
     let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir_all(&staging)?;
+    std::fs::create_dir_all(&staging).map_err(|e| error(&staging, e))?;
     Ok(staging)
 }
 
 /// Replaces `dir` by its complete staging directory (the old checkpoint is kept as
 /// `<dir>.previous` until the new one is in place).
-pub fn publish(dir: &Path) -> std::io::Result<()> {
+pub fn publish(dir: &Path) -> Result<(), CheckpointError> {
     let (staging, previous) = (sibling(dir, "partial"), sibling(dir, "previous"));
     let _ = std::fs::remove_dir_all(&previous);
     if dir.exists() {
-        std::fs::rename(dir, &previous)?;
+        std::fs::rename(dir, &previous).map_err(|e| error(dir, e))?;
     }
-    std::fs::rename(&staging, dir)?;
+    std::fs::rename(&staging, dir).map_err(|e| error(dir, e))?;
     let _ = std::fs::remove_dir_all(&previous);
     Ok(())
 }

@@ -43,6 +43,7 @@ mod weights;
 pub use advantage::{ReturnScaler, RunningMoments, Targets, generalised_advantages};
 pub use config::{Backend, EnvConfig, NetworkConfig, PpoConfig};
 pub use controller::RlController;
+pub use emg_learning::checkpoint::CheckpointError;
 pub use emg_learning::container::ContainerError;
 pub use env::{ArmEnvironment, TrainingPool};
 pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
@@ -66,13 +67,8 @@ pub enum PolicyError {
         problem: String,
     },
     /// A checkpoint file could not be read or written.
-    #[error("checkpoint {path}: {problem}")]
-    Checkpoint {
-        /// File.
-        path: String,
-        /// What went wrong.
-        problem: String,
-    },
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
     /// A checkpoint made with other settings.
     #[error("checkpoint was made with a different {what}; start a new run or restore the settings")]
     ConfigMismatch {

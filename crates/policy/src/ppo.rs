@@ -11,9 +11,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use burn::grad_clipping::GradientClippingConfig;
-use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
+use emg_learning::checkpoint;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
@@ -162,12 +162,7 @@ impl Trainer {
         backend: Backend,
         envs: Vec<E>,
     ) -> Result<(Self, VecEnv<E>), PolicyError> {
-        let read_error = |path: &Path, problem: String| PolicyError::Checkpoint {
-            path: path.display().to_string(),
-            problem,
-        };
-        let state: CheckpointState = emg_learning::checkpoint::read_state(dir)
-            .map_err(|e| read_error(Path::new(&e.path), e.problem))?;
+        let state: CheckpointState = checkpoint::read_state(dir)?;
         if state.network != network {
             return Err(PolicyError::ConfigMismatch {
                 what: "network config",
@@ -182,15 +177,8 @@ impl Trainer {
         }
         let mut trainer = Self::new(network, state.ppo.clone(), backend)?;
         trainer.check_env_count(envs.len())?;
-        let model_path = dir.join("model.bpk");
-        trainer.model = trainer
-            .model
-            .try_load_file(&model_path)
-            .map_err(|e| read_error(&model_path, e.to_string()))?;
-        let optimizer_path = dir.join("optimizer.bpk");
-        trainer.optimizer = optimizer(&trainer.ppo)
-            .load(&optimizer_path)
-            .map_err(|e| read_error(&optimizer_path, e.to_string()))?;
+        (trainer.model, trainer.optimizer) =
+            checkpoint::read_training(dir, trainer.model, optimizer(&trainer.ppo))?;
         trainer.iteration = state.iteration;
         trainer.scaler = state.scaler;
         trainer.log = state.log;
@@ -206,18 +194,8 @@ impl Trainer {
         dir: &Path,
         envs: &VecEnv<E>,
     ) -> Result<(), PolicyError> {
-        let fail = |path: &Path, problem: String| PolicyError::Checkpoint {
-            path: path.display().to_string(),
-            problem,
-        };
-        let staging = emg_learning::checkpoint::stage(dir).map_err(|e| fail(dir, e.to_string()))?;
-        self.model
-            .clone()
-            .save_file(staging.join("model.bpk"))
-            .map_err(|e| fail(&staging, e.to_string()))?;
-        self.optimizer
-            .save(staging.join("optimizer.bpk"))
-            .map_err(|e| fail(&staging, e.to_string()))?;
+        let staging = checkpoint::stage(dir)?;
+        checkpoint::write_training(&staging, &self.model, &self.optimizer)?;
         let state = CheckpointState {
             network: self.network.clone(),
             ppo: self.ppo.clone(),
@@ -227,9 +205,8 @@ impl Trainer {
             timing: self.timing.clone(),
             envs: envs.snapshot(),
         };
-        emg_learning::checkpoint::write_state(&staging, &state)
-            .map_err(|e| fail(Path::new(&e.path), e.problem))?;
-        emg_learning::checkpoint::publish(dir).map_err(|e| fail(dir, e.to_string()))
+        checkpoint::write_state(&staging, &state)?;
+        Ok(checkpoint::publish(dir)?)
     }
 
     /// Iterations done.
