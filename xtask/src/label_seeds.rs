@@ -104,14 +104,8 @@ struct Manifest {
 /// Runs the requested labelling, merge or report.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
-    let config = match &args.config {
-        Some(path) => serde_json::from_str(
-            &std::fs::read_to_string(path)
-                .with_context(|| format!("reading {}", path.display()))?,
-        )
-        .with_context(|| format!("{}: not a labelling config", path.display()))?,
-        None => LabelConfig::default(),
-    };
+    let config: LabelConfig =
+        workspace::read_config(args.config.as_deref(), "labelling configuration")?;
     let pool = workspace::thread_pool(args.threads)?;
     if args.report {
         return pool.install(|| report(args, &robot, &config));

@@ -95,14 +95,8 @@ struct ModelCard<'a> {
 
 /// Runs `train-diffusion`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let run_config: RunConfig = match &args.config {
-        Some(path) => serde_json::from_str(
-            &std::fs::read_to_string(path)
-                .with_context(|| format!("reading {}", path.display()))?,
-        )
-        .with_context(|| format!("parsing run configuration {}", path.display()))?,
-        None => RunConfig::default(),
-    };
+    let run_config: RunConfig =
+        workspace::read_config(args.config.as_deref(), "run configuration")?;
     let robot = workspace::load_robot(&args.robot)?;
     let tasks = read_tasks(&args.tasks, &robot)
         .with_context(|| format!("reading {}", args.tasks.display()))?;

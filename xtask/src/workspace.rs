@@ -6,6 +6,7 @@ use std::sync::OnceLock;
 use anyhow::Context;
 use emg_control::ReferenceModel;
 use emg_kinematics::{Robot, ShippedRobot};
+use serde::de::DeserializeOwned;
 
 /// The workspace root (parent of `xtask/`).
 pub fn root() -> PathBuf {
@@ -108,6 +109,20 @@ pub fn relative(path: &Path) -> String {
         .unwrap_or(&path)
         .display()
         .to_string()
+}
+
+/// The JSON configuration in `path` (`what` names it in errors: serde's message names the
+/// unknown or ill-typed field), or the default one when no file is given.
+pub fn read_config<T: DeserializeOwned + Default>(
+    path: Option<&Path>,
+    what: &str,
+) -> anyhow::Result<T> {
+    let Some(path) = path else {
+        return Ok(T::default());
+    };
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| format!("parsing {what} {}", path.display()))
 }
 
 /// Loads a robot file whose links form one chain (base = its root link, tip = its leaf).
