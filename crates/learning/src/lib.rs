@@ -5,7 +5,8 @@
 //!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
 //!   values as little-endian `f32` — with strict truncation and trailing-byte checks and an
 //!   atomic write through a `.partial` sibling;
-//! - [`checkpoint`]: checkpoint directories written into a staging sibling and swapped in whole.
+//! - [`checkpoint`]: checkpoint directories (a model, its optimizer and the JSON run state)
+//!   written into a staging sibling and swapped in whole.
 //!
 //! ```
 //! use emg_learning::container::{decode, encode};

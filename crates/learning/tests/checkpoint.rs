@@ -1,5 +1,5 @@
 //! Checkpoint directories: a staged checkpoint replaces the old one whole, and the staging and
-//! previous siblings are gone afterwards.
+//! previous siblings are gone afterwards; a model with its optimizer and the run state round-trip.
 
 use emg_learning::checkpoint::{publish, stage};
 
@@ -39,4 +39,39 @@ fn run_state_round_trips_and_a_missing_state_names_its_file() {
     assert_eq!(state, (7, vec![0.25, -1.5]));
     let error = read_state::<u64>(&root.join("missing")).unwrap_err();
     assert!(error.to_string().contains("state.json"), "{error}");
+}
+
+#[test]
+fn a_model_and_its_optimizer_round_trip_and_a_missing_file_is_named() {
+    use burn::nn::{Linear, LinearConfig};
+    use emg_learning::Backend;
+    use emg_learning::checkpoint::{read_training, write_training};
+
+    let device = Backend::Flex.device();
+    let saved: Linear = LinearConfig::new(3, 2).init(&device);
+    let fresh = || {
+        let model: Linear = LinearConfig::new(3, 2).init(&device);
+        (model, burn::optim::AdamConfig::new().init())
+    };
+    let (other, optimizer) = fresh();
+    let weights = |model: &Linear| model.weight.val().into_data().try_to_vec::<f32>().unwrap();
+    assert_ne!(
+        weights(&saved),
+        weights(&other),
+        "two initialisations differ"
+    );
+
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    let staging = stage(&dir).unwrap();
+    write_training(&staging, &saved, &optimizer).unwrap();
+    publish(&dir).unwrap();
+    let (loaded, _) = read_training(&dir, other, optimizer).unwrap();
+    assert_eq!(weights(&loaded), weights(&saved));
+
+    let (model, optimizer) = fresh();
+    let Err(error) = read_training(&tmp.path().join("missing"), model, optimizer) else {
+        panic!("a missing checkpoint must not load");
+    };
+    assert!(error.to_string().contains("model.bpk"), "{error}");
 }
