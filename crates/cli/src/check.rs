@@ -307,6 +307,20 @@ fn print_report(report: &ReplayReport) {
         .map(|f| format!("{f:.3}"))
         .collect();
     println!("  peak joint speed / limit: {}", peaks.join(" "));
+    let accelerations: Vec<String> = report
+        .peak_acceleration_rad_s2
+        .iter()
+        .map(|a| format!("{a:.2}"))
+        .collect();
+    println!(
+        "  peak joint acceleration between points (rad/s², not bounded by the planner): {}",
+        accelerations.join(" ")
+    );
+    let [first, last] = report.boundary_speed_fraction;
+    println!(
+        "  fastest joint at the first point {first:.3} × its limit, at the last point {last:.3} × \
+         (the file starts and ends at those speeds)"
+    );
     let (clearance, a, b) = &report.min_clearance;
     println!(
         "  max line deviation {:.3} mm, max tool angle {:.2}°, min clearance {:.1} mm ({a}, {b})",

@@ -100,6 +100,11 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     );
     // The slowed steps run at the limit fraction: the peak is reported as such.
     assert!(out.contains(&format!("{FRACTION:.3}")), "{out}");
+    assert!(
+        out.contains("peak joint acceleration between points")
+            && out.contains("fastest joint at the first point"),
+        "{out}"
+    );
     let points = read_json(&joint)["points"].as_array().unwrap().len();
     assert!(out.contains(&format!("{points} points")), "{out}");
     // `replay` is an alias.

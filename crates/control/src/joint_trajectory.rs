@@ -454,6 +454,19 @@ pub fn point_velocities(time_s: &[f64], q: &[JointVector]) -> Vec<JointVector> {
         .collect()
 }
 
+/// Per joint, `max_k |q̇_{k+1,i} − q̇_{k,i}| / (t_{k+1} − t_k)` over consecutive timed points
+/// (zeros for a single point).
+fn peak_accelerations(time_s: &[f64], velocities: &[JointVector]) -> Vec<f64> {
+    let mut peak = vec![0.0_f64; DOF];
+    for k in 1..velocities.len() {
+        let gap = time_s[k] - time_s[k - 1];
+        for (i, peak) in peak.iter_mut().enumerate() {
+            *peak = peak.max((velocities[k][i] - velocities[k - 1][i]).abs() / gap);
+        }
+    }
+    peak
+}
+
 /// The CSV table of a rollout's steps: [`CSV_HEADER`], then one row per step: time (s),
 /// positions (rad), velocities by [`point_velocities`] (rad/s), TCP (m), tool angle (degrees),
 /// `ρ`, and the acting controller (`classical`, `learned` or empty). Numbers are Rust's
@@ -640,6 +653,15 @@ pub struct ReplayReport {
     /// Per joint, the fastest segment speed `|Δq_i| / Δt` as a fraction of the robot file's
     /// velocity limit of that joint (0 for a single point).
     pub peak_speed_fraction: Vec<f64>,
+    /// Per joint, the largest change of point velocity between consecutive points over their
+    /// time gap (rad/s²), from the declared velocities or else [`point_velocities`]: what a
+    /// controller interpolating the points meets between them (0 for a single point). The
+    /// planner does not bound it.
+    pub peak_acceleration_rad_s2: Vec<f64>,
+    /// The fastest joint at the first and at the last point, as a fraction of its velocity
+    /// limit: a motion that starts or ends moving needs the arm brought up to (down from) that
+    /// speed outside the file.
+    pub boundary_speed_fraction: [f64; 2],
     /// Largest lateral distance of the TCP from the task line (m).
     pub max_line_deviation_m: f64,
     /// Largest angle between the tool axis and `n` (degrees).
@@ -810,6 +832,17 @@ pub fn check_replay(
             *peak = peak.max(speed / v_max[i]);
         }
     }
+    let velocities = match &samples.qd {
+        Some(declared) => declared.clone(),
+        None => point_velocities(&samples.time_s, &samples.q),
+    };
+    let peak_acceleration_rad_s2 = peak_accelerations(&samples.time_s, &velocities);
+    let fastest_joint =
+        |qd: &JointVector| (0..DOF).map(|i| qd[i].abs() / v_max[i]).fold(0.0, f64::max);
+    let boundary_speed_fraction = [
+        fastest_joint(&velocities[0]),
+        fastest_joint(&velocities[velocities.len() - 1]),
+    ];
     let mut max_line_deviation_m = 0.0_f64;
     let mut max_tool_angle_deg = 0.0_f64;
     let mut min_clearance = (f64::INFINITY, String::new(), String::new());
@@ -831,6 +864,8 @@ pub fn check_replay(
         duration_s: samples.time_s[last],
         path_length_m: (tcp - task.p0).dot(&task.d),
         peak_speed_fraction,
+        peak_acceleration_rad_s2,
+        boundary_speed_fraction,
         max_line_deviation_m,
         max_tool_angle_deg,
         min_clearance,
@@ -936,6 +971,25 @@ mod tests {
             peak > 0.99 * FRACTION && peak <= FRACTION * (1.0 + 1e-9),
             "{peak}"
         );
+        // The first and last points move at their segment's speed, within the peak.
+        let [first, last] = report.boundary_speed_fraction;
+        assert!(first > 0.0 && first <= peak && last > 0.0 && last <= peak);
+        assert!(report.peak_acceleration_rad_s2.iter().all(|a| *a > 0.0));
+    }
+
+    #[test]
+    fn peak_accelerations_compare_consecutive_point_velocities() {
+        let velocity = |v: f64| JointVector::from_element(v);
+        // Joint velocities 1, 2/3, 1/2 rad/s at 0, 1 and 3 s: changes of 1/3 over 1 s and
+        // 1/6 over 2 s.
+        let peaks = peak_accelerations(
+            &[0.0, 1.0, 3.0],
+            &[velocity(1.0), velocity(2.0 / 3.0), velocity(0.5)],
+        );
+        for peak in peaks {
+            assert!((peak - 1.0 / 3.0).abs() < 1e-15, "{peak}");
+        }
+        assert_eq!(peak_accelerations(&[0.0], &[velocity(1.0)]), vec![0.0; DOF]);
     }
 
     #[test]
