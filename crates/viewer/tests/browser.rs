@@ -63,15 +63,19 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
         .expect("create temp dir")
 }
 
-/// A classical rollout of a line along +y from the mid-range configuration, and its page.
-fn planned_page() -> (Trajectory, String) {
+/// A classical rollout of at most `max_steps` steps of a line along +y from the mid-range
+/// configuration, and its page.
+fn page_of(max_steps: usize, title: &str) -> (Trajectory, String) {
     let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
         .expect("the FR3 robot file loads");
     let seed = robot.mid_range();
     let kin = robot.forward(&seed);
     let task =
         Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed)).expect("a valid task");
-    let config = RolloutConfig::default();
+    let config = RolloutConfig {
+        max_steps,
+        ..RolloutConfig::default()
+    };
     let trajectory = rollout(
         &robot,
         &task,
@@ -84,9 +88,17 @@ fn planned_page() -> (Trajectory, String) {
         task: &task,
         trajectory: &trajectory,
         constraints: &config.constraints,
-        title: "FR3 line along +y (classical)",
+        title,
     });
     (trajectory, page)
+}
+
+/// The full classical rollout of [`page_of`] and its page.
+fn planned_page() -> (Trajectory, String) {
+    page_of(
+        RolloutConfig::default().max_steps,
+        "FR3 line along +y (classical)",
+    )
 }
 
 /// What one headless Chromium run left behind.
@@ -444,31 +456,8 @@ fn a_motion_of_only_the_seed_renders() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom-seed-only");
     let dir = tmp.path();
-    let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
-        .expect("the FR3 robot file loads");
-    let seed = robot.mid_range();
-    let kin = robot.forward(&seed);
-    let task =
-        Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed)).expect("a valid task");
-    let config = RolloutConfig {
-        max_steps: 0,
-        ..RolloutConfig::default()
-    };
-    let trajectory = rollout(
-        &robot,
-        &task,
-        &seed,
-        &mut ClassicalController::default(),
-        &config,
-    );
+    let (trajectory, page) = page_of(0, "seed only");
     assert_eq!(trajectory.steps.len(), 1, "only the seed");
-    let page = render_html(&ViewerInput {
-        robot: &robot,
-        task: &task,
-        trajectory: &trajectory,
-        constraints: &config.constraints,
-        title: "seed only",
-    });
     if let Err(problems) = page_problems(&dump_dom(&browser, dir, &page)) {
         panic!("a one-step motion did not render cleanly:\n{problems}");
     }
