@@ -5,7 +5,8 @@
 //! assert!(!fixture.tasks.is_empty());
 //! ```
 
-use emg_control::{Task, read_tasks};
+use emg_control::Task;
+use emg_io::read_tasks;
 use emg_kinematics::Robot;
 
 /// The shipped robot and the first tasks of the shipped evaluation set.
@@ -19,13 +20,22 @@ pub struct Fixture {
 impl Fixture {
     /// Loads the robot file and the evaluation set from `data/`.
     pub fn load() -> Self {
-        let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
+        let robot = Robot::from_urdf_file(fr3_path(), "link0", "pen_tip")
             .expect("shipped robot file loads");
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/tasks/eval-v1.tasks");
+        let path = data_dir().join("tasks/eval-v1.tasks");
         let mut tasks = read_tasks(&path, &robot)
             .expect("shipped evaluation set loads (cargo xtask make-tasks)");
         tasks.truncate(100);
         Self { robot, tasks }
     }
+}
+
+/// The workspace's shipped data directory.
+fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data")
+}
+
+/// The shipped FR3 robot file.
+fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

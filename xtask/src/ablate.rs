@@ -3,10 +3,12 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{RolloutConfig, Summary, Task, read_tasks, rollout_all};
+use emg_control::{RolloutConfig, Task};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedOrigin, SeedWorkspace};
-use emg_hybrid::{Executor, ExecutorConfig};
+use emg_eval::{Summary, rollout_all};
+use emg_io::read_tasks;
 use emg_kinematics::ProjectionConfig;
+use emg_planner::{ControllerKind, Executor};
 use emg_seeding::{HeuristicConfig, HeuristicObjective, LabelSet, heuristic_seed};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -35,7 +37,8 @@ pub struct DpArgs {
     /// Evaluation tasks (never seen in training).
     #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
-    /// Labels of the evaluation tasks; their best length is the reference, when present.
+    /// Labels of the evaluation tasks: their starts give the reference lengths ℓ_ref (as in the
+    /// protocol), when the file exists.
     #[arg(long, default_value_os_t = workspace::data("labels/eval-v1.labels"))]
     reference: PathBuf,
     /// Use only the first N tasks.
@@ -49,8 +52,8 @@ pub struct DpArgs {
     #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Controller that rolls out from the seeds.
-    #[arg(long, value_enum, default_value_t = crate::eval::ControllerChoice::Hybrid)]
-    controller: crate::eval::ControllerChoice,
+    #[arg(long, value_name = "classical|rl|hybrid", value_parser = <ControllerKind as std::str::FromStr>::from_str, default_value = "hybrid")]
+    controller: ControllerKind,
     /// Policy weights of the learned controllers.
     #[arg(long, default_value_os_t = crate::protocol::default_policy())]
     policy: PathBuf,
@@ -134,8 +137,9 @@ fn dp_sweep(
     values: &[f64],
     apply: impl Fn(&mut DpSeedConfig, f64),
 ) -> anyhow::Result<()> {
-    let robot = workspace::load_robot(&args.robot)?;
-    let mut tasks = read_tasks(&args.tasks, &robot)
+    let setup = crate::protocol::load_setup(&args.robot, &args.policy, &args.weights)?;
+    let robot = &setup.robot;
+    let mut tasks = read_tasks(&args.tasks, robot)
         .with_context(|| format!("reading {}", args.tasks.display()))?;
     if let Some(limit) = args.limit {
         tasks.truncate(limit);
@@ -152,23 +156,24 @@ fn dp_sweep(
             args.weights.display()
         )
     })?;
-    let reference = reference_lengths(&args.reference, tasks.len())?;
     let pool = workspace::thread_pool(args.threads)?;
-    let rollout = RolloutConfig::default();
-
-    let kind = args.controller.kind();
-    let policy = if kind.needs_policy() {
-        Some(crate::protocol::load_policy(&args.policy)?)
-    } else {
-        None
+    let reference = match args.reference.exists() {
+        true => {
+            let labels = LabelSet::read(&args.reference)
+                .with_context(|| format!("reading {}", args.reference.display()))?;
+            let indices: Vec<usize> = (0..tasks.len()).collect();
+            Some(pool.install(|| setup.references(&tasks, &indices, &labels))?)
+        }
+        false => None,
     };
-    let prototype = Executor::new(kind, policy.as_ref(), &ExecutorConfig::default())?;
-    let checker = workspace::load_checker(&args.robot, &robot)?;
+    let rollout = setup.rollout.clone();
+    let kind = args.controller;
+    let prototype = Executor::new(kind, Some(&setup.policy), &setup.executor)?;
     let lengths_from = |tasks: &[Task], what: &str| -> anyhow::Result<Vec<f64>> {
         let bar = progress::bar(tasks.len() as u64, what);
         let trajectories = pool.install(|| {
             rollout_all(
-                &robot,
+                robot,
                 tasks,
                 |t| t.q0_seed.expect("seeded"),
                 || prototype.clone(),
@@ -177,14 +182,7 @@ fn dp_sweep(
             )
         });
         bar.finish();
-        pool.install(|| {
-            crate::protocol::check_trajectories(
-                &checker,
-                tasks,
-                &trajectories,
-                &rollout.constraints,
-            )
-        })?;
+        pool.install(|| setup.check(tasks, &trajectories))?;
         Ok(trajectories.iter().map(|t| t.path_length_m).collect())
     };
     let mut baselines = Vec::new();
@@ -203,7 +201,7 @@ fn dp_sweep(
                         .map(|task| {
                             bar.inc(1);
                             let q = heuristic_seed(
-                                &robot,
+                                robot,
                                 task,
                                 objective,
                                 &HeuristicConfig::default(),
@@ -240,7 +238,7 @@ fn dp_sweep(
                 .par_iter()
                 .map_init(SeedWorkspace::default, |workspace, task| {
                     bar.inc(1);
-                    seeder.seed(&robot, task, &rollout.constraints, workspace)
+                    seeder.seed(robot, task, &rollout.constraints, workspace)
                 })
                 .collect::<Result<Vec<_>, _>>()
         })?;
@@ -303,34 +301,13 @@ fn dp_sweep(
     Ok(())
 }
 
-/// Best label length per task (`None` for a task without labels), when the evaluation labels
-/// exist.
-fn reference_lengths(
-    path: &std::path::Path,
-    count: usize,
-) -> anyhow::Result<Option<Vec<Option<f64>>>> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let labels = LabelSet::read(path).with_context(|| format!("reading {}", path.display()))?;
-    Ok(Some(
-        (0..count)
-            .map(|i| {
-                labels
-                    .get(i as u32)
-                    .and_then(|t| t.labels.first())
-                    .map(|l| l.length_m)
-            })
-            .collect(),
-    ))
-}
-
-/// Per-task ratio `L / L_ref` in percent, over the tasks that have a reference.
-fn ratio(lengths: &[f64], reference: &[Option<f64>]) -> Summary {
+/// Per-task ratio `L / ℓ_ref` in percent, over the tasks with a positive reference.
+fn ratio(lengths: &[f64], reference: &[f64]) -> Summary {
     let ratios: Vec<f64> = lengths
         .iter()
         .zip(reference)
-        .filter_map(|(l, r)| r.filter(|r| *r > 0.0).map(|r| 100.0 * l / r))
+        .filter(|(_, r)| **r > 0.0)
+        .map(|(l, r)| 100.0 * l / r)
         .collect();
     summary(&ratios)
 }
@@ -404,6 +381,6 @@ fn markdown(report: &Report) -> String {
             ratio_cell(&baseline.ratio_to_reference_pct)
         );
     }
-    text += "\nRatios are per task over the tasks with at least one label (the reference is the best label).\n";
+    text += "\nRatios are per task against the protocol's reference length ℓ_ref (the longest hybrid rollout over the task's labelled starts, as in Tables 1–2).\n";
     text
 }

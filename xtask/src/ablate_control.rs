@@ -5,15 +5,15 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::{ClassicalGains, Summary, read_tasks};
-use emg_hybrid::{
-    BoundaryMeasure, CellStats, ControllerKind, ExecutorConfig, SwitchConfig, cell_stats,
-    count_switches,
-};
+use emg_control::ClassicalGains;
+use emg_eval::{CellStats, Setup, Summary, cell_stats, four};
+use emg_hybrid::{BoundaryMeasure, SwitchConfig, count_switches};
+use emg_io::read_tasks;
+use emg_planner::{ControllerKind, ExecutorConfig, SeedSource};
 use emg_seeding::LabelSet;
 use serde::{Deserialize, Serialize};
 
-use crate::protocol::{self, SeedKind, Setup, four};
+use crate::protocol;
 use crate::workspace;
 
 /// Options of the controller ablations.
@@ -124,17 +124,48 @@ impl Default for SwitchGrid {
     }
 }
 
-/// One ablation row.
-#[derive(Serialize)]
-struct Row {
-    setting: serde_json::Value,
-    stats: CellStats,
-    switches_per_episode: Option<f64>,
+/// The result file of a controller ablation: its grid, the task count and one row per setting.
+#[derive(Serialize, Deserialize)]
+pub struct ControlAblation<G, S> {
+    /// The settings swept.
+    pub grid: G,
+    /// Tasks per setting.
+    pub task_count: usize,
+    /// One row per setting, in table order.
+    pub rows: Vec<Row<S>>,
 }
+
+/// One ablation row: a setting and its statistics.
+#[derive(Serialize, Deserialize)]
+pub struct Row<S> {
+    /// The setting.
+    pub setting: S,
+    /// Path length and ratio to ℓ_ref.
+    pub stats: CellStats,
+    /// Mean hand-overs per episode (hybrid only).
+    pub switches_per_episode: Option<f64>,
+}
+
+/// One switch setting of Table 6.
+#[derive(Serialize, Deserialize)]
+pub struct SwitchSetting {
+    /// Boundary measure.
+    pub measure: BoundaryMeasure,
+    /// Entry threshold `τ_enter`.
+    pub tau_enter: f64,
+    /// Exit threshold `τ_exit`.
+    pub tau_exit: f64,
+}
+
+/// `docs/results/ablate-classical-weights.json` (Table 3).
+pub type WeightsAblation = ControlAblation<GainGrid, ClassicalGains>;
+
+/// `docs/results/ablate-switching.json` (Table 6).
+pub type SwitchingAblation = ControlAblation<SwitchGrid, SwitchSetting>;
 
 /// Loads the setup, the tasks and their reference lengths.
 fn prepare(args: &ControlArgs) -> anyhow::Result<(Setup, Vec<emg_control::Task>, Vec<f64>)> {
-    let setup = Setup::load(&args.robot, &args.policy, &args.diffusion)?;
+    let setup = protocol::load_setup(&args.robot, &args.policy, &args.diffusion)?;
     let mut tasks = read_tasks(&args.tasks, &setup.robot)?;
     if let Some(limit) = args.limit {
         tasks.truncate(limit);
@@ -152,7 +183,7 @@ pub fn classical_weights(args: &ControlArgs) -> anyhow::Result<()> {
     pool.install(|| {
         let started = Instant::now();
         let (setup, tasks, references) = prepare(args)?;
-        let (seeds, _) = setup.seeds(&tasks, SeedKind::Q0Seed)?;
+        let (seeds, _) = setup.seeds(&tasks, &SeedSource::Generating)?;
         let grid = GainGrid::default();
         let all: Vec<usize> = (0..tasks.len()).collect();
         let mut rows = Vec::new();
@@ -162,7 +193,7 @@ pub fn classical_weights(args: &ControlArgs) -> anyhow::Result<()> {
             let trajectories = setup.rollouts(&tasks, &seeds, ControllerKind::Classical, &executor, &what)?;
             let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
             rows.push(Row {
-                setting: serde_json::to_value(&gains)?,
+                setting: gains,
                 stats: cell_stats(&lengths, &references, &all).context("no tasks")?,
                 switches_per_episode: None,
             });
@@ -179,21 +210,19 @@ pub fn classical_weights(args: &ControlArgs) -> anyhow::Result<()> {
             .max_by(|a, b| a.1.stats.ratio_percent.mean.total_cmp(&b.1.stats.ratio_percent.mean))
             .map(|(i, _)| i);
         for (i, row) in rows.iter().enumerate() {
-            let gain = |key: &str| {
-                let v = row.setting[key].as_f64().unwrap_or(0.0);
-                if v == 0.0 { "—".to_string() } else { format!("{v}") }
-            };
+            let gain = |v: f64| if v == 0.0 { "—".to_string() } else { format!("{v}") };
             let mark = if Some(i) == best { " **(best)**" } else { "" };
             md += &format!(
                 "| {} | {} | {} | {} | {}{mark} |\n",
-                gain("k_mu"),
-                gain("k_jl"),
-                gain("k_theta"),
+                gain(row.setting.k_mu),
+                gain(row.setting.k_jl),
+                gain(row.setting.k_theta),
                 four(&row.stats.length_m, 3),
                 four(&row.stats.ratio_percent, 1)
             );
         }
-        finish(args, "classical-weights", &serde_json::json!({"grid": grid, "task_count": tasks.len(), "rows": rows}), md, started)
+        let record = WeightsAblation { grid, task_count: tasks.len(), rows };
+        finish(args, "classical-weights", &record, md, started)
     })
 }
 
@@ -203,7 +232,7 @@ pub fn switching(args: &ControlArgs) -> anyhow::Result<()> {
     pool.install(|| {
         let started = Instant::now();
         let (setup, tasks, references) = prepare(args)?;
-        let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
+        let (seeds, _) = setup.seeds(&tasks, &SeedSource::Dp)?;
         let grid = SwitchGrid::default();
         let all: Vec<usize> = (0..tasks.len()).collect();
         let thresholds: Vec<(f64, f64)> =
@@ -237,20 +266,21 @@ pub fn switching(args: &ControlArgs) -> anyhow::Result<()> {
                     four(&stats.ratio_percent, 1)
                 );
                 rows.push(Row {
-                    setting: serde_json::json!({"measure": measure, "tau_enter": tau_enter, "tau_exit": tau_exit}),
+                    setting: SwitchSetting { measure: measure.clone(), tau_enter, tau_exit },
                     stats,
                     switches_per_episode,
                 });
             }
         }
-        finish(args, "switching", &serde_json::json!({"grid": grid, "task_count": tasks.len(), "rows": rows}), md, started)
+        let record = SwitchingAblation { grid, task_count: tasks.len(), rows };
+        finish(args, "switching", &record, md, started)
     })
 }
 
 fn finish(
     args: &ControlArgs,
     name: &str,
-    record: &serde_json::Value,
+    record: &impl Serialize,
     mut md: String,
     started: Instant,
 ) -> anyhow::Result<()> {

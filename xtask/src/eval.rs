@@ -5,45 +5,26 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use emg_control::{
-    RolloutConfig, Summary, Task, joint_limit_histogram, read_tasks, rollout_all,
+use emg_control::{RolloutConfig, Task};
+use emg_eval::{
+    BucketConfig, EvalRecord, RawSet, Summary, check_trajectories, joint_limit_histogram,
+    markdown as protocol_markdown, merge_sets, rollout_all, run_set, summarize,
     termination_histogram,
 };
-use emg_hybrid::{BucketConfig, ControllerKind, Executor, ExecutorConfig};
+use emg_io::read_tasks;
+use emg_planner::{ControllerKind, Executor, ExecutorConfig};
 use serde::Serialize;
 
 use crate::velocity_limits::{self, VelocityLimits};
 use crate::{progress, protocol, workspace};
-
-/// Controllers `eval --controller` can run.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum ControllerChoice {
-    /// The classical null-space controller (Eq. 3).
-    Classical,
-    /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
-    Rl,
-    /// Learned inside, classical near the joint limits (Sec. 4.3).
-    Hybrid,
-}
-
-impl ControllerChoice {
-    /// The executor's controller of this choice.
-    pub fn kind(self) -> ControllerKind {
-        match self {
-            Self::Classical => ControllerKind::Classical,
-            Self::Rl => ControllerKind::Rl,
-            Self::Hybrid => ControllerKind::Hybrid,
-        }
-    }
-}
 
 /// Options of `eval`.
 #[derive(clap::Args)]
 pub struct Args {
     /// Evaluate one controller from q0_seed; without it, run the whole seed × controller
     /// protocol (docs/results/eval.{json,md}).
-    #[arg(long, value_enum)]
-    controller: Option<ControllerChoice>,
+    #[arg(long, value_name = "classical|rl|hybrid", value_parser = <ControllerKind as std::str::FromStr>::from_str)]
+    controller: Option<ControllerKind>,
     /// Task set.
     #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     tasks: PathBuf,
@@ -125,13 +106,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let pool = workspace::thread_pool(args.threads)?;
     if args.compare_velocity_limits {
         return pool.install(|| {
-            let mut setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
             velocity_limits::run(&mut setup, &args.tasks, args.limit, &args.out_dir)
         });
     }
     match args.controller {
         None => pool.install(|| run_protocol(args)),
-        Some(choice) => run_controller(args, choice.kind(), &pool),
+        Some(kind) => run_controller(args, kind, &pool),
     }
 }
 
@@ -154,20 +135,20 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
                         path.display()
                     )
                 })?;
-                shards.push(serde_json::from_str::<Vec<protocol::RawSet>>(&text)?);
+                shards.push(serde_json::from_str::<Vec<RawSet>>(&text)?);
             }
             let mut merged = Vec::new();
             while !shards[0].is_empty() {
                 let parts = shards.iter_mut().map(|sets| sets.remove(0)).collect();
-                merged.push(protocol::merge_sets(parts)?);
+                merged.push(merge_sets(parts)?);
             }
             merged
         }
         None => {
-            let mut setup = protocol::Setup::load(&args.robot, &args.weights, &args.diffusion)?;
+            let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
             args.velocity_limits.apply(&mut setup.rollout.constraints);
             let shard = args.shard.map(|s| (s.index, s.count));
-            let mut sets = vec![protocol::run_set(
+            let mut sets = vec![protocol_set(
                 &setup,
                 "unseen",
                 &args.tasks,
@@ -176,7 +157,7 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
                 shard,
             )?];
             if args.seen_count > 0 {
-                sets.push(protocol::run_set(
+                sets.push(protocol_set(
                     &setup,
                     "seen",
                     &args.seen_tasks,
@@ -203,21 +184,21 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
     let buckets = BucketConfig::default();
     let sets = raw_sets
         .iter()
-        .map(|raw| protocol::summarize(raw, &buckets))
-        .collect::<anyhow::Result<Vec<_>>>()?;
+        .map(|raw| summarize(raw, &buckets))
+        .collect::<Result<Vec<_>, _>>()?;
     let seconds = started.elapsed().as_secs_f64();
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("{name}.json"));
     let mut rollout = RolloutConfig::default();
     args.velocity_limits.apply(&mut rollout.constraints);
-    let record = serde_json::json!({
-        "rollout": rollout,
-        "executor": ExecutorConfig::default(),
-        "buckets": buckets,
-        "policy": workspace::relative(&args.weights),
-        "diffusion": workspace::relative(&args.diffusion),
-        "sets": sets,
-    });
+    let record = EvalRecord {
+        rollout,
+        executor: ExecutorConfig::default(),
+        buckets,
+        policy: workspace::relative(&args.weights),
+        diffusion: workspace::relative(&args.diffusion),
+        sets,
+    };
     std::fs::write(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
     let mut md = format!(
         "# Evaluation protocol: seeds × controllers\n\nWritten by `cargo xtask eval`. Do not edit by hand. \
@@ -225,8 +206,8 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
          (disjoint from every training set); seen = the first {} tasks of the training pool.\n\n",
         args.seen_count
     );
-    for set in &sets {
-        md += &protocol::markdown(set);
+    for set in &record.sets {
+        md += &protocol_markdown(set);
         md += "\n";
     }
     md += &match args.merge {
@@ -272,7 +253,7 @@ fn run_controller(
     }
     let executor = ExecutorConfig::default();
     let policy = if kind.needs_policy() {
-        Some(protocol::load_policy(&args.weights)?)
+        Some(emg_planner::load_policy(&args.weights)?)
     } else {
         None
     };
@@ -299,9 +280,7 @@ fn run_controller(
     if !args.no_check {
         let checker = workspace::load_checker(&args.robot, &robot)?;
         let started = Instant::now();
-        pool.install(|| {
-            protocol::check_trajectories(&checker, &tasks, &trajectories, &rollout.constraints)
-        })?;
+        pool.install(|| check_trajectories(&checker, &tasks, &trajectories, &rollout.constraints))?;
         checked = tasks.len();
         check_seconds = Some(started.elapsed().as_secs_f64());
     }
@@ -398,4 +377,35 @@ fn markdown(
         );
     }
     md
+}
+
+/// The protocol's raw outcomes on the task file `tasks_path` (its first `limit` tasks) with the
+/// labels `labels_path`, for the whole set or one shard.
+fn protocol_set(
+    setup: &emg_eval::Setup,
+    name: &str,
+    tasks_path: &std::path::Path,
+    labels_path: &std::path::Path,
+    limit: Option<usize>,
+    shard: Option<(usize, usize)>,
+) -> anyhow::Result<RawSet> {
+    let mut tasks = read_tasks(tasks_path, &setup.robot)?;
+    if let Some(limit) = limit {
+        tasks.truncate(limit);
+    }
+    let labels = emg_seeding::LabelSet::read(labels_path).with_context(|| {
+        format!(
+            "reading {} (create it with `cargo xtask label-seeds`)",
+            labels_path.display()
+        )
+    })?;
+    println!("{name}: {} tasks", tasks.len());
+    Ok(run_set(
+        setup,
+        name,
+        &workspace::relative(tasks_path),
+        &tasks,
+        &labels,
+        shard,
+    )?)
 }

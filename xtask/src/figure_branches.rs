@@ -10,7 +10,8 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{ClassicalController, read_tasks, rollout};
+use emg_control::{ClassicalController, rollout};
+use emg_io::read_tasks;
 use emg_kinematics::{JointVector, PoseTarget, project_to_pose};
 use emg_seeding::{
     LabelConfig, SelfMotionWalk, WalkEnd, cone_ik_solutions, tangent_directions, walk,

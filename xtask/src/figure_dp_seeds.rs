@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{ClassicalController, RolloutConfig, first_violation, read_tasks, rollout};
+use emg_control::{ClassicalController, RolloutConfig, first_violation, rollout};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
+use emg_io::read_tasks;
 use emg_kinematics::{DOF, PoseTarget, Vec3, project_to_pose};
 use plotters::prelude::*;
 

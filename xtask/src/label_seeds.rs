@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use emg_control::{ClassicalController, Summary, Task, read_tasks, rollout};
+use emg_control::{ClassicalController, Task, rollout};
+use emg_eval::Summary;
+use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_seeding::{
     HeuristicConfig, HeuristicObjective, LABEL_FORMAT_VERSION, LabelConfig, LabelJob, LabelSet,

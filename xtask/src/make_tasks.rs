@@ -7,9 +7,8 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use emg_control::{
-    ClassicalGains, RolloutConfig, SamplerConfig, TASK_FORMAT_VERSION, TaskSampler, write_task_set,
-};
+use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, TaskSampler};
+use emg_io::{TASK_FORMAT_VERSION, write_task_set};
 use serde::Serialize;
 
 use crate::{progress, workspace};

@@ -1,17 +1,22 @@
 //! `cargo xtask report`: regenerates `docs/results.md` from the result files of `eval` and
-//! `ablate`, beside the paper's numbers (`data/paper/tables.json`), with its figures.
+//! `ablate`, beside the paper's numbers (`data/paper/tables.json`), with its figures. Every file
+//! is read into its typed record.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use emg_control::{Task, read_tasks, rollout};
-use emg_hybrid::{ControllerKind, Executor, count_switches};
-use emg_kinematics::SHIPPED_ROBOTS;
+use emg_control::{Task, rollout};
+use emg_eval::{EvalRecord, SetResult, four};
+use emg_hybrid::count_switches;
+use emg_io::read_tasks;
+use emg_planner::{ControllerKind, Executor, SHIPPED_ROBOTS, SeedSource};
 use plotters::prelude::*;
-use serde_json::Value;
+use serde::Deserialize;
+use serde::de::DeserializeOwned;
 
-use crate::protocol::{self, SeedKind, Setup};
-use crate::workspace;
+use crate::ablate_control::{SwitchingAblation, WeightsAblation};
+use crate::{protocol, workspace};
 
 /// Options of `report`.
 #[derive(clap::Args)]
@@ -30,26 +35,73 @@ pub struct Args {
     robot: PathBuf,
 }
 
-fn read(path: &Path) -> anyhow::Result<Value> {
+/// `[mean, std, min, max]` as the paper's tables give them.
+type Four = [f64; 4];
+
+/// The paper's tables, transcribed once (`data/paper/tables.json`).
+#[derive(Deserialize)]
+struct PaperTables {
+    /// Table 1: by bucket, by controller, `[length, ratio]`.
+    table1: BTreeMap<String, BTreeMap<String, [Four; 2]>>,
+    /// Table 1's task count per bucket.
+    table1_counts: BTreeMap<String, usize>,
+    /// Table 2: by controller, by seed, `(t_ms, length, ratio)`.
+    table2: BTreeMap<String, BTreeMap<String, (f64, Four, Four)>>,
+    /// Table 3's representative rows.
+    table3: Vec<PaperGains>,
+    /// Table 4: guidance scales.
+    table4: Vec<PaperDpRow>,
+    /// Table 5: DDIM steps.
+    table5: Vec<PaperDpRow>,
+    /// Table 6: switch thresholds.
+    table6: Vec<PaperSwitchRow>,
+}
+
+/// A row of the paper's Table 3.
+#[derive(Deserialize)]
+struct PaperGains {
+    k_mu: f64,
+    k_jl: f64,
+    k_theta: f64,
+    length: Four,
+    ratio: Four,
+}
+
+/// A row of the paper's Tables 4 and 5.
+#[derive(Deserialize)]
+struct PaperDpRow {
+    /// The guidance scale `w` or the DDIM step count.
+    #[serde(alias = "w", alias = "steps")]
+    value: f64,
+    t_ms: f64,
+    length: Four,
+    ratio: Four,
+}
+
+/// A row of the paper's Table 6.
+#[derive(Deserialize)]
+struct PaperSwitchRow {
+    tau_enter: f64,
+    tau_exit: f64,
+    switches: f64,
+    length: Four,
+    ratio: Four,
+}
+
+/// The typed record in the result file `path`.
+fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
     let text = std::fs::read_to_string(path).with_context(|| {
         format!(
             "reading {} (run the command that writes it first)",
             path.display()
         )
     })?;
-    Ok(serde_json::from_str(&text)?)
+    serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }
 
-/// `mean / std / min / max` of a JSON summary or a 4-array.
-fn four(value: &Value, decimals: usize) -> String {
-    let numbers: Vec<f64> = match value {
-        Value::Array(items) => items.iter().filter_map(Value::as_f64).collect(),
-        _ => ["mean", "std", "min", "max"]
-            .iter()
-            .filter_map(|k| value[*k].as_f64())
-            .collect(),
-    };
-    numbers
+/// `mean / std / min / max` of one of the paper's entries.
+fn paper_four(values: &Four, decimals: usize) -> String {
+    values
         .iter()
         .map(|v| format!("{v:.decimals$}"))
         .collect::<Vec<_>>()
@@ -58,12 +110,11 @@ fn four(value: &Value, decimals: usize) -> String {
 
 /// Writes the report and its figures.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let paper = read(&workspace::root().join("data/paper/tables.json"))?;
-    let eval = read(&args.results.join("eval.json"))?;
+    let paper: PaperTables = read(&workspace::root().join("data/paper/tables.json"))?;
+    let eval: EvalRecord = read(&args.results.join("eval.json"))?;
     std::fs::create_dir_all(&args.figures)?;
-    let unseen = eval["sets"]
-        .as_array()
-        .and_then(|sets| sets.iter().find(|s| s["name"] == "unseen"))
+    let unseen = eval
+        .set("unseen")
         .context("eval.json lacks the unseen set")?;
     let mut md = String::from(
         "# Results\n\nWritten by `cargo xtask report` from the files in `docs/results/` (themselves written by \
@@ -79,24 +130,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         &args.results,
         "ablate-cfg-scale.md",
         "Table 4: guidance scale",
-        &paper["table4"],
+        &paper.table4,
         "w",
     )?;
     md += &included(
         &args.results,
         "ablate-ddim-steps.md",
         "Table 5: DDIM steps",
-        &paper["table5"],
+        &paper.table5,
         "steps",
     )?;
     md += &table6(&args.results, &paper)?;
-    if let Some(seen) = eval["sets"]
-        .as_array()
-        .and_then(|sets| sets.iter().find(|s| s["name"] == "seen"))
-    {
+    if let Some(seen) = eval.set("seen") {
         md += &format!(
             "## Seen tasks\n\nThe same DP-seed rows on {} tasks of the training pool (seen in training):\n\n",
-            seen["task_count"]
+            seen.task_count
         );
         md += &dp_rows(seen, "all");
     }
@@ -107,67 +155,60 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn cells<'a>(
-    set: &'a Value,
-    seed: &'a str,
-    group: &'a str,
-) -> impl Iterator<Item = &'a Value> + 'a {
-    set["cells"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter(move |c| c["seed"] == seed && c["group"] == group)
+/// The name of the DP seed in result files.
+fn dp() -> &'static str {
+    SeedSource::Dp.name()
 }
 
-fn dp_rows(set: &Value, group: &str) -> String {
+fn dp_rows(set: &SetResult, group: &str) -> String {
     let mut md = String::from("| π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|\n");
-    for cell in cells(set, "dp", group) {
+    for cell in set.cells(dp(), group) {
         md += &format!(
             "| {} | {} | {} |\n",
-            cell["controller"].as_str().unwrap_or(""),
-            four(&cell["stats"]["length_m"], 3),
-            four(&cell["stats"]["ratio_percent"], 1)
+            cell.controller.name(),
+            four(&cell.stats.length_m, 3),
+            four(&cell.stats.ratio_percent, 1)
         );
     }
     md + "\n"
 }
 
-fn table1(set: &Value, paper: &Value) -> String {
+/// Mean path length of `controller` from DP seeds over all tasks of `set`.
+fn dp_mean(set: &SetResult, controller: ControllerKind) -> f64 {
+    set.cell(dp(), controller, "all")
+        .map_or(f64::NAN, |c| c.stats.length_m.mean)
+}
+
+fn table1(set: &SetResult, paper: &PaperTables) -> String {
     let mut md = String::from(
         "## Table 1: three controllers from DP seeds, by difficulty\n\n\
          | tasks | π | ours: path length (m) | paper | ours: ratio to ℓ_ref (%) | paper |\n|---|---|---|---|---|---|\n",
     );
     for group in ["all", "easy", "medium", "difficult"] {
-        for cell in cells(set, "dp", group) {
-            let controller = cell["controller"].as_str().unwrap_or("");
-            let theirs = &paper["table1"][group][controller];
+        for cell in set.cells(dp(), group) {
+            let controller = cell.controller.name();
+            let theirs = &paper.table1[group][controller];
             md += &format!(
                 "| {group} (ours n = {}, paper n = {}) | {controller} | {} | {} | {} | {} |\n",
-                cell["stats"]["length_m"]["count"],
-                paper["table1_counts"][group],
-                four(&cell["stats"]["length_m"], 3),
-                four(&theirs[0], 2),
-                four(&cell["stats"]["ratio_percent"], 1),
-                four(&theirs[1], 1)
+                cell.stats.length_m.count,
+                paper.table1_counts[group],
+                four(&cell.stats.length_m, 3),
+                paper_four(&theirs[0], 2),
+                four(&cell.stats.ratio_percent, 1),
+                paper_four(&theirs[1], 1)
             );
         }
     }
-    let mean = |controller: &str| {
-        cells(set, "dp", "all")
-            .find(|c| c["controller"] == controller)
-            .and_then(|c| c["stats"]["length_m"]["mean"].as_f64())
-            .unwrap_or(f64::NAN)
-    };
-    let ratio = cells(set, "dp", "all")
-        .find(|c| c["controller"] == "hybrid")
-        .and_then(|c| c["stats"]["ratio_percent"]["mean"].as_f64())
-        .unwrap_or(f64::NAN);
+    let ratio = set
+        .cell(dp(), ControllerKind::Hybrid, "all")
+        .map_or(f64::NAN, |c| c.stats.ratio_percent.mean);
+    let classical = dp_mean(set, ControllerKind::Classical);
     md += &format!(
         "\nHybrid + DP vs Classical + DP: **{:+.1} %** mean path length (paper +27 %, goal ≥ +35 %); \
          Hybrid + DP reaches **{ratio:.1} %** of ℓ_ref on average (paper 90.6 %, goal ≥ 92 %). \
          RL + DP vs Classical + DP: {:+.1} %.\n\n",
-        100.0 * (mean("hybrid") / mean("classical") - 1.0),
-        100.0 * (mean("rl") / mean("classical") - 1.0),
+        100.0 * (dp_mean(set, ControllerKind::Hybrid) / classical - 1.0),
+        100.0 * (dp_mean(set, ControllerKind::Rl) / classical - 1.0),
     );
     md
 }
@@ -203,11 +244,10 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
     let mut md = String::new();
     for robot in &SHIPPED_ROBOTS[1..] {
         let file = Path::new(robot.data_subdir()).join("eval.json");
-        let eval = read(&results.join(&file))
+        let eval: EvalRecord = read(&results.join(&file))
             .with_context(|| format!("run `cargo xtask eval --robot {}` first", robot.name))?;
-        let unseen = eval["sets"]
-            .as_array()
-            .and_then(|sets| sets.iter().find(|s| s["name"] == "unseen"))
+        let unseen = eval
+            .set("unseen")
             .with_context(|| format!("docs/results/{} lacks the unseen set", file.display()))?;
         md += &format!(
             "## Second arm: `{}`, Table 1\n\nThe whole pipeline on the second shipped arm (its own task sets, labels, \
@@ -215,99 +255,85 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
              | tasks | π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|\n",
             robot.name,
             file.display(),
-            unseen["task_count"]
+            unseen.task_count
         );
         for group in ["all", "easy", "medium", "difficult"] {
-            for cell in cells(unseen, "dp", group) {
+            for cell in unseen.cells(dp(), group) {
                 md += &format!(
                     "| {group} (n = {}) | {} | {} | {} |\n",
-                    cell["stats"]["length_m"]["count"],
-                    cell["controller"].as_str().unwrap_or(""),
-                    four(&cell["stats"]["length_m"], 3),
-                    four(&cell["stats"]["ratio_percent"], 1)
+                    cell.stats.length_m.count,
+                    cell.controller.name(),
+                    four(&cell.stats.length_m, 3),
+                    four(&cell.stats.ratio_percent, 1)
                 );
             }
         }
-        let mean = |controller: &str| {
-            cells(unseen, "dp", "all")
-                .find(|c| c["controller"] == controller)
-                .and_then(|c| c["stats"]["length_m"]["mean"].as_f64())
-                .unwrap_or(f64::NAN)
-        };
+        let classical = dp_mean(unseen, ControllerKind::Classical);
         md += &format!(
             "\nHybrid + DP vs Classical + DP: **{:+.1} %** mean path length; RL + DP vs Classical + DP: {:+.1} %.\n\n",
-            100.0 * (mean("hybrid") / mean("classical") - 1.0),
-            100.0 * (mean("rl") / mean("classical") - 1.0),
+            100.0 * (dp_mean(unseen, ControllerKind::Hybrid) / classical - 1.0),
+            100.0 * (dp_mean(unseen, ControllerKind::Rl) / classical - 1.0),
         );
     }
     Ok(md)
 }
 
-fn table2(set: &Value, paper: &Value) -> String {
+fn table2(set: &SetResult, paper: &PaperTables) -> String {
     let mut md = String::from(
         "## Table 2: seeds × controllers (all tasks)\n\nt = mean per-task seed time on this machine (ms; the paper's on its own hardware).\n\n\
          | π | q₀* | ours t (ms) | paper t | ours: path length (m) | paper | ours: ratio (%) | paper |\n|---|---|---|---|---|---|---|---|\n",
     );
     for controller in ControllerKind::ALL {
-        for seed in SeedKind::ALL {
-            let key = serde_json::to_value(seed).unwrap_or_default();
-            let Some(cell) = cells(set, key.as_str().unwrap_or(""), "all")
-                .find(|c| c["controller"] == controller.name())
-            else {
+        for seed in &emg_eval::PROTOCOL_SEEDS {
+            let Some(cell) = set.cell(seed.name(), controller, "all") else {
                 continue;
             };
-            let theirs = &paper["table2"][controller.name()][key.as_str().unwrap_or("")];
-            let time = set["seed_time_ms"][seed.title()]["mean"]
-                .as_f64()
-                .unwrap_or(f64::NAN);
-            let paper_cell = |i: usize, d: usize| {
-                if theirs.is_null() {
-                    "—".into()
-                } else {
-                    four(&theirs[i], d)
-                }
-            };
+            let theirs = paper.table2[controller.name()].get(seed.name());
+            let time = set
+                .seed_time_ms
+                .get(seed.title())
+                .map_or(f64::NAN, |t| t.mean);
             md += &format!(
                 "| {} | {} | {time:.2} | {} | {} | {} | {} | {} |\n",
                 controller.title(),
                 seed.title(),
-                theirs[0].as_f64().map_or("—".into(), |t| format!("{t:.2}")),
-                four(&cell["stats"]["length_m"], 3),
-                paper_cell(1, 2),
-                four(&cell["stats"]["ratio_percent"], 1),
-                paper_cell(2, 1)
+                theirs.map_or("—".into(), |t| format!("{:.2}", t.0)),
+                four(&cell.stats.length_m, 3),
+                theirs.map_or("—".into(), |t| paper_four(&t.1, 2)),
+                four(&cell.stats.ratio_percent, 1),
+                theirs.map_or("—".into(), |t| paper_four(&t.2, 1))
             );
         }
     }
     md + "\n"
 }
 
-fn table3(results: &Path, paper: &Value) -> anyhow::Result<String> {
-    let ours = read(&results.join("ablate-classical-weights.json"))?;
+fn table3(results: &Path, paper: &PaperTables) -> anyhow::Result<String> {
+    let ours: WeightsAblation = read(&results.join("ablate-classical-weights.json"))?;
     let mut md = String::from(
         "## Table 3: classical secondary-objective weights (from q0_seed)\n\nOurs (all 39 settings):\n\n\
          | k_μ | k_jl | k_θ | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|---|\n",
     );
-    for row in ours["rows"].as_array().into_iter().flatten() {
-        let s = &row["setting"];
+    for row in &ours.rows {
+        let s = &row.setting;
         md += &format!(
-            "| {} | {} | {} | {} | {} |\n",
-            s["k_mu"],
-            s["k_jl"],
-            s["k_theta"],
-            four(&row["stats"]["length_m"], 3),
-            four(&row["stats"]["ratio_percent"], 1)
+            "| {:?} | {:?} | {:?} | {} | {} |\n",
+            s.k_mu,
+            s.k_jl,
+            s.k_theta,
+            four(&row.stats.length_m, 3),
+            four(&row.stats.ratio_percent, 1)
         );
     }
     md += "\nPaper (representative rows):\n\n| k_μ | k_jl | k_θ | path length (m) | ratio (%) |\n|---|---|---|---|---|\n";
-    for row in paper["table3"].as_array().into_iter().flatten() {
+    for row in &paper.table3 {
         md += &format!(
-            "| {} | {} | {} | {} | {} |\n",
-            row["k_mu"],
-            row["k_jl"],
-            row["k_theta"],
-            four(&row["length"], 2),
-            four(&row["ratio"], 1)
+            "| {:?} | {:?} | {:?} | {} | {} |\n",
+            row.k_mu,
+            row.k_jl,
+            row.k_theta,
+            paper_four(&row.length, 2),
+            paper_four(&row.ratio, 1)
         );
     }
     Ok(md + "\n")
@@ -317,7 +343,7 @@ fn included(
     results: &Path,
     file: &str,
     title: &str,
-    paper: &Value,
+    paper: &[PaperDpRow],
     key: &str,
 ) -> anyhow::Result<String> {
     let text = std::fs::read_to_string(results.join(file))
@@ -330,65 +356,61 @@ fn included(
     let mut md = format!(
         "## {title}\n\nOurs (`docs/results/{file}`):\n\n{body}\n\nPaper:\n\n| {key} | t (ms) | path length (m) | ratio (%) |\n|---|---|---|---|\n"
     );
-    for row in paper.as_array().into_iter().flatten() {
+    for row in paper {
         md += &format!(
             "| {} | {} | {} | {} |\n",
-            row[key],
-            row["t_ms"],
-            four(&row["length"], 3),
-            four(&row["ratio"], 1)
+            row.value,
+            row.t_ms,
+            paper_four(&row.length, 3),
+            paper_four(&row.ratio, 1)
         );
     }
     Ok(md + "\n")
 }
 
-fn table6(results: &Path, paper: &Value) -> anyhow::Result<String> {
-    let ours = read(&results.join("ablate-switching.json"))?;
+fn table6(results: &Path, paper: &PaperTables) -> anyhow::Result<String> {
+    let ours: SwitchingAblation = read(&results.join("ablate-switching.json"))?;
     let mut md = String::from(
         "## Table 6: switching thresholds and boundary measure (DP seeds, hybrid)\n\n\
          | measure | (τ_enter, τ_exit) | ours: switches | paper | ours: path length (m) | paper | ours: ratio (%) | paper |\n|---|---|---|---|---|---|---|---|\n",
     );
-    for row in ours["rows"].as_array().into_iter().flatten() {
-        let s = &row["setting"];
-        let theirs = paper["table6"].as_array().into_iter().flatten().find(|p| {
-            s["measure"]["kind"] == "joint_limits"
-                && p["tau_enter"] == s["tau_enter"]
-                && p["tau_exit"] == s["tau_exit"]
-        });
+    for row in &ours.rows {
+        let s = &row.setting;
+        let paper_rule = s.measure == emg_hybrid::BoundaryMeasure::JointLimits;
+        let theirs = paper
+            .table6
+            .iter()
+            .find(|p| paper_rule && p.tau_enter == s.tau_enter && p.tau_exit == s.tau_exit);
         md += &format!(
-            "| {} | ({}, {}) | {:.2} | {} | {} | {} | {} | {} |\n",
-            s["measure"]["kind"].as_str().unwrap_or(""),
-            s["tau_enter"],
-            s["tau_exit"],
-            row["switches_per_episode"].as_f64().unwrap_or(0.0),
-            theirs.map_or("—".into(), |p| format!("{}", p["switches"])),
-            four(&row["stats"]["length_m"], 3),
-            theirs.map_or("—".into(), |p| four(&p["length"], 3)),
-            four(&row["stats"]["ratio_percent"], 1),
-            theirs.map_or("—".into(), |p| four(&p["ratio"], 1)),
+            "| {} | ({:?}, {:?}) | {:.2} | {} | {} | {} | {} | {} |\n",
+            s.measure.name(),
+            s.tau_enter,
+            s.tau_exit,
+            row.switches_per_episode.unwrap_or(0.0),
+            theirs.map_or("—".into(), |p| format!("{}", p.switches)),
+            four(&row.stats.length_m, 3),
+            theirs.map_or("—".into(), |p| paper_four(&p.length, 3)),
+            four(&row.stats.ratio_percent, 1),
+            theirs.map_or("—".into(), |p| paper_four(&p.ratio, 1)),
         );
     }
     Ok(md + "\n")
 }
 
-fn figures(args: &Args, set: &Value) -> anyhow::Result<String> {
-    let numbers = |v: &Value| -> Vec<f64> {
-        v.as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(Value::as_f64)
-            .collect()
-    };
-    let references = numbers(&set["references_m"]);
+fn figures(args: &Args, set: &SetResult) -> anyhow::Result<String> {
+    let references = &set.references_m;
     histogram(
         &args.figures.join("reference-lengths.svg"),
         "reference length ℓ_ref (m)",
-        &[("ℓ_ref", &references)],
+        &[("ℓ_ref", references)],
         &[0.45, 0.80],
     )?;
     let per_controller: Vec<(&str, Vec<f64>)> = ControllerKind::ALL
         .iter()
-        .map(|c| (c.title(), numbers(&set["dp_lengths_m"][c.name()])))
+        .map(|c| {
+            let lengths = set.dp_lengths_m.get(c.name()).cloned().unwrap_or_default();
+            (c.title(), lengths)
+        })
         .collect();
     let series: Vec<(&str, &[f64])> = per_controller
         .iter()
@@ -487,14 +509,14 @@ fn histogram(
 /// The first evaluation task (of the first 300) whose DP + hybrid rollout hands over at least
 /// twice, drawn over time.
 fn trace(args: &Args) -> anyhow::Result<()> {
-    let setup = Setup::load(
+    let setup = protocol::load_setup(
         &args.robot,
         &protocol::default_policy(),
         &protocol::default_diffusion(),
     )?;
     let mut tasks: Vec<Task> = read_tasks(&workspace::data("tasks/eval-v1.tasks"), &setup.robot)?;
     tasks.truncate(300);
-    let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
+    let (seeds, _) = setup.seeds(&tasks, &SeedSource::Dp)?;
     let prototype = Executor::new(ControllerKind::Hybrid, Some(&setup.policy), &setup.executor)?;
     let mut chosen = None;
     for (task, seed) in tasks.iter().zip(&seeds) {

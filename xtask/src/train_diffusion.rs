@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::read_tasks;
 use emg_diffusion::{Backend, DiffusionConfig, TrainConfig, Trainer, TrainingSet, training_set};
+use emg_io::read_tasks;
 use emg_seeding::{LabelSet, hex};
 use serde::{Deserialize, Serialize};
 

@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::{RolloutConfig, read_tasks};
+use emg_control::RolloutConfig;
+use emg_io::read_tasks;
 use emg_policy::{
     Backend, EnvConfig, IterationLog, NetworkConfig, PpoConfig, Trainer, TrainingPool,
 };

@@ -6,11 +6,12 @@
 use std::path::Path;
 
 use anyhow::Context;
-use emg_control::{ConstraintConfig, Summary, Trajectory, VelocityLimitFraction, read_tasks};
-use emg_hybrid::ControllerKind;
+use emg_control::{ConstraintConfig, Trajectory, VelocityLimitFraction};
+use emg_eval::{Setup, Summary, four};
+use emg_io::read_tasks;
+use emg_planner::{ControllerKind, SeedSource};
 use serde::Serialize;
 
-use crate::protocol::{SeedKind, Setup, four};
 use crate::workspace;
 
 /// `eval --velocity-limits`: whether rollouts honour the robot file's joint-velocity limits.
@@ -113,7 +114,7 @@ pub fn run(
         tasks.truncate(limit);
     }
     let limits: Vec<f64> = setup.robot.limits().velocity.iter().copied().collect();
-    let (seeds, _) = setup.seeds(&tasks, SeedKind::Dp)?;
+    let (seeds, _) = setup.seeds(&tasks, &SeedSource::Dp)?;
     let executor = setup.executor.clone();
     let dt = setup.rollout.dt_s;
     let mut comparisons = Vec::new();
@@ -127,7 +128,7 @@ pub fn run(
                 None => format!("DP+{} (no limits)", controller.name()),
                 Some(f) => format!("DP+{} ({f} × limits)", controller.name()),
             };
-            setup.rollouts(&tasks, &seeds, controller, &executor, &what)
+            Ok(setup.rollouts(&tasks, &seeds, controller, &executor, &what)?)
         };
         let off = run(None)?;
         let mut limited = Vec::new();

@@ -4,8 +4,9 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use anyhow::Context;
-use emg_control::ReferenceModel;
-use emg_kinematics::{Robot, ShippedRobot};
+use emg_kinematics::Robot;
+use emg_planner::{DataDir, ShippedRobot};
+use emg_verify::ReferenceModel;
 use serde::de::DeserializeOwned;
 
 /// The workspace root (parent of `xtask/`).
@@ -14,6 +15,11 @@ pub fn root() -> PathBuf {
         .parent()
         .expect("xtask lives inside the workspace")
         .to_path_buf()
+}
+
+/// The workspace's `data/` directory, which the pipelines read and write.
+pub fn data_dir() -> DataDir {
+    DataDir::new(root().join("data"))
 }
 
 /// Where one robot's files live: its robot file and the sub-directory of its data, results,
@@ -34,10 +40,12 @@ pub fn robot_file(value: &str) -> Result<PathBuf, String> {
 /// The layout of `--robot` (a shipped robot's name or a URDF path): a shipped robot's own, or
 /// `custom/<file stem>` directories for any other robot file.
 fn layout_of(value: &str) -> RobotLayout {
-    let shipped = ShippedRobot::by_name(value).or_else(|| ShippedRobot::by_path(Path::new(value)));
+    let data = data_dir();
+    let shipped =
+        ShippedRobot::by_name(value).or_else(|| ShippedRobot::by_path(Path::new(value), &data));
     if let Some(robot) = shipped {
         return RobotLayout {
-            urdf: robot.path(),
+            urdf: robot.path(&data),
             subdir: robot.data_subdir().into(),
         };
     }
@@ -80,7 +88,7 @@ pub fn default_robot() -> PathBuf {
 
 /// `relative` inside the selected robot's data directory (`data/` for the FR3).
 pub fn data(relative: &str) -> PathBuf {
-    root().join("data").join(&layout().subdir).join(relative)
+    data_dir().path().join(&layout().subdir).join(relative)
 }
 
 /// The selected robot's results directory (`docs/results/` for the FR3).
@@ -133,7 +141,6 @@ pub fn load_robot(path: &Path) -> anyhow::Result<Robot> {
 /// The independent checker of `robot`, read again from its file.
 pub fn load_checker(path: &Path, robot: &Robot) -> anyhow::Result<ReferenceModel> {
     ReferenceModel::from_urdf_file(path, robot.base_link(), robot.tip_link())
-        .map_err(anyhow::Error::msg)
         .with_context(|| format!("loading the checker's model of {}", path.display()))
 }
 

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
-use emg_kinematics::{DOF, JointVector};
+use clap::{Args, Parser, Subcommand};
+use emg_planner::{ControllerKind, SeedSource};
 
 /// Extreme straight-line motion on a 7-DoF arm holding a pen.
 #[derive(Debug, Parser)]
@@ -94,10 +94,11 @@ pub struct PlanArgs {
     #[arg(long, value_name = "FILE", conflicts_with = "p0")]
     pub task_file: Option<PathBuf>,
     /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`
-    /// (mid-range of the joint limits) or `q=v1,...,v7` (radians). Default: `dp` when the
-    /// --weights file exists, else `generating` when the task has a q0_seed, else `home`.
-    #[arg(long, value_name = "SOURCE", value_parser = SeedRequest::from_str, allow_hyphen_values = true)]
-    pub seed: Option<SeedRequest>,
+    /// (mid-range of the joint limits), `q_mu` / `q_jl` (heuristic ascents from q0_seed) or
+    /// `q=v1,...,v7` (radians). Default: `dp` when the --weights file exists, else `generating`
+    /// when the task has a q0_seed, else `home`.
+    #[arg(long, value_name = "SOURCE", value_parser = SeedSource::from_str, allow_hyphen_values = true)]
+    pub seed: Option<SeedSource>,
     /// Diffusion-seeder weights for `--seed dp` (default: those shipped for a shipped robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub weights: Option<PathBuf>,
@@ -112,8 +113,9 @@ pub struct PlanArgs {
     /// task file holding several tasks: PATH-00000.html, ..., the extension kept).
     #[arg(long, value_name = "PATH")]
     pub html: Option<PathBuf>,
-    /// Null-space controller.
-    #[arg(long, value_enum, default_value_t = ControllerKind::Hybrid)]
+    /// Null-space controller: `classical` (Eq. 3), `rl` (the PPO policy, Sec. 4.2) or `hybrid`
+    /// (learned inside, classical near the joint limits, Sec. 4.3).
+    #[arg(long, value_name = "NAME", value_parser = ControllerKind::from_str, default_value = "hybrid")]
     pub controller: ControllerKind,
     /// Policy weights of `--controller rl` and `hybrid` (default: those shipped for a shipped
     /// robot).
@@ -121,97 +123,23 @@ pub struct PlanArgs {
     pub policy: Option<PathBuf>,
 }
 
-/// The null-space controllers the CLI can run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ControllerKind {
-    /// The classical gradient controller (Eq. 3).
-    Classical,
-    /// The learned PPO policy (Sec. 4.2), acting with `tanh(μ)`.
-    Rl,
-    /// The learned policy inside, the classical controller near the joint limits (Sec. 4.3).
-    Hybrid,
-}
-
-impl ControllerKind {
-    /// The executor's controller of this choice.
-    pub fn kind(self) -> emg_hybrid::ControllerKind {
-        match self {
-            Self::Classical => emg_hybrid::ControllerKind::Classical,
-            Self::Rl => emg_hybrid::ControllerKind::Rl,
-            Self::Hybrid => emg_hybrid::ControllerKind::Hybrid,
-        }
-    }
-}
-
 impl PlanArgs {
     /// The diffusion-seeder weights: `--weights`, else those shipped for the robot (if any).
     pub fn weights_path(&self) -> Option<PathBuf> {
-        self.weights
-            .clone()
-            .or_else(|| crate::robot::shipped_model(&self.robot, "diffusion-v1.weights"))
+        self.weights.clone().or_else(|| {
+            crate::robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE)
+        })
     }
 
     /// The policy weights: `--policy`, else those shipped for the robot (if any).
     pub fn policy_path(&self) -> Option<PathBuf> {
         self.policy
             .clone()
-            .or_else(|| crate::robot::shipped_model(&self.robot, "ppo-v1.weights"))
-    }
-}
-
-/// Where the rollout's seed configuration comes from.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SeedRequest {
-    /// The DP seed: diffusion candidates projected onto the start pose, else `q0_seed`.
-    Dp,
-    /// The task's generating configuration `q0_seed`.
-    Generating,
-    /// The mid-range configuration of the joint limits.
-    Home,
-    /// A configuration given on the command line (rad).
-    Given(JointVector),
-}
-
-impl FromStr for SeedRequest {
-    type Err = String;
-
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "dp" => Ok(Self::Dp),
-            "generating" => Ok(Self::Generating),
-            "home" => Ok(Self::Home),
-            _ => match s.strip_prefix("q=") {
-                Some(values) => {
-                    let q: [f64; DOF] = parse_numbers(values)?;
-                    Ok(Self::Given(JointVector::from(q)))
-                }
-                None => Err(format!(
-                    "unknown seed source '{s}': use dp, generating, home or q=v1,...,v7 (radians)"
-                )),
-            },
-        }
+            .or_else(|| crate::robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE))
     }
 }
 
 /// Parses `x,y,z`.
 pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
-    parse_numbers(s)
-}
-
-/// Parses exactly `N` comma-separated finite numbers.
-fn parse_numbers<const N: usize>(s: &str) -> Result<[f64; N], String> {
-    let values = s
-        .split(',')
-        .map(|v| {
-            let v = v.trim();
-            match v.parse::<f64>() {
-                Ok(x) if x.is_finite() => Ok(x),
-                _ => Err(format!("'{v}' is not a finite number")),
-            }
-        })
-        .collect::<Result<Vec<f64>, String>>()?;
-    let count = values.len();
-    values
-        .try_into()
-        .map_err(|_| format!("expected {N} comma-separated numbers, got {count}"))
+    emg_planner::parse::numbers(s)
 }

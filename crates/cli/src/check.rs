@@ -2,155 +2,24 @@
 //!
 //! Reads `emg-trajectory/1` JSON, `emg-joint-trajectory/1` JSON or the CSV (told apart by the
 //! content: JSON starts with `{`, and its `format` field names the layout), resolves the robot,
-//! the task and the constraints, and runs [`emg_control::check_replay`]. The layouts and what is
+//! the task and the constraints, and runs [`emg_verify::check_replay`]. The layouts and what is
 //! verified are documented in `docs/joint-trajectory-format.md`.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use emg_control::{
-    ConstraintConfig, JOINT_TRAJECTORY_FORMAT, JointSamples, JointTrajectory, ReplayError,
-    ReplayReport, RolloutConfig, Task, Trajectory, check_joint_names, check_replay, read_csv,
-};
+use emg_control::{ConstraintConfig, Task};
+use emg_io::{Carried, TrajectoryContents};
 use emg_kinematics::{Robot, Vec3};
-use serde_json::Value;
+use emg_verify::{ReplayError, ReplayReport, check_joint_names, check_replay};
 
 use crate::args::CheckArgs;
-use crate::output::TRAJECTORY_FORMAT;
-use crate::settings::Settings;
-
-/// What a trajectory file holds, by layout.
-enum Contents {
-    /// `emg-trajectory/1`: the rollout as recorded.
-    Rollout(RolloutFile),
-    /// `emg-joint-trajectory/1`.
-    Joint(JointTrajectory),
-    /// The CSV: times, positions and declared velocities only.
-    Csv(JointSamples),
-}
-
-/// The parts of an `emg-trajectory/1` file the check reads.
-struct RolloutFile {
-    robot: String,
-    joint_names: Vec<String>,
-    task: Task,
-    constraints: ConstraintConfig,
-    trajectory: Trajectory,
-}
-
-/// Task and constraints a JSON file carries, with the robot it names.
-struct Carried {
-    robot: String,
-    task: Task,
-    constraints: ConstraintConfig,
-}
-
-impl Contents {
-    /// Reads `path`; errors name the file, the field or CSV cell, and what is wrong.
-    fn read(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let contents = if text.trim_start().starts_with('{') {
-            read_json(&text)
-        } else {
-            read_csv(&text).map(Self::Csv).map_err(anyhow::Error::from)
-        };
-        contents.with_context(|| format!("{} is not a readable trajectory file", path.display()))
-    }
-
-    fn layout(&self) -> &'static str {
-        match self {
-            Self::Rollout(_) => TRAJECTORY_FORMAT,
-            Self::Joint(_) => JOINT_TRAJECTORY_FORMAT,
-            Self::Csv(_) => "CSV",
-        }
-    }
-
-    /// Task, constraints and robot the file carries (none for a CSV).
-    fn carried(&self) -> Option<Carried> {
-        match self {
-            Self::Rollout(file) => Some(Carried {
-                robot: file.robot.clone(),
-                task: file.task.clone(),
-                constraints: file.constraints.clone(),
-            }),
-            Self::Joint(file) => Some(Carried {
-                robot: file.robot.clone(),
-                task: file.task.clone(),
-                constraints: file.constraints.clone(),
-            }),
-            Self::Csv(_) => None,
-        }
-    }
-
-    fn joint_names(&self) -> Option<&[String]> {
-        match self {
-            Self::Rollout(file) => Some(&file.joint_names),
-            Self::Joint(file) => Some(&file.joint_names),
-            Self::Csv(_) => None,
-        }
-    }
-
-    fn samples(&self) -> JointSamples {
-        match self {
-            Self::Rollout(file) => JointSamples::from_steps(&file.trajectory.steps),
-            Self::Joint(file) => file.samples(),
-            Self::Csv(samples) => samples.clone(),
-        }
-    }
-}
-
-/// A JSON trajectory file of either layout, by its `format` field.
-fn read_json(text: &str) -> Result<Contents> {
-    let doc: Value = serde_json::from_str(text).context("not valid JSON")?;
-    let format = doc
-        .get("format")
-        .context("field 'format' is missing")?
-        .as_str()
-        .with_context(|| format!("field 'format' is {}, expected a string", doc["format"]))?;
-    match format {
-        TRAJECTORY_FORMAT => read_rollout(&doc).map(Contents::Rollout),
-        JOINT_TRAJECTORY_FORMAT => Ok(Contents::Joint(JointTrajectory::from_json(text)?)),
-        other => bail!(
-            "field 'format' is {other:?}, expected {TRAJECTORY_FORMAT:?} or \
-             {JOINT_TRAJECTORY_FORMAT:?}"
-        ),
-    }
-}
-
-/// The parts of an `emg-trajectory/1` document the check needs.
-fn read_rollout(doc: &Value) -> Result<RolloutFile> {
-    let field = |name: &str| {
-        doc.get(name)
-            .with_context(|| format!("field '{name}' is missing"))
-    };
-    let robot = field("robot")?
-        .as_str()
-        .context("field 'robot' is not a string")?
-        .to_string();
-    let joint_names = serde_json::from_value(field("joint_names")?.clone())
-        .context("field 'joint_names' is not an array of strings")?;
-    let task = serde_json::from_value(field("task")?.clone()).context("field 'task'")?;
-    let config: RolloutConfig =
-        serde_json::from_value(field("config")?.clone()).context("field 'config'")?;
-    for name in ["steps", "termination", "path_length_m"] {
-        field(name)?;
-    }
-    let trajectory = serde_json::from_value(doc.clone())
-        .context("fields 'steps', 'termination', 'path_length_m'")?;
-    Ok(RolloutFile {
-        robot,
-        joint_names,
-        task,
-        constraints: config.constraints,
-        trajectory,
-    })
-}
+use emg_planner::PlannerConfig;
 
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
 pub fn run_check(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
-    let contents = Contents::read(file)?;
+    let contents = TrajectoryContents::read(file)?;
     let carried = contents.carried();
     let task_from = match args.task_from.as_deref() {
         Some(path) => Some((path, read_task_from(path)?)),
@@ -161,7 +30,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         (Some(path), _, _) => path.clone(),
         (None, _, Some(c)) => named_robot(&c.robot, file)?,
         (None, Some((path, c)), None) => named_robot(&c.robot, path)?,
-        (None, None, None) => emg_kinematics::default_robot_path(),
+        (None, None, None) => crate::robot::default_robot(),
     };
     let robot = crate::robot::load_robot(
         &robot_path,
@@ -194,7 +63,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     };
     let (constraints, constraints_origin) = match (&args.config, &carried, &task_from) {
         (Some(path), _, _) => (
-            Settings::load(Some(path))?.rollout.constraints,
+            PlannerConfig::read(path)?.rollout.constraints,
             format!("--config {}", path.display()),
         ),
         (None, Some(c), _) => (c.constraints.clone(), "the file".to_string()),
@@ -214,12 +83,19 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     // end) only against its own task: its tool angles are measured from that task's normal.
     let own_task = args.line.p0.is_none() && task_from.is_none();
     let recorded = match &contents {
-        Contents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
+        TrajectoryContents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
         _ => None,
     };
-    let report = match check_replay(&model, &task, &constraints, &samples, recorded) {
+    let recording = recorded.map(emg_verify::Recording::from);
+    let report = match check_replay(
+        &model,
+        &(&task).into(),
+        &(&constraints).into(),
+        &samples,
+        recording.as_ref(),
+    ) {
         Ok(report) => report,
-        Err(ReplayError::Point { point, problem }) => {
+        Err(ReplayError::Point { point, problem, .. }) => {
             let at = samples
                 .time_s
                 .get(point)
@@ -259,7 +135,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
 fn read_task_from(path: &Path) -> Result<Carried> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let contents = read_json(&text)
+    let contents = TrajectoryContents::parse_json(&text)
         .with_context(|| format!("--task-from {}: not a trajectory JSON file", path.display()))?;
     contents
         .carried()

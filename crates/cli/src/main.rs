@@ -16,12 +16,12 @@
 //!   first task of the robot's task population when that configuration is near a singularity).
 //! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the robot's shipped
 //!   `diffusion-v1.weights`), `generating` (the task's `q0_seed`), `home` (the
-//!   mid-range configuration of the joint limits; the robot file carries no home pose) or
-//!   `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
+//!   mid-range configuration of the joint limits; the robot file carries no home pose),
+//!   `q_mu` / `q_jl` (heuristic ascents from `q0_seed`) or `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
 //!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
-//! * `--config <json>`: optional `rollout`, `gains`, `switch` (`tau_enter`, `tau_exit`) and
-//!   `measure` objects; unset fields keep SPEC defaults.
+//! * `--config <json>`: an `emg_planner::PlannerConfig`: optional `rollout`, `gains`, `switch`
+//!   (`tau_enter`, `tau_exit`) and `measure` objects; unset fields keep SPEC defaults.
 //! * `--controller hybrid` (default: the PPO policy over `--policy`, default the robot's shipped
 //!   `ppo-v1.weights`, inside; the classical controller near the joint limits),
 //!   `rl` or `classical`.
@@ -41,27 +41,20 @@
 mod args;
 mod check;
 mod output;
-mod plan;
 mod robot;
-mod seed;
-mod settings;
 mod tasks;
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use emg_kinematics::Robot;
+use emg_control::{Task, Trajectory};
+use emg_io::{JointTrajectory, PlanPaths, TrajectoryFile, html_path};
+use emg_planner::{Models, Plan, PlanError, PlanRequest, Planner, PlannerConfig, SeedSource};
 
-use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder};
-use emg_policy::{PolicyWeights, RlController};
-
-use crate::args::{Cli, Command, PlanArgs, SeedRequest};
-use crate::output::{
-    TrajectoryFile, html_path, joint_trajectory_path, result_paths, write_html,
-    write_joint_trajectory, write_result,
-};
-use crate::settings::Settings;
+use crate::args::{Cli, Command, PlanArgs};
+use crate::output::{write_result, write_text};
 
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
@@ -83,10 +76,20 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         args.base_link.as_deref(),
         args.tip_link.as_deref(),
     )?;
-    let settings = Settings::load(args.config.as_deref())?;
-    let dp = load_dp_seeder(args)?;
-    let policy = load_policy(args)?;
+    let config = match &args.config {
+        Some(path) => PlannerConfig::read(path)?,
+        None => PlannerConfig::default(),
+    };
+    let models = Models::load(
+        diffusion_weights(args)?.as_deref(),
+        policy_weights(args)?.as_deref(),
+    )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
+    let planner = Planner::new(robot, models, config);
+    let request = PlanRequest {
+        seed: args.seed.clone(),
+        controller: args.controller,
+    };
     let many = tasks.len() > 1;
     let mut failures = 0;
     for (index, task) in tasks.iter().enumerate() {
@@ -95,15 +98,11 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         } else {
             String::new()
         };
-        match plan_and_write(
-            &robot,
-            args,
-            &settings,
-            dp.as_ref(),
-            policy.as_ref(),
-            task,
-            many.then_some(index),
-        ) {
+        let planned = planner
+            .plan(task, &request)
+            .map_err(|error| plan_error(error, &request))
+            .and_then(|plan| write_plan(&planner, args, task, &plan, many.then_some(index)));
+        match planned {
             Ok(report) => println!("{label}{report}"),
             Err(error) if many => {
                 failures += 1;
@@ -116,93 +115,87 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     Ok(())
 }
 
-/// The diffusion seeder: required by `--seed dp`, used by default when `--weights` exists.
-fn load_dp_seeder(args: &PlanArgs) -> Result<Option<DpSeeder>> {
-    let explicit = matches!(args.seed, Some(SeedRequest::Dp));
-    let path = match args.weights_path() {
-        Some(path) if explicit || (args.seed.is_none() && path.exists()) => path,
+/// A planning error with the option it comes from.
+fn plan_error(error: PlanError, request: &PlanRequest) -> anyhow::Error {
+    let option = match &error {
+        PlanError::Seed(_) => match &request.seed {
+            Some(seed) => format!("--seed {}", seed.name()),
+            None => "the default seed".to_string(),
+        },
+        PlanError::Controller(_) => format!("--controller {}", request.controller),
+    };
+    anyhow::Error::new(error).context(option)
+}
+
+/// The diffusion weights to load: `--weights`, or the robot's shipped ones when the seed may
+/// be `dp` and they exist; `--seed dp` without any is an error.
+fn diffusion_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
+    let explicit = matches!(args.seed, Some(SeedSource::Dp));
+    match args.weights_path() {
+        Some(path) if explicit || (args.seed.is_none() && path.exists()) => Ok(Some(path)),
         None if explicit => anyhow::bail!(
             "--seed dp: no diffusion weights are shipped for robot {}; pass --weights",
             args.robot.display()
         ),
-        _ => return Ok(None),
-    };
-    let weights = DenoiserWeights::read(&path).with_context(|| {
-        format!(
-            "--seed dp: cannot load diffusion weights {}",
-            path.display()
-        )
-    })?;
-    let seeder = DpSeeder::new(&weights, DpSeedConfig::default())
-        .with_context(|| format!("--seed dp: unusable diffusion weights {}", path.display()))?;
-    Ok(Some(seeder))
+        _ => Ok(None),
+    }
 }
 
-/// The policy of `--controller rl` and `hybrid`, loaded from `--policy`.
-fn load_policy(args: &PlanArgs) -> Result<Option<RlController>> {
-    if !args.controller.kind().needs_policy() {
+/// The policy weights of `--controller rl` and `hybrid`: `--policy`, else the robot's shipped
+/// ones.
+fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
+    if !args.controller.needs_policy() {
         return Ok(None);
     }
-    let Some(path) = args.policy_path() else {
-        anyhow::bail!(
+    match args.policy_path() {
+        Some(path) => Ok(Some(path)),
+        None => anyhow::bail!(
             "--controller {}: no policy is shipped for robot {}; pass --policy or use --controller classical",
-            args.controller.kind().name(),
+            args.controller,
             args.robot.display()
-        );
-    };
-    let weights = PolicyWeights::read(&path).with_context(|| {
-        format!(
-            "--controller {}: cannot load policy weights {}",
-            args.controller.kind().name(),
-            path.display()
-        )
-    })?;
-    Ok(Some(RlController::new(&weights)))
+        ),
+    }
 }
 
-/// Plans one task, writes its files and returns the lines to print.
-fn plan_and_write(
-    robot: &Robot,
+/// Writes one planned task's files and returns the lines to print.
+fn write_plan(
+    planner: &Planner,
     args: &PlanArgs,
-    settings: &Settings,
-    dp: Option<&DpSeeder>,
-    policy: Option<&RlController>,
-    task: &emg_control::Task,
+    task: &Task,
+    plan: &Plan,
     index: Option<usize>,
 ) -> Result<String> {
-    let plan = plan::plan_task(
-        robot,
-        task,
-        args.seed.as_ref(),
-        dp,
-        args.controller,
-        policy,
-        settings,
-    )?;
+    let robot = planner.robot();
+    let config = planner.config();
     let trajectory = &plan.trajectory;
-    let (json_path, csv_path) = result_paths(&args.out, index);
-    let file = TrajectoryFile::new(
-        &args.robot,
+    let paths = PlanPaths::new(&args.out, index);
+    let robot_name = args.robot.display().to_string();
+    let file = TrajectoryFile {
+        format: emg_io::TRAJECTORY_FORMAT,
+        robot: robot_name.clone(),
+        joint_names: robot.joint_names(),
+        task,
+        seed_source: plan.seed.source,
+        controller: args.controller.name(),
+        config: &config.rollout,
+        gains: &config.gains,
+        steps: &trajectory.steps,
+        termination: &trajectory.termination,
+        path_length_m: trajectory.path_length_m,
+    };
+    let joint = JointTrajectory::new(
+        &robot_name,
         robot.joint_names(),
         task,
-        plan.seed.source,
-        args.controller.kind().name(),
-        &settings.rollout,
-        &settings.gains,
-        trajectory,
-    );
-    write_result(&file, &json_path, &csv_path)?;
-    let joint_path = joint_trajectory_path(&args.out, index);
-    let joint_file = emg_control::JointTrajectory::new(
-        &file.robot,
-        robot.joint_names(),
-        task,
-        &settings.rollout.constraints,
+        &config.rollout.constraints,
         trajectory,
     )
     .context("cannot build the joint trajectory")?;
-    write_joint_trajectory(&joint_file, &joint_path)?;
-    let viewer = write_viewer(robot, args, settings, task, trajectory, index)?;
+    write_result(&file, &joint, &paths)?;
+    let viewer = match &args.html {
+        Some(html) => write_viewer(planner, args, task, trajectory, &html_path(html, index))?,
+        None => String::new(),
+    };
     let steps = trajectory.steps.len() - 1;
     let duration = trajectory.steps.last().map_or(0.0, |s| s.time_s);
     let projected = match plan.seed.projection_iterations {
@@ -215,38 +208,32 @@ fn plan_and_write(
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,
-        json_path.display(),
-        csv_path.display(),
-        joint_path.display()
+        paths.json.display(),
+        paths.csv.display(),
+        paths.joint_trajectory.display()
     ))
 }
 
-/// Writes the `--html` viewer page of one planned task; returns the line to print (empty without
-/// `--html`).
+/// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.
 fn write_viewer(
-    robot: &Robot,
+    planner: &Planner,
     args: &PlanArgs,
-    settings: &Settings,
-    task: &emg_control::Task,
-    trajectory: &emg_control::Trajectory,
-    index: Option<usize>,
+    task: &Task,
+    trajectory: &Trajectory,
+    path: &Path,
 ) -> Result<String> {
-    let Some(html) = &args.html else {
-        return Ok(String::new());
-    };
-    let path = html_path(html, index);
     let name = path
         .file_stem()
         .unwrap_or(path.as_os_str())
         .to_string_lossy();
-    let title = format!("{name}: {} controller", args.controller.kind().name());
+    let title = format!("{name}: {} controller", args.controller);
     let page = emg_viewer::render_html(&emg_viewer::ViewerInput {
-        robot,
+        robot: planner.robot(),
         task,
         trajectory,
-        constraints: &settings.rollout.constraints,
+        constraints: &planner.config().rollout.constraints,
         title: &title,
     });
-    write_html(&path, &page)?;
+    write_text(path, &page)?;
     Ok(format!("\n  wrote {}", path.display()))
 }

@@ -4,8 +4,20 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use emg_control::ReferenceModel;
-use emg_kinematics::{Robot, SHIPPED_ROBOTS, ShippedRobot};
+use emg_kinematics::Robot;
+use emg_planner::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
+use emg_verify::ReferenceModel;
+
+/// The shipped data: `$EMG_DATA` when set, else the `data/` directory of the workspace this
+/// binary was built in.
+pub fn data_dir() -> DataDir {
+    DataDir::locate(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+}
+
+/// The FR3's robot file, the default robot.
+pub fn default_robot() -> PathBuf {
+    SHIPPED_ROBOTS[0].path(&data_dir())
+}
 
 /// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`) gives its file, anything else is a
 /// path to a robot file.
@@ -17,7 +29,7 @@ pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
             names.join(", ")
         ));
     }
-    Ok(ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), ShippedRobot::path))
+    Ok(ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(&data_dir())))
 }
 
 /// Loads the robot file: the chain between `base` and `tip` when both are named, else from the
@@ -34,14 +46,14 @@ pub fn load_robot(path: &Path, base: Option<&str>, tip: Option<&str>) -> Result<
 /// The independent checker's model of the same chain, read again from the file.
 pub fn load_checker(path: &Path, robot: &Robot) -> Result<ReferenceModel> {
     ReferenceModel::from_urdf_file(path, robot.base_link(), robot.tip_link())
-        .map_err(anyhow::Error::msg)
         .with_context(|| format!("the checker cannot load robot {}", path.display()))
 }
 
 /// Model file `name` (e.g. `ppo-v1.weights`) shipped for the robot file `robot`, when that file
 /// is one of the shipped robots.
 pub fn shipped_model(robot: &Path, name: &str) -> Option<PathBuf> {
-    ShippedRobot::by_path(robot).map(|r| r.data_dir().join("models").join(name))
+    let data = data_dir();
+    ShippedRobot::by_path(robot, &data).map(|r| r.data_dir(&data).join("models").join(name))
 }
 
 #[cfg(test)]
@@ -52,10 +64,10 @@ mod tests {
     fn names_select_shipped_files_and_paths_pass_through() {
         for robot in SHIPPED_ROBOTS {
             let path = parse_robot(robot.name).unwrap();
-            assert_eq!(path, robot.path());
+            assert_eq!(path, robot.path(&data_dir()));
             assert!(path.exists(), "{}", path.display());
             let model = shipped_model(&path, "ppo-v1.weights").unwrap();
-            assert!(model.starts_with(robot.data_dir()));
+            assert!(model.starts_with(robot.data_dir(&data_dir())));
         }
         assert_eq!(
             parse_robot("my/arm.urdf").unwrap(),

@@ -1,7 +1,8 @@
 //! Where the tasks to plan come from: the command line, a task file, or the built-in demo.
 
 use anyhow::{Context, Result};
-use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, Task, TaskSampler, read_tasks};
+use emg_control::Task;
+use emg_io::read_tasks;
 use emg_kinematics::{Robot, Vec3};
 
 use crate::args::PlanArgs;
@@ -24,35 +25,8 @@ pub fn requested_tasks(robot: &Robot, args: &PlanArgs) -> Result<Vec<Task>> {
                 .context("invalid task given on the command line")?;
             Ok(vec![task])
         }
-        _ => Ok(vec![demo_task(robot)?]),
+        _ => Ok(vec![
+            emg_planner::demo_task(robot).context("the built-in demo task is invalid")?,
+        ]),
     }
-}
-
-/// Smallest singular value (m/rad) of the position Jacobian at which the mid-range
-/// configuration still makes a demo: below it the arm is too near a singularity (an arm whose
-/// mid-range configuration is stretched out, like the iiwa's, cannot move its TCP sideways).
-const DEMO_MIN_SINGULAR_VALUE: f64 = 0.05;
-
-/// The built-in demo task: from the mid-range configuration, `p0` = its TCP, `n` = its tool
-/// axis, `d` = +y made perpendicular to `n`; `q0_seed` = the mid-range configuration. When the
-/// mid-range configuration is near a singularity, the first task of the robot's task population
-/// (`emg_control::TaskSampler` with its default settings) instead.
-pub fn demo_task(robot: &Robot) -> Result<Task> {
-    let seed = robot.mid_range();
-    let kinematics = robot.forward(&seed);
-    let smallest = kinematics.jacobian().singular_values().min();
-    if smallest < DEMO_MIN_SINGULAR_VALUE {
-        let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());
-        let config = SamplerConfig::default();
-        let mut sampler = TaskSampler::new(robot, &rollout, &gains, &config);
-        return sampler
-            .take(1, &|_| {})
-            .pop()
-            .context("the robot's task population yields no demo task");
-    }
-    let n = kinematics.tool_axis();
-    let y = Vec3::y();
-    let d = (y - n * y.dot(&n)).normalize();
-    Task::new(robot, kinematics.tcp(), d, n, Some(seed))
-        .context("the built-in demo task is invalid")
 }

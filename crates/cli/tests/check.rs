@@ -294,12 +294,8 @@ fn malformed_files_name_the_file_and_the_field() {
 fn a_task_set_writes_one_joint_trajectory_per_task() {
     let tmp = temp_dir("set");
     let dir = tmp.path();
-    let robot = emg_kinematics::Robot::from_urdf_file(
-        emg_kinematics::default_robot_path(),
-        "link0",
-        "pen_tip",
-    )
-    .unwrap();
+    let robot =
+        emg_kinematics::Robot::from_urdf_file(common::fr3_path(), "link0", "pen_tip").unwrap();
     let mid = robot.mid_range();
     let tasks: Vec<Value> = [
         mid,

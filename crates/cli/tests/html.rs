@@ -4,7 +4,7 @@ mod common;
 
 use std::process::{Command, Output};
 
-use emg_kinematics::{JointVector, Robot, default_robot_path};
+use emg_kinematics::{JointVector, Robot};
 use serde_json::Value;
 
 use common::{NO_WEIGHTS, read, task_json, temp_dir};
@@ -79,7 +79,7 @@ fn html_page_holds_the_planned_motion() {
 fn html_pages_follow_the_per_task_suffix_rule() {
     let tmp = temp_dir("set");
     let dir = tmp.path();
-    let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
+    let robot = Robot::from_urdf_file(common::fr3_path(), "link0", "pen_tip").unwrap();
     let mid = robot.mid_range();
     let tasks: Vec<Value> = [
         mid,

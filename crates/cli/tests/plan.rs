@@ -5,8 +5,9 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use emg_control::{ReferenceModel, RolloutConfig, Task, Trajectory};
-use emg_kinematics::{JointVector, Robot, default_robot_path};
+use emg_control::{CheckRollout, RolloutConfig, Task, Trajectory};
+use emg_kinematics::{JointVector, Robot};
+use emg_verify::ReferenceModel;
 use serde_json::Value;
 
 use common::{NO_WEIGHTS, emg, read_json, task_json, temp_dir, text};
@@ -73,11 +74,10 @@ fn demo_task_writes_documented_json_and_csv() {
     }
     assert_eq!(steps[0]["q"].as_array().unwrap().len(), 7);
     assert_eq!(steps[0]["tcp"].as_array().unwrap().len(), 3);
-    assert!(
-        steps[0]["controller"] == "learned" || steps[0]["controller"] == "classical",
-        "{}",
-        steps[0]["controller"]
-    );
+    // The demo starts at the mid-range configuration (ρ = 0, far inside the switch's shell), so
+    // the hybrid's learned policy acts first.
+    assert_eq!(steps[0]["rho"], 0.0);
+    assert_eq!(steps[0]["controller"], "learned");
     let reason = doc["termination"]["reason"].as_str().unwrap();
     assert!(["violation", "invalid_start", "step_cap"].contains(&reason));
     if reason == "violation" {
@@ -130,13 +130,12 @@ fn written_trajectory_passes_the_independent_checker() {
         "{}",
         trajectory.path_length_m
     );
-    let checker =
-        ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip").unwrap();
+    let checker = ReferenceModel::from_urdf_file(&common::fr3_path(), "link0", "pen_tip").unwrap();
     checker
         .check(&task, &trajectory, &config.constraints)
         .unwrap();
     // The seed was projected onto the exact start pose.
-    let (tcp, _) = checker.tcp_pose(trajectory.steps[0].q.as_slice());
+    let (tcp, _) = checker.tcp_pose(&trajectory.steps[0].q);
     assert!((tcp - task.p0).norm() < 1e-8);
 }
 
@@ -196,7 +195,7 @@ fn bad_inputs_fail_naming_the_field() {
 fn task_file_with_three_tasks_gives_three_results() {
     let tmp = temp_dir("set");
     let dir = tmp.path();
-    let robot = Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").unwrap();
+    let robot = Robot::from_urdf_file(common::fr3_path(), "link0", "pen_tip").unwrap();
     let mid = robot.mid_range();
     let configs = [
         mid,
@@ -273,8 +272,7 @@ fn dp_seed_is_the_default_with_the_shipped_weights() {
     let task: Task = serde_json::from_value(doc["task"].clone()).unwrap();
     let config: RolloutConfig = serde_json::from_value(doc["config"].clone()).unwrap();
     let trajectory: Trajectory = serde_json::from_value(doc.clone()).unwrap();
-    let checker =
-        ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip").unwrap();
+    let checker = ReferenceModel::from_urdf_file(&common::fr3_path(), "link0", "pen_tip").unwrap();
     checker
         .check(&task, &trajectory, &config.constraints)
         .expect("the DP-seeded trajectory passes the independent checker");

@@ -1,15 +1,16 @@
 //! Straight-line tasks, their constraints, the one rollout loop every controller shares, the
-//! classical null-space controller, an independent trajectory checker, trajectory files a robot
-//! stack can replay, and the task population.
+//! classical null-space controller, the task population, and the hand-over of rollouts to the
+//! independent checker (`emg-verify`).
 //!
 //! A controller implements [`NullSpaceController`]: at each step it sees a [`StepContext`]
 //! (kinematics, gradients, the basis `B(q)`, `ρ(q)`) and returns an action `a ∈ [−1, 1]⁴`;
 //! [`rollout`] applies `q̇ = J⁺ẋ + a_max B a` (Eq. 2) and stops at the first broken constraint.
 //!
 //! ```
-//! use emg_control::{ClassicalController, ReferenceModel, RolloutConfig, Task, rollout};
+//! use emg_control::{CheckRollout, ClassicalController, RolloutConfig, Task, rollout};
+//! use emg_verify::ReferenceModel;
 //! use emg_kinematics::{Robot, Vec3};
-//! let path = emg_kinematics::default_robot_path();
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
 //! let robot = Robot::from_urdf_file(&path, "link0", "pen_tip")?;
 //! let seed = robot.mid_range();
 //! let kin = robot.forward(&seed);
@@ -23,35 +24,22 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod checker;
 mod classical;
 mod config;
 mod constraints;
 mod controller;
-mod evaluation;
-mod joint_trajectory;
 mod rollout;
 mod sampler;
 mod step;
 mod task;
-mod task_file;
+mod verification;
 
-pub use checker::{CheckFailure, ReferenceModel};
 pub use classical::ClassicalController;
 pub use config::{ClassicalGains, ConstraintConfig, RolloutConfig, VelocityLimitFraction};
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
-pub use evaluation::{
-    Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram,
-};
-pub use joint_trajectory::{
-    CSV_HEADER, DECLARED_VELOCITY_TOLERANCE, GAP_ROUNDING_NOISE_NS, JOINT_TRAJECTORY_FORMAT,
-    JointSamples, JointTrajectory, JointTrajectoryError, JointTrajectoryPoint, ReplayError,
-    ReplayReport, TimeFromStart, VELOCITY_LIMIT_SLACK, check_joint_names, check_replay,
-    point_velocities, read_csv, times_from_start, trajectory_csv,
-};
 pub use rollout::{Episode, StepOutcome, StepRecord, Termination, Trajectory, rollout};
 pub use sampler::{SamplerConfig, TaskSampler, candidate};
 pub use step::{NullAction, StepContext};
 pub use task::{PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, Task, TaskError};
-pub use task_file::{TASK_FORMAT_VERSION, TaskFileError, TaskSpec, read_tasks, write_task_set};
+pub use verification::CheckRollout;

@@ -13,7 +13,9 @@
 
 mod common;
 
-use emg_control::{ConstraintConfig, RolloutConfig, Task, Termination, Trajectory, Violation};
+use emg_control::{
+    CheckRollout, ConstraintConfig, RolloutConfig, Task, Termination, Trajectory, Violation,
+};
 use emg_kinematics::{JointVector, Vec3};
 use rayon::prelude::*;
 
@@ -28,7 +30,7 @@ fn checker_kinematics_match_library_and_spec() {
     for _ in 0..500 {
         let q = random_q(&mut rng, &robot);
         let kin = robot.forward(&q);
-        let (tcp, z) = checker.tcp_pose(q.as_slice());
+        let (tcp, z) = checker.tcp_pose(&q);
         assert!((tcp - kin.tcp()).norm() < 1e-12, "TCP differs at {q:?}");
         assert!(
             (z - kin.tool_axis()).norm() < 1e-12,
@@ -36,7 +38,7 @@ fn checker_kinematics_match_library_and_spec() {
         );
     }
     // SPEC §1 known answers.
-    let (tcp, z) = checker.tcp_pose(&[0.0; 7]);
+    let (tcp, z) = checker.tcp_pose(&emg_verify::Joints::zeros());
     assert!(
         (tcp - Vec3::new(0.088, 0.0, 0.7226)).norm() < 1e-9,
         "{tcp:?}"
@@ -52,7 +54,7 @@ fn checker_kinematics_match_library_and_spec() {
         FRAC_PI_2,
         FRAC_PI_4,
     ];
-    let (tcp, z) = checker.tcp_pose(&home);
+    let (tcp, z) = checker.tcp_pose(&emg_verify::Joints::from(home));
     assert!(
         (tcp - Vec3::new(0.306891, 0.0, 0.386882)).norm() < 1e-5,
         "{tcp:?}"
@@ -79,7 +81,7 @@ fn checker_collision_model_matches_library() {
         let q = random_q(&mut rng, &robot);
         let kin = robot.forward(&q);
         let library = robot.min_clearance(&kin).expect("pairs exist").clearance;
-        let (reference, a, b) = checker.min_clearance(q.as_slice());
+        let (reference, a, b) = checker.min_clearance(&q);
         assert!(
             (library - reference).abs() < 1e-9,
             "clearance {library} (library) vs {reference} (checker, {a}–{b}) at {q:?}"
@@ -481,7 +483,7 @@ fn checker_rejects_a_colliding_configuration() {
     let mut rng = rng(13);
     let colliding: JointVector = loop {
         let q = random_q(&mut rng, &robot);
-        if checker.min_clearance(q.as_slice()).0 < -0.005 {
+        if checker.min_clearance(&q).0 < -0.005 {
             break q;
         }
     };
@@ -509,7 +511,7 @@ fn checker_rejects_a_colliding_configuration() {
     let clearance = original
         .steps
         .iter()
-        .map(|s| checker.min_clearance(s.q.as_slice()).0)
+        .map(|s| checker.min_clearance(&s.q).0)
         .fold(f64::INFINITY, f64::min);
     let margin = ConstraintConfig {
         collision_margin_m: clearance + 1e-3,

@@ -2,14 +2,16 @@
 //! first evaluation tasks regenerated from the default sampler configuration equal the shipped
 //! file bit for bit.
 
-use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, TaskSampler, read_tasks};
-use emg_kinematics::{Robot, SHIPPED_ROBOTS};
+use emg_control::{ClassicalGains, RolloutConfig, SamplerConfig, TaskSampler};
+use emg_io::read_tasks;
+use emg_kinematics::Robot;
+use emg_planner::{DataDir, SHIPPED_ROBOTS};
 
 #[test]
 fn shipped_evaluation_sets_start_with_the_regenerated_tasks() {
     for shipped in SHIPPED_ROBOTS {
-        let robot = Robot::from_chain_file(shipped.path()).expect("robot loads");
-        let tasks_dir = shipped.data_dir().join("tasks");
+        let robot = Robot::from_chain_file(shipped.path(&data())).expect("robot loads");
+        let tasks_dir = shipped.data_dir(&data()).join("tasks");
         let shipped_set = read_tasks(&tasks_dir.join("eval-v1.tasks"), &robot)
             .unwrap_or_else(|e| panic!("{}: shipped set loads: {e}", shipped.name));
         assert_eq!(shipped_set.len(), 10_000, "{}", shipped.name);
@@ -49,4 +51,9 @@ fn shipped_evaluation_sets_start_with_the_regenerated_tasks() {
             );
         }
     }
+}
+
+/// The workspace's shipped data directory.
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
 }

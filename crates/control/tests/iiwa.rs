@@ -2,15 +2,18 @@
 //! collision model agree with the library's for the iiwa 14, and classical rollouts on its
 //! shipped evaluation tasks hold every constraint (joint speeds included) when re-checked.
 
-use emg_control::{ClassicalController, ReferenceModel, RolloutConfig, read_tasks, rollout};
-use emg_kinematics::{JointVector, Robot, ShippedRobot};
+use emg_control::{CheckRollout, ClassicalController, RolloutConfig, rollout};
+use emg_io::read_tasks;
+use emg_kinematics::{JointVector, Robot};
+use emg_planner::{DataDir, ShippedRobot};
+use emg_verify::ReferenceModel;
 use rand::{RngExt, SeedableRng};
 
 fn iiwa() -> (Robot, ReferenceModel, ShippedRobot) {
     let shipped = ShippedRobot::by_name("iiwa14").expect("shipped");
-    let robot = Robot::from_chain_file(shipped.path()).expect("robot loads");
+    let robot = Robot::from_chain_file(shipped.path(&data())).expect("robot loads");
     let checker =
-        ReferenceModel::from_urdf_file(&shipped.path(), robot.base_link(), robot.tip_link())
+        ReferenceModel::from_urdf_file(&shipped.path(&data()), robot.base_link(), robot.tip_link())
             .expect("checker loads");
     (robot, checker, shipped)
 }
@@ -23,14 +26,14 @@ fn checker_agrees_with_the_library_on_the_iiwa() {
     for _ in 0..300 {
         let q = JointVector::from_fn(|i, _| rng.random_range(limits.lower[i]..limits.upper[i]));
         let kin = robot.forward(&q);
-        let (tcp, axis) = checker.tcp_pose(q.as_slice());
+        let (tcp, axis) = checker.tcp_pose(&q);
         assert!((tcp - kin.tcp()).norm() < 1e-12, "TCP at {q:?}");
         assert!(
             (axis - kin.tool_axis()).norm() < 1e-12,
             "tool axis at {q:?}"
         );
         let library = robot.min_clearance(&kin).expect("pairs exist").clearance;
-        let (reference, _, _) = checker.min_clearance(q.as_slice());
+        let (reference, _, _) = checker.min_clearance(&q);
         assert!(
             (library - reference).abs() < 1e-9,
             "{library} vs {reference}"
@@ -43,7 +46,11 @@ fn checker_agrees_with_the_library_on_the_iiwa() {
 #[test]
 fn classical_rollouts_on_iiwa_tasks_pass_the_checker() {
     let (robot, checker, shipped) = iiwa();
-    let tasks = read_tasks(&shipped.data_dir().join("tasks/eval-v1.tasks"), &robot).unwrap();
+    let tasks = read_tasks(
+        &shipped.data_dir(&data()).join("tasks/eval-v1.tasks"),
+        &robot,
+    )
+    .unwrap();
     let config = RolloutConfig::default();
     let mut slowed = 0;
     for task in tasks.iter().take(200) {
@@ -71,4 +78,9 @@ fn classical_rollouts_on_iiwa_tasks_pass_the_checker() {
         slowed > 0,
         "the iiwa's lower velocity limits slow some rollouts"
     );
+}
+
+/// The workspace's shipped data directory.
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
 }

@@ -40,8 +40,7 @@ static GLOBAL: CountingAllocator = CountingAllocator;
 
 #[test]
 fn classical_control_step_and_constraint_check_do_not_allocate() {
-    let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
-        .expect("robot loads");
+    let robot = Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("robot loads");
     let config = RolloutConfig::default();
     let tasks: Vec<_> = (0..40)
         .filter_map(|i| candidate(&robot, &SamplerConfig::default(), i))
@@ -83,4 +82,14 @@ fn classical_control_step_and_constraint_check_do_not_allocate() {
         assert_eq!(allocations(), before, "the control step allocated");
     }
     assert!(steps > 200, "only {steps} steps exercised");
+}
+
+/// The workspace's shipped data directory.
+fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

@@ -10,9 +10,8 @@ mod common;
 
 use std::path::PathBuf;
 
-use emg_control::{
-    SEED_POSITION_TOLERANCE_M, Task, TaskError, TaskFileError, read_tasks, write_task_set,
-};
+use emg_control::{SEED_POSITION_TOLERANCE_M, Task, TaskError};
+use emg_io::{TaskFileError, read_tasks, write_task_set};
 use emg_kinematics::{JointVector, Robot, Vec3};
 
 use common::{robot, tasks};

@@ -4,7 +4,7 @@
 
 mod common;
 
-use emg_control::{ConstraintConfig, RolloutConfig, VelocityLimitFraction};
+use emg_control::{CheckRollout, ConstraintConfig, RolloutConfig, VelocityLimitFraction};
 
 use common::{checker, classical, robot, tasks};
 

@@ -2,17 +2,18 @@
 //! an arm with a sideways joint offset or asymmetric limits on a mirrored joint does not.
 
 use emg_diffusion::has_mirror_symmetry;
-use emg_kinematics::{Robot, SHIPPED_ROBOTS, ShippedRobot};
+use emg_kinematics::Robot;
+use emg_planner::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 
 fn iiwa_text() -> String {
-    let path = ShippedRobot::by_name("iiwa14").unwrap().path();
+    let path = ShippedRobot::by_name("iiwa14").unwrap().path(&data());
     std::fs::read_to_string(path).unwrap()
 }
 
 #[test]
 fn both_shipped_arms_are_mirror_symmetric() {
     for shipped in SHIPPED_ROBOTS {
-        let robot = Robot::from_chain_file(shipped.path()).unwrap();
+        let robot = Robot::from_chain_file(shipped.path(&data())).unwrap();
         assert!(has_mirror_symmetry(&robot), "{}", shipped.name);
     }
 }
@@ -32,4 +33,9 @@ fn a_sideways_offset_or_asymmetric_limits_break_the_symmetry() {
     assert!(!has_mirror_symmetry(
         &Robot::from_chain_str(&asymmetric).unwrap()
     ));
+}
+
+/// The workspace's shipped data directory.
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
 }

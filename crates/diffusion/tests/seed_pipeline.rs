@@ -9,7 +9,7 @@ use emg_diffusion::{
 use emg_kinematics::{JointVector, Robot, Vec3};
 
 fn robot() -> Robot {
-    Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip").unwrap()
+    Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").unwrap()
 }
 
 /// Tasks generated from a few configurations around mid-range.
@@ -117,4 +117,14 @@ fn a_task_without_fallback_and_no_valid_candidate_is_a_clear_error() {
         .seed(&robot, &task, &constraints, &mut SeedWorkspace::default())
         .unwrap_err();
     assert!(error.to_string().contains("no q0_seed"), "{error}");
+}
+
+/// The workspace's shipped data directory.
+fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

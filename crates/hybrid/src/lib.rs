@@ -16,14 +16,8 @@
 
 mod boundary;
 mod controller;
-mod executor;
-mod protocol;
 mod switch;
 
 pub use boundary::BoundaryMeasure;
 pub use controller::{HybridController, count_switches};
-pub use executor::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
-pub use protocol::{
-    BucketConfig, CellStats, Difficulty, bucket_members, cell_stats, reference_length,
-};
 pub use switch::{HysteresisSwitch, Regime, SwitchConfig, SwitchConfigError};

@@ -18,7 +18,8 @@
 //! ```
 //! use emg_kinematics::{JointVector, Robot, Vec3};
 //! use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
-//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+//! let robot = Robot::from_urdf_file(path, "link0", "pen_tip")?;
 //! let home = JointVector::from_column_slice(&[0.0, -FRAC_PI_4, 0.0, -3.0 * FRAC_PI_4, 0.0, FRAC_PI_2, FRAC_PI_4]);
 //! let kin = robot.forward(&home);
 //! assert!((kin.tcp() - Vec3::new(0.306891, 0.0, 0.386882)).norm() < 1e-6);
@@ -53,70 +54,3 @@ pub type JointVector = nalgebra::SVector<f64, DOF>;
 
 /// A Cartesian 3-vector, metres or unit direction.
 pub type Vec3 = nalgebra::Vector3<f64>;
-
-/// A robot file shipped in the workspace's `data/robots/`, with the directory under `data/`
-/// that holds its task sets, labels and models.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ShippedRobot {
-    /// Selection name (`--robot fr3`).
-    pub name: &'static str,
-    file: &'static str,
-    data_subdir: &'static str,
-}
-
-/// The shipped robots: the paper's Franka FR3 (whose data keep the top level of `data/`) and the
-/// KUKA LBR iiwa 14 R820 (`data/iiwa14/`), both holding the same pen.
-pub const SHIPPED_ROBOTS: [ShippedRobot; 2] = [
-    ShippedRobot {
-        name: "fr3",
-        file: "fr3_pen.urdf",
-        data_subdir: "",
-    },
-    ShippedRobot {
-        name: "iiwa14",
-        file: "iiwa14_pen.urdf",
-        data_subdir: "iiwa14",
-    },
-];
-
-impl ShippedRobot {
-    /// The shipped robot called `name`.
-    pub fn by_name(name: &str) -> Option<Self> {
-        SHIPPED_ROBOTS.into_iter().find(|r| r.name == name)
-    }
-
-    /// The shipped robot whose file `path` is (compared after resolving links and `..`).
-    pub fn by_path(path: &std::path::Path) -> Option<Self> {
-        let path = canonical(path);
-        SHIPPED_ROBOTS.into_iter().find(|r| r.path() == path)
-    }
-
-    /// Its robot file (canonical when it exists).
-    pub fn path(self) -> std::path::PathBuf {
-        canonical(&data_root().join("robots").join(self.file))
-    }
-
-    /// The directory of its task sets, labels and models (`data/` or `data/<name>/`).
-    pub fn data_dir(self) -> std::path::PathBuf {
-        canonical(&data_root().join(self.data_subdir))
-    }
-
-    /// The sub-directory name of its data and results (empty for the FR3).
-    pub fn data_subdir(self) -> &'static str {
-        self.data_subdir
-    }
-}
-
-fn data_root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
-}
-
-fn canonical(path: &std::path::Path) -> std::path::PathBuf {
-    path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
-}
-
-/// Path of the FR3-with-pen robot file shipped in the workspace's `data/robots/` (canonical when
-/// the file exists).
-pub fn default_robot_path() -> std::path::PathBuf {
-    SHIPPED_ROBOTS[0].path()
-}

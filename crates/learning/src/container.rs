@@ -4,9 +4,6 @@
 //! `u64` value count, then that many little-endian `f32` values and nothing after them. Every
 //! integer is little-endian.
 
-use std::io::Write;
-use std::path::Path;
-
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
@@ -133,16 +130,6 @@ fn decode_impl<H: DeserializeOwned>(
         return Err(ContainerError::TrailingBytes(rest));
     }
     Ok((header, values))
-}
-
-/// Writes `bytes` to `path` through a `.partial` sibling (synced, then renamed into place), so
-/// an interrupted write never leaves a half-written file at `path`.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let partial = path.with_extension("partial");
-    let mut file = std::fs::File::create(&partial)?;
-    file.write_all(bytes)?;
-    file.sync_all()?;
-    std::fs::rename(&partial, path)
 }
 
 struct Cursor<'a> {

@@ -3,8 +3,8 @@
 //! - [`Backend`]: the Burn CPU backend training runs on, chosen at run time by the tensor device;
 //! - [`container`]: the versioned binary container their weights files use — 8 magic bytes, a
 //!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
-//!   values as little-endian `f32` — with strict truncation and trailing-byte checks and an
-//!   atomic write through a `.partial` sibling;
+//!   values as little-endian `f32` — with strict truncation and trailing-byte checks (the
+//!   weights files are written with `emg_io::write_atomically`);
 //! - [`checkpoint`]: checkpoint directories (a model, its optimizer and the JSON run state)
 //!   written into a staging sibling and swapped in whole.
 //!

@@ -1,6 +1,6 @@
 //! The weights container: round trip and every rejection.
 
-use emg_learning::container::{decode, decode_checked, encode, write_atomically};
+use emg_learning::container::{decode, decode_checked, encode};
 use emg_learning::{Backend, ContainerError};
 use serde::{Deserialize, Serialize};
 
@@ -120,16 +120,6 @@ fn bad_header_and_count_mismatch_are_rejected() {
             found: 3
         })
     ));
-}
-
-#[test]
-fn write_atomically_replaces_the_file_and_leaves_no_partial() {
-    let tmp = tempfile::tempdir().unwrap();
-    let path = tmp.path().join("w.weights");
-    write_atomically(&path, b"first").unwrap();
-    write_atomically(&path, b"second").unwrap();
-    assert_eq!(std::fs::read(&path).unwrap(), b"second");
-    assert!(!path.with_extension("partial").exists());
 }
 
 #[test]

@@ -17,7 +17,8 @@
 //! use emg_control::{RolloutConfig, Task, rollout};
 //! use emg_kinematics::{Robot, Vec3};
 //! use emg_policy::{Backend, NetworkConfig, PpoConfig, RlController, Trainer};
-//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+//! let robot = Robot::from_urdf_file(path, "link0", "pen_tip")?;
 //! let network = NetworkConfig { hidden: vec![8] };
 //! let trainer = Trainer::new(network, PpoConfig::default(), Backend::Flex)?;
 //! let mut controller = RlController::new(&trainer.weights());

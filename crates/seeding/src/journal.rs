@@ -224,13 +224,12 @@ impl<'a> LabelJob<'a> {
         // Statistics first: a chunk counts as finished once its label file exists.
         let stats_path = self.stats_path(chunk);
         let text = serde_json::to_string(&stats).expect("stats serialise");
-        let temporary = stats_path.with_extension("partial");
-        std::fs::write(&temporary, text)
-            .and_then(|()| std::fs::rename(&temporary, &stats_path))
-            .map_err(|source| LabelError::Io {
+        emg_io::write_atomically(&stats_path, text.as_bytes()).map_err(|source| {
+            LabelError::Io {
                 path: stats_path.display().to_string(),
                 source,
-            })?;
+            }
+        })?;
         set.write(&self.label_path(chunk))?;
         Ok(last - first)
     }

@@ -8,7 +8,6 @@
 //! `u8` label count, and per label `q` (7 × `f64`, rad), `length_m` (`f32`), `stability_m`
 //! (`f32`) and `branch` (`u32`).
 
-use std::io::Write;
 use std::path::Path;
 
 use emg_kinematics::{DOF, JointVector};
@@ -233,11 +232,7 @@ impl LabelSet {
                 bytes.extend_from_slice(&label.branch.to_le_bytes());
             }
         }
-        let temporary = path.with_extension("partial");
-        let mut file = std::fs::File::create(&temporary).map_err(io)?;
-        file.write_all(&bytes).map_err(io)?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&temporary, path).map_err(io)
+        emg_io::write_atomically(path, &bytes).map_err(io)
     }
 
     /// Joins label sets of the same task set holding disjoint tasks into one, in task order.

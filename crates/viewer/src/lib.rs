@@ -21,7 +21,8 @@
 //! use emg_control::{ClassicalController, RolloutConfig, Task, rollout};
 //! use emg_kinematics::{Robot, Vec3};
 //! use emg_viewer::{ViewerInput, render_html};
-//! let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")?;
+//! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+//! let robot = Robot::from_urdf_file(path, "link0", "pen_tip")?;
 //! let seed = robot.mid_range();
 //! let kin = robot.forward(&seed);
 //! let task = Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed))?;

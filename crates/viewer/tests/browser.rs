@@ -66,8 +66,8 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
 /// A classical rollout of at most `max_steps` steps of a line along +y from the mid-range
 /// configuration, and its page.
 fn page_of(max_steps: usize, title: &str) -> (Trajectory, String) {
-    let robot = Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
-        .expect("the FR3 robot file loads");
+    let robot =
+        Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("the FR3 robot file loads");
     let seed = robot.mid_range();
     let kin = robot.forward(&seed);
     let task =
@@ -461,4 +461,14 @@ fn a_motion_of_only_the_seed_renders() {
     if let Err(problems) = page_problems(&dump_dom(&browser, dir, &page)) {
         panic!("a one-step motion did not render cleanly:\n{problems}");
     }
+}
+
+/// The workspace's shipped data directory.
+fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

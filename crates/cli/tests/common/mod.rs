@@ -53,3 +53,13 @@ pub fn task_json(robot: &emg_kinematics::Robot, q: &emg_kinematics::JointVector)
         "p0": kin.tcp().as_slice(), "d": d.as_slice(), "n": n.as_slice(), "q0_seed": q.as_slice(),
     })
 }
+
+/// The workspace's shipped data directory.
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+pub fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
+}

@@ -3,23 +3,21 @@
 #![allow(dead_code)]
 
 use emg_control::{
-    ClassicalController, ReferenceModel, RolloutConfig, SamplerConfig, Task, Trajectory, candidate,
-    rollout,
+    ClassicalController, RolloutConfig, SamplerConfig, Task, Trajectory, candidate, rollout,
 };
-use emg_kinematics::{JointVector, Robot, default_robot_path};
+use emg_kinematics::{JointVector, Robot};
+use emg_verify::ReferenceModel;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The FR3-with-pen chain of the shipped robot file.
 pub fn robot() -> Robot {
-    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip")
-        .expect("shipped robot file loads")
+    Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("shipped robot file loads")
 }
 
 /// The independent checker built from the same file.
 pub fn checker() -> ReferenceModel {
-    ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip")
-        .expect("checker loads")
+    ReferenceModel::from_urdf_file(&fr3_path(), "link0", "pen_tip").expect("checker loads")
 }
 
 /// A deterministic generator.
@@ -62,4 +60,14 @@ pub fn classical(robot: &Robot, task: &Task, config: &RolloutConfig) -> Trajecto
         &mut ClassicalController::default(),
         config,
     )
+}
+
+/// The workspace's shipped data directory.
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+pub fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

@@ -2,7 +2,7 @@
 //! and directions, and central finite differences.
 #![allow(dead_code)]
 
-use emg_kinematics::{JointVector, Robot, Vec3, default_robot_path};
+use emg_kinematics::{JointVector, Robot, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
@@ -12,13 +12,12 @@ pub const FD_STEP: f64 = 1e-6;
 
 /// The FR3-with-pen chain of the shipped robot file.
 pub fn robot() -> Robot {
-    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip")
-        .expect("shipped robot file loads")
+    Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("shipped robot file loads")
 }
 
 /// The text of the shipped robot file.
 pub fn robot_text() -> String {
-    std::fs::read_to_string(default_robot_path()).expect("shipped robot file is readable")
+    std::fs::read_to_string(fr3_path()).expect("shipped robot file is readable")
 }
 
 /// A deterministic generator.
@@ -78,4 +77,14 @@ pub fn central_difference<const R: usize>(
 /// Angle (rad) between two vectors, accurate for tiny angles.
 pub fn angle_between(a: &Vec3, b: &Vec3) -> f64 {
     a.cross(b).norm().atan2(a.dot(b))
+}
+
+/// The workspace's shipped data directory.
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+pub fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

@@ -5,8 +5,7 @@ use emg_kinematics::Robot;
 
 /// The FR3 with the pen tool.
 pub fn robot() -> Robot {
-    Robot::from_urdf_file(emg_kinematics::default_robot_path(), "link0", "pen_tip")
-        .expect("the robot file loads")
+    Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("the robot file loads")
 }
 
 /// `count` tasks from the standard population (fixed seed).
@@ -19,4 +18,14 @@ pub fn tasks(robot: &Robot, count: usize) -> Vec<Task> {
         ..SamplerConfig::default()
     };
     TaskSampler::new(robot, &rollout, &gains, &config).take(count, &|_| {})
+}
+
+/// The workspace's shipped data directory.
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+pub fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

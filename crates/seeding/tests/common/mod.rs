@@ -2,19 +2,20 @@
 //! checker, the first tasks of the shipped evaluation set and a small, fast labelling config.
 #![allow(dead_code)]
 
-use emg_control::{ReferenceModel, Task, read_tasks};
-use emg_kinematics::{Robot, default_robot_path};
+use emg_control::Task;
+use emg_io::read_tasks;
+use emg_kinematics::Robot;
 use emg_seeding::LabelConfig;
+use emg_verify::ReferenceModel;
 
 /// The FR3-with-pen chain of the shipped robot file.
 pub fn robot() -> Robot {
-    Robot::from_urdf_file(default_robot_path(), "link0", "pen_tip").expect("robot loads")
+    Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("robot loads")
 }
 
 /// The independent checker built from the same file.
 pub fn checker() -> ReferenceModel {
-    ReferenceModel::from_urdf_file(&default_robot_path(), "link0", "pen_tip")
-        .expect("checker loads")
+    ReferenceModel::from_urdf_file(&fr3_path(), "link0", "pen_tip").expect("checker loads")
 }
 
 /// Path of the shipped evaluation set.
@@ -44,4 +45,14 @@ pub fn temporary_dir(name: &str) -> tempfile::TempDir {
         .prefix(&format!("emg-seeding-{name}-"))
         .tempdir()
         .expect("temporary directory")
+}
+
+/// The workspace's shipped data directory.
+pub fn data_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
+}
+
+/// The shipped FR3 robot file.
+pub fn fr3_path() -> std::path::PathBuf {
+    data_dir().join("robots/fr3_pen.urdf")
 }

@@ -6,10 +6,7 @@ use emg_kinematics::{JointVector, Robot};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::config::RolloutConfig;
-use crate::controller::NullSpaceController;
-use crate::rollout::{Trajectory, rollout};
-use crate::task::Task;
+use emg_control::{NullSpaceController, RolloutConfig, Task, Trajectory, rollout};
 
 /// Runs a fresh controller from `make_controller` on every task from the seed `seed_of(task)`.
 /// Results are in task order and independent of the number of threads; `progress()` is called
@@ -108,8 +105,8 @@ pub fn termination_histogram(trajectories: &[Trajectory]) -> BTreeMap<String, us
 pub fn joint_limit_histogram(trajectories: &[Trajectory]) -> BTreeMap<usize, usize> {
     let mut histogram = BTreeMap::new();
     for trajectory in trajectories {
-        if let crate::rollout::Termination::Violation {
-            violation: crate::constraints::Violation::JointLimit { joint, .. },
+        if let emg_control::Termination::Violation {
+            violation: emg_control::Violation::JointLimit { joint, .. },
             ..
         } = &trajectory.termination
         {

@@ -1,7 +1,7 @@
-//! The evaluation protocol of Sec. 5: per-task reference lengths, difficulty buckets, and the
-//! length / ratio-to-reference statistics of every table.
+//! Difficulty buckets by reference length (Sec. 5.1) and the length / ratio-to-reference
+//! statistics of every table cell.
 
-use emg_control::Summary;
+use crate::batch::Summary;
 use serde::{Deserialize, Serialize};
 
 /// Difficulty buckets by reference length `ℓ_ref` (Sec. 5.1).
@@ -83,11 +83,6 @@ pub fn cell_stats(lengths: &[f64], references: &[f64], members: &[usize]) -> Opt
         length_m: Summary::of(&picked)?,
         ratio_percent: Summary::of(&ratios)?,
     })
-}
-
-/// The reference length `ℓ_ref` of a task: the longest of its candidate rollouts (Sec. 5).
-pub fn reference_length(candidate_lengths: &[f64]) -> Option<f64> {
-    candidate_lengths.iter().copied().reduce(f64::max)
 }
 
 /// Task indices grouped by bucket, in task order.

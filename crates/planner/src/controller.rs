@@ -7,9 +7,9 @@ use emg_control::{
 use emg_policy::RlController;
 use serde::{Deserialize, Serialize};
 
-use crate::boundary::BoundaryMeasure;
-use crate::controller::HybridController;
-use crate::switch::{HysteresisSwitch, SwitchConfig, SwitchConfigError};
+use emg_hybrid::{
+    BoundaryMeasure, HybridController, HysteresisSwitch, SwitchConfig, SwitchConfigError,
+};
 
 /// Which null-space controller drives a rollout.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -48,6 +48,24 @@ impl ControllerKind {
     /// Whether it needs a trained policy.
     pub fn needs_policy(self) -> bool {
         !matches!(self, Self::Classical)
+    }
+}
+
+impl std::str::FromStr for ControllerKind {
+    type Err = String;
+
+    /// `classical`, `rl` or `hybrid`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|kind| kind.name() == s)
+            .ok_or_else(|| format!("unknown controller '{s}': use classical, rl or hybrid"))
+    }
+}
+
+impl std::fmt::Display for ControllerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 

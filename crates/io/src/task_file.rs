@@ -7,13 +7,13 @@
 //! JSON layout: an array of objects `{"p0": [x, y, z], "d": [..], "n": [..], "q0_seed": [7 values]}`
 //! (`q0_seed` optional), or one such object.
 
-use std::io::Write;
 use std::path::Path;
 
+use emg_control::{Task, TaskError};
 use emg_kinematics::{JointVector, Robot, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::task::{Task, TaskError};
+use crate::atomic::write_atomically;
 
 const MAGIC: &[u8; 8] = b"EMGTASKS";
 /// Version of the binary task-set layout written by [`write_task_set`].
@@ -91,7 +91,7 @@ impl From<&Task> for TaskSpec {
     }
 }
 
-/// Writes `tasks` in the binary layout (bit-exact values).
+/// Writes `tasks` in the binary layout (bit-exact values), atomically.
 pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> {
     let io = |source| TaskFileError::Io {
         path: path.display().to_string(),
@@ -110,8 +110,7 @@ pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> 
             bytes.extend_from_slice(&value.to_le_bytes());
         }
     }
-    let mut file = std::fs::File::create(path).map_err(io)?;
-    file.write_all(&bytes).map_err(io)
+    write_atomically(path, &bytes).map_err(io)
 }
 
 /// Reads tasks from a binary task set or a JSON file (chosen by the `.json` extension),

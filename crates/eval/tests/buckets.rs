@@ -1,6 +1,6 @@
-//! Reference lengths, buckets and cell statistics of the evaluation protocol on hand-checked data.
+//! Buckets and cell statistics of the evaluation protocol on hand-checked data.
 
-use emg_hybrid::{BucketConfig, Difficulty, bucket_members, cell_stats, reference_length};
+use emg_eval::{BucketConfig, Difficulty, bucket_members, cell_stats};
 
 #[test]
 fn buckets_follow_the_paper_thresholds() {
@@ -18,12 +18,6 @@ fn buckets_follow_the_paper_thresholds() {
             (Difficulty::Difficult, vec![2, 4]),
         ]
     );
-}
-
-#[test]
-fn reference_is_the_longest_candidate() {
-    assert_eq!(reference_length(&[0.3, 0.7, 0.5]), Some(0.7));
-    assert_eq!(reference_length(&[]), None);
 }
 
 #[test]

@@ -1,0 +1,99 @@
+//! Handing rollouts to the independent checker (`emg-verify`): the task, the constraints and the
+//! recorded trajectory as the checker's plain data. Nothing here checks anything; the checker
+//! recomputes every quantity from the robot file.
+
+use emg_verify::{
+    Blame, Bounds, CheckFailure, Ending, Line, RecordedStep, Recording, ReferenceModel,
+};
+
+use crate::config::ConstraintConfig;
+use crate::constraints::Violation;
+use crate::rollout::{Termination, Trajectory};
+use crate::task::Task;
+
+impl From<&Task> for Line {
+    fn from(task: &Task) -> Self {
+        Self {
+            p0: task.p0,
+            d: task.d,
+            n: task.n,
+        }
+    }
+}
+
+impl From<&ConstraintConfig> for Bounds {
+    fn from(constraints: &ConstraintConfig) -> Self {
+        Self {
+            line_tolerance_m: constraints.line_tolerance_m,
+            theta_max_deg: constraints.theta_max_deg,
+            collision_margin_m: constraints.collision_margin_m,
+            velocity_limit_fraction: constraints.velocity_limit_fraction.map(|f| f.get()),
+        }
+    }
+}
+
+impl From<&Violation> for Blame {
+    fn from(violation: &Violation) -> Self {
+        match violation {
+            Violation::JointLimit { joint, .. } => Self::JointLimit { joint: *joint },
+            Violation::LineTolerance { .. } => Self::LineTolerance,
+            Violation::ToolCone { .. } => Self::ToolCone,
+            Violation::SelfCollision { .. } => Self::SelfCollision,
+        }
+    }
+}
+
+impl From<&Trajectory> for Recording {
+    fn from(trajectory: &Trajectory) -> Self {
+        let ending = match &trajectory.termination {
+            Termination::Violation {
+                violation,
+                rejected_q,
+            } => Ending::Rejected {
+                blame: violation.into(),
+                rejected_q: *rejected_q,
+            },
+            Termination::InvalidStart { violation } => Ending::InvalidStart {
+                blame: violation.into(),
+            },
+            Termination::StepCap => Ending::Stopped,
+        };
+        Self {
+            steps: trajectory
+                .steps
+                .iter()
+                .map(|step| RecordedStep {
+                    time_s: step.time_s,
+                    q: step.q,
+                    tcp: step.tcp,
+                    tool_angle_deg: step.tool_angle_deg,
+                })
+                .collect(),
+            ending,
+            path_length_m: trajectory.path_length_m,
+        }
+    }
+}
+
+/// The independent re-check of a rollout: [`ReferenceModel::check_recording`] of the
+/// trajectory as recorded, against the task's line and the constraints.
+pub trait CheckRollout {
+    /// Verifies every recorded step of `trajectory` of `task` under `constraints`.
+    fn check(
+        &self,
+        task: &Task,
+        trajectory: &Trajectory,
+        constraints: &ConstraintConfig,
+    ) -> Result<(), CheckFailure>;
+}
+
+impl CheckRollout for ReferenceModel {
+    fn check(
+        &self,
+        task: &Task,
+        trajectory: &Trajectory,
+        constraints: &ConstraintConfig,
+    ) -> Result<(), CheckFailure> {
+        self.check_recording(&task.into(), &trajectory.into(), &constraints.into())
+    }
+}

@@ -1,0 +1,144 @@
+//! Any trajectory file, told apart by its content: JSON starts with `{` and its `format` field
+//! names the layout; anything else is read as the CSV.
+
+use std::path::Path;
+
+use emg_control::{ConstraintConfig, Task};
+use emg_verify::JointSamples;
+use serde_json::Value;
+
+use crate::csv::{read_csv, samples_from_steps};
+use crate::error::{FormatError, field_error};
+use crate::joint_trajectory::{JOINT_TRAJECTORY_FORMAT, JointTrajectory};
+use crate::rollout_file::{RolloutRecord, TRAJECTORY_FORMAT};
+
+/// What a trajectory file holds, by layout.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TrajectoryContents {
+    /// `emg-trajectory/1`: the rollout as recorded.
+    Rollout(RolloutRecord),
+    /// `emg-joint-trajectory/1`.
+    Joint(JointTrajectory),
+    /// The CSV: times, positions and declared velocities only.
+    Csv(JointSamples),
+}
+
+/// Why a trajectory file cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file cannot be read.
+    #[error("cannot read {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not in any trajectory layout.
+    #[error("{path} is not a readable trajectory file")]
+    Format {
+        /// The file.
+        path: String,
+        /// What is wrong, naming the field or cell.
+        #[source]
+        source: FormatError,
+    },
+}
+
+/// Task, constraints and robot a JSON file carries.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Carried {
+    /// The robot the file names.
+    pub robot: String,
+    /// The task.
+    pub task: Task,
+    /// The constraints.
+    pub constraints: ConstraintConfig,
+}
+
+impl TrajectoryContents {
+    /// Reads `path`, whatever its layout.
+    pub fn read(path: &Path) -> Result<Self, ReadError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ReadError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::parse(&text).map_err(|source| ReadError::Format {
+            path: path.display().to_string(),
+            source,
+        })
+    }
+
+    /// Reads a file's text, whatever its layout.
+    pub fn parse(text: &str) -> Result<Self, FormatError> {
+        if text.trim_start().starts_with('{') {
+            Self::parse_json(text)
+        } else {
+            read_csv(text).map(Self::Csv)
+        }
+    }
+
+    /// Reads a JSON trajectory file of either layout, by its `format` field.
+    pub fn parse_json(text: &str) -> Result<Self, FormatError> {
+        let doc: Value =
+            serde_json::from_str(text).map_err(|e| FormatError::Json(e.to_string()))?;
+        let format = doc
+            .get("format")
+            .ok_or_else(|| field_error("format", "is missing"))?;
+        match format.as_str() {
+            Some(TRAJECTORY_FORMAT) => RolloutRecord::from_value(&doc).map(Self::Rollout),
+            Some(JOINT_TRAJECTORY_FORMAT) => JointTrajectory::from_json(text).map(Self::Joint),
+            _ => Err(field_error(
+                "format",
+                format!(
+                    "is {format}, expected {TRAJECTORY_FORMAT:?} or {JOINT_TRAJECTORY_FORMAT:?}"
+                ),
+            )),
+        }
+    }
+
+    /// The layout's name.
+    pub fn layout(&self) -> &'static str {
+        match self {
+            Self::Rollout(_) => TRAJECTORY_FORMAT,
+            Self::Joint(_) => JOINT_TRAJECTORY_FORMAT,
+            Self::Csv(_) => "CSV",
+        }
+    }
+
+    /// Task, constraints and robot the file carries (none for a CSV).
+    pub fn carried(&self) -> Option<Carried> {
+        match self {
+            Self::Rollout(file) => Some(Carried {
+                robot: file.robot.clone(),
+                task: file.task.clone(),
+                constraints: file.constraints.clone(),
+            }),
+            Self::Joint(file) => Some(Carried {
+                robot: file.robot.clone(),
+                task: file.task.clone(),
+                constraints: file.constraints.clone(),
+            }),
+            Self::Csv(_) => None,
+        }
+    }
+
+    /// The joint names the file declares (none for a CSV).
+    pub fn joint_names(&self) -> Option<&[String]> {
+        match self {
+            Self::Rollout(file) => Some(&file.joint_names),
+            Self::Joint(file) => Some(&file.joint_names),
+            Self::Csv(_) => None,
+        }
+    }
+
+    /// The timed points of the file (with the velocities it declares, if any).
+    pub fn samples(&self) -> JointSamples {
+        match self {
+            Self::Rollout(file) => samples_from_steps(&file.trajectory.steps),
+            Self::Joint(file) => file.samples(),
+            Self::Csv(samples) => samples.clone(),
+        }
+    }
+}

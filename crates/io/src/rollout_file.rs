@@ -1,0 +1,107 @@
+//! The `emg-trajectory/1` JSON layout: one planned task as recorded (task, settings, every step,
+//! why it ended, the path length), written by the planner and read back by `emg check`. The
+//! layout is documented in `docs/trajectory-format.md`.
+
+use emg_control::{
+    ClassicalGains, ConstraintConfig, RolloutConfig, StepRecord, Task, Termination, Trajectory,
+};
+use serde::Serialize;
+use serde_json::Value;
+
+use crate::error::{FormatError, field_error};
+
+/// Value of the `format` field of every `emg-trajectory/1` file.
+pub const TRAJECTORY_FORMAT: &str = "emg-trajectory/1";
+
+/// One planned task as written to `<stem>.json`.
+#[derive(Debug, Serialize)]
+pub struct TrajectoryFile<'a> {
+    /// Always [`TRAJECTORY_FORMAT`].
+    pub format: &'static str,
+    /// Robot: a shipped robot's file or the path as given to the planner.
+    pub robot: String,
+    /// Names of the seven joints, base to tip (the order of every `q`).
+    pub joint_names: &'a [String],
+    /// The validated task.
+    pub task: &'a Task,
+    /// Where the seed came from (`dp`, `generating`, `home`, `given`, ...).
+    pub seed_source: &'a str,
+    /// Controller that was requested.
+    pub controller: &'a str,
+    /// Rollout settings used.
+    pub config: &'a RolloutConfig,
+    /// Controller gains used.
+    pub gains: &'a ClassicalGains,
+    /// Accepted steps, the seed first.
+    pub steps: &'a [StepRecord],
+    /// Why the rollout ended.
+    pub termination: &'a Termination,
+    /// `(p_T − p0)·d` at the last accepted step (m).
+    pub path_length_m: f64,
+}
+
+impl TrajectoryFile<'_> {
+    /// The file's text: compact JSON on one line, numbers in their shortest round-trip form,
+    /// then a newline.
+    pub fn to_json(&self) -> String {
+        let mut json = serde_json::to_string(self).expect("a trajectory file serialises");
+        json.push('\n');
+        json
+    }
+}
+
+/// The parts of an `emg-trajectory/1` file that can be verified: the robot it names, the joint
+/// order, the task, the constraints and the trajectory as recorded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RolloutRecord {
+    /// The robot the file names.
+    pub robot: String,
+    /// Joint names, base to tip.
+    pub joint_names: Vec<String>,
+    /// The task as written (validate it against the robot before use).
+    pub task: Task,
+    /// The constraints of the rollout settings.
+    pub constraints: ConstraintConfig,
+    /// The trajectory as recorded.
+    pub trajectory: Trajectory,
+}
+
+impl RolloutRecord {
+    /// Reads an `emg-trajectory/1` document (already parsed); the error names the field.
+    pub fn from_value(doc: &Value) -> Result<Self, FormatError> {
+        let field = |name: &str| doc.get(name).ok_or_else(|| field_error(name, "is missing"));
+        let format = field("format")?;
+        if format.as_str() != Some(TRAJECTORY_FORMAT) {
+            return Err(field_error(
+                "format",
+                format!("is {format}, expected {TRAJECTORY_FORMAT:?}"),
+            ));
+        }
+        let robot = field("robot")?
+            .as_str()
+            .ok_or_else(|| field_error("robot", "is not a string"))?
+            .to_string();
+        let joint_names = serde_json::from_value(field("joint_names")?.clone())
+            .map_err(|e| field_error("joint_names", format!("is not an array of strings: {e}")))?;
+        let task = serde_json::from_value(field("task")?.clone())
+            .map_err(|e| field_error("task", format!("is not a task: {e}")))?;
+        let config: RolloutConfig = serde_json::from_value(field("config")?.clone())
+            .map_err(|e| field_error("config", format!("is not a rollout config: {e}")))?;
+        for name in ["steps", "termination", "path_length_m"] {
+            field(name)?;
+        }
+        let trajectory = serde_json::from_value(doc.clone()).map_err(|e| {
+            field_error(
+                "steps/termination/path_length_m",
+                format!("do not form a trajectory: {e}"),
+            )
+        })?;
+        Ok(Self {
+            robot,
+            joint_names,
+            task,
+            constraints: config.constraints,
+            trajectory,
+        })
+    }
+}

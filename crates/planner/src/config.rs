@@ -1,0 +1,76 @@
+//! The planner's one configuration, which is also the `--config` JSON schema of `emg plan`:
+//! rollout settings, classical gains and the hybrid switch, every field optional with SPEC
+//! defaults.
+
+use std::path::Path;
+
+use emg_control::{ClassicalGains, RolloutConfig};
+use emg_hybrid::{BoundaryMeasure, SwitchConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::controller::ExecutorConfig;
+
+/// Every setting of a plan; unset fields keep their defaults (SPEC §2–4, Sec. 4.3):
+/// `rollout` ([`RolloutConfig`]: `dt_s` 0.05 s, `speed_m_per_s` 0.2 m/s, `max_steps` 500,
+/// `null_speed_max_rad_per_s` 0.5, `lateral_gain_per_s` 5, constraints: `line_tolerance_m` 0.02,
+/// `theta_max_deg` 30, `collision_margin_m` 0, `velocity_limit_fraction` 1), `gains`
+/// ([`ClassicalGains`]: `k_mu` 0.8, `k_jl` 0.4, `k_theta` 0.2, `cone_gate_width_deg` 8),
+/// `switch` ([`SwitchConfig`]: `tau_enter` 0.98, `tau_exit` 0.94) and `measure`
+/// ([`BoundaryMeasure`], default `rho`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerConfig {
+    /// Settings of the shared rollout loop.
+    pub rollout: RolloutConfig,
+    /// Gains of the classical controller.
+    pub gains: ClassicalGains,
+    /// Hysteresis thresholds of the hybrid switch.
+    pub switch: SwitchConfig,
+    /// Boundary measure of the hybrid switch.
+    pub measure: BoundaryMeasure,
+}
+
+/// Why a configuration file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file cannot be read.
+    #[error("cannot read config file {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not a planner configuration; the message names the field.
+    #[error("invalid config file {path}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// The JSON reader's message (field, value, line and column).
+        message: String,
+    },
+}
+
+impl PlannerConfig {
+    /// The controllers' settings.
+    pub fn executor(&self) -> ExecutorConfig {
+        ExecutorConfig {
+            gains: self.gains.clone(),
+            switch: self.switch.clone(),
+            measure: self.measure.clone(),
+        }
+    }
+
+    /// Reads a configuration file (JSON).
+    pub fn read(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| ConfigError::Parse {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+    }
+}

@@ -1,0 +1,39 @@
+//! The entry point of extreme straight-line motion: give a [`Planner`] a robot, its trained
+//! [`Models`] and a [`PlannerConfig`], and [`Planner::plan`] a task (Eq. 1: start `p0`,
+//! direction `d`, normal `n`) into a trajectory that moves the tool along the line as far as it
+//! can while every step holds every constraint.
+//!
+//! A plan is the paper's pipeline: a seed ([`SeedSource`]: the diffusion seeder by default,
+//! Sec. 4.1) put exactly on the start pose, then one rollout of the chosen null-space controller
+//! ([`ControllerKind`]: classical, RL or the hybrid of Sec. 4.3) through the shared step.
+//!
+//! ```
+//! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
+//! let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+//! let robot = emg_kinematics::Robot::from_chain_file(data.join("robots/fr3_pen.urdf"))?;
+//! let planner = Planner::new(robot, Models::shipped(&data)?, PlannerConfig::default());
+//! let task = demo_task(planner.robot())?;
+//! let plan = planner.plan(&task, &PlanRequest::default())?;
+//! println!("{:.3} m, ended: {}", plan.trajectory.path_length_m, plan.trajectory.termination);
+//! assert!(plan.trajectory.path_length_m > 0.1);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod config;
+mod controller;
+mod demo;
+mod models;
+pub mod parse;
+mod planner;
+mod seed;
+mod shipped;
+
+pub use config::{ConfigError, PlannerConfig};
+pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
+pub use demo::demo_task;
+pub use models::{
+    DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
+};
+pub use planner::{Plan, PlanError, PlanRequest, Planner};
+pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
+pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};

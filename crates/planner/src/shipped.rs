@@ -1,0 +1,95 @@
+//! The robots shipped with the workspace, and where the shipped data are found.
+//!
+//! A library never guesses where the data live: a binary names the data directory (the
+//! `data/` next to its workspace, or the `EMG_DATA` directory when that variable is set) and
+//! hands it over as a [`DataDir`].
+
+use std::path::{Path, PathBuf};
+
+/// The directory of the shipped data: `robots/`, and per robot its `tasks/`, `labels/` and
+/// `models/` (the FR3's at the top, others' in a sub-directory).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DataDir(PathBuf);
+
+impl DataDir {
+    /// The environment variable that, when set, names the data directory.
+    pub const ENV: &'static str = "EMG_DATA";
+
+    /// The data directory at `path`.
+    pub fn new(path: impl Into<PathBuf>) -> Self {
+        Self(path.into())
+    }
+
+    /// `$EMG_DATA` when it is set (and not empty), else `default` (a binary passes the `data/`
+    /// directory next to its workspace).
+    pub fn locate(default: impl Into<PathBuf>) -> Self {
+        match std::env::var_os(Self::ENV) {
+            Some(dir) if !dir.is_empty() => Self::new(dir),
+            _ => Self::new(default),
+        }
+    }
+
+    /// The directory itself.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+/// A robot file shipped in `robots/` of the data directory, with the sub-directory that holds
+/// its task sets, labels and models.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShippedRobot {
+    /// Selection name (`--robot fr3`).
+    pub name: &'static str,
+    file: &'static str,
+    data_subdir: &'static str,
+}
+
+/// The shipped robots: the paper's Franka FR3 (whose data keep the top level of the data
+/// directory) and the KUKA LBR iiwa 14 R820 (`iiwa14/`), both holding the same pen.
+pub const SHIPPED_ROBOTS: [ShippedRobot; 2] = [
+    ShippedRobot {
+        name: "fr3",
+        file: "fr3_pen.urdf",
+        data_subdir: "",
+    },
+    ShippedRobot {
+        name: "iiwa14",
+        file: "iiwa14_pen.urdf",
+        data_subdir: "iiwa14",
+    },
+];
+
+impl ShippedRobot {
+    /// The shipped robot called `name`.
+    pub fn by_name(name: &str) -> Option<Self> {
+        SHIPPED_ROBOTS.into_iter().find(|r| r.name == name)
+    }
+
+    /// The shipped robot whose file in `data` is `path` (compared after resolving links and
+    /// `..`).
+    pub fn by_path(path: &Path, data: &DataDir) -> Option<Self> {
+        let path = canonical(path);
+        SHIPPED_ROBOTS.into_iter().find(|r| r.path(data) == path)
+    }
+
+    /// Its robot file in `data` (canonical when it exists).
+    pub fn path(self, data: &DataDir) -> PathBuf {
+        canonical(&data.path().join("robots").join(self.file))
+    }
+
+    /// The directory of its task sets, labels and models in `data` (`data/` itself or
+    /// `data/<name>/`).
+    pub fn data_dir(self, data: &DataDir) -> PathBuf {
+        canonical(&data.path().join(self.data_subdir))
+    }
+
+    /// The sub-directory name of its data and results (empty for the FR3).
+    pub fn data_subdir(self) -> &'static str {
+        self.data_subdir
+    }
+}
+
+fn canonical(path: &Path) -> PathBuf {
+    path.canonicalize().unwrap_or_else(|_| path.to_path_buf())
+}

@@ -1,0 +1,213 @@
+//! The planner end to end on the shipped FR3 models: each controller kind plans exactly what its
+//! controller rolls out by hand, every plan passes the independent checker, `plan_many` is the
+//! same on one and two threads, and bad requests fail with errors that say what is missing.
+
+use emg_control::{CheckRollout, ClassicalController, RolloutConfig, Task, rollout};
+use emg_hybrid::{HybridController, HysteresisSwitch};
+use emg_io::read_tasks;
+use emg_kinematics::Robot;
+use emg_planner::{
+    ControllerKind, DataDir, Models, PlanError, PlanRequest, Planner, PlannerConfig,
+    SHIPPED_ROBOTS, SeedError, SeedSource, ShippedRobot, demo_task,
+};
+use emg_verify::ReferenceModel;
+
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+}
+
+fn fr3() -> ShippedRobot {
+    ShippedRobot::by_name("fr3").expect("the FR3 ships")
+}
+
+fn robot() -> Robot {
+    Robot::from_chain_file(fr3().path(&data())).expect("robot loads")
+}
+
+fn planner(models: Models) -> Planner {
+    Planner::new(robot(), models, PlannerConfig::default())
+}
+
+fn shipped_models() -> Models {
+    Models::shipped(&fr3().data_dir(&data())).expect("shipped models load")
+}
+
+fn checker(robot: &Robot) -> ReferenceModel {
+    ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+        .expect("checker loads")
+}
+
+fn eval_tasks(robot: &Robot, count: usize) -> Vec<Task> {
+    let mut tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
+        .expect("shipped tasks load");
+    tasks.truncate(count);
+    tasks
+}
+
+#[test]
+fn each_kind_plans_what_its_controller_rolls_out() {
+    let planner = planner(shipped_models());
+    let robot = planner.robot();
+    let config = RolloutConfig::default();
+    let policy = planner.models().policy.clone().expect("shipped policy");
+    let switch = PlannerConfig::default().switch;
+    for task in eval_tasks(robot, 6) {
+        let seed = task.q0_seed.expect("shipped tasks carry q0_seed");
+        for kind in ControllerKind::ALL {
+            let request = PlanRequest {
+                seed: Some(SeedSource::Generating),
+                controller: kind,
+            };
+            let plan = planner.plan(&task, &request).expect("plans");
+            assert_eq!(plan.seed.q, seed);
+            assert_eq!(plan.seed.source, "generating");
+            let by_hand = match kind {
+                ControllerKind::Classical => rollout(
+                    robot,
+                    &task,
+                    &seed,
+                    &mut ClassicalController::default(),
+                    &config,
+                ),
+                ControllerKind::Rl => rollout(robot, &task, &seed, &mut policy.clone(), &config),
+                ControllerKind::Hybrid => rollout(
+                    robot,
+                    &task,
+                    &seed,
+                    &mut HybridController::new(
+                        policy.clone(),
+                        ClassicalController::default(),
+                        HysteresisSwitch::new(switch.clone()).unwrap(),
+                        Default::default(),
+                    ),
+                    &config,
+                ),
+            };
+            assert_eq!(plan.trajectory, by_hand, "{kind}");
+        }
+    }
+}
+
+#[test]
+fn plans_pass_the_checker_and_do_not_depend_on_the_thread_count() {
+    let planner = planner(shipped_models());
+    let tasks = eval_tasks(planner.robot(), 24);
+    let request = PlanRequest::default();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| planner.plan_many(&tasks, &request))
+    };
+    let one: Vec<_> = on(1).into_iter().map(|p| p.expect("plans")).collect();
+    let two: Vec<_> = on(2).into_iter().map(|p| p.expect("plans")).collect();
+    assert_eq!(one, two);
+    let checker = checker(planner.robot());
+    let constraints = &planner.config().rollout.constraints;
+    for (task, plan) in tasks.iter().zip(&one) {
+        assert_eq!(
+            *plan,
+            planner.plan(task, &request).unwrap(),
+            "in task order"
+        );
+        checker
+            .check(task, &plan.trajectory, constraints)
+            .expect("every plan holds every constraint");
+    }
+    assert!(
+        one.iter().any(|p| p.seed.source == "dp"),
+        "the default seed is the diffusion seeder's"
+    );
+}
+
+#[test]
+fn the_demo_plans_on_every_shipped_robot() {
+    for shipped in SHIPPED_ROBOTS {
+        let robot = Robot::from_chain_file(shipped.path(&data())).expect("robot loads");
+        let models = Models::shipped(&shipped.data_dir(&data())).expect("models load");
+        let planner = Planner::new(robot, models, PlannerConfig::default());
+        let task = demo_task(planner.robot()).expect("demo task");
+        let plan = planner.plan(&task, &PlanRequest::default()).unwrap();
+        assert!(plan.trajectory.path_length_m > 0.1, "{}", shipped.name);
+    }
+}
+
+#[test]
+fn missing_models_and_seeds_are_named() {
+    let planner = planner(Models::default());
+    let task = demo_task(planner.robot()).unwrap();
+    let learned = PlanRequest {
+        seed: None,
+        controller: ControllerKind::Rl,
+    };
+    let error = planner.plan(&task, &learned).unwrap_err();
+    assert!(matches!(error, PlanError::Controller(_)), "{error}");
+    assert!(error.to_string().contains("policy"), "{error}");
+
+    let dp = PlanRequest {
+        seed: Some(SeedSource::Dp),
+        controller: ControllerKind::Classical,
+    };
+    let error = planner.plan(&task, &dp).unwrap_err();
+    assert!(
+        matches!(error, PlanError::Seed(SeedError::NoSeeder)),
+        "{error}"
+    );
+
+    let unseeded = Task {
+        q0_seed: None,
+        ..task.clone()
+    };
+    let generating = PlanRequest {
+        seed: Some(SeedSource::Generating),
+        controller: ControllerKind::Classical,
+    };
+    let error = planner.plan(&unseeded, &generating).unwrap_err();
+    assert!(error.to_string().contains("q0_seed"), "{error}");
+    // Without a seeder or a q0_seed the default seed is the mid-range configuration.
+    let default = PlanRequest {
+        seed: None,
+        controller: ControllerKind::Classical,
+    };
+    let plan = planner.plan(&unseeded, &default).unwrap();
+    assert_eq!(plan.seed.source, "home");
+}
+
+#[test]
+fn names_parse_back() {
+    for kind in ControllerKind::ALL {
+        assert_eq!(kind.name().parse::<ControllerKind>().unwrap(), kind);
+    }
+    let error = "pid".parse::<ControllerKind>().unwrap_err();
+    assert!(error.contains("classical, rl or hybrid"), "{error}");
+    for source in [
+        SeedSource::Dp,
+        SeedSource::Generating,
+        SeedSource::Home,
+        SeedSource::QMu,
+        SeedSource::QJl,
+    ] {
+        assert_eq!(source.name().parse::<SeedSource>().unwrap(), source);
+    }
+    let given: SeedSource = "q=0,0.1,0,-1.5,0,1.5,0.7".parse().unwrap();
+    assert_eq!(given.name(), "given");
+    let error = "q=0,1".parse::<SeedSource>().unwrap_err();
+    assert!(error.contains("expected 7"), "{error}");
+}
+
+#[test]
+fn a_bad_config_file_names_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plan.json");
+    std::fs::write(&path, r#"{"rollout": {"dt": 0.1}}"#).unwrap();
+    let error = PlannerConfig::read(&path).unwrap_err().to_string();
+    assert!(
+        error.contains("dt") && error.contains("plan.json"),
+        "{error}"
+    );
+    let config: PlannerConfig =
+        serde_json::from_str(r#"{"switch": {"tau_enter": 0.9, "tau_exit": 0.8}}"#).unwrap();
+    assert_eq!(config.switch.tau_exit, 0.8);
+    assert_eq!(config.rollout, RolloutConfig::default());
+}

@@ -1,0 +1,253 @@
+//! The robot as the checker sees it: read straight from the URDF file, evaluated with plain 4×4
+//! homogeneous transforms (URDF joint origin × rotation about the file's joint axis), its own
+//! collision-pair rule and its own segment-distance routine.
+
+use nalgebra::{Matrix4, Rotation3, Unit, Vector3, Vector4};
+
+use crate::record::{JOINTS, Joints};
+
+/// One body's capsule in its link frame.
+struct ReferenceCapsule {
+    link: String,
+    chain_index: usize,
+    start: Vector3<f64>,
+    end: Vector3<f64>,
+    radius: f64,
+}
+
+/// One joint of the chain, as the file states it.
+struct ReferenceJoint {
+    origin: Matrix4<f64>,
+    axis: Option<Unit<Vector3<f64>>>,
+    lower: f64,
+    upper: f64,
+    velocity: f64,
+}
+
+/// The robot as the checker sees it, built straight from the URDF file.
+pub struct ReferenceModel {
+    joints: Vec<ReferenceJoint>,
+    capsules: Vec<ReferenceCapsule>,
+}
+
+/// Why the checker cannot read a robot file.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// The file cannot be read.
+    #[error("cannot read {path}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not a URDF document.
+    #[error("not a URDF document: {0}")]
+    Urdf(String),
+    /// No joint has this link as its child, so the chain cannot reach the base.
+    #[error("no joint leads to link '{0}' on the way from the tip to the base")]
+    Unreachable(String),
+    /// A link of the chain is named by a joint but not defined.
+    #[error("link '{0}' is not defined")]
+    MissingLink(String),
+    /// A collision element is neither a capsule nor a sphere.
+    #[error("link '{0}': unsupported collision geometry (the checker reads capsules and spheres)")]
+    Geometry(String),
+    /// The chain does not have the supported number of revolute joints.
+    #[error("the chain has {0} revolute joints, expected {JOINTS}")]
+    JointCount(usize),
+}
+
+impl ReferenceModel {
+    /// Reads the chain from `base` to `tip` of URDF text.
+    pub fn from_urdf_str(text: &str, base: &str, tip: &str) -> Result<Self, ModelError> {
+        let urdf = urdf_rs::read_from_string(text).map_err(|e| ModelError::Urdf(e.to_string()))?;
+        let mut path = Vec::new();
+        let mut link = tip.to_string();
+        while link != base {
+            let joint = urdf
+                .joints
+                .iter()
+                .find(|j| j.child.link == link)
+                .ok_or_else(|| ModelError::Unreachable(link.clone()))?;
+            path.push(joint);
+            link = joint.parent.link.clone();
+        }
+        path.reverse();
+        let mut joints = Vec::new();
+        let mut capsules = Vec::new();
+        let mut link_names = vec![base.to_string()];
+        link_names.extend(path.iter().map(|j| j.child.link.clone()));
+        for joint in &path {
+            let [x, y, z] = joint.origin.xyz.0;
+            let [r, p, yaw] = joint.origin.rpy.0;
+            let mut origin = Rotation3::from_euler_angles(r, p, yaw).to_homogeneous();
+            origin[(0, 3)] = x;
+            origin[(1, 3)] = y;
+            origin[(2, 3)] = z;
+            let revolute = matches!(joint.joint_type, urdf_rs::JointType::Revolute);
+            joints.push(ReferenceJoint {
+                origin,
+                axis: revolute.then(|| Unit::new_normalize(Vector3::from(joint.axis.xyz.0))),
+                lower: joint.limit.lower,
+                upper: joint.limit.upper,
+                velocity: joint.limit.velocity,
+            });
+        }
+        for (chain_index, name) in link_names.iter().enumerate() {
+            let link = urdf
+                .links
+                .iter()
+                .find(|l| &l.name == name)
+                .ok_or_else(|| ModelError::MissingLink(name.clone()))?;
+            for collision in &link.collision {
+                let (radius, half) = match collision.geometry {
+                    urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0),
+                    urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
+                    _ => return Err(ModelError::Geometry(name.clone())),
+                };
+                let [x, y, z] = collision.origin.xyz.0;
+                let [r, p, yaw] = collision.origin.rpy.0;
+                let rotation = Rotation3::from_euler_angles(r, p, yaw);
+                let centre = Vector3::new(x, y, z);
+                let axis = rotation * Vector3::z() * half;
+                capsules.push(ReferenceCapsule {
+                    link: name.clone(),
+                    chain_index,
+                    start: centre - axis,
+                    end: centre + axis,
+                    radius,
+                });
+            }
+        }
+        let revolute = joints.iter().filter(|j| j.axis.is_some()).count();
+        if revolute != JOINTS {
+            return Err(ModelError::JointCount(revolute));
+        }
+        Ok(Self { joints, capsules })
+    }
+
+    /// Reads the chain from `base` to `tip` of a URDF file.
+    pub fn from_urdf_file(
+        path: &std::path::Path,
+        base: &str,
+        tip: &str,
+    ) -> Result<Self, ModelError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Self::from_urdf_str(&text, base, tip)
+    }
+
+    /// Link frames base to tip (one per link of the chain) for configuration `q`.
+    fn link_frames(&self, q: &Joints) -> Vec<Matrix4<f64>> {
+        let mut frames = vec![Matrix4::identity()];
+        let mut revolute = 0;
+        for joint in &self.joints {
+            let mut transform = frames.last().expect("base frame") * joint.origin;
+            if let Some(axis) = &joint.axis {
+                transform *= Rotation3::from_axis_angle(axis, q[revolute]).to_homogeneous();
+                revolute += 1;
+            }
+            frames.push(transform);
+        }
+        frames
+    }
+
+    /// TCP position and tool axis (z of the tip link) for `q`.
+    pub fn tcp_pose(&self, q: &Joints) -> (Vector3<f64>, Vector3<f64>) {
+        let tip = *self.link_frames(q).last().expect("tip frame");
+        (
+            tip.fixed_view::<3, 1>(0, 3).into_owned(),
+            tip.fixed_view::<3, 1>(0, 2).into_owned(),
+        )
+    }
+
+    /// Joint limits `(lower, upper)` of the revolute joints in order.
+    pub fn limits(&self) -> Vec<(f64, f64)> {
+        self.joints
+            .iter()
+            .filter(|j| j.axis.is_some())
+            .map(|j| (j.lower, j.upper))
+            .collect()
+    }
+
+    /// Velocity limits (rad/s) of the revolute joints in order, as the file states them.
+    pub fn velocity_limits(&self) -> Vec<f64> {
+        self.joints
+            .iter()
+            .filter(|j| j.axis.is_some())
+            .map(|j| j.velocity)
+            .collect()
+    }
+
+    /// Smallest clearance (m) over capsule pairs at least three links apart, with their links.
+    pub fn min_clearance(&self, q: &Joints) -> (f64, String, String) {
+        let frames = self.link_frames(q);
+        let world = |c: &ReferenceCapsule, v: &Vector3<f64>| {
+            (frames[c.chain_index] * Vector4::new(v.x, v.y, v.z, 1.0)).xyz()
+        };
+        let mut best = (f64::INFINITY, String::new(), String::new());
+        for (i, a) in self.capsules.iter().enumerate() {
+            for b in &self.capsules[i + 1..] {
+                if a.chain_index.abs_diff(b.chain_index) < 3 {
+                    continue;
+                }
+                let gap = segments_gap(
+                    &world(a, &a.start),
+                    &world(a, &a.end),
+                    &world(b, &b.start),
+                    &world(b, &b.end),
+                ) - a.radius
+                    - b.radius;
+                if gap < best.0 {
+                    best = (gap, a.link.clone(), b.link.clone());
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Angle between unit vectors (degrees) as `atan2(|a × b|, a·b)`: `acos(a·b)` loses half the
+/// digits near 0°, where one rounding of the dot product already reads as ~1e-6°.
+pub(crate) fn angle_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    a.cross(b).norm().atan2(a.dot(b)).to_degrees()
+}
+
+/// `value <= bound`; false when either is NaN, so that every check fails closed.
+pub(crate) fn within(value: f64, bound: f64) -> bool {
+    value <= bound
+}
+
+/// Distance between segments `a0–a1` and `b0–b1`: the minimum over the unconstrained stationary
+/// point (when it lies inside both segments) and the four end-point-to-segment distances.
+fn segments_gap(a0: &Vector3<f64>, a1: &Vector3<f64>, b0: &Vector3<f64>, b1: &Vector3<f64>) -> f64 {
+    let point_to_segment = |p: &Vector3<f64>, s0: &Vector3<f64>, s1: &Vector3<f64>| {
+        let axis = s1 - s0;
+        let length2 = axis.norm_squared();
+        let t = if length2 > 0.0 {
+            ((p - s0).dot(&axis) / length2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p - (s0 + axis * t)).norm()
+    };
+    let mut best = point_to_segment(a0, b0, b1)
+        .min(point_to_segment(a1, b0, b1))
+        .min(point_to_segment(b0, a0, a1))
+        .min(point_to_segment(b1, a0, a1));
+    let (u, v, w) = (a1 - a0, b1 - b0, a0 - b0);
+    let (uu, uv, vv, uw, vw) = (u.dot(&u), u.dot(&v), v.dot(&v), u.dot(&w), v.dot(&w));
+    let det = uu * vv - uv * uv;
+    if det > 1e-14 * uu * vv {
+        let s = (uv * vw - vv * uw) / det;
+        let t = (uu * vw - uv * uw) / det;
+        if (0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&t) {
+            best = best.min(((a0 + u * s) - (b0 + v * t)).norm());
+        }
+    }
+    best
+}

@@ -1,0 +1,109 @@
+//! What the checker is given: the task line, the bounds, and a recorded motion, as plain data
+//! that any planner (or any file reader) fills in.
+
+use nalgebra::{SVector, Vector3};
+
+/// Number of revolute joints of every arm the checker verifies.
+pub const JOINTS: usize = 7;
+
+/// A joint configuration or joint velocity, one value per revolute joint, base to tip.
+pub type Joints = SVector<f64, JOINTS>;
+
+/// The task line: start `p0`, unit direction `d`, unit normal `n` (the tool axis must stay near
+/// it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    /// Start position (m).
+    pub p0: Vector3<f64>,
+    /// Unit direction of motion.
+    pub d: Vector3<f64>,
+    /// Unit task-plane normal.
+    pub n: Vector3<f64>,
+}
+
+impl Line {
+    /// Lateral distance of `point` from the line (m).
+    pub fn lateral_distance(&self, point: &Vector3<f64>) -> f64 {
+        let offset = point - self.p0;
+        (offset - self.d * offset.dot(&self.d)).norm()
+    }
+
+    /// Progress `(point − p0)·d` of `point` along the line (m).
+    pub fn progress(&self, point: &Vector3<f64>) -> f64 {
+        (point - self.p0).dot(&self.d)
+    }
+}
+
+/// The bounds every recorded point must hold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bounds {
+    /// Largest lateral distance of the TCP from the line (m).
+    pub line_tolerance_m: f64,
+    /// Largest angle between the tool axis and `n` (degrees).
+    pub theta_max_deg: f64,
+    /// Smallest clearance between checked capsule pairs (m).
+    pub collision_margin_m: f64,
+    /// Joint speeds stay within this fraction of the robot file's velocity limits; `None` when
+    /// joint speeds are not bounded.
+    pub velocity_limit_fraction: Option<f64>,
+}
+
+/// One recorded point of a motion, with what the planner says it measured there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordedStep {
+    /// Time since the start (s).
+    pub time_s: f64,
+    /// Joint configuration (rad).
+    pub q: Joints,
+    /// TCP position the planner recorded (m).
+    pub tcp: Vector3<f64>,
+    /// Angle between the tool axis and `n` the planner recorded (degrees).
+    pub tool_angle_deg: f64,
+}
+
+/// A constraint a planner blames for the end of a motion.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blame {
+    /// Joint `joint` (1-based) left its position limits.
+    JointLimit {
+        /// 1-based joint number.
+        joint: usize,
+    },
+    /// The TCP left the line tolerance.
+    LineTolerance,
+    /// The tool axis left the cone around `n`.
+    ToolCone,
+    /// Two capsules of the arm touch.
+    SelfCollision,
+}
+
+/// Why a recorded motion ended, as its planner claims.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ending {
+    /// The next configuration `rejected_q` breaks `blame`, so it was not taken.
+    Rejected {
+        /// The constraint blamed.
+        blame: Blame,
+        /// The configuration that was not taken.
+        rejected_q: Joints,
+    },
+    /// The first configuration already breaks `blame`; the motion holds only that point.
+    InvalidStart {
+        /// The constraint blamed.
+        blame: Blame,
+    },
+    /// The planner stopped with every constraint held (a step cap, or a file of points that
+    /// says nothing about why the motion ended).
+    Stopped,
+}
+
+/// A recorded motion: its points, why it ended and the length it reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Recording {
+    /// The points, the start first.
+    pub steps: Vec<RecordedStep>,
+    /// Why it ended.
+    pub ending: Ending,
+    /// The reported path length `(p_last − p0)·d` (m).
+    pub path_length_m: f64,
+}
