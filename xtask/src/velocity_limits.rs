@@ -120,10 +120,8 @@ pub fn run(
     let mut comparisons = Vec::new();
     for controller in ControllerKind::ALL {
         let mut run = |fraction: Option<f64>| -> anyhow::Result<Vec<Trajectory>> {
-            setup.rollout.constraints.velocity_limit_fraction = fraction
-                .map(VelocityLimitFraction::new)
-                .transpose()
-                .map_err(anyhow::Error::msg)?;
+            setup.rollout.constraints.velocity_limit_fraction =
+                fraction.map(VelocityLimitFraction::new).transpose()?;
             let what = match fraction {
                 None => format!("DP+{} (no limits)", controller.name()),
                 Some(f) => format!("DP+{} ({f} × limits)", controller.name()),

@@ -140,6 +140,6 @@ impl PlanArgs {
 }
 
 /// Parses `x,y,z`.
-pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], emg_planner::ParseError> {
     emg_planner::parse::numbers(s)
 }

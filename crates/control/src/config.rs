@@ -30,6 +30,18 @@ impl Default for ConstraintConfig {
     }
 }
 
+/// A configuration value outside its allowed range; names the field, the value and the range.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field} must be in {allowed}, got {value}")]
+pub struct OutOfRange {
+    /// The field.
+    pub field: &'static str,
+    /// The value given.
+    pub value: f64,
+    /// The allowed range.
+    pub allowed: &'static str,
+}
+
 /// A fraction in `(0, 1]` of the joint-velocity limits; reading any other value is an error that
 /// names the field.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,13 +53,15 @@ impl VelocityLimitFraction {
     pub const FULL: Self = Self(1.0);
 
     /// `fraction` if it lies in `(0, 1]`.
-    pub fn new(fraction: f64) -> Result<Self, String> {
+    pub fn new(fraction: f64) -> Result<Self, OutOfRange> {
         if fraction > 0.0 && fraction <= 1.0 {
             Ok(Self(fraction))
         } else {
-            Err(format!(
-                "velocity_limit_fraction must be in (0, 1], got {fraction}"
-            ))
+            Err(OutOfRange {
+                field: "velocity_limit_fraction",
+                value: fraction,
+                allowed: "(0, 1]",
+            })
         }
     }
 
@@ -58,9 +72,9 @@ impl VelocityLimitFraction {
 }
 
 impl TryFrom<f64> for VelocityLimitFraction {
-    type Error = String;
+    type Error = OutOfRange;
 
-    fn try_from(fraction: f64) -> Result<Self, String> {
+    fn try_from(fraction: f64) -> Result<Self, OutOfRange> {
         Self::new(fraction)
     }
 }

@@ -35,7 +35,9 @@ mod task;
 mod verification;
 
 pub use classical::ClassicalController;
-pub use config::{ClassicalGains, ConstraintConfig, RolloutConfig, VelocityLimitFraction};
+pub use config::{
+    ClassicalGains, ConstraintConfig, OutOfRange, RolloutConfig, VelocityLimitFraction,
+};
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
 pub use rollout::{Episode, StepOutcome, StepRecord, Termination, Trajectory, rollout};

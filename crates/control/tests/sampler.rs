@@ -1,6 +1,7 @@
 //! The task population (SPEC §2).
 //!
-//! `candidate(i)` is a pure function of the seed and `i`; sampled tasks have `n` within 5° of
+//! `candidate(i)` is a pure function of the seed and `i` (`committed_tasks.rs` regenerates the
+//! shipped sets bit for bit in another process); sampled tasks have `n` within 5° of
 //! the generating tool axis, `d ⟂ n`, `p0 = TCP(q0_seed)` and a collision-free seed inside the
 //! limits. `TaskSampler::take` gives the same tasks on 1 and 2 threads, in any batch size and
 //! when taken in pieces, and keeps exactly the candidates whose classical rollout reaches 0.1 m.
@@ -15,20 +16,16 @@ use emg_kinematics::Robot;
 use common::{checker, classical, robot};
 
 #[test]
-fn candidates_are_deterministic_and_well_formed() {
+fn candidates_are_well_formed() {
     let robot = robot();
     let checker = checker();
     let config = SamplerConfig::default();
     let (mut kept, mut max_tilt, mut min_tilt) = (0, 0.0f64, f64::INFINITY);
     let mut mean_d = emg_kinematics::Vec3::zeros();
     for index in 0..600 {
-        let task = candidate(&robot, &config, index);
-        assert_eq!(
-            task,
-            candidate(&robot, &config, index),
-            "candidate {index} is not deterministic"
-        );
-        let Some(task) = task else { continue };
+        let Some(task) = candidate(&robot, &config, index) else {
+            continue;
+        };
         kept += 1;
         let q = task.q0_seed.expect("sampled tasks keep their seed");
         let kin = robot.forward(&q);

@@ -56,7 +56,7 @@ impl TimeFromStart {
 ///
 /// Fails, naming the point, on a time that is not finite, a negative first time, times that do
 /// not increase, or a time past 2³¹ s.
-pub fn times_from_start(time_s: &[f64]) -> Result<Vec<TimeFromStart>, String> {
+pub fn times_from_start(time_s: &[f64]) -> Result<Vec<TimeFromStart>, FormatError> {
     let mut out: Vec<TimeFromStart> = Vec::with_capacity(time_s.len());
     for (k, t) in time_s.iter().enumerate() {
         let total = match out.last() {
@@ -65,9 +65,13 @@ pub fn times_from_start(time_s: &[f64]) -> Result<Vec<TimeFromStart>, String> {
             Some(previous) => {
                 let gap = t - time_s[k - 1];
                 if gap.is_nan() || gap <= 0.0 {
-                    return Err(format!(
-                        "point {k}: time {t} s does not come after the previous point's {} s",
-                        time_s[k - 1]
+                    return Err(field_error(
+                        format!("points[{k}].time_from_start"),
+                        format!(
+                            "cannot be made from time {t} s: it does not come after the previous \
+                             point's {} s",
+                            time_s[k - 1]
+                        ),
                     ));
                 }
                 let gap_ns = (gap * 1e9 - GAP_ROUNDING_NOISE_NS).ceil().max(1.0);
@@ -77,7 +81,10 @@ pub fn times_from_start(time_s: &[f64]) -> Result<Vec<TimeFromStart>, String> {
         let time = total
             .and_then(TimeFromStart::from_nanoseconds)
             .ok_or_else(|| {
-                format!("point {k}: time {t} s cannot be a time_from_start (finite, ≥ 0, < 2^31 s)")
+                field_error(
+                    format!("points[{k}].time_from_start"),
+                    format!("cannot be made from time {t} s (it must be finite, ≥ 0, < 2^31 s)"),
+                )
             })?;
         out.push(time);
     }
@@ -134,8 +141,7 @@ impl JointTrajectory {
             ));
         }
         let planned: Vec<f64> = trajectory.steps.iter().map(|s| s.time_s).collect();
-        let times = times_from_start(&planned)
-            .map_err(|problem| field_error("points[].time_from_start", problem))?;
+        let times = times_from_start(&planned)?;
         let seconds: Vec<f64> = times.iter().map(TimeFromStart::seconds).collect();
         let q: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
         let velocities = point_velocities(&seconds, &q);

@@ -52,14 +52,14 @@ impl ControllerKind {
 }
 
 impl std::str::FromStr for ControllerKind {
-    type Err = String;
+    type Err = crate::parse::ParseError;
 
     /// `classical`, `rl` or `hybrid`.
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
         Self::ALL
             .into_iter()
             .find(|kind| kind.name() == s)
-            .ok_or_else(|| format!("unknown controller '{s}': use classical, rl or hybrid"))
+            .ok_or_else(|| crate::parse::ParseError::Controller(s.to_string()))
     }
 }
 

@@ -34,6 +34,7 @@ pub use demo::demo_task;
 pub use models::{
     DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
 };
+pub use parse::ParseError;
 pub use planner::{Plan, PlanError, PlanRequest, Planner};
 pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};

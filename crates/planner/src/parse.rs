@@ -1,19 +1,44 @@
-//! Small value parsers shared by the seed sources and the binaries' arguments.
+//! Small value parsers shared by the seed sources and the binaries' arguments, with one typed
+//! error.
+
+/// A value given as text that cannot be read.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ParseError {
+    /// A list entry is not a finite number.
+    #[error("'{0}' is not a finite number")]
+    NotFinite(String),
+    /// A list has the wrong number of entries.
+    #[error("expected {expected} comma-separated numbers, got {found}")]
+    Count {
+        /// Entries needed.
+        expected: usize,
+        /// Entries given.
+        found: usize,
+    },
+    /// Not the name of a controller.
+    #[error("unknown controller '{0}': use classical, rl or hybrid")]
+    Controller(String),
+    /// Not the name of a seed source.
+    #[error(
+        "unknown seed source '{0}': use dp, generating, home, q_mu, q_jl or q=v1,...,v7 (radians)"
+    )]
+    Seed(String),
+}
 
 /// Parses exactly `N` comma-separated finite numbers (`x,y,z`, `v1,...,v7`).
-pub fn numbers<const N: usize>(s: &str) -> Result<[f64; N], String> {
+pub fn numbers<const N: usize>(s: &str) -> Result<[f64; N], ParseError> {
     let values = s
         .split(',')
         .map(|v| {
             let v = v.trim();
             match v.parse::<f64>() {
                 Ok(x) if x.is_finite() => Ok(x),
-                _ => Err(format!("'{v}' is not a finite number")),
+                _ => Err(ParseError::NotFinite(v.to_string())),
             }
         })
-        .collect::<Result<Vec<f64>, String>>()?;
-    let count = values.len();
+        .collect::<Result<Vec<f64>, ParseError>>()?;
+    let found = values.len();
     values
         .try_into()
-        .map_err(|_| format!("expected {N} comma-separated numbers, got {count}"))
+        .map_err(|_| ParseError::Count { expected: N, found })
 }

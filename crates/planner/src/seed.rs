@@ -10,6 +10,8 @@ use emg_kinematics::{
 };
 use emg_seeding::{HeuristicConfig, HeuristicObjective, heuristic_seed};
 
+use crate::parse::ParseError;
+
 /// Where the rollout's start configuration comes from (Table 2's rows, plus the CLI's own).
 #[derive(Clone, Debug, PartialEq)]
 pub enum SeedSource {
@@ -56,10 +58,10 @@ impl SeedSource {
 }
 
 impl FromStr for SeedSource {
-    type Err = String;
+    type Err = ParseError;
 
     /// `dp`, `generating`, `home`, `q_mu`, `q_jl` or `q=v1,...,v7` (radians).
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, ParseError> {
         match s {
             "dp" => Ok(Self::Dp),
             "generating" => Ok(Self::Generating),
@@ -71,10 +73,7 @@ impl FromStr for SeedSource {
                     let q: [f64; DOF] = crate::parse::numbers(values)?;
                     Ok(Self::Given(JointVector::from(q)))
                 }
-                None => Err(format!(
-                    "unknown seed source '{s}': use dp, generating, home, q_mu, q_jl or \
-                     q=v1,...,v7 (radians)"
-                )),
+                None => Err(ParseError::Seed(s.to_string())),
             },
         }
     }

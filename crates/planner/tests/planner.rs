@@ -179,7 +179,7 @@ fn names_parse_back() {
     for kind in ControllerKind::ALL {
         assert_eq!(kind.name().parse::<ControllerKind>().unwrap(), kind);
     }
-    let error = "pid".parse::<ControllerKind>().unwrap_err();
+    let error = "pid".parse::<ControllerKind>().unwrap_err().to_string();
     assert!(error.contains("classical, rl or hybrid"), "{error}");
     for source in [
         SeedSource::Dp,
@@ -192,7 +192,7 @@ fn names_parse_back() {
     }
     let given: SeedSource = "q=0,0.1,0,-1.5,0,1.5,0.7".parse().unwrap();
     assert_eq!(given.name(), "given");
-    let error = "q=0,1".parse::<SeedSource>().unwrap_err();
+    let error = "q=0,1".parse::<SeedSource>().unwrap_err().to_string();
     assert!(error.contains("expected 7"), "{error}");
 }
 

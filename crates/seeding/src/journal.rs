@@ -32,22 +32,36 @@ impl Shard {
     pub const WHOLE: Shard = Shard { index: 0, count: 1 };
 }
 
+/// A shard given as text that is not `i/n` with `0 ≤ i < n`.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("shard '{text}': {problem}")]
+pub struct ShardError {
+    /// The text given.
+    pub text: String,
+    /// What is wrong with it.
+    pub problem: &'static str,
+}
+
 impl std::str::FromStr for Shard {
-    type Err = String;
+    type Err = ShardError;
 
     /// Parses `i/n` with `0 ≤ i < n`.
-    fn from_str(text: &str) -> Result<Self, String> {
+    fn from_str(text: &str) -> Result<Self, ShardError> {
+        let error = |problem| ShardError {
+            text: text.to_string(),
+            problem,
+        };
         let (index, count) = text
             .split_once('/')
-            .ok_or_else(|| format!("shard '{text}' is not of the form i/n"))?;
+            .ok_or_else(|| error("not of the form i/n"))?;
         let parse = |s: &str| {
             s.trim()
                 .parse::<usize>()
-                .map_err(|_| format!("shard '{text}': '{s}' is not a whole number"))
+                .map_err(|_| error("i and n must be whole numbers"))
         };
         let (index, count) = (parse(index)?, parse(count)?);
         if count == 0 || index >= count {
-            return Err(format!("shard '{text}': need 0 ≤ i < n"));
+            return Err(error("need 0 ≤ i < n"));
         }
         Ok(Self { index, count })
     }

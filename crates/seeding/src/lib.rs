@@ -54,7 +54,7 @@ pub use branch::{
 pub use config::{BranchConfig, HeuristicConfig, IkConfig, LabelConfig, StabilityConfig};
 pub use heuristic::{HeuristicError, HeuristicObjective, HeuristicSeed, heuristic_seed};
 pub use ik::{cone_ik_solutions, solve_cone_ik};
-pub use journal::{LabelJob, RunProgress, Shard};
+pub use journal::{LabelJob, RunProgress, Shard, ShardError};
 pub use labelling::{TaskStats, label_task};
 pub use labels::{
     LABEL_FORMAT_VERSION, Label, LabelError, LabelSet, TaskLabels, hex, task_set_sha256,
