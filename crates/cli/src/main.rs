@@ -85,7 +85,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         policy_weights(args)?.as_deref(),
     )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
-    let planner = Planner::new(robot, models, config);
+    let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
         seed: args.seed.clone(),
         controller: args.controller,

@@ -109,6 +109,135 @@ pub struct RolloutConfig {
     pub constraints: ConstraintConfig,
 }
 
+/// The largest accepted `max_steps`: 100,000 steps of 50 ms are well over an hour of motion.
+pub const MAX_STEPS_CAP: usize = 100_000;
+
+/// `value` if it is finite and `check` accepts it, else the range error of `field`.
+fn require(
+    field: &'static str,
+    value: f64,
+    allowed: &'static str,
+    check: impl Fn(f64) -> bool,
+) -> Result<(), OutOfRange> {
+    if value.is_finite() && check(value) {
+        Ok(())
+    } else {
+        Err(OutOfRange {
+            field,
+            value,
+            allowed,
+        })
+    }
+}
+
+impl ConstraintConfig {
+    /// Checks every bound: `line_tolerance_m > 0`, `0 < theta_max_deg < 90`,
+    /// `collision_margin_m ≥ 0`, all finite (the velocity fraction is checked when read).
+    pub fn validate(&self) -> Result<(), OutOfRange> {
+        require(
+            "constraints.line_tolerance_m",
+            self.line_tolerance_m,
+            "(0, ∞)",
+            |v| v > 0.0,
+        )?;
+        require(
+            "constraints.theta_max_deg",
+            self.theta_max_deg,
+            "(0, 90)",
+            |v| v > 0.0 && v < 90.0,
+        )?;
+        require(
+            "constraints.collision_margin_m",
+            self.collision_margin_m,
+            "[0, ∞)",
+            |v| v >= 0.0,
+        )
+    }
+}
+
+impl RolloutConfig {
+    /// Checks every setting: `dt_s`, `speed_m_per_s` and `null_speed_max_rad_per_s` positive,
+    /// `1 ≤ max_steps ≤` [`MAX_STEPS_CAP`], gains, dampings and thresholds finite and
+    /// non-negative (the damping threshold and `λ_max` positive), and the constraints.
+    pub fn validate(&self) -> Result<(), OutOfRange> {
+        let positive = |v: f64| v > 0.0;
+        let non_negative = |v: f64| v >= 0.0;
+        require("rollout.dt_s", self.dt_s, "(0, ∞)", positive)?;
+        require(
+            "rollout.speed_m_per_s",
+            self.speed_m_per_s,
+            "(0, ∞)",
+            positive,
+        )?;
+        if self.max_steps == 0 || self.max_steps > MAX_STEPS_CAP {
+            return Err(OutOfRange {
+                field: "rollout.max_steps",
+                value: self.max_steps as f64,
+                allowed: "[1, 100000]",
+            });
+        }
+        require(
+            "rollout.null_speed_max_rad_per_s",
+            self.null_speed_max_rad_per_s,
+            "(0, ∞)",
+            positive,
+        )?;
+        require(
+            "rollout.lateral_gain_per_s",
+            self.lateral_gain_per_s,
+            "[0, ∞)",
+            non_negative,
+        )?;
+        require(
+            "rollout.manipulability_damping",
+            self.manipulability_damping,
+            "[0, ∞)",
+            non_negative,
+        )?;
+        require(
+            "rollout.damping.sigma_threshold",
+            self.damping.sigma_threshold,
+            "(0, ∞)",
+            positive,
+        )?;
+        require(
+            "rollout.damping.lambda_max",
+            self.damping.lambda_max,
+            "(0, ∞)",
+            positive,
+        )?;
+        require(
+            "rollout.basis.residual_floor",
+            self.basis.residual_floor,
+            "[0, ∞)",
+            non_negative,
+        )?;
+        require(
+            "rollout.basis.residual_relative",
+            self.basis.residual_relative,
+            "[0, ∞)",
+            non_negative,
+        )?;
+        self.constraints.validate()
+    }
+}
+
+impl ClassicalGains {
+    /// Checks that every gain is finite and non-negative and the cone gate width positive.
+    pub fn validate(&self) -> Result<(), OutOfRange> {
+        let non_negative = |v: f64| v >= 0.0;
+        require("gains.k_mu", self.k_mu, "[0, ∞)", non_negative)?;
+        require("gains.k_jl", self.k_jl, "[0, ∞)", non_negative)?;
+        require("gains.k_theta", self.k_theta, "[0, ∞)", non_negative)?;
+        require(
+            "gains.cone_gate_width_deg",
+            self.cone_gate_width_deg,
+            "(0, ∞)",
+            |v| v > 0.0,
+        )
+    }
+}
+
 impl Default for RolloutConfig {
     fn default() -> Self {
         Self {

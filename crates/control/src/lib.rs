@@ -36,7 +36,8 @@ mod verification;
 
 pub use classical::ClassicalController;
 pub use config::{
-    ClassicalGains, ConstraintConfig, OutOfRange, RolloutConfig, VelocityLimitFraction,
+    ClassicalGains, ConstraintConfig, MAX_STEPS_CAP, OutOfRange, RolloutConfig,
+    VelocityLimitFraction,
 };
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};

@@ -9,6 +9,10 @@ use crate::controller::{ActingController, NullSpaceController};
 use crate::step::{NullAction, StepContext};
 use crate::task::Task;
 
+/// Steps a rollout reserves room for up front (the default step cap and its seed fit); longer
+/// rollouts grow their record as they go, so memory follows the steps taken, not the cap.
+const PREALLOCATED_STEPS: usize = 1024;
+
 /// One recorded step of a trajectory.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepRecord {
@@ -138,7 +142,7 @@ impl<'a> Episode<'a> {
             time_s: 0.0,
             kinematics,
             previous_action: NullAction::zeros(),
-            steps: Vec::with_capacity(config.max_steps + 1),
+            steps: Vec::with_capacity((config.max_steps + 1).min(PREALLOCATED_STEPS)),
             termination: None,
         };
         if let Some(violation) =

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use emg_control::{ClassicalGains, RolloutConfig};
-use emg_hybrid::{BoundaryMeasure, SwitchConfig};
+use emg_control::{ClassicalGains, OutOfRange, RolloutConfig};
+use emg_hybrid::{BoundaryMeasure, SwitchConfig, SwitchConfigError};
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ExecutorConfig;
@@ -50,6 +50,12 @@ pub enum ConfigError {
         /// The JSON reader's message (field, value, line and column).
         message: String,
     },
+    /// A value lies outside its allowed range.
+    #[error("invalid configuration: {0}")]
+    OutOfRange(#[from] OutOfRange),
+    /// The switch thresholds are not `0 < τ_exit ≤ τ_enter ≤ 1`.
+    #[error("invalid configuration: {0}")]
+    Switch(#[from] SwitchConfigError),
 }
 
 impl PlannerConfig {
@@ -62,15 +68,37 @@ impl PlannerConfig {
         }
     }
 
-    /// Reads a configuration file (JSON).
+    /// Checks every value against its allowed range ([`RolloutConfig::validate`],
+    /// [`ClassicalGains::validate`], the switch thresholds and the boundary measure's scale);
+    /// the error names the field, the value and the range.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.rollout.validate()?;
+        self.gains.validate()?;
+        self.switch.validate()?;
+        if let BoundaryMeasure::AllConstraints { clearance_scale_m } = self.measure
+            && !(clearance_scale_m.is_finite() && clearance_scale_m > 0.0)
+        {
+            return Err(OutOfRange {
+                field: "measure.clearance_scale_m",
+                value: clearance_scale_m,
+                allowed: "(0, ∞)",
+            }
+            .into());
+        }
+        Ok(())
+    }
+
+    /// Reads and validates a configuration file (JSON).
     pub fn read(path: &Path) -> Result<Self, ConfigError> {
         let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        serde_json::from_str(&text).map_err(|e| ConfigError::Parse {
+        let config: Self = serde_json::from_str(&text).map_err(|e| ConfigError::Parse {
             path: path.display().to_string(),
             message: e.to_string(),
-        })
+        })?;
+        config.validate()?;
+        Ok(config)
     }
 }

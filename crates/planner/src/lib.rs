@@ -11,7 +11,7 @@
 //! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
 //! let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
 //! let robot = emg_kinematics::Robot::from_chain_file(data.join("robots/fr3_pen.urdf"))?;
-//! let planner = Planner::new(robot, Models::shipped(&data)?, PlannerConfig::default());
+//! let planner = Planner::new(robot, Models::shipped(&data)?, PlannerConfig::default())?;
 //! let task = demo_task(planner.robot())?;
 //! let plan = planner.plan(&task, &PlanRequest::default())?;
 //! println!("{:.3} m, ended: {}", plan.trajectory.path_length_m, plan.trajectory.termination);

@@ -4,7 +4,7 @@ use emg_control::{Task, Trajectory, rollout};
 use emg_kinematics::Robot;
 use rayon::prelude::*;
 
-use crate::config::PlannerConfig;
+use crate::config::{ConfigError, PlannerConfig};
 use crate::controller::{ControllerKind, Executor, ExecutorError};
 use crate::models::Models;
 use crate::seed::{Seed, SeedError, SeedSource, prepare_seed};
@@ -58,13 +58,15 @@ pub struct Planner {
 }
 
 impl Planner {
-    /// A planner for `robot` with `models` under `config`.
-    pub fn new(robot: Robot, models: Models, config: PlannerConfig) -> Self {
-        Self {
+    /// A planner for `robot` with `models` under `config` (validated: the error names the
+    /// field, the value and its allowed range).
+    pub fn new(robot: Robot, models: Models, config: PlannerConfig) -> Result<Self, ConfigError> {
+        config.validate()?;
+        Ok(Self {
             robot,
             models,
             config,
-        }
+        })
     }
 
     /// The robot.

@@ -25,7 +25,7 @@ fn robot() -> Robot {
 }
 
 fn planner(models: Models) -> Planner {
-    Planner::new(robot(), models, PlannerConfig::default())
+    Planner::new(robot(), models, PlannerConfig::default()).expect("default config is valid")
 }
 
 fn shipped_models() -> Models {
@@ -126,7 +126,7 @@ fn the_demo_plans_on_every_shipped_robot() {
     for shipped in SHIPPED_ROBOTS {
         let robot = Robot::from_chain_file(shipped.path(&data())).expect("robot loads");
         let models = Models::shipped(&shipped.data_dir(&data())).expect("models load");
-        let planner = Planner::new(robot, models, PlannerConfig::default());
+        let planner = Planner::new(robot, models, PlannerConfig::default()).unwrap();
         let task = demo_task(planner.robot()).expect("demo task");
         let plan = planner.plan(&task, &PlanRequest::default()).unwrap();
         assert!(plan.trajectory.path_length_m > 0.1, "{}", shipped.name);
@@ -210,4 +210,59 @@ fn a_bad_config_file_names_the_field() {
         serde_json::from_str(r#"{"switch": {"tau_enter": 0.9, "tau_exit": 0.8}}"#).unwrap();
     assert_eq!(config.switch.tau_exit, 0.8);
     assert_eq!(config.rollout, RolloutConfig::default());
+}
+
+#[test]
+fn out_of_range_values_are_refused_naming_field_value_and_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("plan.json");
+    for (json, expected) in [
+        (
+            r#"{"rollout": {"max_steps": 1000000000}}"#,
+            "rollout.max_steps must be in [1, 100000], got 1000000000",
+        ),
+        (
+            r#"{"rollout": {"max_steps": 0}}"#,
+            "rollout.max_steps must be in [1, 100000], got 0",
+        ),
+        (
+            r#"{"rollout": {"dt_s": -0.05}}"#,
+            "rollout.dt_s must be in (0, ∞), got -0.05",
+        ),
+        (
+            r#"{"rollout": {"speed_m_per_s": 0}}"#,
+            "rollout.speed_m_per_s must be in (0, ∞), got 0",
+        ),
+        (
+            r#"{"rollout": {"constraints": {"theta_max_deg": 0}}}"#,
+            "constraints.theta_max_deg must be in (0, 90), got 0",
+        ),
+        (
+            r#"{"rollout": {"constraints": {"theta_max_deg": 90}}}"#,
+            "constraints.theta_max_deg must be in (0, 90), got 90",
+        ),
+        (
+            r#"{"rollout": {"constraints": {"line_tolerance_m": 0}}}"#,
+            "constraints.line_tolerance_m must be in (0, ∞), got 0",
+        ),
+        (
+            r#"{"gains": {"k_mu": -1}}"#,
+            "gains.k_mu must be in [0, ∞), got -1",
+        ),
+        (
+            r#"{"measure": {"kind": "all_constraints", "clearance_scale_m": 0}}"#,
+            "measure.clearance_scale_m must be in (0, ∞), got 0",
+        ),
+        (r#"{"switch": {"tau_enter": 0.5, "tau_exit": 0.9}}"#, "tau"),
+    ] {
+        std::fs::write(&path, json).unwrap();
+        let error = PlannerConfig::read(&path).unwrap_err().to_string();
+        assert!(error.contains(expected), "{json}: {error}");
+    }
+    let mut config = PlannerConfig::default();
+    config.rollout.dt_s = f64::NAN;
+    let error = Planner::new(robot(), Models::default(), config)
+        .err()
+        .unwrap();
+    assert!(error.to_string().contains("rollout.dt_s"), "{error}");
 }
