@@ -171,6 +171,14 @@ fn bad_inputs_fail_naming_the_field() {
     let err = plan_err(&["--config", config.to_str().unwrap(), "--out", out]);
     assert!(err.contains("unknown field `gain`"), "{err}");
 
+    // A step cap no rollout could use is refused before anything is allocated for it.
+    std::fs::write(&config, r#"{"rollout": {"max_steps": 1000000000}}"#).unwrap();
+    let err = plan_err(&["--config", config.to_str().unwrap(), "--out", out]);
+    assert!(
+        err.contains("rollout.max_steps must be in [1, 100000], got 1000000000"),
+        "{err}"
+    );
+
     let err = plan_err(&[
         "--p0",
         "0.4,0,0.3",
