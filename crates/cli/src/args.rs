@@ -90,7 +90,7 @@ pub struct PlanArgs {
     /// A task given on the command line.
     #[command(flatten)]
     pub line: TaskLineArgs,
-    /// Task set to plan: JSON (by the .json extension) or the binary EMGTASKS layout.
+    /// Task set to plan: JSON or the binary EMGTASKS layout (told apart by the content).
     #[arg(long, value_name = "FILE", conflicts_with = "p0")]
     pub task_file: Option<PathBuf>,
     /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`

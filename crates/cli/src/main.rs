@@ -10,8 +10,8 @@
 //! * Robot: `--robot fr3` (the default), `--robot iiwa14`, or `--robot <urdf>` for any 7-DoF
 //!   serial arm; the chain runs from the file's root link to its only leaf unless `--base-link`
 //!   and `--tip-link` name its ends. A shipped robot brings its own trained models.
-//! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON by the `.json`
-//!   extension, else the binary `EMGTASKS` set), or nothing for the demo task: from the
+//! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON or the binary
+//!   `EMGTASKS` set, told apart by the content), or nothing for the demo task: from the
 //!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n` (the
 //!   first task of the robot's task population when that configuration is near a singularity).
 //! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the robot's shipped

@@ -406,3 +406,25 @@ fn json_task_files() {
     std::fs::write(&file.path, "not json").unwrap();
     format_error(read_tasks(&file.path, &robot));
 }
+
+#[test]
+fn task_files_are_told_apart_by_content_not_by_name() {
+    let robot = robot();
+    let set = sample_set(&robot);
+    // A binary set under a `.json` name.
+    let binary = TempFile::new("set.json");
+    write_task_set(&binary.path, &set).unwrap();
+    assert_eq!(read_tasks(&binary.path, &robot).unwrap(), set);
+    // A JSON list under a `.tasks` name.
+    let json = TempFile::new("hand.tasks");
+    let specs: Vec<emg_io::TaskSpec> = set.iter().map(emg_io::TaskSpec::from).collect();
+    std::fs::write(&json.path, serde_json::to_string(&specs).unwrap()).unwrap();
+    assert_eq!(read_tasks(&json.path, &robot).unwrap().len(), set.len());
+    // Neither.
+    std::fs::write(&json.path, "p0,d,n\n").unwrap();
+    let m = format_error(read_tasks(&json.path, &robot));
+    assert!(
+        m.contains("neither the EMGTASKS header") && m.contains("JSON"),
+        "{m}"
+    );
+}

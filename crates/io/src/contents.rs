@@ -70,12 +70,21 @@ impl TrajectoryContents {
         })
     }
 
-    /// Reads a file's text, whatever its layout.
+    /// Reads a file's text, whatever its layout, told apart by its content (the file name
+    /// does not matter): JSON opens with `{` (or `[`, which no layout uses, so its parse error
+    /// is reported), the CSV with its `time_s` header.
     pub fn parse(text: &str) -> Result<Self, FormatError> {
-        if text.trim_start().starts_with('{') {
+        let start = text.trim_start();
+        if start.starts_with('{') || start.starts_with('[') {
             Self::parse_json(text)
-        } else {
+        } else if start.starts_with("time_s") {
             read_csv(text).map(Self::Csv)
+        } else {
+            let opening: String = start.chars().take(20).collect();
+            Err(FormatError::Unrecognised(format!(
+                "it opens with {opening:?}: JSON opens with '{{', the CSV with its header \
+                 'time_s,q1,...'"
+            )))
         }
     }
 

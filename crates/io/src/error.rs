@@ -5,9 +5,12 @@
 /// wrong with it.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FormatError {
-    /// The text is not JSON at all.
+    /// The text is not JSON at all (the message gives the line and column).
     #[error("not valid JSON: {0}")]
     Json(String),
+    /// The content is in none of the layouts.
+    #[error("not a trajectory file: {0}")]
+    Unrecognised(String),
     /// A field is missing, of the wrong type or holds a wrong value.
     #[error("field '{field}' {problem}")]
     Field {

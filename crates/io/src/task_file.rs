@@ -113,7 +113,8 @@ pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> 
     write_atomically(path, &bytes).map_err(io)
 }
 
-/// Reads tasks from a binary task set or a JSON file (chosen by the `.json` extension),
+/// Reads tasks from a binary task set or a JSON file, told apart by their content (the
+/// `EMGTASKS` magic bytes, or JSON's opening `{` or `[`; the file name does not matter),
 /// validating every task against `robot`.
 pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError> {
     let bytes = std::fs::read(path).map_err(|source| TaskFileError::Io {
@@ -121,10 +122,26 @@ pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError
         source,
     })?;
     let name = path.display().to_string();
-    let specs = if path.extension().is_some_and(|e| e == "json") {
-        parse_json(&name, &bytes)?
-    } else {
+    let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
+    let specs = if bytes.starts_with(MAGIC) {
         parse_binary(&name, &bytes)?
+    } else if matches!(first, Some(b'{' | b'[')) {
+        parse_json(&name, &bytes)?
+    } else if bytes.starts_with(&MAGIC[..bytes.len().min(MAGIC.len())]) && !bytes.is_empty() {
+        return Err(TaskFileError::Format {
+            path: name,
+            problem: format!(
+                "truncated header: {} of its {HEADER_BYTES} bytes",
+                bytes.len()
+            ),
+        });
+    } else {
+        return Err(TaskFileError::Format {
+            path: name,
+            problem: "not a task set: it starts with neither the EMGTASKS header of the binary \
+                      layout nor the '{' or '[' of JSON"
+                .into(),
+        });
     };
     specs
         .iter()

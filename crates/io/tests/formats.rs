@@ -274,3 +274,33 @@ fn check_replay_blames_the_point_and_the_constraint() {
     assert!(e.contains("same order"), "{e}");
     assert!(check_joint_names(&file.joint_names, &file.joint_names).is_ok());
 }
+
+#[test]
+fn files_are_told_apart_by_content_and_json_errors_give_their_position() {
+    use emg_io::TrajectoryContents;
+    // Not valid JSON: the JSON reader's own error, with its line and column.
+    let error = TrajectoryContents::parse("{\"format\": ")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.starts_with("not valid JSON") && error.contains("line 1 column"),
+        "{error}"
+    );
+    let error = TrajectoryContents::parse("[1, 2").unwrap_err().to_string();
+    assert!(error.starts_with("not valid JSON"), "{error}");
+    // Neither JSON nor the CSV: said so, with what the file opens with.
+    let error = TrajectoryContents::parse("hello, world")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("not a trajectory file") && error.contains("hello"),
+        "{error}"
+    );
+    // The CSV is recognised by its header.
+    let (_, _, _, trajectory) = planned();
+    let csv = trajectory_csv(&trajectory.steps);
+    assert!(matches!(
+        TrajectoryContents::parse(&csv),
+        Ok(TrajectoryContents::Csv(_))
+    ));
+}

@@ -44,7 +44,7 @@ pub use projection::{
     PoseTarget, ProjectionConfig, ProjectionError, pose_residual, project_to_pose,
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
-pub use robot::{JointLimits, Robot, RobotError};
+pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
 
 /// Number of actuated joints of every supported arm.
 pub const DOF: usize = 7;

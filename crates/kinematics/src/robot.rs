@@ -55,8 +55,8 @@ pub enum RobotError {
         /// Their names.
         joints: String,
     },
-    /// A joint of the chain is neither revolute nor fixed.
-    #[error("joint '{joint}' is {kind}; only revolute and fixed joints are supported")]
+    /// A joint of the chain is neither revolute (or continuous) nor fixed.
+    #[error("joint '{joint}' is {kind}; only revolute, continuous and fixed joints are supported")]
     UnsupportedJoint {
         /// Joint name.
         joint: String,
@@ -237,17 +237,17 @@ impl Robot {
             let origin = pose_to_isometry(&joint.origin);
             match joint.joint_type {
                 urdf_rs::JointType::Fixed => offset *= origin,
-                urdf_rs::JointType::Revolute => {
+                urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous => {
                     let axis_alignment = axis_alignment(joint)?;
                     let frame = offset * origin * axis_alignment;
                     joints.push(JointFrame {
                         rotation: frame.rotation.to_rotation_matrix().into_inner(),
                         translation: frame.translation.vector,
                     });
-                    check_limits(joint)?;
+                    let (lo, hi) = position_range(joint)?;
                     joint_names.push(joint.name.clone());
-                    lower.push(joint.limit.lower);
-                    upper.push(joint.limit.upper);
+                    lower.push(lo);
+                    upper.push(hi);
                     velocity.push(joint.limit.velocity);
                     offset = axis_alignment.inverse();
                 }
@@ -458,13 +458,23 @@ fn axis_alignment(joint: &urdf_rs::Joint) -> Result<Isometry3<f64>, RobotError> 
     ))
 }
 
-fn check_limits(joint: &urdf_rs::Joint) -> Result<(), RobotError> {
+/// Position range (rad) of a `continuous` joint, an unbounded revolute joint: a full turn each
+/// way of zero. A robot file that wants another range declares the joint `revolute` with its
+/// `<limit lower upper>`.
+pub const CONTINUOUS_JOINT_RANGE_RAD: f64 = std::f64::consts::TAU;
+
+/// The position range of a revolute joint (its `<limit>`) or a continuous one
+/// (±[`CONTINUOUS_JOINT_RANGE_RAD`]), after checking the range and the velocity limit.
+fn position_range(joint: &urdf_rs::Joint) -> Result<(f64, f64), RobotError> {
     let bad = |field, problem: String| RobotError::BadJoint {
         joint: joint.name.clone(),
         field,
         problem,
     };
-    let (lo, hi) = (joint.limit.lower, joint.limit.upper);
+    let (lo, hi) = match joint.joint_type {
+        urdf_rs::JointType::Continuous => (-CONTINUOUS_JOINT_RANGE_RAD, CONTINUOUS_JOINT_RANGE_RAD),
+        _ => (joint.limit.lower, joint.limit.upper),
+    };
     if !(lo.is_finite() && hi.is_finite() && lo < hi) {
         return Err(bad(
             "limit",
@@ -475,7 +485,7 @@ fn check_limits(joint: &urdf_rs::Joint) -> Result<(), RobotError> {
     if !(v.is_finite() && v > 0.0) {
         return Err(bad("velocity", format!("{v} must be a positive number")));
     }
-    Ok(())
+    Ok((lo, hi))
 }
 
 fn chain_capsules(chain: &[ChainLink<'_>]) -> Result<Vec<Capsule>, RobotError> {

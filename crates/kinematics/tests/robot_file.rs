@@ -147,6 +147,32 @@ fn prismatic_joint_is_rejected() {
 }
 
 #[test]
+fn continuous_joints_are_revolute_with_a_full_turn_each_way() {
+    let text = edited(
+        "<joint name=\"fr3_joint7\" type=\"revolute\">",
+        "<joint name=\"fr3_joint7\" type=\"continuous\">",
+    );
+    let continuous = load(&text).expect("a continuous joint loads");
+    let shipped = robot();
+    let range = emg_kinematics::CONTINUOUS_JOINT_RANGE_RAD;
+    assert_eq!(range, std::f64::consts::TAU);
+    assert_eq!(
+        (continuous.limits().lower[6], continuous.limits().upper[6]),
+        (-range, range)
+    );
+    assert_eq!(
+        continuous.limits().velocity[6],
+        shipped.limits().velocity[6]
+    );
+    // Same kinematics, and a joint value past the shipped limit is now within range.
+    let mut q = shipped.mid_range();
+    q[6] = 4.0;
+    assert!((continuous.forward(&q).tcp() - shipped.forward(&q).tcp()).norm() < 1e-15);
+    assert!(continuous.limits().first_violation(&q, 0.0).is_none());
+    assert!(shipped.limits().first_violation(&q, 0.0).is_some());
+}
+
+#[test]
 fn six_revolute_joints_are_rejected() {
     let text = edited(
         "<joint name=\"fr3_joint7\" type=\"revolute\">",

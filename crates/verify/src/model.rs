@@ -6,6 +6,10 @@ use nalgebra::{Matrix4, Rotation3, Unit, Vector3, Vector4};
 
 use crate::record::{JOINTS, Joints};
 
+/// The position range (rad) the planners give a `continuous` joint, as documented: a full turn
+/// each way of zero.
+const CONTINUOUS_RANGE: f64 = std::f64::consts::TAU;
+
 /// One body's capsule in its link frame.
 struct ReferenceCapsule {
     link: String,
@@ -86,12 +90,16 @@ impl ReferenceModel {
             origin[(0, 3)] = x;
             origin[(1, 3)] = y;
             origin[(2, 3)] = z;
-            let revolute = matches!(joint.joint_type, urdf_rs::JointType::Revolute);
+            let (revolute, lower, upper) = match joint.joint_type {
+                urdf_rs::JointType::Revolute => (true, joint.limit.lower, joint.limit.upper),
+                urdf_rs::JointType::Continuous => (true, -CONTINUOUS_RANGE, CONTINUOUS_RANGE),
+                _ => (false, 0.0, 0.0),
+            };
             joints.push(ReferenceJoint {
                 origin,
                 axis: revolute.then(|| Unit::new_normalize(Vector3::from(joint.axis.xyz.0))),
-                lower: joint.limit.lower,
-                upper: joint.limit.upper,
+                lower,
+                upper,
                 velocity: joint.limit.velocity,
             });
         }

@@ -1,0 +1,39 @@
+//! The checker's own reading of robot files: the chain's joint count, and `continuous` joints
+//! read with the documented range of a full turn each way.
+
+use emg_verify::{Joints, ModelError, ReferenceModel};
+
+fn fr3_text() -> String {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+    std::fs::read_to_string(path).expect("the shipped robot file reads")
+}
+
+#[test]
+fn a_continuous_joint_has_a_full_turn_each_way() {
+    let text = fr3_text().replace(
+        "<joint name=\"fr3_joint7\" type=\"revolute\">",
+        "<joint name=\"fr3_joint7\" type=\"continuous\">",
+    );
+    let continuous = ReferenceModel::from_urdf_str(&text, "link0", "pen_tip").unwrap();
+    let shipped = ReferenceModel::from_urdf_str(&fr3_text(), "link0", "pen_tip").unwrap();
+    let tau = std::f64::consts::TAU;
+    assert_eq!(continuous.limits()[6], (-tau, tau));
+    assert_eq!(continuous.limits()[..6], shipped.limits()[..6]);
+    assert_eq!(continuous.velocity_limits(), shipped.velocity_limits());
+    let q = Joints::from_column_slice(&[0.1, -0.4, 0.2, -2.0, 0.1, 1.7, 4.0]);
+    assert_eq!(continuous.tcp_pose(&q), shipped.tcp_pose(&q));
+}
+
+#[test]
+fn a_chain_without_seven_revolute_joints_is_refused() {
+    let text = fr3_text().replace(
+        "<joint name=\"fr3_joint7\" type=\"revolute\">",
+        "<joint name=\"fr3_joint7\" type=\"fixed\">",
+    );
+    let error = ReferenceModel::from_urdf_str(&text, "link0", "pen_tip")
+        .err()
+        .expect("six revolute joints are refused");
+    assert!(matches!(error, ModelError::JointCount(6)), "{error}");
+    assert!(error.to_string().contains("expected 7"), "{error}");
+}
