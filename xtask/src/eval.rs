@@ -253,7 +253,7 @@ fn run_controller(
     }
     let executor = ExecutorConfig::default();
     let policy = if kind.needs_policy() {
-        Some(emg_planner::load_policy(&args.weights)?)
+        Some(emg_planner::load_policy(&robot, &args.weights)?)
     } else {
         None
     };

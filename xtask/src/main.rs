@@ -21,6 +21,7 @@ mod make_tasks;
 mod progress;
 mod protocol;
 mod report;
+mod stamp_weights;
 mod train_diffusion;
 mod train_ppo;
 mod velocity_limits;
@@ -59,6 +60,8 @@ enum Command {
     FigureBranches(figure_branches::Args),
     /// Train the RL null-space controller with PPO (resumable); ship its weights in data/models/.
     TrainPpo(train_ppo::Args),
+    /// Record in weights files which robot they were trained for (the values are unchanged).
+    StampWeights(stamp_weights::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -74,5 +77,6 @@ fn main() -> anyhow::Result<()> {
         Command::LabelSeeds(args) => label_seeds::run(&args),
         Command::TrainPpo(args) => train_ppo::run(&args),
         Command::FigureBranches(args) => figure_branches::run(&args),
+        Command::StampWeights(args) => stamp_weights::run(&args),
     }
 }

@@ -176,7 +176,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    trainer.ema_weights().write(&args.out)?;
+    trainer
+        .ema_weights()
+        .clone()
+        .stamped(emg_planner::robot_stamp(&robot))
+        .write(&args.out)?;
     let card = ModelCard {
         weights: workspace::relative(&args.out),
         labels: workspace::relative(&args.labels),

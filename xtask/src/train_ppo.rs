@@ -112,6 +112,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
         None
     };
+    let stamp = emg_planner::robot_stamp(&robot);
     let pool = TrainingPool::new(
         robot,
         tasks,
@@ -127,7 +128,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let threads = workspace::thread_pool(args.threads)?;
     threads.install(|| match args.measure_backends {
         Some(iterations) => measure_backends(&run_config, &pool, iterations, &args.results),
-        None => train(args, &run_config, &pool, labels.is_some()),
+        None => train(args, &run_config, &pool, labels.is_some(), &stamp),
     })
 }
 
@@ -136,6 +137,7 @@ fn train(
     run_config: &RunConfig,
     pool: &TrainingPool,
     labelled: bool,
+    stamp: &emg_learning::RobotStamp,
 ) -> anyhow::Result<()> {
     let backend = Backend::from(args.backend);
     let envs = pool.environments(run_config.ppo.envs);
@@ -173,7 +175,7 @@ fn train(
             .is_some_and(|m| session.elapsed().as_secs_f64() > 60.0 * m);
         if trainer.iteration() % args.checkpoint_every.max(1) == 0 || trainer.is_done() || stop {
             trainer.save_checkpoint(&args.checkpoint, &vec_env)?;
-            write_outputs(args, run_config, &trainer, labelled, pool)?;
+            write_outputs(args, run_config, &trainer, labelled, pool, stamp)?;
         }
         if stop {
             println!(
@@ -185,7 +187,7 @@ fn train(
         }
     }
     bar.finish();
-    write_outputs(args, run_config, &trainer, labelled, pool)?;
+    write_outputs(args, run_config, &trainer, labelled, pool, stamp)?;
     println!("wrote {}", args.out.display());
     Ok(())
 }
@@ -197,11 +199,12 @@ fn write_outputs(
     trainer: &Trainer,
     labelled: bool,
     pool: &TrainingPool,
+    stamp: &emg_learning::RobotStamp,
 ) -> anyhow::Result<()> {
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let weights = trainer.weights();
+    let weights = trainer.weights().stamped(stamp.clone());
     weights.write(&args.out)?;
     let wall: f64 = trainer
         .timing()

@@ -81,6 +81,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         None => PlannerConfig::default(),
     };
     let models = Models::load(
+        &robot,
         diffusion_weights(args)?.as_deref(),
         policy_weights(args)?.as_deref(),
     )?;

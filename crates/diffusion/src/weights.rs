@@ -30,6 +30,10 @@ pub struct WeightsHeader {
     pub dataset: String,
     /// Optimiser steps the weights were trained for.
     pub train_steps: usize,
+    /// The robot the weights were trained for (absent in files written before robots were
+    /// recorded; the planner refuses such a file until it is stamped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<emg_learning::RobotStamp>,
 }
 
 /// Why a weights file cannot be used.
@@ -174,6 +178,8 @@ impl DenoiserWeights {
                 config,
                 dataset: dataset.to_string(),
                 train_steps,
+
+                robot: None,
             },
             values,
         }
@@ -223,6 +229,12 @@ impl DenoiserWeights {
     /// The header.
     pub fn header(&self) -> &WeightsHeader {
         &self.header
+    }
+
+    /// The same weights recorded as trained for `robot` (the values are unchanged).
+    pub fn stamped(mut self, robot: emg_learning::RobotStamp) -> Self {
+        self.header.robot = Some(robot);
+        self
     }
 
     /// The network shape.

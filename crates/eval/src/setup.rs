@@ -116,13 +116,15 @@ impl Setup {
                     path: robot_path.to_path_buf(),
                     source,
                 })?;
+        let policy = load_policy(&robot, policy_path)?;
+        let dp = load_seeder(&robot, diffusion_path)?;
         Ok(Self {
             robot,
             checker,
             rollout: RolloutConfig::default(),
             executor: ExecutorConfig::default(),
-            policy: load_policy(policy_path)?,
-            dp: load_seeder(diffusion_path)?,
+            policy,
+            dp,
             heuristic: HeuristicConfig::default(),
             projection: ProjectionConfig::default(),
             progress: Box::new(Silent),

@@ -302,6 +302,31 @@ impl Robot {
         })
     }
 
+    /// SHA-256 (hex) of the chain as the planners see it: every joint frame (rotation and
+    /// translation, the axis turned onto local +z), the TCP offset, and the position and velocity
+    /// limits, as little-endian `f64`. Two files that describe the same arm give the same
+    /// fingerprint; any change of a frame, an axis, a limit or the tool gives another.
+    pub fn fingerprint(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut hash = Sha256::new();
+        let frames = self.joints.iter().chain(std::iter::once(&self.tcp_offset));
+        for frame in frames {
+            for value in frame.rotation.iter().chain(frame.translation.iter()) {
+                hash.update(value.to_le_bytes());
+            }
+        }
+        let limits = &self.limits;
+        for value in limits
+            .lower
+            .iter()
+            .chain(&limits.upper)
+            .chain(&limits.velocity)
+        {
+            hash.update(value.to_le_bytes());
+        }
+        hash.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    }
+
     /// The robot's name from the file.
     pub fn name(&self) -> &str {
         &self.name

@@ -5,6 +5,8 @@
 //!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
 //!   values as little-endian `f32` — with strict truncation and trailing-byte checks (the
 //!   weights files are written with `emg_io::write_atomically`);
+//! - [`RobotStamp`]: the robot a weights file was trained for (name and chain fingerprint), and
+//!   [`check_stamp`], which refuses a file trained for another arm;
 //! - [`checkpoint`]: checkpoint directories (a model, its optimizer and the JSON run state)
 //!   written into a staging sibling and swapped in whole.
 //!
@@ -20,6 +22,8 @@
 mod backend;
 pub mod checkpoint;
 pub mod container;
+mod stamp;
 
 pub use backend::Backend;
 pub use container::ContainerError;
+pub use stamp::{RobotStamp, StampError, check_stamp};

@@ -11,7 +11,8 @@
 //! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
 //! let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
 //! let robot = emg_kinematics::Robot::from_chain_file(data.join("robots/fr3_pen.urdf"))?;
-//! let planner = Planner::new(robot, Models::shipped(&data)?, PlannerConfig::default())?;
+//! let models = Models::shipped(&robot, &data)?;
+//! let planner = Planner::new(robot, models, PlannerConfig::default())?;
 //! let task = demo_task(planner.robot())?;
 //! let plan = planner.plan(&task, &PlanRequest::default())?;
 //! println!("{:.3} m, ended: {}", plan.trajectory.path_length_m, plan.trajectory.termination);
@@ -33,6 +34,7 @@ pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
 pub use demo::demo_task;
 pub use models::{
     DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
+    robot_stamp,
 };
 pub use parse::ParseError;
 pub use planner::{Plan, PlanError, PlanRequest, Planner};

@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeedError, DpSeeder, WeightsError};
+use emg_kinematics::Robot;
+use emg_learning::{RobotStamp, StampError, check_stamp};
 use emg_policy::{PolicyWeights, RlController};
 
 /// File name of a robot's shipped diffusion-seeder weights, in its `models/` directory.
@@ -25,6 +27,9 @@ pub struct Models {
 /// Why a model cannot be loaded.
 #[derive(Debug, thiserror::Error)]
 pub enum ModelsError {
+    /// The weights were trained for another robot, or record none.
+    #[error(transparent)]
+    Robot(#[from] StampError),
     /// The diffusion weights cannot be read.
     #[error("cannot load diffusion weights {path}")]
     Diffusion {
@@ -55,41 +60,60 @@ pub enum ModelsError {
 }
 
 impl Models {
-    /// Loads the models whose files are given (with the default DP seed settings).
-    pub fn load(diffusion: Option<&Path>, policy: Option<&Path>) -> Result<Self, ModelsError> {
+    /// Loads the models of `robot` whose files are given (with the default DP seed settings);
+    /// each file must have been trained for `robot`.
+    pub fn load(
+        robot: &Robot,
+        diffusion: Option<&Path>,
+        policy: Option<&Path>,
+    ) -> Result<Self, ModelsError> {
         Ok(Self {
-            seeder: diffusion.map(load_seeder).transpose()?,
-            policy: policy.map(load_policy).transpose()?,
+            seeder: diffusion.map(|p| load_seeder(robot, p)).transpose()?,
+            policy: policy.map(|p| load_policy(robot, p)).transpose()?,
         })
     }
 
-    /// Loads both models shipped in a robot's data directory (`<dir>/models/`).
-    pub fn shipped(data_dir: &Path) -> Result<Self, ModelsError> {
+    /// Loads both models shipped for `robot` in its data directory (`<dir>/models/`).
+    pub fn shipped(robot: &Robot, data_dir: &Path) -> Result<Self, ModelsError> {
         let models = data_dir.join("models");
         Self::load(
+            robot,
             Some(&models.join(DIFFUSION_WEIGHTS_FILE)),
             Some(&models.join(POLICY_WEIGHTS_FILE)),
         )
     }
 }
 
-/// The diffusion seeder of a weights file, with the default DP seed settings.
-pub fn load_seeder(path: &Path) -> Result<DpSeeder, ModelsError> {
+/// The stamp weights trained for `robot` record: its name and its chain's fingerprint.
+pub fn robot_stamp(robot: &Robot) -> RobotStamp {
+    RobotStamp {
+        name: robot.name().to_string(),
+        fingerprint: robot.fingerprint(),
+    }
+}
+
+/// The diffusion seeder of a weights file trained for `robot`, with the default DP seed
+/// settings.
+pub fn load_seeder(robot: &Robot, path: &Path) -> Result<DpSeeder, ModelsError> {
     let weights = DenoiserWeights::read(path).map_err(|source| ModelsError::Diffusion {
         path: path.to_path_buf(),
         source,
     })?;
+    let file = path.display().to_string();
+    check_stamp(weights.header().robot.as_ref(), &robot_stamp(robot), &file)?;
     DpSeeder::new(&weights, DpSeedConfig::default()).map_err(|source| ModelsError::Seeder {
         path: path.to_path_buf(),
         source,
     })
 }
 
-/// The learned controller of a policy weights file.
-pub fn load_policy(path: &Path) -> Result<RlController, ModelsError> {
+/// The learned controller of a policy weights file trained for `robot`.
+pub fn load_policy(robot: &Robot, path: &Path) -> Result<RlController, ModelsError> {
     let weights = PolicyWeights::read(path).map_err(|source| ModelsError::Policy {
         path: path.to_path_buf(),
         source,
     })?;
+    let file = path.display().to_string();
+    check_stamp(weights.header().robot.as_ref(), &robot_stamp(robot), &file)?;
     Ok(RlController::new(&weights))
 }

@@ -29,7 +29,7 @@ fn planner(models: Models) -> Planner {
 }
 
 fn shipped_models() -> Models {
-    Models::shipped(&fr3().data_dir(&data())).expect("shipped models load")
+    Models::shipped(&robot(), &fr3().data_dir(&data())).expect("shipped models load")
 }
 
 fn checker(robot: &Robot) -> ReferenceModel {
@@ -125,7 +125,7 @@ fn plans_pass_the_checker_and_do_not_depend_on_the_thread_count() {
 fn the_demo_plans_on_every_shipped_robot() {
     for shipped in SHIPPED_ROBOTS {
         let robot = Robot::from_chain_file(shipped.path(&data())).expect("robot loads");
-        let models = Models::shipped(&shipped.data_dir(&data())).expect("models load");
+        let models = Models::shipped(&robot, &shipped.data_dir(&data())).expect("models load");
         let planner = Planner::new(robot, models, PlannerConfig::default()).unwrap();
         let task = demo_task(planner.robot()).expect("demo task");
         let plan = planner.plan(&task, &PlanRequest::default()).unwrap();
@@ -265,4 +265,54 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
         .err()
         .unwrap();
     assert!(error.to_string().contains("rollout.dt_s"), "{error}");
+}
+
+#[test]
+fn models_trained_for_another_arm_are_refused_naming_both_robots() {
+    let fr3 = robot();
+    let iiwa = ShippedRobot::by_name("iiwa14").unwrap();
+    let models = iiwa.data_dir(&data()).join("models");
+    for file in [
+        emg_planner::POLICY_WEIGHTS_FILE,
+        emg_planner::DIFFUSION_WEIGHTS_FILE,
+    ] {
+        let path = models.join(file);
+        let error = if file == emg_planner::POLICY_WEIGHTS_FILE {
+            Models::load(&fr3, None, Some(&path))
+        } else {
+            Models::load(&fr3, Some(&path), None)
+        }
+        .err()
+        .expect("the iiwa's weights are refused on the FR3");
+        let message = error.to_string();
+        assert!(
+            message.contains("trained for robot 'iiwa14_pen'")
+                && message.contains("not for robot 'fr3_pen'"),
+            "{message}"
+        );
+    }
+    // A file that records no robot is refused too, and says how to stamp it.
+    let dir = tempfile::tempdir().unwrap();
+    let unstamped = dir.path().join("policy.weights");
+    let weights =
+        emg_policy::PolicyWeights::read(&fr3_models().join(emg_planner::POLICY_WEIGHTS_FILE))
+            .unwrap();
+    let mut header = weights.header().clone();
+    header.robot = None;
+    emg_policy::PolicyWeights::new(header, weights.values().to_vec())
+        .unwrap()
+        .write(&unstamped)
+        .unwrap();
+    let message = Models::load(&fr3, None, Some(&unstamped))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        message.contains("records no robot") && message.contains("stamp-weights"),
+        "{message}"
+    );
+}
+
+fn fr3_models() -> std::path::PathBuf {
+    fr3().data_dir(&data()).join("models")
 }

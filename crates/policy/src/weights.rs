@@ -36,6 +36,10 @@ pub struct WeightsHeader {
     pub log_std_range: [f64; 2],
     /// Environment steps the weights were trained for.
     pub env_steps: u64,
+    /// The robot the weights were trained for (absent in files written before robots were
+    /// recorded; the planner refuses such a file until it is stamped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub robot: Option<emg_learning::RobotStamp>,
 }
 
 /// Why a weights file is unusable; every variant says what is wrong.
@@ -159,6 +163,8 @@ impl PolicyWeights {
                 action_dim: ACTION_DIM,
                 log_std_range: [log_std_range.0, log_std_range.1],
                 env_steps,
+
+                robot: None,
             },
             values,
         }
@@ -198,6 +204,12 @@ impl PolicyWeights {
     /// The header.
     pub fn header(&self) -> &WeightsHeader {
         &self.header
+    }
+
+    /// The same weights recorded as trained for `robot` (the values are unchanged).
+    pub fn stamped(mut self, robot: emg_learning::RobotStamp) -> Self {
+        self.header.robot = Some(robot);
+        self
     }
 
     /// The values in file order.
