@@ -49,6 +49,10 @@ struct Manifest {
     split: &'static str,
 }
 
+/// Candidates drawn per requested task before the sampler gives up (the shipped robots'
+/// populations accept about 1 in 1.1).
+const MAX_CANDIDATES_PER_TASK: u64 = 1000;
+
 /// Runs the sampler and writes both sets and their manifest.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
@@ -64,8 +68,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut files = Vec::new();
     for (name, count) in [("eval", args.eval_count), ("train", args.train_count)] {
         let bar = progress::bar(count as u64, name);
-        let tasks = sampler.take(count, &|accepted| bar.set_position(accepted as u64));
+        let max_candidates = (count as u64).saturating_mul(MAX_CANDIDATES_PER_TASK);
+        let tasks = sampler.take(count, max_candidates, &|accepted| {
+            bar.set_position(accepted as u64)
+        });
         bar.finish();
+        anyhow::ensure!(
+            tasks.len() == count,
+            "{name} set: only {} of {count} tasks among {max_candidates} candidates; the \
+             population of {} accepts fewer than 1 candidate in {MAX_CANDIDATES_PER_TASK}",
+            tasks.len(),
+            args.robot.display()
+        );
         let file = args.out_dir.join(format!("{name}-v{version}.tasks"));
         write_task_set(&file, &tasks)?;
         println!("wrote {} tasks to {}", tasks.len(), file.display());

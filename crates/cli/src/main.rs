@@ -28,6 +28,8 @@
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv` +
 //!   `<stem>.joint_trajectory.json`; a task file with several tasks gives `<stem>-00000.json`,
 //!   ... and so on, each written as soon as its task is planned. Parent directories are created.
+//!   SIGINT (Ctrl-C) or SIGTERM lets the task being planned finish and write its files whole,
+//!   starts no further task, and exits with 128 + the signal number (130, 143).
 //! * `--html <path>`: also a self-contained HTML page that animates the motion in 3D
 //!   (`<path without extension>-00000.html`, ... for several tasks).
 //!
@@ -40,6 +42,7 @@
 
 mod args;
 mod check;
+mod interrupt;
 mod output;
 mod robot;
 mod tasks;
@@ -54,6 +57,7 @@ use emg_io::{JointTrajectory, PlanPaths, TrajectoryFile, html_path};
 use emg_planner::{Models, Plan, PlanError, PlanRequest, Planner, PlannerConfig, SeedSource};
 
 use crate::args::{Cli, Command, PlanArgs};
+use crate::interrupt::{Interrupt, Interrupted};
 use crate::output::{write_result, write_text};
 
 fn main() -> ExitCode {
@@ -63,6 +67,12 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(error) if error.is::<Interrupted>() => {
+            eprintln!("{error:#}");
+            error
+                .downcast_ref::<Interrupted>()
+                .map_or(ExitCode::FAILURE, |stop| ExitCode::from(stop.exit_code()))
+        }
         Err(error) => {
             eprintln!("error: {error:#}");
             ExitCode::FAILURE
@@ -71,6 +81,7 @@ fn main() -> ExitCode {
 }
 
 fn run_plan(args: &PlanArgs) -> Result<()> {
+    let interrupt = Interrupt::install()?;
     let robot = robot::load_robot(
         &args.robot,
         args.base_link.as_deref(),
@@ -94,6 +105,14 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     let many = tasks.len() > 1;
     let mut failures = 0;
     for (index, task) in tasks.iter().enumerate() {
+        if let Some(stop) = interrupt.received() {
+            let written = index - failures;
+            return Err(anyhow::Error::new(stop).context(format!(
+                "{written} of {} tasks planned and written whole, {failures} failed; the rest \
+                 were not started",
+                tasks.len()
+            )));
+        }
         let label = if many {
             format!("task {index}: ")
         } else {

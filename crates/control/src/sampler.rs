@@ -68,12 +68,23 @@ impl<'a> TaskSampler<'a> {
         self.next_candidate
     }
 
-    /// The next `count` accepted tasks; `progress(accepted)` is called after every batch.
-    pub fn take(&mut self, count: usize, progress: &dyn Fn(usize)) -> Vec<Task> {
+    /// The next `count` accepted tasks among at most `max_candidates` further candidates (fewer
+    /// tasks when those are spent first, so that a robot whose population accepts almost
+    /// nothing cannot stall the caller); `progress(accepted)` is called after every batch.
+    pub fn take(
+        &mut self,
+        count: usize,
+        max_candidates: u64,
+        progress: &dyn Fn(usize),
+    ) -> Vec<Task> {
+        let limit = self.next_candidate.saturating_add(max_candidates);
         let mut tasks = Vec::with_capacity(count);
-        while tasks.len() < count {
+        while tasks.len() < count && self.next_candidate < limit {
             let first = self.next_candidate;
-            let batch: Vec<Option<Task>> = (first..first + self.config.batch_size.max(1) as u64)
+            let end = first
+                .saturating_add(self.config.batch_size.max(1) as u64)
+                .min(limit);
+            let batch: Vec<Option<Task>> = (first..end)
                 .into_par_iter()
                 .map(|index| self.accepted_candidate(index))
                 .collect();

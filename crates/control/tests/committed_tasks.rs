@@ -32,7 +32,8 @@ fn shipped_evaluation_sets_start_with_the_regenerated_tasks() {
             batch_size: 64,
             ..sampler
         };
-        let regenerated = TaskSampler::new(&robot, &rollout, &gains, &config).take(150, &|_| {});
+        let regenerated =
+            TaskSampler::new(&robot, &rollout, &gains, &config).take(150, u64::MAX, &|_| {});
         for (i, (a, b)) in regenerated.iter().zip(&shipped_set).enumerate() {
             let bits = |t: &emg_control::Task| {
                 let seed = t.q0_seed.expect("seeded");

@@ -4,7 +4,8 @@
 //! shipped sets bit for bit in another process); sampled tasks have `n` within 5° of
 //! the generating tool axis, `d ⟂ n`, `p0 = TCP(q0_seed)` and a collision-free seed inside the
 //! limits. `TaskSampler::take` gives the same tasks on 1 and 2 threads, in any batch size and
-//! when taken in pieces, and keeps exactly the candidates whose classical rollout reaches 0.1 m.
+//! when taken in pieces, keeps exactly the candidates whose classical rollout reaches 0.1 m, and
+//! stops once its candidate budget is spent.
 
 mod common;
 
@@ -108,7 +109,7 @@ fn take_in_pool(
         let mut tasks = Vec::new();
         for &count in counts {
             let reported = std::sync::Mutex::new(Vec::new());
-            let batch = sampler.take(count, &|n| reported.lock().unwrap().push(n));
+            let batch = sampler.take(count, u64::MAX, &|n| reported.lock().unwrap().push(n));
             assert_eq!(batch.len(), count);
             let reported = reported.into_inner().unwrap();
             assert_eq!(reported.last(), Some(&count), "progress ends at the count");
@@ -171,4 +172,31 @@ fn sampler_is_independent_of_threads_and_batches() {
             trajectory.path_length_m
         );
     }
+}
+
+#[test]
+fn a_candidate_budget_bounds_the_draw() {
+    let robot = robot();
+    let config = SamplerConfig {
+        batch_size: 16,
+        ..SamplerConfig::default()
+    };
+    let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());
+    let mut bounded = TaskSampler::new(&robot, &rollout, &gains, &config);
+    // Far more tasks than 40 candidates can give: the budget, not the count, ends the draw.
+    let tasks = bounded.take(1000, 40, &|_| {});
+    assert_eq!(bounded.candidates_drawn(), 40);
+    assert!(
+        !tasks.is_empty() && tasks.len() < 40,
+        "{} tasks",
+        tasks.len()
+    );
+    let (unbounded, _) = take_in_pool(2, &robot, &config, &[tasks.len()]);
+    assert_eq!(
+        tasks, unbounded,
+        "the budget changes which tasks are accepted"
+    );
+    // The budget counts from where the previous draw stopped.
+    bounded.take(1000, 25, &|_| {});
+    assert_eq!(bounded.candidates_drawn(), 65);
 }

@@ -56,4 +56,6 @@ pub use joint_trajectory::{
 };
 pub use paths::{PlanPaths, html_path};
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
-pub use task_file::{TASK_FORMAT_VERSION, TaskFileError, TaskSpec, read_tasks, write_task_set};
+pub use task_file::{
+    TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_tasks, write_task_set,
+};

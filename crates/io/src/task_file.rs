@@ -121,12 +121,18 @@ pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError
         path: path.display().to_string(),
         source,
     })?;
-    let name = path.display().to_string();
+    parse_tasks(&path.display().to_string(), &bytes, robot)
+}
+
+/// Parses the bytes of a task file (either layout, told apart by content as in
+/// [`read_tasks`]); `origin` names the bytes in errors.
+pub fn parse_tasks(origin: &str, bytes: &[u8], robot: &Robot) -> Result<Vec<Task>, TaskFileError> {
+    let name = origin.to_string();
     let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
     let specs = if bytes.starts_with(MAGIC) {
-        parse_binary(&name, &bytes)?
+        parse_binary(&name, bytes)?
     } else if matches!(first, Some(b'{' | b'[')) {
-        parse_json(&name, &bytes)?
+        parse_json(&name, bytes)?
     } else if bytes.starts_with(&MAGIC[..bytes.len().min(MAGIC.len())]) && !bytes.is_empty() {
         return Err(TaskFileError::Format {
             path: name,

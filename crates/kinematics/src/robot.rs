@@ -28,7 +28,7 @@ pub enum RobotError {
     /// A link named as the chain's base or tip does not exist.
     #[error("{role} link '{name}' is not in the robot file (links: {available})")]
     MissingLink {
-        /// `"base"` or `"tip"`.
+        /// `"base"`, `"tip"`, or `"joint parent"` for a link a joint of the chain names.
         role: &'static str,
         /// Requested link name.
         name: String,
@@ -90,7 +90,17 @@ pub enum RobotError {
     BadJoint {
         /// Joint name.
         joint: String,
-        /// Offending field (`axis`, `limit`, `velocity`).
+        /// Offending field (`origin`, `axis`, `limit`, `velocity`).
+        field: &'static str,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A collision element has a position, a radius or a length that is not a usable number.
+    #[error("link '{link}': collision {field} {problem}")]
+    BadGeometry {
+        /// Link carrying the geometry.
+        link: String,
+        /// Offending field (`origin`, `radius`, `length`).
         field: &'static str,
         /// What is wrong with it.
         problem: String,
@@ -234,7 +244,12 @@ impl Robot {
         // current link's URDF frame.
         let mut offset = Isometry3::identity();
         for joint in &path {
-            let origin = pose_to_isometry(&joint.origin);
+            let origin =
+                pose_to_isometry(&joint.origin).map_err(|problem| RobotError::BadJoint {
+                    joint: joint.name.clone(),
+                    field: "origin",
+                    problem,
+                })?;
             match joint.joint_type {
                 urdf_rs::JointType::Fixed => offset *= origin,
                 urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous => {
@@ -423,17 +438,27 @@ fn chain_joints<'a>(
         .iter()
         .map(|j| (j.child.link.as_str(), j))
         .collect();
+    let not_a_chain = || RobotError::NotAChain {
+        base: base.into(),
+        tip: tip.into(),
+    };
     let mut path = Vec::new();
     let mut link = tip;
     while link != base {
-        let joint = parent_joint
-            .get(link)
-            .ok_or_else(|| RobotError::NotAChain {
-                base: base.into(),
-                tip: tip.into(),
-            })?;
+        let joint = parent_joint.get(link).ok_or_else(not_a_chain)?;
+        // A walk longer than the file's joints has met a loop.
+        if path.len() == urdf.joints.len() {
+            return Err(not_a_chain());
+        }
         path.push(*joint);
         link = joint.parent.link.as_str();
+        if !urdf.links.iter().any(|l| l.name == link) {
+            return Err(RobotError::MissingLink {
+                role: "joint parent",
+                name: link.into(),
+                available: available(),
+            });
+        }
     }
     path.reverse();
     for joint in &path {
@@ -455,13 +480,20 @@ fn chain_joints<'a>(
     Ok(path)
 }
 
-fn pose_to_isometry(pose: &urdf_rs::Pose) -> Isometry3<f64> {
+/// The transform of a URDF `<origin>`; fails unless its six numbers are finite.
+fn pose_to_isometry(pose: &urdf_rs::Pose) -> Result<Isometry3<f64>, String> {
     let [x, y, z] = pose.xyz.0;
     let [roll, pitch, yaw] = pose.rpy.0;
-    Isometry3::from_parts(
+    if !pose.xyz.0.iter().chain(&pose.rpy.0).all(|v| v.is_finite()) {
+        return Err(format!(
+            "xyz {:?} rpy {:?} must be finite numbers",
+            pose.xyz.0, pose.rpy.0
+        ));
+    }
+    Ok(Isometry3::from_parts(
         Translation3::new(x, y, z),
         UnitQuaternion::from_euler_angles(roll, pitch, yaw),
-    )
+    ))
 }
 
 /// Rotation that takes local +z onto the joint's axis, so the joint turns about +z after it.
@@ -531,7 +563,20 @@ fn chain_capsules(chain: &[ChainLink<'_>]) -> Result<Vec<Capsule>, RobotError> {
                     });
                 }
             };
-            let frame = entry.offset * pose_to_isometry(&collision.origin);
+            let bad = |field, problem| RobotError::BadGeometry {
+                link: entry.link.name.clone(),
+                field,
+                problem,
+            };
+            if !(radius.is_finite() && radius >= 0.0) {
+                return Err(bad("radius", format!("{radius} must be a number ≥ 0")));
+            }
+            if !(half_length.is_finite() && half_length >= 0.0) {
+                let length = 2.0 * half_length;
+                return Err(bad("length", format!("{length} must be a number ≥ 0")));
+            }
+            let origin = pose_to_isometry(&collision.origin).map_err(|p| bad("origin", p))?;
+            let frame = entry.offset * origin;
             let a = frame * Point3::new(0.0, 0.0, -half_length);
             let b = frame * Point3::new(0.0, 0.0, half_length);
             capsules.push(Capsule {

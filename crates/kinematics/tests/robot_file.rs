@@ -1,9 +1,10 @@
 //! Loading robot files: the shipped FR3 file's structure (joint names, limits), every load error
 //! (unreadable file, malformed XML, missing base/tip link, tip not below base, a branching
-//! chain, a prismatic joint, six revolute joints, lower > upper, zero axis, bad velocity,
-//! unsupported geometry) with a message naming the offending field or link, and the load-time
-//! axis alignment: joints given with a non-z axis and a compensating origin rotation must give
-//! the same FK and collision geometry as the z-axis original.
+//! chain, a loop of joints, a prismatic joint, six revolute joints, lower > upper, zero axis, bad
+//! velocity, non-finite origins or capsules, unsupported geometry) with a message naming the
+//! offending field or link, and the load-time axis alignment: joints given with a non-z axis and
+//! a compensating origin rotation must give the same FK and collision geometry as the z-axis
+//! original.
 
 mod common;
 
@@ -361,4 +362,49 @@ fn negative_and_unnormalised_axes_are_aligned_at_load_time() {
     });
     println!("axis '0 0 -1' / '0 0 2.5': worst difference {worst:.3e}");
     assert!(worst < 1e-9, "FK differs by {worst:e}");
+}
+
+#[test]
+fn non_finite_origins_and_capsules_are_rejected() {
+    let text = edited("<origin xyz=\"0 0 0.333\"", "<origin xyz=\"inf 0 0.333\"");
+    let (error, message) = error_message(load(&text));
+    assert!(
+        matches!(
+            error,
+            RobotError::BadJoint {
+                field: "origin",
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert!(message.contains("fr3_joint1"), "{message}");
+    let text = edited(
+        "<geometry><capsule radius=\"0.05\" length=\"0.08\"/></geometry>",
+        "<geometry><capsule radius=\"NaN\" length=\"0.08\"/></geometry>",
+    );
+    let (error, message) = error_message(load(&text));
+    assert!(
+        matches!(
+            error,
+            RobotError::BadGeometry {
+                field: "radius",
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert!(message.contains("link6"), "{message}");
+}
+
+#[test]
+fn a_loop_of_joints_is_not_a_chain() {
+    // link1's joint names link2 as its parent, and link2's names link1: walking up from the tip
+    // never reaches the base.
+    let text = edited(
+        "<parent link=\"link0\"/>\n    <child link=\"link1\"/>",
+        "<parent link=\"link2\"/>\n    <child link=\"link1\"/>",
+    );
+    let (error, _) = error_message(load(&text));
+    assert!(matches!(error, RobotError::NotAChain { .. }), "{error:?}");
 }

@@ -94,8 +94,13 @@ impl PlannerConfig {
             path: path.display().to_string(),
             source,
         })?;
-        let config: Self = serde_json::from_str(&text).map_err(|e| ConfigError::Parse {
-            path: path.display().to_string(),
+        Self::from_json(&path.display().to_string(), &text)
+    }
+
+    /// Parses and validates a configuration's JSON text; `origin` names it in errors.
+    pub fn from_json(origin: &str, text: &str) -> Result<Self, ConfigError> {
+        let config: Self = serde_json::from_str(text).map_err(|e| ConfigError::Parse {
+            path: origin.to_string(),
             message: e.to_string(),
         })?;
         config.validate()?;

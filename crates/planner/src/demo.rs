@@ -8,11 +8,15 @@ use emg_kinematics::{Robot, Vec3};
 /// mid-range configuration is stretched out, like the iiwa's, cannot move its TCP sideways).
 const DEMO_MIN_SINGULAR_VALUE: f64 = 0.05;
 
+/// Candidates of the task population tried for a demo task before the mid-range task is used
+/// all the same.
+const DEMO_MAX_CANDIDATES: u64 = 4096;
+
 /// The built-in demo task: from the mid-range configuration, `p0` = its TCP, `n` = its tool
 /// axis, `d` = +y made perpendicular to `n`; `q0_seed` = the mid-range configuration. When the
 /// mid-range configuration is near a singularity, the first task of the robot's task population
-/// (`emg_control::TaskSampler` with its default settings) instead (or, should the population
-/// yield none, the mid-range task all the same).
+/// (`emg_control::TaskSampler` with its default settings) instead (or, should none of its
+/// first [`DEMO_MAX_CANDIDATES`] candidates be accepted, the mid-range task all the same).
 pub fn demo_task(robot: &Robot) -> Result<Task, TaskError> {
     let seed = robot.mid_range();
     let kinematics = robot.forward(&seed);
@@ -21,7 +25,7 @@ pub fn demo_task(robot: &Robot) -> Result<Task, TaskError> {
         let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());
         let config = SamplerConfig::default();
         let mut sampler = TaskSampler::new(robot, &rollout, &gains, &config);
-        if let Some(task) = sampler.take(1, &|_| {}).pop() {
+        if let Some(task) = sampler.take(1, DEMO_MAX_CANDIDATES, &|_| {}).pop() {
             return Ok(task);
         }
     }

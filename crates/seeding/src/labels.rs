@@ -155,14 +155,17 @@ impl LabelSet {
             path: name.clone(),
             source,
         })?;
+        Self::from_bytes(&name, &bytes)
+    }
+
+    /// Parses and validates the bytes of a label file; `origin` names them in errors.
+    pub fn from_bytes(origin: &str, bytes: &[u8]) -> Result<Self, LabelError> {
+        let name = origin.to_string();
         let format = |problem: String| LabelError::Format {
             path: name.clone(),
             problem,
         };
-        let mut reader = Reader {
-            bytes: &bytes,
-            at: 0,
-        };
+        let mut reader = Reader { bytes, at: 0 };
         let truncated = || "the file is truncated".to_string();
         if reader.take(8).ok_or_else(truncated).map_err(format)? != MAGIC {
             return Err(format("not a label file (magic bytes differ)".into()));
@@ -183,7 +186,10 @@ impl LabelSet {
                 "{records} records for a task set of {task_set_len} tasks"
             )));
         }
-        let mut tasks = Vec::with_capacity(records as usize);
+        // The declared count sizes nothing: a record takes at least `RECORD_HEADER_BYTES`, so
+        // the bytes present bound how many can follow.
+        let room = (bytes.len() - reader.at) / RECORD_HEADER_BYTES;
+        let mut tasks = Vec::with_capacity(usize::try_from(records).map_or(room, |r| r.min(room)));
         for _ in 0..records {
             tasks.push(reader.record().ok_or_else(truncated).map_err(format)?);
         }
@@ -205,11 +211,14 @@ impl LabelSet {
 
     /// Writes the set in the binary layout (atomically: a temporary file renamed into place).
     pub fn write(&self, path: &Path) -> Result<(), LabelError> {
-        let name = path.display().to_string();
-        let io = |source| LabelError::Io {
-            path: name.clone(),
+        emg_io::write_atomically(path, &self.to_bytes()).map_err(|source| LabelError::Io {
+            path: path.display().to_string(),
             source,
-        };
+        })
+    }
+
+    /// The set in the binary layout.
+    pub fn to_bytes(&self) -> Vec<u8> {
         let labels: usize = self.tasks.iter().map(|t| t.labels.len()).sum();
         let mut bytes = Vec::with_capacity(
             HEADER_BYTES + self.tasks.len() * RECORD_HEADER_BYTES + labels * LABEL_BYTES,
@@ -232,7 +241,7 @@ impl LabelSet {
                 bytes.extend_from_slice(&label.branch.to_le_bytes());
             }
         }
-        emg_io::write_atomically(path, &bytes).map_err(io)
+        bytes
     }
 
     /// Joins label sets of the same task set holding disjoint tasks into one, in task order.

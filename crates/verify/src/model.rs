@@ -58,6 +58,17 @@ pub enum ModelError {
     /// A collision element is neither a capsule nor a sphere.
     #[error("link '{0}': unsupported collision geometry (the checker reads capsules and spheres)")]
     Geometry(String),
+    /// The walk from the tip towards the base comes back to a link it has passed.
+    #[error("the joints from the tip towards the base form a loop at link '{0}'")]
+    Loop(String),
+    /// A number of the file the checker needs is not usable.
+    #[error("{element}: {problem}")]
+    Value {
+        /// The joint or link and the field, e.g. `joint 'fr3_joint1' origin`.
+        element: String,
+        /// What is wrong with it.
+        problem: String,
+    },
     /// The chain does not have the supported number of revolute joints.
     #[error("the chain has {0} revolute joints, expected {JOINTS}")]
     JointCount(usize),
@@ -75,6 +86,9 @@ impl ReferenceModel {
                 .iter()
                 .find(|j| j.child.link == link)
                 .ok_or_else(|| ModelError::Unreachable(link.clone()))?;
+            if path.len() == urdf.joints.len() {
+                return Err(ModelError::Loop(link));
+            }
             path.push(joint);
             link = joint.parent.link.clone();
         }
@@ -84,6 +98,11 @@ impl ReferenceModel {
         let mut link_names = vec![base.to_string()];
         link_names.extend(path.iter().map(|j| j.child.link.clone()));
         for joint in &path {
+            let element = |field: &str| format!("joint '{}' {field}", joint.name);
+            finite(
+                &element("origin"),
+                &[&joint.origin.xyz.0, &joint.origin.rpy.0],
+            )?;
             let [x, y, z] = joint.origin.xyz.0;
             let [r, p, yaw] = joint.origin.rpy.0;
             let mut origin = Rotation3::from_euler_angles(r, p, yaw).to_homogeneous();
@@ -95,12 +114,32 @@ impl ReferenceModel {
                 urdf_rs::JointType::Continuous => (true, -CONTINUOUS_RANGE, CONTINUOUS_RANGE),
                 _ => (false, 0.0, 0.0),
             };
+            let axis = Vector3::from(joint.axis.xyz.0);
+            if revolute && !(axis.norm().is_finite() && axis.norm() > 1e-9) {
+                return Err(ModelError::Value {
+                    element: element("axis"),
+                    problem: format!("{:?} is not a direction", joint.axis.xyz.0),
+                });
+            }
+            if revolute && !(lower.is_finite() && upper.is_finite() && lower < upper) {
+                return Err(ModelError::Value {
+                    element: element("limit"),
+                    problem: format!("[{lower}, {upper}] is not a range of finite numbers"),
+                });
+            }
+            let velocity = joint.limit.velocity;
+            if revolute && !(velocity.is_finite() && velocity > 0.0) {
+                return Err(ModelError::Value {
+                    element: element("velocity limit"),
+                    problem: format!("{velocity} is not a positive number"),
+                });
+            }
             joints.push(ReferenceJoint {
                 origin,
-                axis: revolute.then(|| Unit::new_normalize(Vector3::from(joint.axis.xyz.0))),
+                axis: revolute.then(|| Unit::new_normalize(axis)),
                 lower,
                 upper,
-                velocity: joint.limit.velocity,
+                velocity,
             });
         }
         for (chain_index, name) in link_names.iter().enumerate() {
@@ -115,6 +154,17 @@ impl ReferenceModel {
                     urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
                     _ => return Err(ModelError::Geometry(name.clone())),
                 };
+                let element = format!("link '{name}' collision");
+                finite(
+                    &element,
+                    &[&collision.origin.xyz.0, &collision.origin.rpy.0],
+                )?;
+                if !([radius, half].iter().all(|v| v.is_finite() && *v >= 0.0)) {
+                    return Err(ModelError::Value {
+                        element,
+                        problem: format!("radius {radius} and length {} must be ≥ 0", 2.0 * half),
+                    });
+                }
                 let [x, y, z] = collision.origin.xyz.0;
                 let [r, p, yaw] = collision.origin.rpy.0;
                 let rotation = Rotation3::from_euler_angles(r, p, yaw);
@@ -258,4 +308,15 @@ fn segments_gap(a0: &Vector3<f64>, a1: &Vector3<f64>, b0: &Vector3<f64>, b1: &Ve
         }
     }
     best
+}
+
+/// Fails, naming `element`, unless every number of `groups` is finite.
+fn finite(element: &str, groups: &[&[f64; 3]]) -> Result<(), ModelError> {
+    if groups.iter().all(|g| g.iter().all(|v| v.is_finite())) {
+        return Ok(());
+    }
+    Err(ModelError::Value {
+        element: element.to_string(),
+        problem: format!("{groups:?} must be finite numbers"),
+    })
 }

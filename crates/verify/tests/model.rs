@@ -37,3 +37,40 @@ fn a_chain_without_seven_revolute_joints_is_refused() {
     assert!(matches!(error, ModelError::JointCount(6)), "{error}");
     assert!(error.to_string().contains("expected 7"), "{error}");
 }
+
+#[test]
+fn a_loop_of_joints_and_unusable_numbers_are_refused() {
+    let looped = fr3_text().replacen(
+        "<parent link=\"link0\"/>\n    <child link=\"link1\"/>",
+        "<parent link=\"link2\"/>\n    <child link=\"link1\"/>",
+        1,
+    );
+    let result = ReferenceModel::from_urdf_str(&looped, "link0", "pen_tip");
+    assert!(
+        matches!(result, Err(ModelError::Loop(_))),
+        "a loop must be refused"
+    );
+    for (from, to, named) in [
+        (
+            "xyz=\"0 0 0.333\"",
+            "xyz=\"inf 0 0.333\"",
+            "joint 'fr3_joint1' origin",
+        ),
+        (
+            "<axis xyz=\"0 0 1\"/>",
+            "<axis xyz=\"0 0 0\"/>",
+            "joint 'fr3_joint1' axis",
+        ),
+        ("radius=\"0.06\"", "radius=\"NaN\"", "collision"),
+    ] {
+        let text = fr3_text().replacen(from, to, 1);
+        assert_ne!(text, fr3_text(), "anchor {from} not found");
+        match ReferenceModel::from_urdf_str(&text, "link0", "pen_tip") {
+            Err(error @ ModelError::Value { .. }) => {
+                assert!(error.to_string().contains(named), "{error}");
+            }
+            Err(other) => panic!("{to}: refused for another reason: {other}"),
+            Ok(_) => panic!("{to}: accepted"),
+        }
+    }
+}

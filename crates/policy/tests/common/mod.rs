@@ -17,7 +17,7 @@ pub fn tasks(robot: &Robot, count: usize) -> Vec<Task> {
         batch_size: 64,
         ..SamplerConfig::default()
     };
-    TaskSampler::new(robot, &rollout, &gains, &config).take(count, &|_| {})
+    TaskSampler::new(robot, &rollout, &gains, &config).take(count, u64::MAX, &|_| {})
 }
 
 /// The workspace's shipped data directory.
