@@ -21,6 +21,7 @@ mod make_tasks;
 mod progress;
 mod protocol;
 mod report;
+mod search_eval;
 mod stamp_weights;
 mod train_diffusion;
 mod train_ppo;
@@ -62,6 +63,8 @@ enum Command {
     TrainPpo(train_ppo::Args),
     /// Record in weights files which robot they were trained for (the values are unchanged).
     StampWeights(stamp_weights::Args),
+    /// The search planner against the pipeline at several step budgets (docs/results/search.*).
+    SearchEval(search_eval::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -78,5 +81,6 @@ fn main() -> anyhow::Result<()> {
         Command::TrainPpo(args) => train_ppo::run(&args),
         Command::FigureBranches(args) => figure_branches::run(&args),
         Command::StampWeights(args) => stamp_weights::run(&args),
+        Command::SearchEval(args) => search_eval::run(&args),
     }
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand};
-use emg_planner::{ControllerKind, SeedSource};
+use emg_planner::{ControllerKind, PlannerKind, SeedSource};
 
 /// Extreme straight-line motion on a 7-DoF arm holding a pen.
 #[derive(Debug, Parser)]
@@ -113,6 +113,11 @@ pub struct PlanArgs {
     /// task file holding several tasks: PATH-00000.html, ..., the extension kept).
     #[arg(long, value_name = "PATH")]
     pub html: Option<PathBuf>,
+    /// Planner: `controller` (the paper's pipeline: one seed, one rollout) or `search` (many
+    /// candidate starts ranked by rollouts within the config's `search.budget_steps`; the
+    /// controller then drives the best-ranked finalists).
+    #[arg(long, value_name = "NAME", value_parser = PlannerKind::from_str, default_value = "controller")]
+    pub planner: PlannerKind,
     /// Null-space controller: `classical` (Eq. 3), `rl` (the PPO policy, Sec. 4.2) or `hybrid`
     /// (learned inside, classical near the joint limits, Sec. 4.3).
     #[arg(long, value_name = "NAME", value_parser = ControllerKind::from_str, default_value = "hybrid")]
@@ -121,6 +126,20 @@ pub struct PlanArgs {
     /// robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub policy: Option<PathBuf>,
+    /// Also scan the task's reachability bound (how far along the line the arm can be placed
+    /// at all, on a 1 cm grid), print it beside the path length and record it as
+    /// `reachable_m`.
+    #[arg(long, value_name = "on|off", default_value = "on")]
+    pub reach: OnOff,
+}
+
+/// A feature switched on or off on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnOff {
+    /// Enabled.
+    On,
+    /// Disabled.
+    Off,
 }
 
 impl PlanArgs {

@@ -22,6 +22,9 @@
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
 //! * `--config <json>`: an `emg_planner::PlannerConfig`: optional `rollout`, `gains`, `switch`
 //!   (`tau_enter`, `tau_exit`) and `measure` objects; unset fields keep SPEC defaults.
+//! * `--planner controller` (default: the paper's pipeline, one seed and one rollout) or
+//!   `search` (many candidate starts ranked by rollouts within a step budget, `emg_planner`'s
+//!   search planner; the controller drives the finalists).
 //! * `--controller hybrid` (default: the PPO policy over `--policy`, default the robot's shipped
 //!   `ppo-v1.weights`, inside; the classical controller near the joint limits),
 //!   `rl` or `classical`.
@@ -30,6 +33,9 @@
 //!   ... and so on, each written as soon as its task is planned. Parent directories are created.
 //!   SIGINT (Ctrl-C) or SIGTERM lets the task being planned finish and write its files whole,
 //!   starts no further task, and exits with 128 + the signal number (130, 143).
+//! * `--reach on|off` (default on): also the task's reachability bound, how far along the line
+//!   the arm can be placed at all (`emg_planner::reach`), printed beside the path length and
+//!   recorded as `reachable_m`.
 //! * `--html <path>`: also a self-contained HTML page that animates the motion in 3D
 //!   (`<path without extension>-00000.html`, ... for several tasks).
 //!
@@ -56,7 +62,7 @@ use emg_control::{Task, Trajectory};
 use emg_io::{JointTrajectory, PlanPaths, TrajectoryFile, html_path};
 use emg_planner::{Models, Plan, PlanError, PlanRequest, Planner, PlannerConfig, SeedSource};
 
-use crate::args::{Cli, Command, PlanArgs};
+use crate::args::{Cli, Command, OnOff, PlanArgs};
 use crate::interrupt::{Interrupt, Interrupted};
 use crate::output::{write_result, write_text};
 
@@ -99,6 +105,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     let tasks = tasks::requested_tasks(&robot, args)?;
     let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
+        planner: args.planner,
         seed: args.seed.clone(),
         controller: args.controller,
     };
@@ -188,6 +195,7 @@ fn write_plan(
     let robot = planner.robot();
     let config = planner.config();
     let trajectory = &plan.trajectory;
+    let reach = (args.reach == OnOff::On).then(|| planner.reach(task, &[plan.seed.q]));
     let paths = PlanPaths::new(&args.out, index);
     let robot_name = args.robot.display().to_string();
     let file = TrajectoryFile {
@@ -196,12 +204,14 @@ fn write_plan(
         joint_names: robot.joint_names(),
         task,
         seed_source: plan.seed.source,
+        planner: args.planner.name(),
         controller: args.controller.name(),
         config: &config.rollout,
         gains: &config.gains,
         steps: &trajectory.steps,
         termination: &trajectory.termination,
         path_length_m: trajectory.path_length_m,
+        reachable_m: reach.as_ref().map(|r| r.reachable_m),
     };
     let joint = JointTrajectory::new(
         &robot_name,
@@ -222,8 +232,12 @@ fn write_plan(
         Some(n) => format!(", projected onto (p0, n) in {n} Newton iterations"),
         None => String::new(),
     };
+    let bound = match &reach {
+        Some(reach) => format!(" of at most {:.2} m reachable", reach.reachable_m),
+        None => String::new(),
+    };
     Ok(format!(
-        "path length {:.4} m, {steps} steps, {duration:.2} s; ended: {}\n  \
+        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}\n  \
          seed: {}{projected}\n  wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,

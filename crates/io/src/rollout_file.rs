@@ -26,6 +26,8 @@ pub struct TrajectoryFile<'a> {
     pub task: &'a Task,
     /// Where the seed came from (`dp`, `generating`, `home`, `given`, ...).
     pub seed_source: &'a str,
+    /// Planner that was requested (`controller` or `search`).
+    pub planner: &'a str,
     /// Controller that was requested.
     pub controller: &'a str,
     /// Rollout settings used.
@@ -38,6 +40,9 @@ pub struct TrajectoryFile<'a> {
     pub termination: &'a Termination,
     /// `(p_T − p0)·d` at the last accepted step (m).
     pub path_length_m: f64,
+    /// The task's reachability bound (m), when it was computed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reachable_m: Option<f64>,
 }
 
 impl TrajectoryFile<'_> {

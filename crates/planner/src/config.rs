@@ -1,6 +1,6 @@
 //! The planner's one configuration, which is also the `--config` JSON schema of `emg plan`:
-//! rollout settings, classical gains and the hybrid switch, every field optional with SPEC
-//! defaults.
+//! rollout settings, classical gains, the hybrid switch and the reachability scan, every field
+//! optional with SPEC defaults.
 
 use std::path::Path;
 
@@ -9,14 +9,17 @@ use emg_hybrid::{BoundaryMeasure, SwitchConfig, SwitchConfigError};
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ExecutorConfig;
+use crate::reach::ReachConfig;
+use crate::search::SearchConfig;
 
 /// Every setting of a plan; unset fields keep their defaults (SPEC §2–4, Sec. 4.3):
 /// `rollout` ([`RolloutConfig`]: `dt_s` 0.05 s, `speed_m_per_s` 0.2 m/s, `max_steps` 500,
 /// `null_speed_max_rad_per_s` 0.5, `lateral_gain_per_s` 5, constraints: `line_tolerance_m` 0.02,
 /// `theta_max_deg` 30, `collision_margin_m` 0, `velocity_limit_fraction` 1), `gains`
 /// ([`ClassicalGains`]: `k_mu` 0.8, `k_jl` 0.4, `k_theta` 0.2, `cone_gate_width_deg` 8),
-/// `switch` ([`SwitchConfig`]: `tau_enter` 0.98, `tau_exit` 0.94) and `measure`
-/// ([`BoundaryMeasure`], default `rho`).
+/// `switch` ([`SwitchConfig`]: `tau_enter` 0.98, `tau_exit` 0.94), `measure`
+/// ([`BoundaryMeasure`], default `rho`), `reach` ([`ReachConfig`]) and `search`
+/// ([`SearchConfig`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlannerConfig {
@@ -28,6 +31,12 @@ pub struct PlannerConfig {
     pub switch: SwitchConfig,
     /// Boundary measure of the hybrid switch.
     pub measure: BoundaryMeasure,
+    /// The reachability scan ([`ReachConfig`]: `grid_m` 0.01, `restarts` 64, `branches` 4,
+    /// `offsets` 6).
+    pub reach: ReachConfig,
+    /// The search planner ([`SearchConfig`]: `budget_steps` 20,000, `dp_samples` 32,
+    /// `ik_restarts` 64, `finalists` 4).
+    pub search: SearchConfig,
 }
 
 /// Why a configuration file cannot be used.
@@ -75,6 +84,8 @@ impl PlannerConfig {
         self.rollout.validate()?;
         self.gains.validate()?;
         self.switch.validate()?;
+        self.reach.validate()?;
+        self.search.validate()?;
         if let BoundaryMeasure::AllConstraints { clearance_scale_m } = self.measure
             && !(clearance_scale_m.is_finite() && clearance_scale_m > 0.0)
         {

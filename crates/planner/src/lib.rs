@@ -26,6 +26,8 @@ mod demo;
 mod models;
 pub mod parse;
 mod planner;
+mod reach;
+mod search;
 mod seed;
 mod shipped;
 
@@ -37,6 +39,8 @@ pub use models::{
     robot_stamp,
 };
 pub use parse::ParseError;
-pub use planner::{Plan, PlanError, PlanRequest, Planner};
+pub use planner::{Plan, PlanError, PlanRequest, Planner, PlannerKind};
+pub use reach::{MAX_REACH_RESTARTS, Reach, ReachConfig, reach};
+pub use search::{MAX_SEARCH_BUDGET_STEPS, SearchConfig};
 pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};

@@ -18,6 +18,9 @@ pub enum ParseError {
     /// Not the name of a controller.
     #[error("unknown controller '{0}': use classical, rl or hybrid")]
     Controller(String),
+    /// Not the name of a planner.
+    #[error("unknown planner '{0}': use controller or search")]
+    Planner(String),
     /// Not the name of a seed source.
     #[error(
         "unknown seed source '{0}': use dp, generating, home, q_mu, q_jl or q=v1,...,v7 (radians)"

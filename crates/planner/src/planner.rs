@@ -1,31 +1,80 @@
 //! The planner: a robot, its models and one configuration; plans a task or many.
 
 use emg_control::{Task, Trajectory, rollout};
-use emg_kinematics::Robot;
+use emg_kinematics::{JointVector, Robot};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::config::{ConfigError, PlannerConfig};
 use crate::controller::{ControllerKind, Executor, ExecutorError};
 use crate::models::Models;
+use crate::parse::ParseError;
+use crate::reach::{Reach, reach};
+use crate::search::{SearchContext, search};
 use crate::seed::{Seed, SeedError, SeedSource, prepare_seed};
 
-/// What to plan with: the seed source (`None` picks `dp` when the seeder is loaded, else
-/// `generating` when the task has a `q0_seed`, else `home`) and the controller.
+/// What to plan with: the planner, the seed source (`None` picks `dp` when the seeder is
+/// loaded, else `generating` when the task has a `q0_seed`, else `home`) and the controller.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlanRequest {
-    /// Seed source; `None` chooses as described above.
+    /// How the plan is made.
+    pub planner: PlannerKind,
+    /// Seed source; `None` chooses as described above. The search planner tries a requested
+    /// seed first among its candidates.
     pub seed: Option<SeedSource>,
-    /// The null-space controller that rolls out from the seed.
+    /// The null-space controller that rolls out from the seed (the search's finalists).
     pub controller: ControllerKind,
 }
 
 impl Default for PlanRequest {
-    /// The paper's full pipeline: the DP seed (when loaded) and the hybrid controller.
+    /// The paper's full pipeline: one DP seed (when loaded) and the hybrid controller.
     fn default() -> Self {
         Self {
+            planner: PlannerKind::Controller,
             seed: None,
             controller: ControllerKind::Hybrid,
         }
+    }
+}
+
+/// How a plan is made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlannerKind {
+    /// The paper's pipeline: one seed, one rollout of the controller (Sec. 4).
+    #[default]
+    Controller,
+    /// Many starts ranked by rollouts within a step budget (`crate::search`).
+    Search,
+}
+
+impl PlannerKind {
+    /// Both planners.
+    pub const ALL: [PlannerKind; 2] = [Self::Controller, Self::Search];
+
+    /// Lower-case name used in files and command lines.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Controller => "controller",
+            Self::Search => "search",
+        }
+    }
+}
+
+impl std::fmt::Display for PlannerKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for PlannerKind {
+    type Err = ParseError;
+
+    fn from_str(value: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|kind| kind.name() == value)
+            .ok_or_else(|| ParseError::Planner(value.to_string()))
     }
 }
 
@@ -69,6 +118,11 @@ impl Planner {
         })
     }
 
+    /// The same robot and models under another `config` (validated as in [`Planner::new`]).
+    pub fn with_config(&self, config: PlannerConfig) -> Result<Self, ConfigError> {
+        Self::new(self.robot.clone(), self.models.clone(), config)
+    }
+
     /// The robot.
     pub fn robot(&self) -> &Robot {
         &self.robot
@@ -85,20 +139,25 @@ impl Planner {
     }
 
     /// Seeds `task` as `request` asks and rolls out a fresh controller of `request.controller`
-    /// from that seed through the shared rollout loop.
+    /// from that seed through the shared rollout loop; for [`PlannerKind::Search`], that
+    /// rollout comes first and many other starts are tried within the configured step budget.
     pub fn plan(&self, task: &Task, request: &PlanRequest) -> Result<Plan, PlanError> {
-        let mut controller = Executor::new(
-            request.controller,
-            self.models.policy.as_ref(),
-            &self.config.executor(),
-        )?;
-        let seed = prepare_seed(
-            &self.robot,
-            task,
-            request.seed.as_ref(),
-            &self.config.rollout.constraints,
-            self.models.seeder.as_ref(),
-        )?;
+        let executor = self.config.executor();
+        let mut controller =
+            Executor::new(request.controller, self.models.policy.as_ref(), &executor)?;
+        let seed = self.seed(task, request)?;
+        if request.planner == PlannerKind::Search {
+            let context = SearchContext {
+                robot: &self.robot,
+                rollout: &self.config.rollout,
+                executor: &executor,
+                seeder: self.models.seeder.as_ref(),
+                config: &self.config.search,
+            };
+            let (seed, trajectory) =
+                search(&context, task, seed, request.controller, &mut controller)?;
+            return Ok(Plan { seed, trajectory });
+        }
         let trajectory = rollout(
             &self.robot,
             task,
@@ -107,6 +166,31 @@ impl Planner {
             &self.config.rollout,
         );
         Ok(Plan { seed, trajectory })
+    }
+
+    /// The seed `request` names for `task` ([`prepare_seed`]).
+    fn seed(&self, task: &Task, request: &PlanRequest) -> Result<Seed, SeedError> {
+        prepare_seed(
+            &self.robot,
+            task,
+            request.seed.as_ref(),
+            &self.config.rollout.constraints,
+            self.models.seeder.as_ref(),
+        )
+    }
+
+    /// The reachability bound of `task` under the configured constraints ([`reach`]), with the
+    /// task's `q0_seed` and `hints` (e.g. a plan's seed) as warm starts at `p0`.
+    pub fn reach(&self, task: &Task, hints: &[JointVector]) -> Reach {
+        let mut starts: Vec<JointVector> = hints.to_vec();
+        starts.extend(task.q0_seed);
+        reach(
+            &self.robot,
+            task,
+            &self.config.rollout.constraints,
+            &self.config.reach,
+            &starts,
+        )
     }
 
     /// [`Planner::plan`] of every task, in parallel on the current rayon pool; the results come

@@ -25,8 +25,8 @@ use emg_io::{
 };
 use emg_kinematics::{JointVector, Robot};
 use emg_planner::{
-    ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, SeedSource, ShippedRobot,
-    demo_task, robot_stamp,
+    ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SeedSource,
+    ShippedRobot, demo_task, robot_stamp,
 };
 use emg_seeding::{Label, LabelSet, Shard, TaskLabels};
 use emg_verify::{Recording, ReferenceModel, check_joint_names, check_replay};
@@ -303,6 +303,7 @@ fn plan_briefly(robot: &Robot, mut config: PlannerConfig, task: &Task) {
     let request = PlanRequest {
         seed: None,
         controller: ControllerKind::Classical,
+        ..PlanRequest::default()
     };
     let _ = planner.plan(task, &request);
 }
@@ -407,6 +408,7 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
     let request = PlanRequest {
         seed: Some(SeedSource::Home),
         controller: ControllerKind::Classical,
+        ..PlanRequest::default()
     };
     let plan = planner.plan(&task, &request).expect("the demo task plans");
     let trajectory = &plan.trajectory;
@@ -416,12 +418,14 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
         joint_names: robot.joint_names(),
         task: &task,
         seed_source: plan.seed.source,
+        planner: "controller",
         controller: ControllerKind::Classical.name(),
         config: &config.rollout,
         gains: &config.gains,
         steps: &trajectory.steps,
         termination: &trajectory.termination,
         path_length_m: trajectory.path_length_m,
+        reachable_m: Some(0.5),
     };
     let joint = JointTrajectory::new(
         "fr3",
@@ -608,14 +612,16 @@ fn option_values_are_read_or_refused() {
         b"q=0.1,-0.2,0.3,-2.0,0.0,1.9,0.7".to_vec(),
         b"dp".to_vec(),
         b"hybrid".to_vec(),
+        b"search".to_vec(),
         b"2/4".to_vec(),
     ];
     read_or_refuse("option values", values, |bytes| {
         let value = text(bytes);
         let controller = value.parse::<ControllerKind>().is_ok();
+        let planner = value.parse::<PlannerKind>().is_ok();
         let shard = value.parse::<Shard>().is_ok();
         let Ok(seed) = value.parse::<SeedSource>() else {
-            return controller || shard;
+            return controller || planner || shard;
         };
         let models = Models::load(fr3(), None, None).expect("no model files to read");
         let planner =
@@ -623,6 +629,7 @@ fn option_values_are_read_or_refused() {
         let request = PlanRequest {
             seed: Some(seed),
             controller: ControllerKind::Classical,
+            ..PlanRequest::default()
         };
         let _ = planner.plan(&demo_task(fr3()).expect("demo task"), &request);
         true

@@ -57,6 +57,7 @@ fn each_kind_plans_what_its_controller_rolls_out() {
             let request = PlanRequest {
                 seed: Some(SeedSource::Generating),
                 controller: kind,
+                ..PlanRequest::default()
             };
             let plan = planner.plan(&task, &request).expect("plans");
             assert_eq!(plan.seed.q, seed);
@@ -140,6 +141,7 @@ fn missing_models_and_seeds_are_named() {
     let learned = PlanRequest {
         seed: None,
         controller: ControllerKind::Rl,
+        ..PlanRequest::default()
     };
     let error = planner.plan(&task, &learned).unwrap_err();
     assert!(matches!(error, PlanError::Controller(_)), "{error}");
@@ -148,6 +150,7 @@ fn missing_models_and_seeds_are_named() {
     let dp = PlanRequest {
         seed: Some(SeedSource::Dp),
         controller: ControllerKind::Classical,
+        ..PlanRequest::default()
     };
     let error = planner.plan(&task, &dp).unwrap_err();
     assert!(
@@ -162,6 +165,7 @@ fn missing_models_and_seeds_are_named() {
     let generating = PlanRequest {
         seed: Some(SeedSource::Generating),
         controller: ControllerKind::Classical,
+        ..PlanRequest::default()
     };
     let error = planner.plan(&unseeded, &generating).unwrap_err();
     assert!(error.to_string().contains("q0_seed"), "{error}");
@@ -169,6 +173,7 @@ fn missing_models_and_seeds_are_named() {
     let default = PlanRequest {
         seed: None,
         controller: ControllerKind::Classical,
+        ..PlanRequest::default()
     };
     let plan = planner.plan(&unseeded, &default).unwrap();
     assert_eq!(plan.seed.source, "home");

@@ -1,0 +1,123 @@
+//! The reachability bound: every witness it gives is checked by the independent checker (TCP on
+//! the line within the tolerance at its grid point, tool axis inside the cone, joints inside the
+//! limits, no self-collision); no plan goes further than the bound (it is a necessary
+//! condition); a start out of the arm's reach has none.
+
+use emg_control::Task;
+use emg_io::read_tasks;
+use emg_kinematics::{Robot, Vec3};
+use emg_planner::{
+    ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, Reach, SeedSource,
+    ShippedRobot,
+};
+use emg_verify::ReferenceModel;
+
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+}
+
+fn fr3() -> ShippedRobot {
+    ShippedRobot::by_name("fr3").expect("the FR3 ships")
+}
+
+fn planner() -> Planner {
+    let robot = Robot::from_chain_file(fr3().path(&data())).expect("robot loads");
+    let models = Models::load(&robot, None, None).expect("no models");
+    Planner::new(robot, models, PlannerConfig::default()).expect("default config")
+}
+
+fn checker(robot: &Robot) -> ReferenceModel {
+    ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+        .expect("checker loads")
+}
+
+/// Checks every witness of `reach` for `task` with the independent checker.
+fn check_witnesses(planner: &Planner, checker: &ReferenceModel, task: &Task, reach: &Reach) {
+    let constraints = &planner.config().rollout.constraints;
+    let limits = checker.limits();
+    assert_eq!(
+        reach.witnesses.len() as f64,
+        (reach.reachable_m / reach.grid_m).round() + f64::from(u8::from(reach.reachable_p0)),
+        "one witness per grid point"
+    );
+    for (k, q) in reach.witnesses.iter().enumerate() {
+        let (tcp, axis) = checker.tcp_pose(q);
+        let offset = tcp - task.p0;
+        let along = offset.dot(&task.d);
+        let across = (offset - task.d * along).norm();
+        assert!(
+            (along - k as f64 * reach.grid_m).abs() < 1e-3,
+            "witness {k} lies at s = {along}, not on its grid point"
+        );
+        assert!(
+            across <= constraints.line_tolerance_m,
+            "witness {k}: {across} m off the line"
+        );
+        let angle = axis.dot(&task.n).clamp(-1.0, 1.0).acos().to_degrees();
+        assert!(
+            angle <= constraints.theta_max_deg + 1e-9,
+            "witness {k}: tool {angle}° from n"
+        );
+        for (j, (lower, upper)) in limits.iter().enumerate() {
+            assert!(
+                (*lower..=*upper).contains(&q[j]),
+                "witness {k}: joint {j} outside its limits"
+            );
+        }
+        let (clearance, a, b) = checker.min_clearance(q);
+        assert!(
+            clearance >= constraints.collision_margin_m,
+            "witness {k}: {a} and {b} collide"
+        );
+    }
+}
+
+#[test]
+fn no_plan_goes_beyond_the_bound_and_every_witness_holds() {
+    let planner = planner();
+    let robot = planner.robot();
+    let checker = checker(robot);
+    let tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
+        .expect("shipped tasks");
+    let request = PlanRequest {
+        seed: Some(SeedSource::Generating),
+        controller: ControllerKind::Classical,
+        ..PlanRequest::default()
+    };
+    let mut beyond_plan = 0;
+    for task in &tasks[..8] {
+        let plan = planner.plan(task, &request).expect("plans");
+        let reach = planner.reach(task, &[plan.seed.q]);
+        assert!(reach.reachable_p0, "p0 of a sampled task is reachable");
+        check_witnesses(&planner, &checker, task, &reach);
+        let length = plan.trajectory.path_length_m;
+        assert!(
+            length <= reach.reachable_m + reach.grid_m,
+            "the plan travels {length} m, beyond the bound {} m",
+            reach.reachable_m
+        );
+        if reach.reachable_m > length + 0.05 {
+            beyond_plan += 1;
+        }
+    }
+    // The bound is informative: on some tasks the arm could be placed well past where the
+    // classical controller stops.
+    assert!(beyond_plan > 0, "the bound never exceeds the plan");
+}
+
+#[test]
+fn a_start_out_of_reach_has_no_bound() {
+    let planner = planner();
+    let task = Task::new(
+        planner.robot(),
+        // Inside the sphere the links could span (so the task is valid) but past the arm's
+        // real reach.
+        Vec3::new(1.15, 0.0, 0.333),
+        Vec3::y(),
+        -Vec3::z(),
+        None,
+    )
+    .expect("a valid task");
+    let reach = planner.reach(&task, &[]);
+    assert!(!reach.reachable_p0 && reach.reachable_m == 0.0 && reach.witnesses.is_empty());
+}

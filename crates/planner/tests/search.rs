@@ -1,0 +1,116 @@
+//! The search planner on the shipped FR3 models: it evaluates the pipeline's own plan first, so
+//! it never returns a shorter one, and it goes further on many tasks; every plan passes the
+//! independent checker; results do not depend on the thread count; a budget spent by the
+//! pipeline's rollout gives exactly the pipeline's plan.
+
+use emg_control::{CheckRollout, Task};
+use emg_io::read_tasks;
+use emg_kinematics::Robot;
+use emg_planner::{
+    DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig, ShippedRobot,
+};
+use emg_verify::ReferenceModel;
+
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+}
+
+fn fr3() -> ShippedRobot {
+    ShippedRobot::by_name("fr3").expect("the FR3 ships")
+}
+
+fn planner(config: PlannerConfig) -> Planner {
+    let robot = Robot::from_chain_file(fr3().path(&data())).expect("robot loads");
+    let models = Models::shipped(&robot, &fr3().data_dir(&data())).expect("shipped models");
+    Planner::new(robot, models, config).expect("valid config")
+}
+
+/// A small search, so that the test stays short.
+fn small_search() -> PlannerConfig {
+    PlannerConfig {
+        search: SearchConfig {
+            budget_steps: 3_000,
+            dp_samples: 8,
+            ik_restarts: 16,
+            finalists: 2,
+            ..SearchConfig::default()
+        },
+        ..PlannerConfig::default()
+    }
+}
+
+fn tasks(robot: &Robot, count: usize) -> Vec<Task> {
+    let mut tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
+        .expect("shipped tasks");
+    tasks.truncate(count);
+    tasks
+}
+
+fn search_request() -> PlanRequest {
+    PlanRequest {
+        planner: PlannerKind::Search,
+        ..PlanRequest::default()
+    }
+}
+
+#[test]
+fn search_never_returns_less_and_often_more() {
+    let planner = planner(small_search());
+    let robot = planner.robot();
+    let checker =
+        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+            .expect("checker");
+    let constraints = &planner.config().rollout.constraints;
+    let (mut pipeline_total, mut search_total, mut longer) = (0.0, 0.0, 0);
+    for task in tasks(robot, 10) {
+        let pipeline = planner.plan(&task, &PlanRequest::default()).expect("plans");
+        let searched = planner.plan(&task, &search_request()).expect("searches");
+        checker
+            .check(&task, &searched.trajectory, constraints)
+            .expect("every searched plan holds every constraint");
+        let (a, b) = (
+            pipeline.trajectory.path_length_m,
+            searched.trajectory.path_length_m,
+        );
+        assert!(b >= a, "the search returns {b} m, the pipeline {a} m");
+        if b > a + 0.01 {
+            longer += 1;
+        }
+        pipeline_total += a;
+        search_total += b;
+    }
+    assert!(
+        longer >= 3,
+        "the search goes further on only {longer} of 10 tasks ({search_total} m against \
+         {pipeline_total} m)"
+    );
+}
+
+#[test]
+fn a_spent_budget_gives_the_pipeline_plan() {
+    let mut config = small_search();
+    config.search.budget_steps = 1;
+    let planner = planner(config);
+    for task in tasks(planner.robot(), 4) {
+        assert_eq!(
+            planner.plan(&task, &search_request()).expect("searches"),
+            planner.plan(&task, &PlanRequest::default()).expect("plans"),
+        );
+    }
+}
+
+#[test]
+fn search_does_not_depend_on_the_thread_count() {
+    let planner = planner(small_search());
+    let tasks = tasks(planner.robot(), 6);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| planner.plan_many(&tasks, &search_request()))
+    };
+    let one: Vec<_> = on(1).into_iter().map(|p| p.expect("searches")).collect();
+    let two: Vec<_> = on(2).into_iter().map(|p| p.expect("searches")).collect();
+    assert_eq!(one, two);
+}

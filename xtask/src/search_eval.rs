@@ -1,0 +1,308 @@
+//! `cargo xtask search-eval`: the search planner against the paper's pipeline (Hybrid + DP) on
+//! the first tasks of the evaluation set, at several step budgets, beside each task's
+//! reachability bound (`docs/results/search.{json,md}`, `docs/figures/search-budget.svg`).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use emg_control::CheckRollout;
+use emg_eval::{Summary, four};
+use emg_io::{read_tasks, write_atomically};
+use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
+use indicatif::ProgressIterator;
+use plotters::prelude::*;
+use serde::Serialize;
+
+use crate::{progress, workspace};
+
+/// Options of `search-eval`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Tasks: the first this many of the task set.
+    #[arg(long, default_value_t = 200)]
+    tasks: usize,
+    /// Step budgets of the search, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 20_000, 50_000])]
+    budgets: Vec<u64>,
+    /// Worker threads (0 = one per core); the results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Task set.
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
+    task_file: PathBuf,
+    /// Robot file.
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
+    robot: PathBuf,
+    /// Output directory of search.{json,md}.
+    #[arg(long, default_value_os_t = workspace::results_dir())]
+    out_dir: PathBuf,
+    /// Output figure.
+    #[arg(long, default_value_os_t = workspace::figure("search-budget.svg"))]
+    figure: PathBuf,
+}
+
+/// One planner setting over the tasks.
+#[derive(Serialize)]
+struct Row {
+    /// `pipeline` or `search`.
+    planner: &'static str,
+    /// The search's step budget (none for the pipeline).
+    budget_steps: Option<u64>,
+    path_length_m: Summary,
+    /// Mean over tasks of length / pipeline length (tasks where the pipeline moved).
+    ratio_to_pipeline: f64,
+    /// Mean over tasks of length / reachability bound (tasks with a bound above 0).
+    share_of_bound: f64,
+    /// Steps actually taken by the returned plans, mean.
+    plan_steps: f64,
+    /// Wall time × threads per task on this machine (ms): the CPU time a task takes.
+    cpu_ms_per_task: f64,
+    /// Plans the independent checker rejected.
+    checker_failures: usize,
+}
+
+/// The whole record written to `search.json`.
+#[derive(Serialize)]
+struct Record {
+    robot: String,
+    tasks: String,
+    task_count: usize,
+    machine: String,
+    threads: usize,
+    search: SearchConfig,
+    reachability_bound_m: Summary,
+    rows: Vec<Row>,
+}
+
+/// Runs the comparison and writes the record, its table and its figure.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = workspace::load_robot(&args.robot)?;
+    let checker = workspace::load_checker(&args.robot, &robot)?;
+    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir())
+        .context("search-eval needs a shipped robot's models")?;
+    let models = Models::shipped(&robot, &shipped.data_dir(&workspace::data_dir()))?;
+    let mut tasks = read_tasks(&args.task_file, &robot)?;
+    tasks.truncate(args.tasks);
+    let pool = workspace::thread_pool(args.threads)?;
+    let threads = pool.current_num_threads();
+    let planner = Planner::new(robot, models, PlannerConfig::default())?;
+
+    println!("reachability bound of {} tasks", tasks.len());
+    let bar = progress::bar(tasks.len() as u64, "reach");
+    let bounds: Vec<f64> = pool.install(|| {
+        use rayon::prelude::*;
+        tasks
+            .par_iter()
+            .map(|task| {
+                let reach = planner.reach(task, &[]);
+                bar.inc(1);
+                reach.reachable_m
+            })
+            .collect()
+    });
+    bar.finish();
+
+    let mut rows = Vec::new();
+    let mut pipeline_lengths: Option<Vec<f64>> = None;
+    let settings = std::iter::once(None).chain(args.budgets.iter().copied().map(Some));
+    for budget in settings.progress_with(progress::bar(1 + args.budgets.len() as u64, "budgets")) {
+        let mut config = PlannerConfig::default();
+        let request = match budget {
+            None => PlanRequest::default(),
+            Some(steps) => {
+                config.search.budget_steps = steps;
+                PlanRequest {
+                    planner: PlannerKind::Search,
+                    ..PlanRequest::default()
+                }
+            }
+        };
+        let planner = planner.with_config(config)?;
+        let started = Instant::now();
+        let plans = pool.install(|| planner.plan_many(&tasks, &request));
+        let cpu_ms = started.elapsed().as_secs_f64() * 1e3 * threads as f64;
+        let mut lengths = Vec::with_capacity(tasks.len());
+        let mut steps = 0usize;
+        let mut failures = 0;
+        for (task, plan) in tasks.iter().zip(plans) {
+            let plan = plan.with_context(|| format!("planning {task:?}"))?;
+            if checker
+                .check(
+                    task,
+                    &plan.trajectory,
+                    &planner.config().rollout.constraints,
+                )
+                .is_err()
+            {
+                failures += 1;
+            }
+            steps += plan.trajectory.steps.len() - 1;
+            lengths.push(plan.trajectory.path_length_m);
+        }
+        let pipeline = pipeline_lengths.get_or_insert_with(|| lengths.clone());
+        rows.push(Row {
+            planner: if budget.is_some() {
+                "search"
+            } else {
+                "pipeline"
+            },
+            budget_steps: budget,
+            path_length_m: Summary::of(&lengths).context("no tasks")?,
+            ratio_to_pipeline: mean_ratio(&lengths, pipeline),
+            share_of_bound: mean_ratio(&lengths, &bounds),
+            plan_steps: steps as f64 / tasks.len() as f64,
+            cpu_ms_per_task: cpu_ms / tasks.len() as f64,
+            checker_failures: failures,
+        });
+    }
+
+    let record = Record {
+        robot: planner.robot().name().to_string(),
+        tasks: workspace::relative(&args.task_file),
+        task_count: tasks.len(),
+        machine: workspace::machine(),
+        threads,
+        search: SearchConfig::default(),
+        reachability_bound_m: Summary::of(&bounds).context("no tasks")?,
+        rows,
+    };
+    write_record(&record, &args.out_dir)?;
+    draw(&record, &args.figure)?;
+    println!("wrote {}", args.figure.display());
+    Ok(())
+}
+
+/// Mean of `values[i] / of[i]` over the tasks where `of[i]` is positive.
+fn mean_ratio(values: &[f64], of: &[f64]) -> f64 {
+    let ratios: Vec<f64> = values
+        .iter()
+        .zip(of)
+        .filter(|(_, o)| **o > 1e-9)
+        .map(|(v, o)| v / o)
+        .collect();
+    ratios.iter().sum::<f64>() / ratios.len().max(1) as f64
+}
+
+fn write_record(record: &Record, out_dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out_dir)?;
+    let json = out_dir.join("search.json");
+    write_atomically(
+        &json,
+        (serde_json::to_string_pretty(record)? + "\n").as_bytes(),
+    )?;
+    let md = out_dir.join("search.md");
+    write_atomically(&md, markdown(record).as_bytes())?;
+    println!("wrote {} and {}", json.display(), md.display());
+    Ok(())
+}
+
+fn markdown(record: &Record) -> String {
+    let mut md = format!(
+        "# Search planner vs the paper's pipeline\n\nWritten by `cargo xtask search-eval`. Do not \
+         edit by hand. Robot `{}`, the first {} tasks of `{}`. The pipeline is Hybrid + DP (one \
+         seed, one rollout); the search rolls that plan out first, then ranks candidate starts \
+         (q0_seed, q_mu, q_jl, {} diffusion samples, cone IK from {} restarts) by classical \
+         rollouts and re-rolls the best {} with the hybrid controller, until its budget of control \
+         steps is spent. Every plan is re-checked by the independent checker. Reachability bound \
+         (m, mean / std / min / max): {}. Times are CPU time per task on {} ({} threads) and \
+         depend on the machine; the lengths do not.\n\n\
+         | planner | budget (steps) | path length (m, mean / std / min / max) | length / pipeline | \
+         length / bound | steps per plan | CPU ms per task | checker failures |\n\
+         |---|---|---|---|---|---|---|---|\n",
+        record.robot,
+        record.task_count,
+        record.tasks,
+        record.search.dp_samples,
+        record.search.ik_restarts,
+        record.search.finalists,
+        four(&record.reachability_bound_m, 3),
+        record.machine,
+        record.threads,
+    );
+    for row in &record.rows {
+        md += &format!(
+            "| {} | {} | {} | {:.3} | {:.3} | {:.1} | {:.1} | {} |\n",
+            row.planner,
+            row.budget_steps.map_or("—".into(), |b| b.to_string()),
+            four(&row.path_length_m, 4),
+            row.ratio_to_pipeline,
+            row.share_of_bound,
+            row.plan_steps,
+            row.cpu_ms_per_task,
+            row.checker_failures,
+        );
+    }
+    md
+}
+
+/// Mean path length against the search budget, with the pipeline and the mean bound as lines.
+fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let searched: Vec<(f64, f64)> = record
+        .rows
+        .iter()
+        .filter_map(|r| r.budget_steps.map(|b| (b as f64, r.path_length_m.mean)))
+        .collect();
+    let pipeline = record
+        .rows
+        .iter()
+        .find(|r| r.budget_steps.is_none())
+        .map_or(0.0, |r| r.path_length_m.mean);
+    let bound = record.reachability_bound_m.mean;
+    let (x_min, x_max) = searched
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), (x, _)| {
+            (lo.min(*x), hi.max(*x))
+        });
+    let y_max = bound.max(pipeline) * 1.1;
+    let root = SVGBackend::new(path, (720, 420)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "{}: mean path length against the search budget",
+                record.robot
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(56)
+        .build_cartesian_2d((x_min * 0.8..x_max * 1.25).log_scale(), 0.0..y_max)?;
+    chart
+        .configure_mesh()
+        .x_desc("budget (control steps per task, log scale)")
+        .y_desc("mean path length (m)")
+        .draw()?;
+    let span = [x_min * 0.8, x_max * 1.25];
+    chart
+        .draw_series(LineSeries::new(
+            span.map(|x| (x, bound)),
+            BLACK.stroke_width(1),
+        ))?
+        .label(format!("reachability bound {bound:.3} m"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    chart
+        .draw_series(LineSeries::new(
+            span.map(|x| (x, pipeline)),
+            RED.stroke_width(2),
+        ))?
+        .label(format!("Hybrid + DP pipeline {pipeline:.3} m"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED));
+    chart
+        .draw_series(LineSeries::new(searched.clone(), BLUE.stroke_width(2)))?
+        .label("search")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLUE));
+    chart.draw_series(searched.iter().map(|p| Circle::new(*p, 4, BLUE.filled())))?;
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
