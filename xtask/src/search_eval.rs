@@ -28,6 +28,10 @@ pub struct Args {
     /// Worker threads (0 = one per core); the results do not depend on it.
     #[arg(long, default_value_t = 0)]
     threads: usize,
+    /// JSON file of search settings (`emg_planner::SearchConfig`; unset fields keep their
+    /// defaults, `budget_steps` is replaced by each of `--budgets`).
+    #[arg(long, value_name = "JSON")]
+    search_config: Option<PathBuf>,
     /// Task set.
     #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
     task_file: PathBuf,
@@ -50,7 +54,7 @@ struct Row {
     /// The search's step budget (none for the pipeline).
     budget_steps: Option<u64>,
     path_length_m: Summary,
-    /// Mean over tasks of length / pipeline length (tasks where the pipeline moved).
+    /// Mean length / the pipeline's mean length.
     ratio_to_pipeline: f64,
     /// Mean over tasks of length / reachability bound (tasks with a bound above 0).
     share_of_bound: f64,
@@ -86,6 +90,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     tasks.truncate(args.tasks);
     let pool = workspace::thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
+    let search: SearchConfig =
+        workspace::read_config(args.search_config.as_deref(), "search config")?;
     let planner = Planner::new(robot, models, PlannerConfig::default())?;
 
     println!("reachability bound of {} tasks", tasks.len());
@@ -104,10 +110,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
 
     let mut rows = Vec::new();
-    let mut pipeline_lengths: Option<Vec<f64>> = None;
+    let mut pipeline_mean: Option<f64> = None;
     let settings = std::iter::once(None).chain(args.budgets.iter().copied().map(Some));
     for budget in settings.progress_with(progress::bar(1 + args.budgets.len() as u64, "budgets")) {
-        let mut config = PlannerConfig::default();
+        let mut config = PlannerConfig {
+            search: search.clone(),
+            ..PlannerConfig::default()
+        };
         let request = match budget {
             None => PlanRequest::default(),
             Some(steps) => {
@@ -140,7 +149,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             steps += plan.trajectory.steps.len() - 1;
             lengths.push(plan.trajectory.path_length_m);
         }
-        let pipeline = pipeline_lengths.get_or_insert_with(|| lengths.clone());
+        let summary = Summary::of(&lengths).context("no tasks")?;
+        let pipeline_mean = *pipeline_mean.get_or_insert(summary.mean);
         rows.push(Row {
             planner: if budget.is_some() {
                 "search"
@@ -148,8 +158,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 "pipeline"
             },
             budget_steps: budget,
-            path_length_m: Summary::of(&lengths).context("no tasks")?,
-            ratio_to_pipeline: mean_ratio(&lengths, pipeline),
+            ratio_to_pipeline: summary.mean / pipeline_mean,
+            path_length_m: summary,
             share_of_bound: mean_ratio(&lengths, &bounds),
             plan_steps: steps as f64 / tasks.len() as f64,
             cpu_ms_per_task: cpu_ms / tasks.len() as f64,
@@ -163,7 +173,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         task_count: tasks.len(),
         machine: workspace::machine(),
         threads,
-        search: SearchConfig::default(),
+        search,
         reachability_bound_m: Summary::of(&bounds).context("no tasks")?,
         rows,
     };
@@ -203,12 +213,14 @@ fn markdown(record: &Record) -> String {
          edit by hand. Robot `{}`, the first {} tasks of `{}`. The pipeline is Hybrid + DP (one \
          seed, one rollout); the search rolls that plan out first, then ranks candidate starts \
          (q0_seed, q_mu, q_jl, {} diffusion samples, cone IK from {} restarts) by classical \
-         rollouts and re-rolls the best {} with the hybrid controller, until its budget of control \
-         steps is spent. Every plan is re-checked by the independent checker. Reachability bound \
+         rollouts, re-rolls the best {} with the hybrid controller, then repairs the longest \
+         rollouts of the best {} starts where they failed (each null-space basis direction held \
+         for {} steps from 1 to 32 steps before the end, then the hybrid or the classical \
+         controller), until its budget of control steps is spent. Every plan is re-checked by the independent checker. Reachability bound \
          (m, mean / std / min / max): {}. Times are CPU time per task on {} ({} threads) and \
          depend on the machine; the lengths do not.\n\n\
-         | planner | budget (steps) | path length (m, mean / std / min / max) | length / pipeline | \
-         length / bound | steps per plan | CPU ms per task | checker failures |\n\
+         | planner | budget (steps) | path length (m, mean / std / min / max) | mean / pipeline \
+         mean | length / bound (task mean) | steps per plan | CPU ms per task | checker failures |\n\
          |---|---|---|---|---|---|---|---|\n",
         record.robot,
         record.task_count,
@@ -216,6 +228,8 @@ fn markdown(record: &Record) -> String {
         record.search.dp_samples,
         record.search.ik_restarts,
         record.search.finalists,
+        record.search.repaired_starts,
+        record.search.detour_steps,
         four(&record.reachability_bound_m, 3),
         record.machine,
         record.threads,
@@ -274,6 +288,8 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
         .build_cartesian_2d((x_min * 0.8..x_max * 1.25).log_scale(), 0.0..y_max)?;
     chart
         .configure_mesh()
+        .light_line_style(WHITE)
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .x_desc("budget (control steps per task, log scale)")
         .y_desc("mean path length (m)")
         .draw()?;

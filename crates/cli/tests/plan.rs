@@ -378,3 +378,50 @@ fn robot_by_name_and_by_file() {
         stem.to_str().unwrap(),
     ]);
 }
+
+#[test]
+fn search_plan_records_its_planner_and_bound_and_checks() {
+    let tmp = temp_dir("search");
+    let dir = tmp.path();
+    let stem = dir.join("searched");
+    let config = dir.join("small.json");
+    std::fs::write(
+        &config,
+        r#"{"search": {"budget_steps": 2000, "ik_restarts": 16}}"#,
+    )
+    .unwrap();
+    let stdout = plan_ok(&[
+        "--planner",
+        "search",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("reachable"), "{stdout}");
+    let doc = read_json(&dir.join("searched.json"));
+    assert_eq!(doc["planner"], "search");
+    let length = doc["path_length_m"].as_f64().unwrap();
+    let bound = doc["reachable_m"].as_f64().unwrap();
+    assert!(
+        length <= bound + 0.01,
+        "{length} m planned, bound {bound} m"
+    );
+    let joint = dir.join("searched.joint_trajectory.json");
+    let output = emg(&["check", joint.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    // Without the bound the file has no reachable_m.
+    plan_ok(&[
+        "--reach",
+        "off",
+        "--out",
+        stem.to_str().unwrap(),
+        "--weights",
+        NO_WEIGHTS,
+    ]);
+    assert!(
+        read_json(&dir.join("searched.json"))
+            .get("reachable_m")
+            .is_none()
+    );
+}

@@ -12,6 +12,8 @@ pub enum ActingController {
     Classical,
     /// A learned policy.
     Learned,
+    /// A planner's search: a detour it tried (a basis direction held for a few steps).
+    Search,
 }
 
 impl ActingController {
@@ -20,6 +22,7 @@ impl ActingController {
         match self {
             Self::Classical => "classical",
             Self::Learned => "learned",
+            Self::Search => "search",
         }
     }
 }

@@ -154,8 +154,7 @@ impl Planner {
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
             };
-            let (seed, trajectory) =
-                search(&context, task, seed, request.controller, &mut controller)?;
+            let (seed, trajectory) = search(&context, task, seed, request.controller, controller)?;
             return Ok(Plan { seed, trajectory });
         }
         let trajectory = rollout(

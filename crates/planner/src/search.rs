@@ -8,8 +8,15 @@
 //! (`q_mu`, `q_jl`), a batch of diffusion samples (all of them, not the first valid one), and
 //! cone-IK solutions from seeded random restarts spread over the branches. Each valid start is
 //! ranked by a rollout of the classical controller (cheap, no network); the best
-//! [`SearchConfig::finalists`] are rolled out again with the requested controller, and the
-//! longest rollout of all is the plan.
+//! [`SearchConfig::finalists`] are rolled out again with the requested controller. Then the
+//! longest rollout so far is repaired where it failed: from 1, 2, 4, … 32 steps before its end,
+//! each null-space basis direction (±`e_i` of `B(q)`) is held for a few steps and the requested
+//! and the classical controller take over again; a round that goes further starts the next
+//! round from the new longest rollout. The longest rollout of all is the plan.
+//!
+//! A search rollout replays the actions of the rollout it branches from (so its first steps
+//! reproduce that rollout's states exactly) before its detour; the action each step took is
+//! recorded, detours as `ActingController::Search`.
 //!
 //! The budget counts control steps (every step evaluated, accepted or rejected), never wall
 //! time, so a plan is a pure function of the task and the configuration, whatever the machine
@@ -17,7 +24,8 @@
 //! is a sequence of steps the one step implementation accepted.
 
 use emg_control::{
-    OutOfRange, RolloutConfig, Task, Termination, Trajectory, first_violation, rollout,
+    ActingController, NullAction, NullSpaceController, OutOfRange, RolloutConfig, StepContext,
+    Task, Termination, Trajectory, first_violation, rollout,
 };
 use emg_diffusion::{DpSeeder, SeedWorkspace};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
@@ -46,6 +54,10 @@ pub struct SearchConfig {
     pub finalists: usize,
     /// Two candidate starts closer than this (rad, largest joint difference) count as one.
     pub distinct_rad: f64,
+    /// Steps a detour of the repair stage holds its basis direction.
+    pub detour_steps: usize,
+    /// Starts whose longest rollouts the repair stage works on, best first.
+    pub repaired_starts: usize,
     /// Seed of the IK restarts.
     pub seed: u64,
 }
@@ -58,6 +70,8 @@ impl Default for SearchConfig {
             ik_restarts: 64,
             finalists: 4,
             distinct_rad: 0.05,
+            detour_steps: 10,
+            repaired_starts: 3,
             seed: 20_261_123,
         }
     }
@@ -92,6 +106,20 @@ impl SearchConfig {
         if !(1..=64).contains(&self.finalists) {
             return Err(out("search.finalists", self.finalists as f64, "[1, 64]"));
         }
+        if !(1..=64).contains(&self.repaired_starts) {
+            return Err(out(
+                "search.repaired_starts",
+                self.repaired_starts as f64,
+                "[1, 64]",
+            ));
+        }
+        if !(1..=100).contains(&self.detour_steps) {
+            return Err(out(
+                "search.detour_steps",
+                self.detour_steps as f64,
+                "[1, 100]",
+            ));
+        }
         if !(self.distinct_rad.is_finite() && self.distinct_rad >= 0.0) {
             return Err(out("search.distinct_rad", self.distinct_rad, "[0, ∞)"));
         }
@@ -115,58 +143,241 @@ pub(crate) struct SearchContext<'a> {
     pub config: &'a SearchConfig,
 }
 
+/// An action a rollout issued, and who chose it.
+type Issued = (NullAction, ActingController);
+
+/// A detour: one null-space action held for a few steps.
+#[derive(Clone, Copy, Debug)]
+struct Detour {
+    action: NullAction,
+    steps: usize,
+}
+
+/// The controller of one search rollout: it replays `prefix` (actions an earlier rollout
+/// issued, so the same states recur exactly), then holds `detour`, then hands over to `tail`;
+/// it records every action it issues.
+struct Branch<'a> {
+    prefix: &'a [Issued],
+    detour: Option<Detour>,
+    tail: &'a mut Executor,
+    issued: Vec<Issued>,
+}
+
+impl NullSpaceController for Branch<'_> {
+    fn reset(&mut self, first: &StepContext<'_>) {
+        self.issued.clear();
+        self.tail.reset(first);
+    }
+
+    fn act(&mut self, step: &StepContext<'_>) -> Issued {
+        let t = step.step;
+        let chosen = match (self.prefix.get(t), self.detour) {
+            (Some(&issued), _) => issued,
+            (None, Some(detour)) if t < self.prefix.len() + detour.steps => {
+                (detour.action, ActingController::Search)
+            }
+            _ => self.tail.act(step),
+        };
+        self.issued.push(chosen);
+        chosen
+    }
+}
+
+/// The longest rollout so far, with its start and the actions that reproduce it.
+#[derive(Clone)]
+struct Best {
+    seed: Seed,
+    trajectory: Trajectory,
+    issued: Vec<Issued>,
+}
+
+/// One task's search: the budget spent so far and the leaders, the longest rollout from each
+/// of the best starts so far (longest first, at most [`SearchConfig::repaired_starts`]).
+struct Search<'a> {
+    context: &'a SearchContext<'a>,
+    task: &'a Task,
+    spent: u64,
+    leaders: Vec<Best>,
+}
+
+impl Search<'_> {
+    fn budget_left(&self) -> bool {
+        self.spent < self.context.config.budget_steps
+    }
+
+    /// Rolls out from `seed` with `prefix`, `detour` and `tail`, charges its steps to the
+    /// budget, and keeps it if it is the longest so far.
+    fn try_rollout(
+        &mut self,
+        seed: &Seed,
+        prefix: &[Issued],
+        detour: Option<Detour>,
+        tail: &mut Executor,
+    ) -> f64 {
+        let mut branch = Branch {
+            prefix,
+            detour,
+            tail,
+            issued: Vec::new(),
+        };
+        let context = self.context;
+        let trajectory = rollout(
+            context.robot,
+            self.task,
+            &seed.q,
+            &mut branch,
+            context.rollout,
+        );
+        self.spent += steps_evaluated(&trajectory);
+        let length = trajectory.path_length_m;
+        let issued = branch.issued;
+        self.offer(Best {
+            seed: seed.clone(),
+            trajectory,
+            issued,
+        });
+        length
+    }
+
+    /// Keeps `rollout` among the leaders if it is the longest from its start so far and
+    /// among the longest of all; a tie keeps the rollout found first.
+    fn offer(&mut self, rollout: Best) {
+        let length = rollout.trajectory.path_length_m;
+        if let Some(same) = self.leaders.iter().position(|b| b.seed.q == rollout.seed.q) {
+            if length <= self.leaders[same].trajectory.path_length_m {
+                return;
+            }
+            self.leaders.remove(same);
+        }
+        let at = self
+            .leaders
+            .iter()
+            .position(|b| length > b.trajectory.path_length_m)
+            .unwrap_or(self.leaders.len());
+        self.leaders.insert(at, rollout);
+        self.leaders.truncate(self.context.config.repaired_starts);
+    }
+
+    /// The longest rollout from `seed` so far.
+    fn leader_of(&self, seed: &Seed) -> Option<&Best> {
+        self.leaders.iter().find(|b| b.seed.q == seed.q)
+    }
+
+    /// Repairs the leaders in turn, longest first: rounds of detours near the end of the
+    /// longest rollout from the leader's start (from a few steps before where it stopped, each
+    /// basis direction held for [`SearchConfig::detour_steps`] steps, then each tail); a round
+    /// that goes further starts the next round from the new rollout.
+    fn repair(&mut self, tails: &mut [Executor]) {
+        let starts: Vec<Seed> = self.leaders.iter().map(|b| b.seed.clone()).collect();
+        for seed in &starts {
+            if !self.repair_from(seed, tails) {
+                return;
+            }
+        }
+    }
+
+    /// Rounds of detours from `seed`'s leader; false once the budget is spent.
+    fn repair_from(&mut self, seed: &Seed, tails: &mut [Executor]) -> bool {
+        let directions: Vec<NullAction> = (0..4)
+            .flat_map(|axis| {
+                [1.0, -1.0].map(|sign| {
+                    let mut action = NullAction::zeros();
+                    action[axis] = sign;
+                    action
+                })
+            })
+            .collect();
+        loop {
+            // A start that has fallen out of the leaders is not repaired further.
+            let Some(base) = self.leader_of(seed).cloned() else {
+                return true;
+            };
+            let issued = base.issued.len();
+            for back in BACKTRACK_STEPS.into_iter().filter(|&b| b <= issued) {
+                for action in &directions {
+                    for tail in tails.iter_mut() {
+                        if !self.budget_left() {
+                            return false;
+                        }
+                        let detour = Detour {
+                            action: *action,
+                            steps: self.context.config.detour_steps,
+                        };
+                        let prefix = &base.issued[..issued - back];
+                        self.try_rollout(&base.seed, prefix, Some(detour), tail);
+                    }
+                }
+            }
+            let improved = self
+                .leader_of(seed)
+                .is_some_and(|b| b.trajectory.path_length_m > base.trajectory.path_length_m);
+            if !improved {
+                return true;
+            }
+        }
+    }
+}
+
+/// How far back from where the longest rollout stopped its detours start (steps).
+const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
+
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
-/// rolled out by `finalist`, the executor of `controller`) is always evaluated first, so the search never returns less;
-/// then the other candidates are ranked by classical rollouts and the best
-/// [`SearchConfig::finalists`] rolled out by `controller`, while budget is left.
+/// rolled out by `finalist`, the executor of `controller`) is always evaluated first, so the
+/// search never returns less; then the other candidates are ranked by classical rollouts, the
+/// best [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollout repaired
+/// by detours near its end, while budget is left.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
     seed: Seed,
     controller: ControllerKind,
-    finalist: &mut Executor,
+    finalist: Executor,
 ) -> Result<(Seed, Trajectory), ExecutorError> {
-    let robot = context.robot;
-    let budget = context.config.budget_steps;
-    let mut classical = Executor::new(ControllerKind::Classical, None, context.executor)?;
-    let pipeline = rollout(robot, task, &seed.q, finalist, context.rollout);
-    let mut spent = steps_evaluated(&pipeline);
+    let classical = Executor::new(ControllerKind::Classical, None, context.executor)?;
+    let mut tails = vec![finalist];
+    if controller != ControllerKind::Classical {
+        tails.push(classical);
+    }
     let candidates = candidates(context, task, &seed.q);
-    let mut best = (seed, pipeline);
-    let mut consider = |candidate: &Candidate, trajectory: Trajectory| {
-        if trajectory.path_length_m > best.1.path_length_m {
-            let seed = Seed {
-                q: candidate.q,
-                source: candidate.source,
-                projection_iterations: None,
-            };
-            best = (seed, trajectory);
-        }
+    let mut search = Search {
+        context,
+        task,
+        spent: 0,
+        leaders: Vec::new(),
     };
+    search.try_rollout(&seed, &[], None, &mut tails[0]);
     let mut ranked: Vec<(usize, f64)> = Vec::new();
+    let classical_tail = tails.len() - 1;
     for (index, candidate) in candidates.iter().enumerate() {
-        if spent >= budget {
+        if !search.budget_left() {
             break;
         }
-        let trajectory = rollout(robot, task, &candidate.q, &mut classical, context.rollout);
-        spent += steps_evaluated(&trajectory);
-        ranked.push((index, trajectory.path_length_m));
-        consider(candidate, trajectory);
+        let length = search.try_rollout(&candidate.seed(), &[], None, &mut tails[classical_tail]);
+        ranked.push((index, length));
     }
     if controller != ControllerKind::Classical {
         // Longest first; equal lengths keep the candidates' order.
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
         for &(index, _) in ranked.iter().take(context.config.finalists) {
-            if spent >= budget {
+            if !search.budget_left() {
                 break;
             }
-            let candidate = &candidates[index];
-            let trajectory = rollout(robot, task, &candidate.q, finalist, context.rollout);
-            spent += steps_evaluated(&trajectory);
-            consider(candidate, trajectory);
+            search.try_rollout(&candidates[index].seed(), &[], None, &mut tails[0]);
         }
     }
-    Ok(best)
+    search.repair(&mut tails);
+    let best = search.leaders.swap_remove(0);
+    Ok((best.seed, best.trajectory))
+}
+
+impl Candidate {
+    fn seed(&self) -> Seed {
+        Seed {
+            q: self.q,
+            source: self.source,
+            projection_iterations: None,
+        }
+    }
 }
 
 /// Steps a rollout evaluated: every accepted step, and the rejected one that ended it.

@@ -109,12 +109,16 @@ const EXTREME_WORDS: [u64; 10] = [
 
 /// What a number or word of a text file may be replaced by: extreme and malformed values, and
 /// plain ones (which keep more inputs valid, so that their use is exercised too).
-const TOKENS: [&str; 29] = [
+const TOKENS: [&str; 33] = [
     "0.5",
     "2",
     "100",
     "0.001",
     "7",
+    "1",
+    "30",
+    "0.05",
+    "500",
     "NaN",
     "inf",
     "-inf",
@@ -165,6 +169,7 @@ enum Mutation {
     },
     Token {
         in_head: bool,
+        numbers_only: bool,
         nth: Index,
         token: usize,
     },
@@ -175,13 +180,14 @@ fn at() -> impl Strategy<Value = At> {
 }
 
 fn token_mutation() -> impl Strategy<Value = Mutation> {
-    (any::<bool>(), any::<Index>(), 0..TOKENS.len()).prop_map(|(in_head, nth, token)| {
-        Mutation::Token {
+    (any::<[bool; 2]>(), any::<Index>(), 0..TOKENS.len()).prop_map(
+        |([in_head, numbers_only], nth, token)| Mutation::Token {
             in_head,
+            numbers_only,
             nth,
             token,
-        }
-    })
+        },
+    )
 }
 
 fn mutation() -> impl Strategy<Value = Mutation> {
@@ -231,11 +237,15 @@ impl Mutation {
             }
             Self::Token {
                 in_head,
+                numbers_only,
                 nth,
                 token,
             } => {
                 let span = if *in_head { len.min(1024) } else { len };
-                let tokens = token_spans(&bytes[..span]);
+                let mut tokens = token_spans(&bytes[..span]);
+                if *numbers_only {
+                    tokens.retain(|&(start, _)| matches!(bytes[start], b'0'..=b'9' | b'-'));
+                }
                 if !tokens.is_empty() {
                     let (start, end) = tokens[nth.index(tokens.len())];
                     bytes.splice(start..end, TOKENS[*token].bytes());

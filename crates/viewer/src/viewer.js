@@ -35,10 +35,16 @@ window.addEventListener("unhandledrejection", function (event) {
   const AXIS_OUT_COLOUR = "#b3261e";
   const GRID_COLOUR = "#d3d9e2";
   const SHADOW_COLOUR = "rgba(30, 40, 60, 0.10)";
-  const CONTROLLER_COLOURS = { classical: "#2b6cb0", learned: "#d53f8c", none: "#9aa3af" };
+  const CONTROLLER_COLOURS = {
+    classical: "#2b6cb0",
+    learned: "#d53f8c",
+    search: "#dd6b20",
+    none: "#9aa3af",
+  };
   const CONTROLLER_LABELS = {
     classical: "classical controller",
     learned: "learned policy",
+    search: "search detour",
     none: "no command (last step)",
   };
 
@@ -464,7 +470,7 @@ window.addEventListener("unhandledrejection", function (event) {
       legend.append(item);
     };
     const present = new Set(steps.map((s) => s.controller || "none"));
-    for (const key of ["classical", "learned", "none"]) {
+    for (const key of ["classical", "learned", "search", "none"]) {
       if (present.has(key)) entry(CONTROLLER_COLOURS[key], CONTROLLER_LABELS[key]);
     }
     entry(LINK_COLOUR, "links");

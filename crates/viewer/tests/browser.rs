@@ -432,6 +432,7 @@ fn controls_scrub_orbit_and_zoom_without_errors() {
     let acting = match trajectory.steps[last].controller {
         Some(ActingController::Classical) => "classical controller",
         Some(ActingController::Learned) => "learned policy",
+        Some(ActingController::Search) => "search detour",
         None => "no command (last step)",
     };
     assert!(
