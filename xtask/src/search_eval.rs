@@ -23,7 +23,7 @@ pub struct Args {
     #[arg(long, default_value_t = 200)]
     tasks: usize,
     /// Step budgets of the search, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 20_000, 50_000])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 10_000, 20_000, 50_000])]
     budgets: Vec<u64>,
     /// Worker threads (0 = one per core); the results do not depend on it.
     #[arg(long, default_value_t = 0)]

@@ -113,10 +113,11 @@ pub struct PlanArgs {
     /// task file holding several tasks: PATH-00000.html, ..., the extension kept).
     #[arg(long, value_name = "PATH")]
     pub html: Option<PathBuf>,
-    /// Planner: `controller` (the paper's pipeline: one seed, one rollout) or `search` (many
-    /// candidate starts ranked by rollouts within the config's `search.budget_steps`; the
-    /// controller then drives the best-ranked finalists).
-    #[arg(long, value_name = "NAME", value_parser = PlannerKind::from_str, default_value = "controller")]
+    /// Planner: `search` (the pipeline's plan first, then many candidate starts ranked by
+    /// rollouts and detours repairing the longest, within the config's `search.budget_steps`;
+    /// never shorter than the pipeline's plan) or `controller` (the paper's pipeline: one seed,
+    /// one rollout).
+    #[arg(long, value_name = "NAME", value_parser = PlannerKind::from_str, default_value = "search")]
     pub planner: PlannerKind,
     /// Null-space controller: `classical` (Eq. 3), `rl` (the PPO policy, Sec. 4.2) or `hybrid`
     /// (learned inside, classical near the joint limits, Sec. 4.3).

@@ -22,9 +22,11 @@
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
 //! * `--config <json>`: an `emg_planner::PlannerConfig`: optional `rollout`, `gains`, `switch`
 //!   (`tau_enter`, `tau_exit`) and `measure` objects; unset fields keep SPEC defaults.
-//! * `--planner controller` (default: the paper's pipeline, one seed and one rollout) or
-//!   `search` (many candidate starts ranked by rollouts within a step budget, `emg_planner`'s
-//!   search planner; the controller drives the finalists).
+//! * `--planner search` (default: `emg_planner`'s search: the pipeline's plan first, then many
+//!   candidate starts ranked by rollouts and detours repairing the longest, within a step
+//!   budget; never shorter than the pipeline's plan) or `controller` (the paper's pipeline, one
+//!   seed and one rollout). The seed option names the pipeline's seed, which the search tries
+//!   first.
 //! * `--controller hybrid` (default: the PPO policy over `--policy`, default the robot's shipped
 //!   `ppo-v1.weights`, inside; the classical controller near the joint limits),
 //!   `rl` or `classical`.

@@ -45,7 +45,14 @@ fn demo_task_writes_documented_json_and_csv() {
     let dir = tmp.path();
     let stem = dir.join("nested/demo");
     // Without diffusion weights the default seed is the task's generating configuration.
-    let stdout = plan_ok(&["--out", stem.to_str().unwrap(), "--weights", NO_WEIGHTS]);
+    let stdout = plan_ok(&[
+        "--planner",
+        "controller",
+        "--out",
+        stem.to_str().unwrap(),
+        "--weights",
+        NO_WEIGHTS,
+    ]);
     assert!(
         stdout.contains("path length") && stdout.contains("wrote"),
         "{stdout}"
@@ -107,6 +114,8 @@ fn written_trajectory_passes_the_independent_checker() {
     let dir = tmp.path();
     let stem = dir.join("line");
     plan_ok(&[
+        "--planner",
+        "controller",
         "--p0",
         "0.45,0.0,0.35",
         "--d",
@@ -225,6 +234,8 @@ fn task_file_with_three_tasks_gives_three_results() {
     std::fs::write(&task_file, serde_json::to_string_pretty(&tasks).unwrap()).unwrap();
     let stem = dir.join("out/set");
     let stdout = plan_ok(&[
+        "--planner",
+        "controller",
         "--task-file",
         task_file.to_str().unwrap(),
         "--out",
@@ -252,6 +263,8 @@ fn given_seed_is_projected_and_recorded() {
     let dir = tmp.path();
     let stem = dir.join("given");
     let stdout = plan_ok(&[
+        "--planner",
+        "controller",
         "--p0",
         "0.45,0.0,0.35",
         "--d",
@@ -273,7 +286,7 @@ fn dp_seed_is_the_default_with_the_shipped_weights() {
     let tmp = temp_dir("dp");
     let dir = tmp.path();
     let stem = dir.join("demo");
-    let stdout = plan_ok(&["--out", stem.to_str().unwrap()]);
+    let stdout = plan_ok(&["--planner", "controller", "--out", stem.to_str().unwrap()]);
     assert!(stdout.contains("seed: dp"), "{stdout}");
     let doc = read_json(&dir.join("demo.json"));
     assert_eq!(doc["seed_source"], "dp");
@@ -284,7 +297,14 @@ fn dp_seed_is_the_default_with_the_shipped_weights() {
     checker
         .check(&task, &trajectory, &config.constraints)
         .expect("the DP-seeded trajectory passes the independent checker");
-    let explicit = plan_ok(&["--seed", "dp", "--out", stem.to_str().unwrap()]);
+    let explicit = plan_ok(&[
+        "--planner",
+        "controller",
+        "--seed",
+        "dp",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
     assert_eq!(explicit, stdout);
 }
 

@@ -42,6 +42,26 @@ pub struct OutOfRange {
     pub allowed: &'static str,
 }
 
+impl OutOfRange {
+    /// `Ok` if `value` is finite and `check` accepts it, else the range error of `field`.
+    pub fn require(
+        field: &'static str,
+        value: f64,
+        allowed: &'static str,
+        check: impl Fn(f64) -> bool,
+    ) -> Result<(), Self> {
+        if value.is_finite() && check(value) {
+            Ok(())
+        } else {
+            Err(Self {
+                field,
+                value,
+                allowed,
+            })
+        }
+    }
+}
+
 /// A fraction in `(0, 1]` of the joint-velocity limits; reading any other value is an error that
 /// names the field.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -112,41 +132,23 @@ pub struct RolloutConfig {
 /// The largest accepted `max_steps`: 100,000 steps of 50 ms are well over an hour of motion.
 pub const MAX_STEPS_CAP: usize = 100_000;
 
-/// `value` if it is finite and `check` accepts it, else the range error of `field`.
-fn require(
-    field: &'static str,
-    value: f64,
-    allowed: &'static str,
-    check: impl Fn(f64) -> bool,
-) -> Result<(), OutOfRange> {
-    if value.is_finite() && check(value) {
-        Ok(())
-    } else {
-        Err(OutOfRange {
-            field,
-            value,
-            allowed,
-        })
-    }
-}
-
 impl ConstraintConfig {
     /// Checks every bound: `line_tolerance_m > 0`, `0 < theta_max_deg < 90`,
     /// `collision_margin_m ≥ 0`, all finite (the velocity fraction is checked when read).
     pub fn validate(&self) -> Result<(), OutOfRange> {
-        require(
+        OutOfRange::require(
             "constraints.line_tolerance_m",
             self.line_tolerance_m,
             "(0, ∞)",
             |v| v > 0.0,
         )?;
-        require(
+        OutOfRange::require(
             "constraints.theta_max_deg",
             self.theta_max_deg,
             "(0, 90)",
             |v| v > 0.0 && v < 90.0,
         )?;
-        require(
+        OutOfRange::require(
             "constraints.collision_margin_m",
             self.collision_margin_m,
             "[0, ∞)",
@@ -162,8 +164,8 @@ impl RolloutConfig {
     pub fn validate(&self) -> Result<(), OutOfRange> {
         let positive = |v: f64| v > 0.0;
         let non_negative = |v: f64| v >= 0.0;
-        require("rollout.dt_s", self.dt_s, "(0, ∞)", positive)?;
-        require(
+        OutOfRange::require("rollout.dt_s", self.dt_s, "(0, ∞)", positive)?;
+        OutOfRange::require(
             "rollout.speed_m_per_s",
             self.speed_m_per_s,
             "(0, ∞)",
@@ -176,43 +178,43 @@ impl RolloutConfig {
                 allowed: "[1, 100000]",
             });
         }
-        require(
+        OutOfRange::require(
             "rollout.null_speed_max_rad_per_s",
             self.null_speed_max_rad_per_s,
             "(0, ∞)",
             positive,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.lateral_gain_per_s",
             self.lateral_gain_per_s,
             "[0, ∞)",
             non_negative,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.manipulability_damping",
             self.manipulability_damping,
             "[0, ∞)",
             non_negative,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.damping.sigma_threshold",
             self.damping.sigma_threshold,
             "(0, ∞)",
             positive,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.damping.lambda_max",
             self.damping.lambda_max,
             "(0, ∞)",
             positive,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.basis.residual_floor",
             self.basis.residual_floor,
             "[0, ∞)",
             non_negative,
         )?;
-        require(
+        OutOfRange::require(
             "rollout.basis.residual_relative",
             self.basis.residual_relative,
             "[0, ∞)",
@@ -226,10 +228,10 @@ impl ClassicalGains {
     /// Checks that every gain is finite and non-negative and the cone gate width positive.
     pub fn validate(&self) -> Result<(), OutOfRange> {
         let non_negative = |v: f64| v >= 0.0;
-        require("gains.k_mu", self.k_mu, "[0, ∞)", non_negative)?;
-        require("gains.k_jl", self.k_jl, "[0, ∞)", non_negative)?;
-        require("gains.k_theta", self.k_theta, "[0, ∞)", non_negative)?;
-        require(
+        OutOfRange::require("gains.k_mu", self.k_mu, "[0, ∞)", non_negative)?;
+        OutOfRange::require("gains.k_jl", self.k_jl, "[0, ∞)", non_negative)?;
+        OutOfRange::require("gains.k_theta", self.k_theta, "[0, ∞)", non_negative)?;
+        OutOfRange::require(
             "gains.cone_gate_width_deg",
             self.cone_gate_width_deg,
             "(0, ∞)",

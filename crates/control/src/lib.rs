@@ -41,7 +41,9 @@ pub use config::{
 };
 pub use constraints::{Violation, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
-pub use rollout::{Episode, StepOutcome, StepRecord, Termination, Trajectory, rollout};
+pub use rollout::{
+    Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,
+};
 pub use sampler::{SamplerConfig, TaskSampler, candidate};
 pub use step::{NullAction, StepContext};
 pub use task::{PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, Task, TaskError};

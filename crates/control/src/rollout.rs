@@ -279,11 +279,20 @@ pub fn rollout(
     controller: &mut dyn NullSpaceController,
     config: &RolloutConfig,
 ) -> Trajectory {
-    let mut episode = Episode::start(robot, task, seed, config);
+    continue_rollout(Episode::start(robot, task, seed, config), controller)
+}
+
+/// Drives `episode` with `controller` from its current step to its end (a broken constraint or
+/// the step cap); `controller` is reset at that step first. An episode taken over midway (a
+/// clone of another at some step) goes on from exactly that state.
+pub fn continue_rollout(
+    mut episode: Episode<'_>,
+    controller: &mut dyn NullSpaceController,
+) -> Trajectory {
+    if let Some(first) = episode.context() {
+        controller.reset(&first);
+    }
     while let Some(context) = episode.context() {
-        if context.step == 0 {
-            controller.reset(&context);
-        }
         let (action, acting) = controller.act(&context);
         episode.apply(&context, &action, acting);
     }

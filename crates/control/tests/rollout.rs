@@ -7,6 +7,7 @@
 //!   every recorded configuration exactly; out-of-range actions are clipped; `reset`/`act` see
 //!   the right step index and previous action.
 //! - The step cap and an invalid start end the rollout as documented.
+//! - An episode copied midway and continued goes on from exactly the copied state.
 //! - In a `StepContext`: the classical action is `clip(Bᵀξ/a_max)` with `ξ` of Eq. 3; `J·B ≈ 0`
 //!   and `BᵀB = I`, so the null-space term leaves the TCP velocity unchanged; `J q̇ = ẋ` when
 //!   undamped; the gradients match finite differences; the cone gate is 0 below `θmax − 8°`,
@@ -637,4 +638,53 @@ fn cone_gate_is_zero_then_linear_then_one() {
     assert_eq!(wide.cone_gate(15.9, 20.0), 0.0);
     assert!((wide.cone_gate(18.0, 20.0) - 0.5).abs() < 1e-12);
     assert_eq!(wide.cone_gate(20.0, 20.0), 1.0);
+}
+
+/// The classical controller, but tagging its actions as a search's (to tell which controller a
+/// continued episode used).
+struct Tagged(ClassicalController);
+
+impl NullSpaceController for Tagged {
+    fn reset(&mut self, first: &StepContext<'_>) {
+        self.0.reset(first);
+    }
+
+    fn act(&mut self, step: &StepContext<'_>) -> (NullAction, ActingController) {
+        (self.0.act(step).0, ActingController::Search)
+    }
+}
+
+#[test]
+fn an_episode_copied_midway_goes_on_from_exactly_that_state() {
+    let robot = robot();
+    let config = RolloutConfig::default();
+    for (_, task) in tasks(&robot, 6) {
+        let seed = task.q0_seed.expect("sampled tasks keep their seed");
+        let mut controller = ClassicalController::new(ClassicalGains::default());
+        let whole = rollout(&robot, &task, &seed, &mut controller, &config);
+        if whole.steps.len() < 6 {
+            continue;
+        }
+        // Drive a fresh episode for a few steps, copy it, and let another controller finish
+        // the copy: the first steps are the whole rollout's, the rest the new controller's.
+        let mut episode = emg_control::Episode::start(&robot, &task, &seed, &config);
+        controller.reset(&episode.context().expect("a valid start"));
+        for _ in 0..4 {
+            let context = episode.context().expect("running");
+            let (action, acting) = controller.act(&context);
+            episode.apply(&context, &action, acting);
+        }
+        let copy = episode.clone();
+        let finished = emg_control::continue_rollout(episode, &mut controller);
+        assert_eq!(finished, whole, "continuing the episode changes nothing");
+        let mut tagged = Tagged(ClassicalController::new(ClassicalGains::default()));
+        let taken_over = emg_control::continue_rollout(copy, &mut tagged);
+        assert_eq!(taken_over.steps[..4], whole.steps[..4]);
+        assert!(
+            taken_over.steps[4..]
+                .iter()
+                .all(|s| s.controller.is_none_or(|c| c == ActingController::Search)),
+            "the copy goes on with the controller that took it over"
+        );
+    }
 }

@@ -34,8 +34,8 @@ pub struct PlannerConfig {
     /// The reachability scan ([`ReachConfig`]: `grid_m` 0.01, `restarts` 64, `branches` 4,
     /// `offsets` 6).
     pub reach: ReachConfig,
-    /// The search planner ([`SearchConfig`]: `budget_steps` 20,000, `dp_samples` 32,
-    /// `ik_restarts` 64, `finalists` 4).
+    /// The search planner ([`SearchConfig`]: `budget_steps` 10,000, `dp_samples` 32,
+    /// `ik_restarts` 64, `finalists` 8, `repaired_starts` 8, `detour_steps` 10).
     pub search: SearchConfig,
 }
 
@@ -86,15 +86,13 @@ impl PlannerConfig {
         self.switch.validate()?;
         self.reach.validate()?;
         self.search.validate()?;
-        if let BoundaryMeasure::AllConstraints { clearance_scale_m } = self.measure
-            && !(clearance_scale_m.is_finite() && clearance_scale_m > 0.0)
-        {
-            return Err(OutOfRange {
-                field: "measure.clearance_scale_m",
-                value: clearance_scale_m,
-                allowed: "(0, ∞)",
-            }
-            .into());
+        if let BoundaryMeasure::AllConstraints { clearance_scale_m } = self.measure {
+            OutOfRange::require(
+                "measure.clearance_scale_m",
+                clearance_scale_m,
+                "(0, ∞)",
+                |v| v > 0.0,
+            )?;
         }
         Ok(())
     }

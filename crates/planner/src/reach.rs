@@ -55,42 +55,19 @@ pub const MAX_REACH_RESTARTS: usize = 10_000;
 impl ReachConfig {
     /// Checks every value against its allowed range.
     pub fn validate(&self) -> Result<(), OutOfRange> {
-        let check = |field, value: f64, ok: bool, allowed| {
-            if ok {
-                Ok(())
-            } else {
-                Err(OutOfRange {
-                    field,
-                    value,
-                    allowed,
-                })
-            }
-        };
-        let grid = self.grid_m;
-        check(
-            "reach.grid_m",
-            grid,
-            (1e-3..=1.0).contains(&grid),
-            "[0.001, 1]",
-        )?;
-        check(
-            "reach.restarts",
-            self.restarts as f64,
-            self.restarts <= MAX_REACH_RESTARTS,
-            "[0, 10000]",
-        )?;
-        check(
-            "reach.branches",
-            self.branches as f64,
-            (1..=64).contains(&self.branches),
-            "[1, 64]",
-        )?;
-        check(
-            "reach.offsets",
-            self.offsets as f64,
-            self.offsets <= 64,
-            "[0, 64]",
-        )
+        let count = |n: usize| n as f64;
+        OutOfRange::require("reach.grid_m", self.grid_m, "[0.001, 1]", |g| {
+            (1e-3..=1.0).contains(&g)
+        })?;
+        OutOfRange::require("reach.restarts", count(self.restarts), "[0, 10000]", |n| {
+            n <= MAX_REACH_RESTARTS as f64
+        })?;
+        OutOfRange::require("reach.branches", count(self.branches), "[1, 64]", |n| {
+            (1.0..=64.0).contains(&n)
+        })?;
+        OutOfRange::require("reach.offsets", count(self.offsets), "[0, 64]", |n| {
+            n <= 64.0
+        })
     }
 }
 

@@ -14,9 +14,11 @@
 //! and the classical controller take over again; a round that goes further starts the next
 //! round from the new longest rollout. The longest rollout of all is the plan.
 //!
-//! A search rollout replays the actions of the rollout it branches from (so its first steps
-//! reproduce that rollout's states exactly) before its detour; the action each step took is
-//! recorded, detours as `ActingController::Search`.
+//! The repair replays the actions of the rollout it branches from once per round (so its states
+//! recur exactly), keeps snapshots of the episode at the branch points, and continues each
+//! branch from a copy of its snapshot through the shared step; the action each step took is
+//! recorded, detours as `ActingController::Search`. The budget counts every step evaluated,
+//! replays included.
 //!
 //! The budget counts control steps (every step evaluated, accepted or rejected), never wall
 //! time, so a plan is a pure function of the task and the configuration, whatever the machine
@@ -24,8 +26,8 @@
 //! is a sequence of steps the one step implementation accepted.
 
 use emg_control::{
-    ActingController, NullAction, NullSpaceController, OutOfRange, RolloutConfig, StepContext,
-    Task, Termination, Trajectory, first_violation, rollout,
+    ActingController, Episode, NullAction, NullSpaceController, OutOfRange, RolloutConfig,
+    StepContext, Task, Termination, Trajectory, continue_rollout, first_violation,
 };
 use emg_diffusion::{DpSeeder, SeedWorkspace};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
@@ -65,13 +67,13 @@ pub struct SearchConfig {
 impl Default for SearchConfig {
     fn default() -> Self {
         Self {
-            budget_steps: 20_000,
+            budget_steps: 10_000,
             dp_samples: 32,
             ik_restarts: 64,
-            finalists: 4,
+            finalists: 8,
             distinct_rad: 0.05,
             detour_steps: 10,
-            repaired_starts: 3,
+            repaired_starts: 8,
             seed: 20_261_123,
         }
     }
@@ -83,47 +85,35 @@ pub const MAX_SEARCH_BUDGET_STEPS: u64 = 10_000_000;
 impl SearchConfig {
     /// Checks every value against its allowed range.
     pub fn validate(&self) -> Result<(), OutOfRange> {
-        let out = |field, value: f64, allowed| OutOfRange {
-            field,
-            value,
-            allowed,
-        };
-        if !(1..=MAX_SEARCH_BUDGET_STEPS).contains(&self.budget_steps) {
-            return Err(out(
-                "search.budget_steps",
-                self.budget_steps as f64,
-                "[1, 10000000]",
-            ));
-        }
+        let count = |n: usize| n as f64;
+        let within = |low: f64, high: f64| move |n: f64| (low..=high).contains(&n);
+        OutOfRange::require(
+            "search.budget_steps",
+            self.budget_steps as f64,
+            "[1, 10000000]",
+            within(1.0, MAX_SEARCH_BUDGET_STEPS as f64),
+        )?;
         for (field, value) in [
             ("search.dp_samples", self.dp_samples),
             ("search.ik_restarts", self.ik_restarts),
         ] {
-            if value > 10_000 {
-                return Err(out(field, value as f64, "[0, 10000]"));
-            }
+            OutOfRange::require(field, count(value), "[0, 10000]", within(0.0, 10_000.0))?;
         }
-        if !(1..=64).contains(&self.finalists) {
-            return Err(out("search.finalists", self.finalists as f64, "[1, 64]"));
+        for (field, value) in [
+            ("search.finalists", self.finalists),
+            ("search.repaired_starts", self.repaired_starts),
+        ] {
+            OutOfRange::require(field, count(value), "[1, 64]", within(1.0, 64.0))?;
         }
-        if !(1..=64).contains(&self.repaired_starts) {
-            return Err(out(
-                "search.repaired_starts",
-                self.repaired_starts as f64,
-                "[1, 64]",
-            ));
-        }
-        if !(1..=100).contains(&self.detour_steps) {
-            return Err(out(
-                "search.detour_steps",
-                self.detour_steps as f64,
-                "[1, 100]",
-            ));
-        }
-        if !(self.distinct_rad.is_finite() && self.distinct_rad >= 0.0) {
-            return Err(out("search.distinct_rad", self.distinct_rad, "[0, ∞)"));
-        }
-        Ok(())
+        OutOfRange::require(
+            "search.detour_steps",
+            count(self.detour_steps),
+            "[1, 100]",
+            within(1.0, 100.0),
+        )?;
+        OutOfRange::require("search.distinct_rad", self.distinct_rad, "[0, ∞)", |d| {
+            d >= 0.0
+        })
     }
 }
 
@@ -153,11 +143,9 @@ struct Detour {
     steps: usize,
 }
 
-/// The controller of one search rollout: it replays `prefix` (actions an earlier rollout
-/// issued, so the same states recur exactly), then holds `detour`, then hands over to `tail`;
-/// it records every action it issues.
+/// The controller of one search rollout from the step it takes over: it holds `detour` for
+/// its steps, then hands over to `tail`; it records every action it issues.
 struct Branch<'a> {
-    prefix: &'a [Issued],
     detour: Option<Detour>,
     tail: &'a mut Executor,
     issued: Vec<Issued>,
@@ -170,10 +158,8 @@ impl NullSpaceController for Branch<'_> {
     }
 
     fn act(&mut self, step: &StepContext<'_>) -> Issued {
-        let t = step.step;
-        let chosen = match (self.prefix.get(t), self.detour) {
-            (Some(&issued), _) => issued,
-            (None, Some(detour)) if t < self.prefix.len() + detour.steps => {
+        let chosen = match self.detour {
+            Some(detour) if self.issued.len() < detour.steps => {
                 (detour.action, ActingController::Search)
             }
             _ => self.tail.act(step),
@@ -205,32 +191,35 @@ impl Search<'_> {
         self.spent < self.context.config.budget_steps
     }
 
-    /// Rolls out from `seed` with `prefix`, `detour` and `tail`, charges its steps to the
-    /// budget, and keeps it if it is the longest so far.
-    fn try_rollout(
+    /// Rolls out from `seed` with `tail`, charges its steps to the budget, and keeps it if it
+    /// is among the longest so far.
+    fn try_start(&mut self, seed: &Seed, tail: &mut Executor) -> f64 {
+        let context = self.context;
+        let episode = Episode::start(context.robot, self.task, &seed.q, context.rollout);
+        self.try_branch(seed, episode, &[], None, tail)
+    }
+
+    /// Takes over `episode` (from `seed`, after the actions `prefix`) with `detour` then `tail`,
+    /// charges the steps it evaluates to the budget, and keeps the rollout if it is among the
+    /// longest so far.
+    fn try_branch(
         &mut self,
         seed: &Seed,
+        episode: Episode<'_>,
         prefix: &[Issued],
         detour: Option<Detour>,
         tail: &mut Executor,
     ) -> f64 {
         let mut branch = Branch {
-            prefix,
             detour,
             tail,
             issued: Vec::new(),
         };
-        let context = self.context;
-        let trajectory = rollout(
-            context.robot,
-            self.task,
-            &seed.q,
-            &mut branch,
-            context.rollout,
-        );
-        self.spent += steps_evaluated(&trajectory);
+        let trajectory = continue_rollout(episode, &mut branch);
+        self.spent += steps_evaluated(&trajectory).saturating_sub(prefix.len() as u64);
         let length = trajectory.path_length_m;
-        let issued = branch.issued;
+        let mut issued = prefix.to_vec();
+        issued.extend(branch.issued);
         self.offer(Best {
             seed: seed.clone(),
             trajectory,
@@ -292,8 +281,7 @@ impl Search<'_> {
             let Some(base) = self.leader_of(seed).cloned() else {
                 return true;
             };
-            let issued = base.issued.len();
-            for back in BACKTRACK_STEPS.into_iter().filter(|&b| b <= issued) {
+            for (at, episode) in self.branch_points(&base) {
                 for action in &directions {
                     for tail in tails.iter_mut() {
                         if !self.budget_left() {
@@ -303,8 +291,8 @@ impl Search<'_> {
                             action: *action,
                             steps: self.context.config.detour_steps,
                         };
-                        let prefix = &base.issued[..issued - back];
-                        self.try_rollout(&base.seed, prefix, Some(detour), tail);
+                        let prefix = &base.issued[..at];
+                        self.try_branch(&base.seed, episode.clone(), prefix, Some(detour), tail);
                     }
                 }
             }
@@ -315,6 +303,38 @@ impl Search<'_> {
                 return true;
             }
         }
+    }
+}
+
+impl<'a> Search<'a> {
+    /// `base` replayed from its start (its own actions, so its states recur exactly), as
+    /// snapshots at [`BACKTRACK_STEPS`] steps before where it stopped, nearest the end first,
+    /// each with the number of actions taken to reach it; the replay is charged to the budget.
+    fn branch_points(&mut self, base: &Best) -> Vec<(usize, Episode<'a>)> {
+        let context = self.context;
+        let issued = base.issued.len();
+        let wanted: Vec<usize> = BACKTRACK_STEPS
+            .into_iter()
+            .filter(|&back| back <= issued)
+            .map(|back| issued - back)
+            .collect();
+        let mut episode = Episode::start(context.robot, self.task, &base.seed.q, context.rollout);
+        let mut points = Vec::new();
+        for (at, (action, acting)) in base.issued.iter().enumerate() {
+            if wanted.contains(&at) {
+                points.push((at, episode.clone()));
+            }
+            if at + 1 >= issued {
+                break;
+            }
+            let Some(step) = episode.context() else {
+                break;
+            };
+            episode.apply(&step, action, *acting);
+            self.spent += 1;
+        }
+        points.reverse();
+        points
     }
 }
 
@@ -345,14 +365,14 @@ pub(crate) fn search(
         spent: 0,
         leaders: Vec::new(),
     };
-    search.try_rollout(&seed, &[], None, &mut tails[0]);
+    search.try_start(&seed, &mut tails[0]);
     let mut ranked: Vec<(usize, f64)> = Vec::new();
     let classical_tail = tails.len() - 1;
     for (index, candidate) in candidates.iter().enumerate() {
         if !search.budget_left() {
             break;
         }
-        let length = search.try_rollout(&candidate.seed(), &[], None, &mut tails[classical_tail]);
+        let length = search.try_start(&candidate.seed(), &mut tails[classical_tail]);
         ranked.push((index, length));
     }
     if controller != ControllerKind::Classical {
@@ -362,7 +382,7 @@ pub(crate) fn search(
             if !search.budget_left() {
                 break;
             }
-            search.try_rollout(&candidates[index].seed(), &[], None, &mut tails[0]);
+            search.try_start(&candidates[index].seed(), &mut tails[0]);
         }
     }
     search.repair(&mut tails);
