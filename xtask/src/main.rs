@@ -17,6 +17,7 @@ mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
 mod label_seeds;
+mod limit;
 mod make_tasks;
 mod progress;
 mod protocol;
@@ -65,6 +66,9 @@ enum Command {
     StampWeights(stamp_weights::Args),
     /// The search planner against the pipeline at several step budgets (docs/results/search.*).
     SearchEval(search_eval::Args),
+    /// Best-known lengths (a large search) and reachability bounds of an evaluation subset
+    /// (resumable, --shard i/n, --merge → docs/results/limit.*).
+    Limit(limit::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -82,5 +86,6 @@ fn main() -> anyhow::Result<()> {
         Command::FigureBranches(args) => figure_branches::run(&args),
         Command::StampWeights(args) => stamp_weights::run(&args),
         Command::SearchEval(args) => search_eval::run(&args),
+        Command::Limit(args) => limit::run(&args),
     }
 }

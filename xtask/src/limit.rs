@@ -1,0 +1,363 @@
+//! `cargo xtask limit`: the best-known length ℓ* of each task of a fixed evaluation subset (the
+//! search planner with a large budget, every trajectory re-checked by the independent checker),
+//! its trajectory, and its reachability bound, beside what the paper's pipeline and the default
+//! search reach.
+//!
+//! Resumable and shardable: each finished task is written atomically as its own file in the
+//! journal directory (`target/limit/` by default) and a run skips the tasks already there;
+//! `--shard i/n` takes the tasks whose index is `i` mod `n`. `--merge` reads every task's file
+//! and writes `docs/results/limit.{json,md}`: per bucket of ℓ*, ℓ*, the bound, and each
+//! planner's share of ℓ*.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use emg_control::CheckRollout;
+use emg_eval::{BucketConfig, Difficulty, Summary, four};
+use emg_io::{read_tasks, write_atomically};
+use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
+use emg_seeding::Shard;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::{progress, workspace};
+
+/// Options of `limit`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Tasks: the first this many of the task set.
+    #[arg(long, default_value_t = 1000)]
+    tasks: usize,
+    /// The part of the tasks this run takes (`i/n`: the tasks whose index is i mod n).
+    #[arg(long, default_value = "0/1")]
+    shard: Shard,
+    /// Merge the journal into docs/results/limit.{json,md} instead of running.
+    #[arg(long)]
+    merge: bool,
+    /// Worker threads (0 = one per core); the results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Task set.
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
+    task_file: PathBuf,
+    /// Robot file.
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
+    robot: PathBuf,
+    /// Journal directory: one file per finished task.
+    #[arg(long, default_value_os_t = workspace::scratch("limit"))]
+    journal: PathBuf,
+    /// Output directory of limit.{json,md}.
+    #[arg(long, default_value_os_t = workspace::results_dir())]
+    out_dir: PathBuf,
+}
+
+/// The search settings of the limit: far more starts, finalists, repairs and steps than the
+/// planner's default.
+fn limit_search() -> SearchConfig {
+    SearchConfig {
+        budget_steps: 200_000,
+        dp_samples: 128,
+        ik_restarts: 512,
+        finalists: 16,
+        repaired_starts: 16,
+        ..SearchConfig::default()
+    }
+}
+
+/// What the journal was made with; a run refuses a journal made otherwise.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct Identity {
+    tasks: String,
+    task_count: usize,
+    limit: SearchConfig,
+    search: SearchConfig,
+}
+
+/// One task's results, the file the journal holds for it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct TaskLimit {
+    index: usize,
+    /// ℓ*: the longest of the large search, the default search and the pipeline (m).
+    limit_m: f64,
+    /// Where the limit's start came from.
+    limit_seed: String,
+    /// The limit's joint configurations, one per step (rad).
+    limit_q: Vec<[f64; 7]>,
+    /// The reachability bound (m).
+    bound_m: f64,
+    /// Hybrid + DP, the paper's pipeline (m).
+    pipeline_m: f64,
+    /// The default search (m).
+    search_m: f64,
+}
+
+/// Runs this shard's pending tasks, or merges the journal.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let robot = workspace::load_robot(&args.robot)?;
+    let checker = workspace::load_checker(&args.robot, &robot)?;
+    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir())
+        .context("limit needs a shipped robot's models")?;
+    let models = Models::shipped(&robot, &shipped.data_dir(&workspace::data_dir()))?;
+    let mut tasks = read_tasks(&args.task_file, &robot)?;
+    anyhow::ensure!(
+        args.tasks <= tasks.len(),
+        "--tasks {}: the task set holds {}",
+        args.tasks,
+        tasks.len()
+    );
+    tasks.truncate(args.tasks);
+    let identity = Identity {
+        tasks: workspace::relative(&args.task_file),
+        task_count: tasks.len(),
+        limit: limit_search(),
+        search: SearchConfig::default(),
+    };
+    open_journal(&args.journal, &identity)?;
+    if args.merge {
+        return merge(args, &identity);
+    }
+    let planner = Planner::new(robot, models, PlannerConfig::default())?;
+    let limit_planner = planner.with_config(PlannerConfig {
+        search: limit_search(),
+        ..PlannerConfig::default()
+    })?;
+    let pending: Vec<usize> = (args.shard.index..tasks.len())
+        .step_by(args.shard.count)
+        .filter(|&i| !task_path(&args.journal, i).exists())
+        .collect();
+    println!(
+        "{} tasks of shard {}/{} to do ({} already in {})",
+        pending.len(),
+        args.shard.index,
+        args.shard.count,
+        (args.shard.index..tasks.len())
+            .step_by(args.shard.count)
+            .count()
+            - pending.len(),
+        args.journal.display()
+    );
+    let bar = progress::bar(pending.len() as u64, "limit");
+    let search = PlanRequest {
+        planner: PlannerKind::Search,
+        ..PlanRequest::default()
+    };
+    workspace::thread_pool(args.threads)?.install(|| {
+        pending.par_iter().try_for_each(|&index| {
+            let task = &tasks[index];
+            let plan = |planner: &Planner, request: &PlanRequest| {
+                planner
+                    .plan(task, request)
+                    .with_context(|| format!("task {index}"))
+            };
+            let pipeline = plan(&planner, &PlanRequest::default())?;
+            let searched = plan(&planner, &search)?;
+            let large = plan(&limit_planner, &search)?;
+            let (pipeline_m, search_m) = (
+                pipeline.trajectory.path_length_m,
+                searched.trajectory.path_length_m,
+            );
+            // ℓ*: the longest of all three plans (the large search usually).
+            let limit = [large, searched, pipeline]
+                .into_iter()
+                .reduce(|best, other| {
+                    if other.trajectory.path_length_m > best.trajectory.path_length_m {
+                        other
+                    } else {
+                        best
+                    }
+                })
+                .context("three plans")?;
+            checker
+                .check(
+                    task,
+                    &limit.trajectory,
+                    &planner.config().rollout.constraints,
+                )
+                .map_err(|failure| {
+                    anyhow::anyhow!("task {index}: the limit fails the checker: {failure:?}")
+                })?;
+            let record = TaskLimit {
+                index,
+                limit_m: limit.trajectory.path_length_m,
+                limit_seed: limit.seed.source.to_string(),
+                limit_q: limit.trajectory.steps.iter().map(|s| s.q.into()).collect(),
+                bound_m: planner.reach(task, &[limit.seed.q]).reachable_m,
+                pipeline_m,
+                search_m,
+            };
+            let text = serde_json::to_string(&record)? + "\n";
+            write_atomically(&task_path(&args.journal, index), text.as_bytes())?;
+            bar.inc(1);
+            anyhow::Ok(())
+        })
+    })?;
+    bar.finish();
+    Ok(())
+}
+
+fn task_path(journal: &Path, index: usize) -> PathBuf {
+    journal.join(format!("task-{index:06}.json"))
+}
+
+/// Creates the journal with `identity`, or checks that an existing one was made with it.
+fn open_journal(dir: &Path, identity: &Identity) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let path = dir.join("journal.json");
+    let text = serde_json::to_string_pretty(identity)? + "\n";
+    match std::fs::read_to_string(&path) {
+        Ok(existing) if existing == text => Ok(()),
+        Ok(_) => bail!(
+            "{} was made for another task set, task count or search settings; remove {} to start over",
+            path.display(),
+            dir.display()
+        ),
+        Err(_) => Ok(write_atomically(&path, text.as_bytes())?),
+    }
+}
+
+/// Per-bucket (by ℓ*) and overall statistics.
+#[derive(Serialize)]
+struct Bucket {
+    bucket: String,
+    tasks: usize,
+    limit_m: Summary,
+    bound_m: Summary,
+    /// Mean of ℓ* / bound over the bucket's tasks with a positive bound.
+    limit_share_of_bound: f64,
+    /// Mean of the pipeline's length / ℓ*.
+    pipeline_share_of_limit: f64,
+    /// Mean of the default search's length / ℓ*.
+    search_share_of_limit: f64,
+}
+
+#[derive(Serialize)]
+struct Record {
+    robot: String,
+    identity: Identity,
+    buckets_by_limit: BucketConfig,
+    rows: Vec<Bucket>,
+}
+
+fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
+    let records = (0..identity.task_count)
+        .map(|index| {
+            let path = task_path(&args.journal, index);
+            let text = std::fs::read_to_string(&path).with_context(|| {
+                format!("task {index} is missing: run every shard to completion before merging")
+            })?;
+            serde_json::from_str::<TaskLimit>(&text)
+                .with_context(|| format!("reading {}", path.display()))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let buckets = BucketConfig::default();
+    let mut rows = Vec::new();
+    let groups = Difficulty::ALL.map(|d| (d.name().to_string(), Some(d)));
+    for (name, difficulty) in groups.into_iter().chain([("All".to_string(), None)]) {
+        let members: Vec<&TaskLimit> = records
+            .iter()
+            .filter(|r| difficulty.is_none_or(|d| buckets.classify(r.limit_m) == d))
+            .collect();
+        if members.is_empty() {
+            continue;
+        }
+        let values =
+            |f: &dyn Fn(&TaskLimit) -> f64| members.iter().map(|r| f(r)).collect::<Vec<_>>();
+        let share = |f: &dyn Fn(&TaskLimit) -> (f64, f64)| {
+            let ratios: Vec<f64> = members
+                .iter()
+                .map(|r| f(r))
+                .filter(|(_, of)| *of > 1e-9)
+                .map(|(v, of)| v / of)
+                .collect();
+            ratios.iter().sum::<f64>() / ratios.len().max(1) as f64
+        };
+        rows.push(Bucket {
+            bucket: name,
+            tasks: members.len(),
+            limit_m: Summary::of(&values(&|r| r.limit_m)).context("bucket")?,
+            bound_m: Summary::of(&values(&|r| r.bound_m)).context("bucket")?,
+            limit_share_of_bound: share(&|r| (r.limit_m, r.bound_m)),
+            pipeline_share_of_limit: share(&|r| (r.pipeline_m, r.limit_m)),
+            search_share_of_limit: share(&|r| (r.search_m, r.limit_m)),
+        });
+    }
+    let record = Record {
+        robot: workspace::relative(&args.robot),
+        identity: identity.clone(),
+        buckets_by_limit: buckets,
+        rows,
+    };
+    std::fs::create_dir_all(&args.out_dir)?;
+    let json = args.out_dir.join("limit.json");
+    write_atomically(
+        &json,
+        (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
+    )?;
+    let md = args.out_dir.join("limit.md");
+    write_atomically(&md, markdown(&record).as_bytes())?;
+    println!("wrote {} and {}", json.display(), md.display());
+    Ok(())
+}
+
+fn markdown(record: &Record) -> String {
+    let limit = &record.identity.limit;
+    let mut md = format!(
+        "# Best-known lengths (ℓ*) and the reachability bound\n\nWritten by `cargo xtask limit` and \
+         `cargo xtask limit --merge`. Do not edit by hand. Robot `{}`, the first {} tasks of `{}`. \
+         ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
+         {} restarts, {} finalists, the best {} starts repaired), every trajectory re-checked by \
+         the independent checker; the bound is the reachability scan (a necessary condition, so an \
+         upper bound as good as its IK sampling). Buckets by ℓ* (Easy ≥ {} m, Difficult < {} m). \
+         Shares are task means of the ratio.\n\n\
+         | bucket | tasks | ℓ* (m, mean / std / min / max) | bound (m) | ℓ* / bound | Hybrid + DP / ℓ* | \
+         search (default budget {}) / ℓ* |\n|---|---|---|---|---|---|---|\n",
+        record.robot,
+        record.identity.task_count,
+        record.identity.tasks,
+        limit.budget_steps,
+        limit.dp_samples,
+        limit.ik_restarts,
+        limit.finalists,
+        limit.repaired_starts,
+        record.buckets_by_limit.easy_min_m,
+        record.buckets_by_limit.difficult_below_m,
+        record.identity.search.budget_steps,
+    );
+    for row in &record.rows {
+        md += &format!(
+            "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} |\n",
+            row.bucket,
+            row.tasks,
+            four(&row.limit_m, 3),
+            row.bound_m.mean,
+            row.limit_share_of_bound,
+            row.pipeline_share_of_limit,
+            row.search_share_of_limit,
+        );
+    }
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn identity(task_count: usize) -> Identity {
+        Identity {
+            tasks: "data/tasks/eval-v1.tasks".into(),
+            task_count,
+            limit: limit_search(),
+            search: SearchConfig::default(),
+        }
+    }
+
+    #[test]
+    fn a_journal_is_reopened_only_with_the_settings_it_was_made_with() {
+        let dir = tempfile::tempdir().expect("temporary directory");
+        let journal = dir.path().join("limit");
+        open_journal(&journal, &identity(10)).expect("a new journal");
+        open_journal(&journal, &identity(10)).expect("the same settings resume it");
+        let error = open_journal(&journal, &identity(20)).expect_err("other settings");
+        assert!(error.to_string().contains("start over"), "{error}");
+    }
+}
