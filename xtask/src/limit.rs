@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use emg_control::CheckRollout;
 use emg_eval::{BucketConfig, Difficulty, Summary, four};
-use emg_io::{read_tasks, write_atomically};
-use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
+use emg_io::write_atomically;
+use emg_planner::{PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
 use emg_seeding::Shard;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -93,19 +93,11 @@ struct TaskLimit {
 
 /// Runs this shard's pending tasks, or merges the journal.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let robot = workspace::load_robot(&args.robot)?;
-    let checker = workspace::load_checker(&args.robot, &robot)?;
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir())
-        .context("limit needs a shipped robot's models")?;
-    let models = Models::shipped(&robot, &shipped.data_dir(&workspace::data_dir()))?;
-    let mut tasks = read_tasks(&args.task_file, &robot)?;
-    anyhow::ensure!(
-        args.tasks <= tasks.len(),
-        "--tasks {}: the task set holds {}",
-        args.tasks,
-        tasks.len()
-    );
-    tasks.truncate(args.tasks);
+    let workspace::PlannerSetup {
+        planner,
+        checker,
+        tasks,
+    } = workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "limit")?;
     let identity = Identity {
         tasks: workspace::relative(&args.task_file),
         task_count: tasks.len(),
@@ -116,7 +108,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.merge {
         return merge(args, &identity);
     }
-    let planner = Planner::new(robot, models, PlannerConfig::default())?;
     let limit_planner = planner.with_config(PlannerConfig {
         search: limit_search(),
         ..PlannerConfig::default()

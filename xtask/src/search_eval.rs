@@ -8,8 +8,8 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{Summary, four};
-use emg_io::{read_tasks, write_atomically};
-use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
+use emg_io::write_atomically;
+use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
 use serde::Serialize;
@@ -81,18 +81,15 @@ struct Record {
 
 /// Runs the comparison and writes the record, its table and its figure.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let robot = workspace::load_robot(&args.robot)?;
-    let checker = workspace::load_checker(&args.robot, &robot)?;
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir())
-        .context("search-eval needs a shipped robot's models")?;
-    let models = Models::shipped(&robot, &shipped.data_dir(&workspace::data_dir()))?;
-    let mut tasks = read_tasks(&args.task_file, &robot)?;
-    tasks.truncate(args.tasks);
+    let workspace::PlannerSetup {
+        planner,
+        checker,
+        tasks,
+    } = workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "search-eval")?;
     let pool = workspace::thread_pool(args.threads)?;
     let threads = pool.current_num_threads();
     let search: SearchConfig =
         workspace::read_config(args.search_config.as_deref(), "search config")?;
-    let planner = Planner::new(robot, models, PlannerConfig::default())?;
 
     println!("reachability bound of {} tasks", tasks.len());
     let bar = progress::bar(tasks.len() as u64, "reach");

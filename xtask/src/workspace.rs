@@ -4,8 +4,10 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use anyhow::Context;
+use emg_control::Task;
+use emg_io::read_tasks;
 use emg_kinematics::Robot;
-use emg_planner::{DataDir, ShippedRobot};
+use emg_planner::{DataDir, Models, Planner, PlannerConfig, ShippedRobot};
 use emg_verify::ReferenceModel;
 use serde::de::DeserializeOwned;
 
@@ -142,6 +144,46 @@ pub fn load_robot(path: &Path) -> anyhow::Result<Robot> {
 pub fn load_checker(path: &Path, robot: &Robot) -> anyhow::Result<ReferenceModel> {
     ReferenceModel::from_urdf_file(path, robot.base_link(), robot.tip_link())
         .with_context(|| format!("loading the checker's model of {}", path.display()))
+}
+
+/// What the planner comparisons start from: a shipped robot's planner (its shipped models, the
+/// default config), its checker, and the first tasks of a task set.
+pub struct PlannerSetup {
+    /// The planner of the robot with its shipped models.
+    pub planner: Planner,
+    /// The independent checker of the same robot file.
+    pub checker: ReferenceModel,
+    /// The tasks.
+    pub tasks: Vec<Task>,
+}
+
+/// The [`PlannerSetup`] of the shipped robot file `robot` and the first `count` tasks of
+/// `task_file`; `command` names the caller in errors.
+pub fn planner_setup(
+    robot: &Path,
+    task_file: &Path,
+    count: usize,
+    command: &str,
+) -> anyhow::Result<PlannerSetup> {
+    let model = load_robot(robot)?;
+    let checker = load_checker(robot, &model)?;
+    let shipped = ShippedRobot::by_path(robot, &data_dir())
+        .with_context(|| format!("{command} needs a shipped robot's models"))?;
+    let models = Models::shipped(&model, &shipped.data_dir(&data_dir()))?;
+    let mut tasks = read_tasks(task_file, &model)?;
+    anyhow::ensure!(
+        count <= tasks.len(),
+        "{command} --tasks {count}: {} holds {} tasks",
+        task_file.display(),
+        tasks.len()
+    );
+    tasks.truncate(count);
+    let planner = Planner::new(model, models, PlannerConfig::default())?;
+    Ok(PlannerSetup {
+        planner,
+        checker,
+        tasks,
+    })
 }
 
 /// Builds a rayon pool with `threads` threads (0 = one per core).
