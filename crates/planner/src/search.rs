@@ -9,21 +9,21 @@
 //! cone-IK solutions from seeded random restarts spread over the branches. Each valid start is
 //! ranked by a rollout of the classical controller (cheap, no network); the best
 //! [`SearchConfig::finalists`] are rolled out again with the requested controller. Then the
-//! longest rollout so far is repaired where it failed: from 1, 2, 4, … 32 steps before its end,
-//! each null-space basis direction (±`e_i` of `B(q)`) is held for a few steps and the requested
-//! and the classical controller take over again; a round that goes further starts the next
-//! round from the new longest rollout. The longest rollout of all is the plan.
+//! longest rollouts of the best [`SearchConfig::repaired_starts`] starts are repaired in turn
+//! where they failed: from 1, 2, 4, … 32 steps before the end, each null-space basis direction
+//! (±`e_i` of `B(q)`) is held for a few steps and the requested and the classical controller
+//! take over again; a round that goes further starts the next round from the new rollout. The
+//! longest rollout of all is the plan.
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
-//! branch from a copy of its snapshot through the shared step; the action each step took is
-//! recorded, detours as `ActingController::Search`. The budget counts every step evaluated,
-//! replays included.
+//! branch from a copy of its snapshot (`emg_control::continue_rollout`): every rollout goes
+//! through the one step implementation. The action each step took is recorded, detours as
+//! `ActingController::Search`.
 //!
-//! The budget counts control steps (every step evaluated, accepted or rejected), never wall
-//! time, so a plan is a pure function of the task and the configuration, whatever the machine
-//! or the thread count. Every rollout goes through the shared `emg_control::rollout`: a plan
-//! is a sequence of steps the one step implementation accepted.
+//! The budget counts control steps (every step evaluated, accepted or rejected, replays
+//! included), never wall time, so a plan is a pure function of the task and the configuration,
+//! whatever the machine or the thread count.
 
 use emg_control::{
     ActingController, Episode, NullAction, NullSpaceController, OutOfRange, RolloutConfig,
@@ -344,8 +344,8 @@ const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
 /// rolled out by `finalist`, the executor of `controller`) is always evaluated first, so the
 /// search never returns less; then the other candidates are ranked by classical rollouts, the
-/// best [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollout repaired
-/// by detours near its end, while budget is left.
+/// best [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollouts of the
+/// best starts repaired by detours near their ends, while budget is left.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
