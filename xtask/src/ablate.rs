@@ -292,11 +292,11 @@ fn dp_sweep(
     };
     std::fs::create_dir_all(&args.out_dir)?;
     let stem = args.out_dir.join(format!("ablate-{name}"));
-    std::fs::write(
+    emg_io::write_atomically(
         stem.with_extension("json"),
         serde_json::to_string_pretty(&report)? + "\n",
     )?;
-    std::fs::write(stem.with_extension("md"), markdown(&report))?;
+    emg_io::write_atomically(stem.with_extension("md"), markdown(&report))?;
     println!("{}", markdown(&report));
     Ok(())
 }

@@ -286,7 +286,7 @@ fn finish(
 ) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("ablate-{name}.json"));
-    std::fs::write(&json_path, serde_json::to_string_pretty(record)? + "\n")?;
+    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(record)? + "\n")?;
     md += &format!(
         "\nRun: {:.1} s wall on {} threads ({}); every trajectory passed the independent checker.\n",
         started.elapsed().as_secs_f64(),
@@ -294,7 +294,7 @@ fn finish(
         workspace::machine()
     );
     let md_path = args.out_dir.join(format!("ablate-{name}.md"));
-    std::fs::write(&md_path, md)?;
+    emg_io::write_atomically(&md_path, md)?;
     println!("wrote {} and {}", json_path.display(), md_path.display());
     Ok(())
 }

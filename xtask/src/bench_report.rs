@@ -71,7 +71,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         workspace::machine()
     );
     let report_path = root.join("docs/results/benchmarks.md");
-    std::fs::write(&report_path, report)?;
+    emg_io::write_atomically(&report_path, report)?;
     let readme_path = root.join("README.md");
     let readme = std::fs::read_to_string(&readme_path)?;
     let (Some(start), Some(end)) = (readme.find(README_START), readme.find(README_END)) else {
@@ -82,7 +82,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         &readme[..start],
         &readme[end..]
     );
-    std::fs::write(&readme_path, updated)?;
+    emg_io::write_atomically(&readme_path, updated)?;
     println!("wrote {} and the README table", report_path.display());
     Ok(())
 }

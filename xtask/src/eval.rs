@@ -1,7 +1,7 @@
 //! `cargo xtask eval`: a controller over the evaluation set, results in `docs/results/`.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
@@ -13,7 +13,7 @@ use emg_eval::{
 };
 use emg_io::read_tasks;
 use emg_planner::{ControllerKind, Executor, ExecutorConfig};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::velocity_limits::{self, VelocityLimits};
 use crate::{progress, protocol, workspace};
@@ -129,22 +129,55 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
             let mut shards = Vec::new();
             for i in 0..n {
                 let path = shard_path(i, n);
-                let text = std::fs::read_to_string(&path).with_context(|| {
+                let shard = ShardFile::read(&path)?.with_context(|| {
                     format!(
-                        "reading {} (run `cargo xtask eval --shard {i}/{n}`)",
+                        "{} is missing (run `cargo xtask eval --shard {i}/{n}`)",
                         path.display()
                     )
                 })?;
-                shards.push(serde_json::from_str::<Vec<RawSet>>(&text)?);
+                if let Some(first) = shards.first().map(|first: &ShardFile| &first.inputs) {
+                    anyhow::ensure!(
+                        shard.inputs == *first,
+                        "{} was computed from other inputs than shard 0/{n} ({:?} against {:?}); \
+                         rerun the shards with the same options",
+                        path.display(),
+                        shard.inputs,
+                        first
+                    );
+                }
+                shards.push(shard);
             }
+            let mut shard_sets: Vec<Vec<RawSet>> = shards.into_iter().map(|s| s.sets).collect();
             let mut merged = Vec::new();
-            while !shards[0].is_empty() {
-                let parts = shards.iter_mut().map(|sets| sets.remove(0)).collect();
+            while !shard_sets[0].is_empty() {
+                let parts = shard_sets.iter_mut().map(|sets| sets.remove(0)).collect();
                 merged.push(merge_sets(parts)?);
             }
             merged
         }
         None => {
+            let inputs = ShardInputs::of(args)?;
+            if let Some(s) = args.shard {
+                let path = shard_path(s.index, s.count);
+                match ShardFile::read(&path)? {
+                    Some(done) if done.inputs == inputs => {
+                        println!(
+                            "shard {}/{} is already done ({}); skipped (remove the file to redo it)",
+                            s.index,
+                            s.count,
+                            path.display()
+                        );
+                        return Ok(());
+                    }
+                    Some(_) => println!(
+                        "{} was computed from other inputs; computing shard {}/{} again",
+                        path.display(),
+                        s.index,
+                        s.count
+                    ),
+                    None => {}
+                }
+            }
             let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
             args.velocity_limits.apply(&mut setup.rollout.constraints);
             let shard = args.shard.map(|s| (s.index, s.count));
@@ -167,9 +200,9 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
                 )?);
             }
             if let Some(s) = args.shard {
-                std::fs::create_dir_all(&shard_dir)?;
                 let path = shard_path(s.index, s.count);
-                std::fs::write(&path, serde_json::to_string(&sets)?)?;
+                let file = ShardFile { inputs, sets };
+                emg_io::write_atomically(&path, serde_json::to_string(&file)?)?;
                 println!(
                     "shard {}/{} done; wrote {}",
                     s.index,
@@ -199,7 +232,7 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
         diffusion: workspace::relative(&args.diffusion),
         sets,
     };
-    std::fs::write(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
+    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
     let mut md = format!(
         "# Evaluation protocol: seeds × controllers\n\nWritten by `cargo xtask eval`. Do not edit by hand. \
          Every trajectory behind these tables passed the independent checker. Unseen = the evaluation set \
@@ -222,9 +255,78 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
         ),
     };
     let md_path = args.out_dir.join(format!("{name}.md"));
-    std::fs::write(&md_path, md)?;
+    emg_io::write_atomically(&md_path, md)?;
     println!("wrote {} and {}", json_path.display(), md_path.display());
     Ok(())
+}
+
+/// What a protocol shard was computed from: rerunning a shard whose file holds the same inputs
+/// skips it (a re-submitted job array redoes only what is missing), and a merge refuses shards of
+/// different inputs.
+#[derive(Debug, PartialEq, Serialize, Deserialize)]
+struct ShardInputs {
+    /// SHA-256 of every input file, by its option name.
+    files: BTreeMap<String, String>,
+    /// `--limit`.
+    limit: Option<usize>,
+    /// `--seen-count`.
+    seen_count: usize,
+    /// `--velocity-limits`.
+    velocity_limits: VelocityLimits,
+}
+
+impl ShardInputs {
+    /// The inputs `args` name.
+    fn of(args: &Args) -> anyhow::Result<Self> {
+        let mut files = BTreeMap::new();
+        let mut inputs = vec![
+            ("robot", &args.robot),
+            ("tasks", &args.tasks),
+            ("labels", &args.labels),
+            ("weights", &args.weights),
+            ("diffusion", &args.diffusion),
+        ];
+        if args.seen_count > 0 {
+            inputs.extend([
+                ("seen-tasks", &args.seen_tasks),
+                ("seen-labels", &args.seen_labels),
+            ]);
+        }
+        for (option, path) in inputs {
+            let digest = emg_seeding::file_sha256(path)
+                .with_context(|| format!("hashing the --{option} file"))?;
+            files.insert(option.to_string(), emg_seeding::hex(&digest));
+        }
+        Ok(Self {
+            files,
+            limit: args.limit,
+            seen_count: args.seen_count,
+            velocity_limits: args.velocity_limits,
+        })
+    }
+}
+
+/// One protocol shard's file in `<out-dir>/eval-shards/`: its inputs and raw per-task outcomes.
+#[derive(Serialize, Deserialize)]
+struct ShardFile {
+    inputs: ShardInputs,
+    sets: Vec<RawSet>,
+}
+
+impl ShardFile {
+    /// The shard file at `path`, or `None` when there is none.
+    fn read(path: &Path) -> anyhow::Result<Option<Self>> {
+        match std::fs::read_to_string(path) {
+            Ok(text) => Ok(Some(serde_json::from_str(&text).with_context(|| {
+                format!(
+                    "{} is not a shard file of this version (remove it to redo the shard)",
+                    path.display()
+                )
+            })?)),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(e) => Err(e).with_context(|| format!("reading {}", path.display())),
+        }
+    }
 }
 
 /// One controller from every task's q0_seed.
@@ -307,9 +409,9 @@ fn run_controller(
     let name = args.name.clone().unwrap_or_else(|| kind.name().into());
     std::fs::create_dir_all(&args.out_dir)?;
     let json_path = args.out_dir.join(format!("{name}.json"));
-    std::fs::write(&json_path, serde_json::to_string_pretty(&result)? + "\n")?;
+    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&result)? + "\n")?;
     let md_path = args.out_dir.join(format!("{name}.md"));
-    std::fs::write(
+    emg_io::write_atomically(
         &md_path,
         markdown(
             &result,

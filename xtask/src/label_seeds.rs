@@ -17,7 +17,7 @@ use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_seeding::{
     HeuristicConfig, HeuristicObjective, LABEL_FORMAT_VERSION, LabelConfig, LabelJob, LabelSet,
-    Shard, TaskStats, heuristic_seed, hex, label_task, task_set_sha256,
+    Shard, TaskStats, file_sha256, heuristic_seed, hex, label_task,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -131,7 +131,7 @@ fn label_set(args: &Args, robot: &Robot, config: &LabelConfig, name: &str) -> an
             task_path.display()
         )
     })?;
-    let sha = task_set_sha256(&task_path)?;
+    let sha = file_sha256(&task_path)?;
     let job = LabelJob::new(
         robot,
         &tasks,
@@ -172,7 +172,7 @@ fn label_set(args: &Args, robot: &Robot, config: &LabelConfig, name: &str) -> an
     set.write(&labels_path)?;
     let manifest = manifest(&labels_path, &task_path, &set, &stats, config)?;
     let manifest_path = args.out_dir.join(format!("{name}.manifest.json"));
-    std::fs::write(
+    emg_io::write_atomically(
         &manifest_path,
         serde_json::to_string_pretty(&manifest)? + "\n",
     )?;
@@ -273,7 +273,7 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
     let task_path = args.tasks_dir.join("eval-v1.tasks");
     let tasks = read_tasks(&task_path, robot)?;
     let labels = LabelSet::read(&args.out_dir.join("eval-v1.labels"))?;
-    if labels.task_set_sha256() != &task_set_sha256(&task_path)? || !labels.is_complete() {
+    if labels.task_set_sha256() != &file_sha256(&task_path)? || !labels.is_complete() {
         bail!(
             "{} does not label the current evaluation set completely",
             args.out_dir.join("eval-v1.labels").display()
@@ -378,9 +378,9 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
     };
     std::fs::create_dir_all(&args.results_dir)?;
     let json = args.results_dir.join("labels.json");
-    std::fs::write(&json, serde_json::to_string_pretty(&report)? + "\n")?;
+    emg_io::write_atomically(&json, serde_json::to_string_pretty(&report)? + "\n")?;
     let md = args.results_dir.join("labels.md");
-    std::fs::write(&md, markdown(&report))?;
+    emg_io::write_atomically(&md, markdown(&report))?;
     println!("wrote {} and {}", json.display(), md.display());
     Ok(())
 }

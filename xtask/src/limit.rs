@@ -11,10 +11,10 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{BucketConfig, Difficulty, Summary, four};
-use emg_io::write_atomically;
+
 use emg_planner::{PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
 use emg_seeding::Shard;
 use rayon::prelude::*;
@@ -177,7 +177,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 search_m,
             };
             let text = serde_json::to_string(&record)? + "\n";
-            write_atomically(&task_path(&args.journal, index), text.as_bytes())?;
+            emg_io::write_atomically(task_path(&args.journal, index), text.as_bytes())?;
             bar.inc(1);
             anyhow::Ok(())
         })
@@ -192,18 +192,9 @@ fn task_path(journal: &Path, index: usize) -> PathBuf {
 
 /// Creates the journal with `identity`, or checks that an existing one was made with it.
 fn open_journal(dir: &Path, identity: &Identity) -> anyhow::Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let path = dir.join("journal.json");
     let text = serde_json::to_string_pretty(identity)? + "\n";
-    match std::fs::read_to_string(&path) {
-        Ok(existing) if existing == text => Ok(()),
-        Ok(_) => bail!(
-            "{} was made for another task set, task count or search settings; remove {} to start over",
-            path.display(),
-            dir.display()
-        ),
-        Err(_) => Ok(write_atomically(&path, text.as_bytes())?),
-    }
+    emg_io::open_journal(dir, &text)
+        .context("the limit journal holds another task set, task count or search settings")
 }
 
 /// Per-bucket (by ℓ*) and overall statistics.
@@ -280,12 +271,12 @@ fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
     };
     std::fs::create_dir_all(&args.out_dir)?;
     let json = args.out_dir.join("limit.json");
-    write_atomically(
+    emg_io::write_atomically(
         &json,
         (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
     )?;
     let md = args.out_dir.join("limit.md");
-    write_atomically(&md, markdown(&record).as_bytes())?;
+    emg_io::write_atomically(&md, markdown(&record).as_bytes())?;
     println!("wrote {} and {}", json.display(), md.display());
     Ok(())
 }
@@ -349,6 +340,6 @@ mod tests {
         open_journal(&journal, &identity(10)).expect("a new journal");
         open_journal(&journal, &identity(10)).expect("the same settings resume it");
         let error = open_journal(&journal, &identity(20)).expect_err("other settings");
-        assert!(error.to_string().contains("start over"), "{error}");
+        assert!(format!("{error:#}").contains("start over"), "{error:#}");
     }
 }

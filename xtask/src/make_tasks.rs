@@ -100,7 +100,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         split: "first eval_count accepted candidates, then the next train_count",
     };
     let manifest_path = args.out_dir.join(format!("tasks-v{version}.manifest.json"));
-    std::fs::write(
+    emg_io::write_atomically(
         &manifest_path,
         serde_json::to_string_pretty(&manifest)? + "\n",
     )?;

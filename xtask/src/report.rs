@@ -150,7 +150,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     md += &velocity_limits(&args.results)?;
     md += &other_arms(&args.results)?;
-    std::fs::write(&args.out, md)?;
+    emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     Ok(())
 }

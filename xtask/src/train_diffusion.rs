@@ -193,7 +193,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         final_loss: trainer.loss_log().last().map(|row| row.loss),
         wall_seconds_this_session: started.elapsed().as_secs_f64(),
     };
-    std::fs::write(
+    emg_io::write_atomically(
         args.out.with_extension("json"),
         serde_json::to_string_pretty(&card)? + "\n",
     )?;
@@ -238,7 +238,7 @@ fn measure_backends(
         network.time_dim
     );
     std::fs::create_dir_all(results)?;
-    std::fs::write(results.join("diffusion-backends.md"), text)?;
+    emg_io::write_atomically(results.join("diffusion-backends.md"), text)?;
     Ok(())
 }
 
@@ -251,7 +251,7 @@ fn write_loss_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()> {
     for row in log {
         csv += &format!("{},{}\n", row.step, row.loss);
     }
-    std::fs::write(results.join("diffusion-training.csv"), csv)?;
+    emg_io::write_atomically(results.join("diffusion-training.csv"), csv)?;
     if log.is_empty() {
         return Ok(());
     }

@@ -223,7 +223,7 @@ fn write_outputs(
         last: trainer.log().last(),
         training_wall_seconds: wall,
     };
-    std::fs::write(
+    emg_io::write_atomically(
         args.out.with_extension("json"),
         serde_json::to_string_pretty(&card)? + "\n",
     )?;
@@ -256,7 +256,7 @@ fn write_learning_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()>
             row.learning_rate
         );
     }
-    std::fs::write(results.join("ppo-learning-curve.csv"), csv)?;
+    emg_io::write_atomically(results.join("ppo-learning-curve.csv"), csv)?;
     let points: Vec<(f64, f64)> = trainer
         .log()
         .iter()
@@ -330,7 +330,7 @@ fn write_summary(
         fmt(last.and_then(|r| r.mean_return)),
         fmt(last.and_then(|r| r.mean_score)),
     );
-    std::fs::write(results.join("ppo-training.md"), text)?;
+    emg_io::write_atomically(results.join("ppo-training.md"), text)?;
     Ok(())
 }
 
@@ -384,6 +384,6 @@ fn measure_backends(
         rayon::current_num_threads(),
     );
     std::fs::create_dir_all(results)?;
-    std::fs::write(results.join("ppo-backends.md"), text)?;
+    emg_io::write_atomically(results.join("ppo-backends.md"), text)?;
     Ok(())
 }

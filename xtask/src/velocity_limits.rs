@@ -10,12 +10,12 @@ use emg_control::{ConstraintConfig, Trajectory, VelocityLimitFraction};
 use emg_eval::{Setup, Summary, four};
 use emg_io::read_tasks;
 use emg_planner::{ControllerKind, SeedSource};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::workspace;
 
 /// `eval --velocity-limits`: whether rollouts honour the robot file's joint-velocity limits.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum VelocityLimits {
     /// Steps that would be too fast are slowed down in time (the default).
@@ -181,9 +181,9 @@ pub fn run(
         "velocity_limits_rad_per_s": limits,
         "controllers": comparisons,
     });
-    std::fs::write(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
+    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
     let md_path = out_dir.join("velocity-limits.md");
-    std::fs::write(
+    emg_io::write_atomically(
         &md_path,
         markdown(setup, &comparisons, tasks.len(), tasks_path),
     )?;

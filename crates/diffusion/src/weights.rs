@@ -302,7 +302,7 @@ impl DenoiserWeights {
 
     /// Writes the file (to a temporary sibling first, so an interrupted write loses nothing).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        emg_io::write_atomically(path, &self.to_bytes()).map_err(|source| WeightsError::Io {
+        emg_io::write_atomically(path, self.to_bytes()).map_err(|source| WeightsError::Io {
             path: path.display().to_string(),
             source,
         })

@@ -8,7 +8,9 @@
 //! * [`TrajectoryContents`]: any of the three, told apart by content, as the independent
 //!   checker's [`emg_verify::JointSamples`].
 //! * [`read_tasks`] / [`write_task_set`]: task sets (binary `EMGTASKS` or JSON).
-//! * [`write_atomically`]: every file of the workspace is written through a `.partial` sibling.
+//! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
+//!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
+//!   for one job's identity.
 //!
 //! Velocities in every file follow [`emg_verify::point_velocities`], so the checker recomputes
 //! exactly what the writers declare.
@@ -46,7 +48,7 @@ mod paths;
 mod rollout_file;
 mod task_file;
 
-pub use atomic::{partial_path, write_atomically};
+pub use atomic::{JournalError, open_journal, write_atomically};
 pub use contents::{Carried, ReadError, TrajectoryContents};
 pub use csv::{CSV_HEADER, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;

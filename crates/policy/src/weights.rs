@@ -235,7 +235,7 @@ impl PolicyWeights {
 
     /// Writes the file (via a `.partial` sibling renamed into place).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        emg_io::write_atomically(path, &self.to_bytes()).map_err(|source| WeightsError::Io {
+        emg_io::write_atomically(path, self.to_bytes()).map_err(|source| WeightsError::Io {
             path: path.display().to_string(),
             source,
         })

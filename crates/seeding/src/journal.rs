@@ -109,17 +109,12 @@ impl<'a> LabelJob<'a> {
         dir: &Path,
         chunk_size: usize,
     ) -> Result<Self, LabelError> {
-        let io = |source| LabelError::Io {
-            path: dir.display().to_string(),
-            source,
-        };
         if chunk_size == 0 {
             return Err(LabelError::Format {
                 path: dir.display().to_string(),
                 problem: "chunk_size must be at least 1".into(),
             });
         }
-        std::fs::create_dir_all(dir).map_err(io)?;
         let identity = JournalIdentity {
             task_set_sha256: hex(&task_set_sha256),
             task_count: tasks.len(),
@@ -127,19 +122,15 @@ impl<'a> LabelJob<'a> {
             config: config.clone(),
         };
         let text = serde_json::to_string_pretty(&identity).expect("identity serialises") + "\n";
-        let path = dir.join("journal.json");
-        match std::fs::read_to_string(&path) {
-            Ok(existing) if existing == text => {}
-            Ok(_) => {
-                return Err(LabelError::Format {
-                    path: path.display().to_string(),
-                    problem: "this journal was made for another task set, chunk size or labelling \
-                              config; remove the directory to start over"
-                        .into(),
-                });
-            }
-            Err(_) => std::fs::write(&path, text).map_err(io)?,
-        }
+        emg_io::open_journal(dir, &text).map_err(|error| match error {
+            emg_io::JournalError::Io { path, source } => LabelError::Io { path, source },
+            emg_io::JournalError::Mismatch { path, .. } => LabelError::Format {
+                path,
+                problem: "this journal was made for another task set, chunk size or labelling \
+                          config; remove the directory to start over"
+                    .into(),
+            },
+        })?;
         Ok(Self {
             robot,
             tasks,

@@ -211,7 +211,7 @@ impl LabelSet {
 
     /// Writes the set in the binary layout (atomically: a temporary file renamed into place).
     pub fn write(&self, path: &Path) -> Result<(), LabelError> {
-        emg_io::write_atomically(path, &self.to_bytes()).map_err(|source| LabelError::Io {
+        emg_io::write_atomically(path, self.to_bytes()).map_err(|source| LabelError::Io {
             path: path.display().to_string(),
             source,
         })
@@ -320,8 +320,8 @@ impl LabelSet {
     }
 }
 
-/// SHA-256 of a file's bytes: the identity of a labelled task set.
-pub fn task_set_sha256(path: &Path) -> Result<[u8; 32], LabelError> {
+/// SHA-256 of a file's bytes: the identity of a labelled task set, of weights, of any input.
+pub fn file_sha256(path: &Path) -> Result<[u8; 32], LabelError> {
     let bytes = std::fs::read(path).map_err(|source| LabelError::Io {
         path: path.display().to_string(),
         source,

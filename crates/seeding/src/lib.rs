@@ -56,7 +56,5 @@ pub use heuristic::{HeuristicError, HeuristicObjective, HeuristicSeed, heuristic
 pub use ik::{cone_ik_solutions, solve_cone_ik};
 pub use journal::{LabelJob, RunProgress, Shard, ShardError};
 pub use labelling::{TaskStats, label_task};
-pub use labels::{
-    LABEL_FORMAT_VERSION, Label, LabelError, LabelSet, TaskLabels, hex, task_set_sha256,
-};
+pub use labels::{LABEL_FORMAT_VERSION, Label, LabelError, LabelSet, TaskLabels, file_sha256, hex};
 pub use tangent::self_motion_projector;

@@ -4,7 +4,7 @@
 mod common;
 
 use common::{eval_path, eval_tasks, robot, small_config, temporary_dir};
-use emg_seeding::{LabelJob, Shard, task_set_sha256};
+use emg_seeding::{LabelJob, Shard, file_sha256};
 
 const TASKS: usize = 7;
 const CHUNK: usize = 2;
@@ -12,7 +12,7 @@ const CHUNK: usize = 2;
 fn label_file(dir: &std::path::Path, runs: &[(Shard, Option<usize>)], threads: usize) -> Vec<u8> {
     let (robot, config) = (robot(), small_config());
     let tasks = eval_tasks(&robot, TASKS);
-    let sha = task_set_sha256(&eval_path()).unwrap();
+    let sha = file_sha256(&eval_path()).unwrap();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -41,7 +41,7 @@ fn interrupted_sharded_and_threaded_runs_equal_the_single_run() {
     {
         let (robot, config) = (robot(), small_config());
         let tasks = eval_tasks(&robot, TASKS);
-        let sha = task_set_sha256(&eval_path()).unwrap();
+        let sha = file_sha256(&eval_path()).unwrap();
         let job = LabelJob::new(&robot, &tasks, sha, &config, dir, CHUNK).unwrap();
         let first = job.run(Shard::WHOLE, Some(1), &|_| {}).unwrap();
         assert_eq!((first.chunks_done, first.chunks_left), (1, 3));
@@ -68,7 +68,7 @@ fn interrupted_sharded_and_threaded_runs_equal_the_single_run() {
 fn journal_of_another_config_is_refused_and_shards_parse() {
     let (robot, config) = (robot(), small_config());
     let tasks = eval_tasks(&robot, 3);
-    let sha = task_set_sha256(&eval_path()).unwrap();
+    let sha = file_sha256(&eval_path()).unwrap();
     let tmp = temporary_dir("refused");
     let dir = tmp.path();
     LabelJob::new(&robot, &tasks, sha, &config, dir, CHUNK).unwrap();
