@@ -20,8 +20,8 @@
 #
 # EMG_SLURM_TEST_KEEP=1 keeps the state directory (logs, outputs) for a look afterwards.
 # Needs root (or sudo) to install packages and run slurmd. Fails, never skips, when Slurm cannot
-# start. Usage: deploy/slurm/test.sh (from anywhere; builds xtask with the test profile, whose
-# dependencies `cargo test` has already compiled).
+# start. Usage: deploy/slurm/test.sh (from anywhere) after `cargo test --workspace`, which builds
+# target/debug/xtask; EMG_XTASK names another xtask binary.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 started_at=$SECONDS
@@ -55,9 +55,11 @@ for tool in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo; do
 done
 
 # --- xtask ------------------------------------------------------------------------------------
-step "building xtask (test profile)"
-(cd "$root" && cargo build --quiet --profile test -p xtask)
-export EMG_XTASK="$root/target/debug/xtask"
+# The binary `cargo test --workspace` builds for xtask's integration tests (test profile, the
+# workspace's feature set: building it alone would compile much of the dependency tree again).
+export EMG_XTASK="${EMG_XTASK:-$root/target/debug/xtask}"
+[[ -x "$EMG_XTASK" ]] \
+    || fail "no xtask binary at $EMG_XTASK: run \`cargo test --workspace\` first (or set EMG_XTASK)"
 
 # --- State and cleanup --------------------------------------------------------------------------
 state="$(mktemp -d /tmp/emg-slurm-test.XXXXXX)"

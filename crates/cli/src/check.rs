@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use emg_control::{ConstraintConfig, Task};
 use emg_io::{Carried, TrajectoryContents};
 use emg_kinematics::{Robot, Vec3};
-use emg_verify::{ReplayError, ReplayReport, check_joint_names, check_replay};
+use emg_verify::ReplayReport;
 
 use crate::args::CheckArgs;
 use emg_planner::PlannerConfig;
@@ -74,39 +74,15 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         (None, None, None) => (ConstraintConfig::default(), "the defaults".to_string()),
     };
 
-    if let Some(names) = contents.joint_names() {
-        check_joint_names(names, robot.joint_names())
-            .with_context(|| format!("{} does not hold up", file.display()))?;
-    }
-    let samples = contents.samples();
     // The recorded trajectory is verified as recorded (its TCP, tool angles, path length and
-    // end) only against its own task: its tool angles are measured from that task's normal.
+    // end) only against its own task.
     let own_task = args.line.p0.is_none() && task_from.is_none();
+    let report = contents
+        .verify(&model, robot.joint_names(), &task, &constraints, own_task)
+        .map_err(|failure| anyhow::anyhow!("{} does not hold up: {failure}", file.display()))?;
     let recorded = match &contents {
         TrajectoryContents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
         _ => None,
-    };
-    let recording = recorded.map(emg_verify::Recording::from);
-    let report = match check_replay(
-        &model,
-        &(&task).into(),
-        &(&constraints).into(),
-        &samples,
-        recording.as_ref(),
-    ) {
-        Ok(report) => report,
-        Err(ReplayError::Point { point, problem, .. }) => {
-            let at = samples
-                .time_s
-                .get(point)
-                .map_or(String::new(), |t| format!(" (t = {t} s)"));
-            bail!(
-                "{} does not hold up: point {point} of {}{at}: {problem}",
-                file.display(),
-                samples.len()
-            );
-        }
-        Err(error) => bail!("{} does not hold up: {error}", file.display()),
     };
 
     println!(

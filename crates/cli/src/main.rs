@@ -58,15 +58,17 @@ mod tasks;
 use std::path::Path;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Parser;
 use emg_control::{Task, Trajectory};
-use emg_io::{JointTrajectory, PlanPaths, TrajectoryFile, html_path};
-use emg_planner::{Models, Plan, PlanError, PlanRequest, Planner, PlannerConfig, SeedSource};
+use emg_io::{PlanPaths, html_path};
+use emg_planner::{
+    Models, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig, SeedSource,
+};
 
 use crate::args::{Cli, Command, OnOff, PlanArgs};
 use crate::interrupt::{Interrupt, Interrupted};
-use crate::output::{write_result, write_text};
+use crate::output::write_text;
 
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
@@ -130,7 +132,9 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         let planned = planner
             .plan(task, &request)
             .map_err(|error| plan_error(error, &request))
-            .and_then(|plan| write_plan(&planner, args, task, &plan, many.then_some(index)));
+            .and_then(|plan| {
+                write_plan(&planner, args, &request, task, &plan, many.then_some(index))
+            });
         match planned {
             Ok(report) => println!("{label}{report}"),
             Err(error) if many => {
@@ -190,40 +194,21 @@ fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
 fn write_plan(
     planner: &Planner,
     args: &PlanArgs,
+    request: &PlanRequest,
     task: &Task,
     plan: &Plan,
     index: Option<usize>,
 ) -> Result<String> {
-    let robot = planner.robot();
-    let config = planner.config();
     let trajectory = &plan.trajectory;
     let reach = (args.reach == OnOff::On).then(|| planner.reach(task, &[plan.seed.q]));
     let paths = PlanPaths::new(&args.out, index);
-    let robot_name = args.robot.display().to_string();
-    let file = TrajectoryFile {
-        format: emg_io::TRAJECTORY_FORMAT,
-        robot: robot_name.clone(),
-        joint_names: robot.joint_names(),
-        task,
-        seed_source: plan.seed.source,
-        planner: args.planner.name(),
-        controller: args.controller.name(),
-        config: &config.rollout,
-        gains: &config.gains,
-        steps: &trajectory.steps,
-        termination: &trajectory.termination,
-        path_length_m: trajectory.path_length_m,
+    let robot = args.robot.display().to_string();
+    let record = PlanRecord {
+        robot: &robot,
+        request,
         reachable_m: reach.as_ref().map(|r| r.reachable_m),
     };
-    let joint = JointTrajectory::new(
-        &robot_name,
-        robot.joint_names(),
-        task,
-        &config.rollout.constraints,
-        trajectory,
-    )
-    .context("cannot build the joint trajectory")?;
-    write_result(&file, &joint, &paths)?;
+    PlanFiles::new(planner, task, plan, &record)?.write(&paths)?;
     let viewer = match &args.html {
         Some(html) => write_viewer(planner, args, task, trajectory, &html_path(html, index))?,
         None => String::new(),

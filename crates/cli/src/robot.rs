@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use emg_kinematics::Robot;
-use emg_planner::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
+use emg_planner::{DataDir, SHIPPED_ROBOTS};
 use emg_verify::ReferenceModel;
 
 /// The shipped data: `$EMG_DATA` when set, else the `data/` directory of the workspace this
@@ -29,7 +29,7 @@ pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
             names.join(", ")
         ));
     }
-    Ok(ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(&data_dir())))
+    Ok(data_dir().robot_file(value))
 }
 
 /// Loads the robot file: the chain between `base` and `tip` when both are named, else from the
@@ -52,8 +52,7 @@ pub fn load_checker(path: &Path, robot: &Robot) -> Result<ReferenceModel> {
 /// Model file `name` (e.g. `ppo-v1.weights`) shipped for the robot file `robot`, when that file
 /// is one of the shipped robots.
 pub fn shipped_model(robot: &Path, name: &str) -> Option<PathBuf> {
-    let data = data_dir();
-    ShippedRobot::by_path(robot, &data).map(|r| r.data_dir(&data).join("models").join(name))
+    data_dir().shipped_model(robot, name)
 }
 
 #[cfg(test)]

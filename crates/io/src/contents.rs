@@ -4,7 +4,10 @@
 use std::path::Path;
 
 use emg_control::{ConstraintConfig, Task};
-use emg_verify::JointSamples;
+use emg_verify::{
+    JointSamples, Recording, ReferenceModel, ReplayError, ReplayReport, check_joint_names,
+    check_replay,
+};
 use serde_json::Value;
 
 use crate::csv::{read_csv, samples_from_steps};
@@ -150,4 +153,74 @@ impl TrajectoryContents {
             Self::Csv(samples) => samples.clone(),
         }
     }
+
+    /// Verifies the file with the independent checker `model` (whose robot's joints, base to
+    /// tip, are `joint_names`) against `task` and `constraints`: the joint names the file
+    /// declares must be the robot's, and every point must hold every constraint. With
+    /// `own_task` (the task is the one the file was planned for), a rollout file's recorded TCP,
+    /// tool angles, path length and end are verified too; its tool angles are measured from
+    /// that task's normal, so against any other task they are not.
+    pub fn verify(
+        &self,
+        model: &ReferenceModel,
+        joint_names: &[String],
+        task: &Task,
+        constraints: &ConstraintConfig,
+        own_task: bool,
+    ) -> Result<ReplayReport, VerifyFailure> {
+        let samples = self.samples();
+        let failure = |error| VerifyFailure {
+            time_s: match &error {
+                ReplayError::Point { point, .. } => samples.time_s.get(*point).copied(),
+                _ => None,
+            },
+            points: samples.len(),
+            error,
+        };
+        if let Some(names) = self.joint_names() {
+            check_joint_names(names, joint_names).map_err(failure)?;
+        }
+        let recording = match self {
+            Self::Rollout(file) if own_task => Some(Recording::from(&file.trajectory)),
+            _ => None,
+        };
+        check_replay(
+            model,
+            &task.into(),
+            &constraints.into(),
+            &samples,
+            recording.as_ref(),
+        )
+        .map_err(failure)
+    }
 }
+
+/// A trajectory file that does not hold up: the checker's finding, with the time of the point
+/// it names.
+#[derive(Debug)]
+pub struct VerifyFailure {
+    /// The checker's finding.
+    pub error: ReplayError,
+    /// Time of the failing point (s), when the finding names a point.
+    pub time_s: Option<f64>,
+    /// Number of points in the file.
+    pub points: usize,
+}
+
+impl std::fmt::Display for VerifyFailure {
+    /// `point k of N (t = … s): problem`, or the finding itself when it names no point.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.error {
+            ReplayError::Point { point, problem, .. } => {
+                write!(f, "point {point} of {}", self.points)?;
+                if let Some(t) = self.time_s {
+                    write!(f, " (t = {t} s)")?;
+                }
+                write!(f, ": {problem}")
+            }
+            error => write!(f, "{error}"),
+        }
+    }
+}
+
+impl std::error::Error for VerifyFailure {}

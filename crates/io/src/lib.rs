@@ -49,7 +49,7 @@ mod rollout_file;
 mod task_file;
 
 pub use atomic::{JournalError, open_journal, write_atomically};
-pub use contents::{Carried, ReadError, TrajectoryContents};
+pub use contents::{Carried, ReadError, TrajectoryContents, VerifyFailure};
 pub use csv::{CSV_HEADER, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;
 pub use joint_trajectory::{

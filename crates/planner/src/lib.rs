@@ -6,6 +6,7 @@
 //! A plan is the paper's pipeline: a seed ([`SeedSource`]: the diffusion seeder by default,
 //! Sec. 4.1) put exactly on the start pose, then one rollout of the chosen null-space controller
 //! ([`ControllerKind`]: classical, RL or the hybrid of Sec. 4.3) through the shared step.
+//! [`PlanFiles`] turns a plan into the files `emg plan` writes.
 //!
 //! ```
 //! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
@@ -23,6 +24,7 @@
 mod config;
 mod controller;
 mod demo;
+mod files;
 mod models;
 pub mod parse;
 mod planner;
@@ -34,6 +36,7 @@ mod shipped;
 pub use config::{ConfigError, PlannerConfig};
 pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
 pub use demo::demo_task;
+pub use files::{PlanFiles, PlanFilesError, PlanRecord};
 pub use models::{
     DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
     robot_stamp,

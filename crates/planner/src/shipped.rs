@@ -33,6 +33,18 @@ impl DataDir {
     pub fn path(&self) -> &Path {
         &self.0
     }
+
+    /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`) gives its file
+    /// here, anything else is a path to a robot file.
+    pub fn robot_file(&self, value: &str) -> PathBuf {
+        ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(self))
+    }
+
+    /// Model file `name` (e.g. [`crate::POLICY_WEIGHTS_FILE`]) shipped here for the robot file
+    /// `robot`, when that file is one of the shipped robots.
+    pub fn shipped_model(&self, robot: &Path, name: &str) -> Option<PathBuf> {
+        ShippedRobot::by_path(robot, self).map(|r| r.data_dir(self).join("models").join(name))
+    }
 }
 
 /// A robot file shipped in `robots/` of the data directory, with the sub-directory that holds

@@ -1,0 +1,106 @@
+//! The files of one planned task, built and written the same way by every front end (`emg plan`,
+//! the Python package): `emg-trajectory/1` JSON, the CSV table and `emg-joint-trajectory/1` JSON.
+
+use emg_control::Task;
+use emg_io::{
+    FormatError, JointTrajectory, PlanPaths, TRAJECTORY_FORMAT, TrajectoryFile, trajectory_csv,
+    write_atomically,
+};
+
+use crate::planner::{Plan, PlanRequest, Planner};
+
+/// How a plan was asked for, as its files record it.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanRecord<'a> {
+    /// The robot as the files name it: a shipped robot's file, or the path the user gave.
+    pub robot: &'a str,
+    /// The request the plan answered (its planner and controller are recorded).
+    pub request: &'a PlanRequest,
+    /// The task's reachability bound (m), when it was computed.
+    pub reachable_m: Option<f64>,
+}
+
+/// The text of the three files of one planned task.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PlanFiles {
+    /// `emg-trajectory/1` JSON: task, settings, every step, why it ended.
+    pub json: String,
+    /// The CSV table of the steps.
+    pub csv: String,
+    /// `emg-joint-trajectory/1` JSON, for a robot stack to replay.
+    pub joint_trajectory: String,
+}
+
+/// Why a plan's files could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlanFilesError {
+    /// The trajectory does not make a valid joint trajectory.
+    #[error("cannot build the joint trajectory: {0}")]
+    JointTrajectory(#[from] FormatError),
+    /// Writing a file failed.
+    #[error("cannot write {path}: {source}")]
+    Write {
+        /// The file.
+        path: String,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+}
+
+impl PlanFiles {
+    /// The files of `plan`, made by `planner` for `task` as `record` says.
+    pub fn new(
+        planner: &Planner,
+        task: &Task,
+        plan: &Plan,
+        record: &PlanRecord<'_>,
+    ) -> Result<Self, PlanFilesError> {
+        let robot = planner.robot();
+        let config = planner.config();
+        let trajectory = &plan.trajectory;
+        let file = TrajectoryFile {
+            format: TRAJECTORY_FORMAT,
+            robot: record.robot.to_string(),
+            joint_names: robot.joint_names(),
+            task,
+            seed_source: plan.seed.source,
+            planner: record.request.planner.name(),
+            controller: record.request.controller.name(),
+            config: &config.rollout,
+            gains: &config.gains,
+            steps: &trajectory.steps,
+            termination: &trajectory.termination,
+            path_length_m: trajectory.path_length_m,
+            reachable_m: record.reachable_m,
+        };
+        let joint = JointTrajectory::new(
+            record.robot,
+            robot.joint_names(),
+            task,
+            &config.rollout.constraints,
+            trajectory,
+        )?;
+        let mut joint_trajectory = joint.to_json();
+        joint_trajectory.push('\n');
+        Ok(Self {
+            json: file.to_json(),
+            csv: trajectory_csv(&trajectory.steps),
+            joint_trajectory,
+        })
+    }
+
+    /// Writes the three files to `paths`, each atomically, creating parent directories.
+    pub fn write(&self, paths: &PlanPaths) -> Result<(), PlanFilesError> {
+        for (path, text) in [
+            (&paths.json, &self.json),
+            (&paths.csv, &self.csv),
+            (&paths.joint_trajectory, &self.joint_trajectory),
+        ] {
+            write_atomically(path, text).map_err(|source| PlanFilesError::Write {
+                path: path.display().to_string(),
+                source,
+            })?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,180 @@
+"""Extreme straight-line motion for redundant robot arms: plan, check and inspect.
+
+Type stubs of the compiled module (PyO3). Arrays are numpy float64 arrays.
+"""
+
+import os
+from pathlib import Path
+from typing import Iterable, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+PathLike = Union[str, "os.PathLike[str]"]
+Vector3 = Sequence[float]
+Vector7 = Sequence[float]
+FloatArray = npt.NDArray[np.float64]
+
+class Error(Exception):
+    """Base class of every error the package raises."""
+
+class InputError(Error):
+    """Bad input: a robot file, model, configuration, task or option that cannot be used."""
+
+class PlanningError(Error):
+    """A valid task that cannot be planned (no seed could be prepared)."""
+
+class CheckFailed(Error):
+    """A trajectory file that does not hold up under the independent checker."""
+
+class Robot:
+    """A 7-DoF serial arm from a robot file: ``Robot("fr3")``, ``Robot("iiwa14")`` or ``Robot(path)``."""
+
+    def __init__(self, robot: PathLike = "fr3") -> None: ...
+    @property
+    def file(self) -> Path:
+        """The robot file (a shipped robot's file, or the path as given)."""
+    @property
+    def name(self) -> str:
+        """The robot's name in its file."""
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the seven joints, base to tip (the order of every ``q``)."""
+    @property
+    def lower_limits(self) -> FloatArray:
+        """Lower joint limits (rad), shape (7,)."""
+    @property
+    def upper_limits(self) -> FloatArray:
+        """Upper joint limits (rad), shape (7,)."""
+    @property
+    def velocity_limits(self) -> FloatArray:
+        """Joint velocity limits (rad/s), shape (7,)."""
+    def fk(self, q: Vector7) -> FloatArray:
+        """The tool-centre-point pose at ``q`` as a 4x4 homogeneous transform (base frame)."""
+    def jacobian(self, q: Vector7) -> FloatArray:
+        """The position Jacobian d(tcp)/dq at ``q``, shape (3, 7)."""
+
+class Task:
+    """A task: move the tool from ``p0`` along ``d`` on the surface with normal ``n``."""
+
+    @property
+    def p0(self) -> FloatArray:
+        """Start point (m), shape (3,)."""
+    @property
+    def d(self) -> FloatArray:
+        """Unit direction, shape (3,)."""
+    @property
+    def n(self) -> FloatArray:
+        """Unit surface normal, shape (3,)."""
+    @property
+    def q0_seed(self) -> Optional[FloatArray]:
+        """The configuration the task was generated from (rad), shape (7,), or None."""
+
+class Plan:
+    """A planned task; arrays have one row per step, the seed first."""
+
+    @property
+    def q(self) -> FloatArray:
+        """Joint configurations (rad), shape (T, 7)."""
+    @property
+    def t(self) -> FloatArray:
+        """Times since the start (s), shape (T,)."""
+    @property
+    def tcp(self) -> FloatArray:
+        """Tool-centre-point positions (m, base frame), shape (T, 3)."""
+    @property
+    def tool_angle_deg(self) -> FloatArray:
+        """Angle between the tool axis and the surface normal (degrees), shape (T,)."""
+    @property
+    def rho(self) -> FloatArray:
+        """Joint-limit proximity per step, shape (T,)."""
+    @property
+    def controllers(self) -> list[Optional[str]]:
+        """The controller acting from each step ("classical", "learned", "search"; None at the end)."""
+    @property
+    def path_length_m(self) -> float:
+        """Path length (p_T - p0) . d (m)."""
+    @property
+    def termination(self) -> str:
+        """Why the motion ended."""
+    @property
+    def seed(self) -> FloatArray:
+        """The seed configuration (rad), shape (7,)."""
+    @property
+    def seed_source(self) -> str:
+        """Where the seed came from (dp, generating, home, given, q_mu, q_jl)."""
+    @property
+    def reachable_m(self) -> Optional[float]:
+        """The task's reachability bound (m) when reach=True was asked."""
+    @property
+    def task(self) -> Task:
+        """The task."""
+    def save(self, stem: PathLike) -> list[Path]:
+        """Writes STEM.json, STEM.csv and STEM.joint_trajectory.json as ``emg plan`` does."""
+
+SeedArg = Union[Literal["dp", "generating", "home", "q_mu", "q_jl"], Vector7, None]
+ControllerArg = Literal["hybrid", "rl", "classical"]
+PlannerArg = Optional[Literal["controller", "search"]]
+TaskArg = Union[Task, Tuple[Vector3, Vector3, Vector3]]
+
+class Planner:
+    """Plans extreme straight-line motions for one robot with its models and configuration."""
+
+    def __init__(
+        self,
+        robot: PathLike = "fr3",
+        models: Optional[PathLike] = None,
+        config: Union[PathLike, dict, None] = None,
+    ) -> None: ...
+    @property
+    def robot(self) -> Robot:
+        """The robot."""
+    @property
+    def models(self) -> dict[str, bool]:
+        """Whether the diffusion seeder and the policy are loaded."""
+    def plan(
+        self,
+        p0: Vector3,
+        d: Vector3,
+        n: Vector3,
+        seed: SeedArg = None,
+        controller: ControllerArg = "hybrid",
+        planner: PlannerArg = None,
+        reach: bool = False,
+    ) -> Plan:
+        """Plans the task (p0, d, n); the GIL is released while planning."""
+    def plan_many(
+        self,
+        tasks: Iterable[TaskArg],
+        seed: SeedArg = None,
+        controller: ControllerArg = "hybrid",
+        planner: PlannerArg = None,
+        reach: bool = False,
+    ) -> list[Plan]:
+        """Plans every task in parallel with the GIL released; plans come in task order."""
+    def reach(self, p0: Vector3, d: Vector3, n: Vector3) -> float:
+        """The task's reachability bound (m)."""
+
+class CheckReport:
+    """What the independent checker measured on a trajectory file that holds up."""
+
+    layout: str
+    robot: Path
+    points: int
+    duration_s: float
+    path_length_m: float
+    max_line_deviation_m: float
+    max_tool_angle_deg: float
+    min_clearance_m: float
+    min_clearance_links: Tuple[str, str]
+    peak_speed_fraction: list[float]
+    peak_acceleration_rad_s2: list[float]
+    recorded_end_verified: bool
+
+def load_tasks(path: PathLike, robot: PathLike = "fr3") -> list[Task]:
+    """The tasks of a task file (JSON or EMGTASKS), validated for ``robot``."""
+
+def check(path: PathLike, robot: Optional[PathLike] = None) -> CheckReport:
+    """Verifies a trajectory file with the independent checker; raises CheckFailed."""

@@ -1,0 +1,113 @@
+//! `check`: a trajectory file verified by the independent checker.
+
+use std::path::PathBuf;
+
+use emg_io::{ReadError, TrajectoryContents};
+use emg_verify::ReferenceModel;
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+
+use crate::robot::Robot;
+use crate::{CheckFailed, InputError, input_error, message};
+
+/// What the independent checker measured on a trajectory file that holds up.
+#[pyclass(frozen, get_all, module = "extreme_line_motion")]
+pub struct CheckReport {
+    /// The file's layout (`emg-trajectory/1`, `emg-joint-trajectory/1`).
+    layout: &'static str,
+    /// The robot file it was checked with.
+    robot: PathBuf,
+    /// Number of points.
+    points: usize,
+    /// Time of the last point (s).
+    duration_s: f64,
+    /// `(p_last − p0)·d` (m), from the checker's own forward kinematics.
+    path_length_m: f64,
+    /// Largest distance of the tool centre point from the line (m).
+    max_line_deviation_m: f64,
+    /// Largest angle between the tool axis and the surface normal (degrees).
+    max_tool_angle_deg: f64,
+    /// Smallest clearance between checked link pairs (m).
+    min_clearance_m: f64,
+    /// The two links of the smallest clearance.
+    min_clearance_links: (String, String),
+    /// Per joint, the fastest segment speed as a fraction of its velocity limit.
+    peak_speed_fraction: Vec<f64>,
+    /// Per joint, the largest change of point velocity over its time gap (rad/s²).
+    peak_acceleration_rad_s2: Vec<f64>,
+    /// Whether the recorded TCP, path length and end were verified too (an
+    /// `emg-trajectory/1` file).
+    recorded_end_verified: bool,
+}
+
+#[pymethods]
+impl CheckReport {
+    fn __repr__(&self) -> String {
+        format!(
+            "CheckReport(points={}, path_length_m={:.4}, max_line_deviation_m={:.2e}, \
+             max_tool_angle_deg={:.3}, min_clearance_m={:.4})",
+            self.points,
+            self.path_length_m,
+            self.max_line_deviation_m,
+            self.max_tool_angle_deg,
+            self.min_clearance_m
+        )
+    }
+}
+
+/// Verifies a trajectory file written by `Plan.save` or `emg plan` (either JSON layout) with
+/// the independent checker, against the task, constraints and robot it carries (`robot`
+/// overrides the robot: a shipped robot's name or a robot file). Returns the report; raises
+/// `CheckFailed` naming the first failing point and constraint.
+#[pyfunction]
+#[pyo3(signature = (path, robot = None))]
+pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
+    let contents = TrajectoryContents::read(&path).map_err(|e| match &e {
+        ReadError::Io { .. } => PyOSError::new_err(message(&e)),
+        ReadError::Format { .. } => InputError::new_err(message(&e)),
+    })?;
+    let carried = contents.carried().ok_or_else(|| {
+        InputError::new_err(format!(
+            "{} is a CSV file, which carries no task: check it with `emg check {} --task-from \
+             <emg-trajectory JSON>`",
+            path.display(),
+            path.display()
+        ))
+    })?;
+    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(&carried.robot)))?;
+    let model = ReferenceModel::from_urdf_file(
+        &robot.file,
+        robot.inner.base_link(),
+        robot.inner.tip_link(),
+    )
+    .map_err(|e| input_error(format!("the checker's robot {}", robot.file.display()), &e))?;
+    let task = &carried.task;
+    let task = emg_control::Task::new(&robot.inner, task.p0, task.d, task.n, task.q0_seed)
+        .map_err(|e| input_error(format!("field 'task' of {}", path.display()), &e))?;
+    let report = contents
+        .verify(
+            &model,
+            robot.inner.joint_names(),
+            &task,
+            &carried.constraints,
+            true,
+        )
+        .map_err(|failure| {
+            CheckFailed::new_err(format!("{} does not hold up: {failure}", path.display()))
+        })?;
+    let (min_clearance_m, a, b) = report.min_clearance;
+    Ok(CheckReport {
+        layout: contents.layout(),
+        robot: robot.file,
+        points: report.points,
+        duration_s: report.duration_s,
+        path_length_m: report.path_length_m,
+        max_line_deviation_m: report.max_line_deviation_m,
+        max_tool_angle_deg: report.max_tool_angle_deg,
+        min_clearance_m,
+        min_clearance_links: (a, b),
+        peak_speed_fraction: report.peak_speed_fraction,
+        peak_acceleration_rad_s2: report.peak_acceleration_rad_s2,
+        recorded_end_verified: matches!(contents, TrajectoryContents::Rollout(_)),
+    })
+}

@@ -1,0 +1,523 @@
+//! `Planner`, `Plan`, `Task` and `load_tasks`: planning from Python.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use emg_control::Trajectory;
+use emg_io::PlanPaths;
+use emg_kinematics::Vec3;
+use emg_planner::{
+    ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, POLICY_WEIGHTS_FILE, PlanError, PlanFiles,
+    PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
+};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+
+use crate::robot::{Robot, joint_vector};
+use crate::{InputError, PlanningError, data_dir, input_error, message};
+
+/// Plans extreme straight-line motions for one robot with its models and configuration.
+///
+/// `robot`: a shipped robot (`"fr3"`, `"iiwa14"`) or a robot file. `models`: a directory holding
+/// `diffusion-v1.weights` and/or `ppo-v1.weights` (default: the ones shipped for a shipped
+/// robot; none for another robot file, which then plans with `seed` other than `"dp"` and
+/// `controller="classical"`). `config`: a planner configuration, as a JSON file or a dict of its
+/// fields (`rollout`, `gains`, `switch`, `measure`, `reach`, `search`); unset fields keep the
+/// defaults.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct Planner {
+    inner: Arc<emg_planner::Planner>,
+    robot: Py<Robot>,
+}
+
+/// A task: move the tool from `p0` along the unit direction `d` on the surface with unit normal
+/// `n` (base frame, m); `q0_seed` is the configuration a sampled task was generated from.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct Task {
+    inner: emg_control::Task,
+}
+
+/// A planned task: the seed it started from and the motion, every step holding every
+/// constraint. Arrays have one row per step, the seed first.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct Plan {
+    planner: Arc<emg_planner::Planner>,
+    robot: String,
+    request: PlanRequest,
+    task: emg_control::Task,
+    plan: emg_planner::Plan,
+    reachable_m: Option<f64>,
+}
+
+/// What `plan` and `plan_many` are asked for, parsed from their arguments.
+struct Request {
+    request: PlanRequest,
+    reach: bool,
+}
+
+impl Request {
+    fn parse(
+        seed: Option<&Bound<'_, PyAny>>,
+        controller: &str,
+        planner: Option<&str>,
+        reach: bool,
+    ) -> PyResult<Self> {
+        let seed = match seed {
+            None => None,
+            Some(value) => Some(match value.extract::<String>() {
+                Ok(name) => name
+                    .parse::<SeedSource>()
+                    .map_err(|e| input_error("seed", &e))?,
+                Err(_) => SeedSource::Given(joint_vector(value.extract::<[f64; 7]>().map_err(
+                    |_| {
+                        InputError::new_err(
+                            "seed: give a seed name (dp, generating, home, q_mu, q_jl) or 7 joint angles (rad)",
+                        )
+                    },
+                )?)),
+            }),
+        };
+        let controller = controller
+            .parse::<ControllerKind>()
+            .map_err(|e| input_error("controller", &e))?;
+        let planner = match planner {
+            Some(name) => name
+                .parse::<PlannerKind>()
+                .map_err(|e| input_error("planner", &e))?,
+            None => PlanRequest::default().planner,
+        };
+        Ok(Self {
+            request: PlanRequest {
+                planner,
+                seed,
+                controller,
+            },
+            reach,
+        })
+    }
+}
+
+impl Planner {
+    fn task(
+        &self,
+        p0: [f64; 3],
+        d: [f64; 3],
+        n: [f64; 3],
+        q0_seed: Option<[f64; 7]>,
+    ) -> PyResult<emg_control::Task> {
+        emg_control::Task::new(
+            self.inner.robot(),
+            Vec3::from(p0),
+            Vec3::from(d),
+            Vec3::from(n),
+            q0_seed.map(joint_vector),
+        )
+        .map_err(|e| input_error("task", &e))
+    }
+
+    /// One plan (and its reachability bound when asked), made without the GIL.
+    fn plan_one(&self, task: &emg_control::Task, request: &Request) -> Result<Planned, PlanError> {
+        let plan = self.inner.plan(task, &request.request)?;
+        let reachable_m = request
+            .reach
+            .then(|| self.inner.reach(task, &[plan.seed.q]).reachable_m);
+        Ok((plan, reachable_m))
+    }
+
+    /// The Python object of a plan of `task`.
+    fn wrap(&self, task: emg_control::Task, request: &Request, planned: Planned) -> Plan {
+        let (plan, reachable_m) = planned;
+        Plan {
+            planner: Arc::clone(&self.inner),
+            robot: self.robot.get().file.display().to_string(),
+            request: request.request.clone(),
+            task,
+            plan,
+            reachable_m,
+        }
+    }
+}
+
+/// A plan and, when asked, its task's reachability bound (m).
+type Planned = (emg_planner::Plan, Option<f64>);
+
+/// A [`PlanError`] as the Python exception it raises (its message prefixed by `tasks[i]: ` for
+/// task `i` of a batch): a controller that cannot be built is bad input (a learned controller
+/// without its policy), a seed that cannot be prepared is a planning failure.
+fn plan_error(error: PlanError, request: &PlanRequest, index: Option<usize>) -> PyErr {
+    let task = index.map_or(String::new(), |i| format!("tasks[{i}]: "));
+    match &error {
+        PlanError::Controller(_) => InputError::new_err(format!(
+            "{task}controller {:?}: {} (pass models= a directory with {POLICY_WEIGHTS_FILE}, or \
+             use controller=\"classical\")",
+            request.controller.name(),
+            message(&error)
+        )),
+        PlanError::Seed(_) => PlanningError::new_err(format!(
+            "{task}seed {:?}: {}",
+            request.seed.as_ref().map_or("default", SeedSource::name),
+            message(&error)
+        )),
+    }
+}
+
+/// The configuration a `config` argument gives: a JSON file or a dict of its fields.
+fn read_config(config: Option<&Bound<'_, PyAny>>) -> PyResult<PlannerConfig> {
+    let Some(config) = config else {
+        return Ok(PlannerConfig::default());
+    };
+    if config.is_instance_of::<PyDict>() {
+        let text: String = config
+            .py()
+            .import("json")?
+            .call_method1("dumps", (config,))?
+            .extract()?;
+        return PlannerConfig::from_json("config", &text).map_err(|e| input_error("config", &e));
+    }
+    let path: PathBuf = config
+        .extract()
+        .map_err(|_| InputError::new_err("config: give a JSON file's path or a dict"))?;
+    PlannerConfig::read(&path).map_err(|e| input_error("config", &e))
+}
+
+/// The model files to load: those in `models`, or those shipped for `robot_file`.
+fn model_files(robot_file: &Path, models: Option<&Path>) -> PyResult<[Option<PathBuf>; 2]> {
+    let pick = |name: &str| match models {
+        Some(dir) => Some(dir.join(name)).filter(|p| p.is_file()),
+        None => data_dir()
+            .shipped_model(robot_file, name)
+            .filter(|p| p.is_file()),
+    };
+    if let Some(dir) = models.filter(|dir| !dir.is_dir()) {
+        return Err(InputError::new_err(format!(
+            "models: {} is not a directory",
+            dir.display()
+        )));
+    }
+    Ok([pick(DIFFUSION_WEIGHTS_FILE), pick(POLICY_WEIGHTS_FILE)])
+}
+
+fn array2<'py, const N: usize>(
+    py: Python<'py>,
+    rows: impl ExactSizeIterator<Item = [f64; N]>,
+) -> Bound<'py, PyArray2<f64>> {
+    let count = rows.len();
+    let flat: Vec<f64> = rows.flatten().collect();
+    Array2::from_shape_vec((count, N), flat)
+        .expect("rows of N values")
+        .into_pyarray(py)
+}
+
+fn array1<'py>(py: Python<'py>, values: impl Iterator<Item = f64>) -> Bound<'py, PyArray1<f64>> {
+    values.collect::<Vec<_>>().into_pyarray(py)
+}
+
+#[pymethods]
+impl Planner {
+    #[new]
+    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None))]
+    fn new(
+        py: Python<'_>,
+        robot: PathBuf,
+        models: Option<PathBuf>,
+        config: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let robot = Robot::load(&robot)?;
+        let config = read_config(config)?;
+        let [diffusion, policy] = model_files(&robot.file, models.as_deref())?;
+        let loaded = Models::load(&robot.inner, diffusion.as_deref(), policy.as_deref())
+            .map_err(|e| input_error("models", &e))?;
+        let inner = emg_planner::Planner::new((*robot.inner).clone(), loaded, config)
+            .map_err(|e| input_error("config", &e))?;
+        Ok(Self {
+            inner: Arc::new(inner),
+            robot: Py::new(py, robot)?,
+        })
+    }
+
+    /// The robot.
+    #[getter]
+    fn robot(&self, py: Python<'_>) -> Py<Robot> {
+        self.robot.clone_ref(py)
+    }
+
+    /// Whether the diffusion seeder (seed `"dp"`) and the policy (controllers `"rl"`,
+    /// `"hybrid"`) are loaded: `{"diffusion": bool, "policy": bool}`.
+    #[getter]
+    fn models(&self) -> std::collections::BTreeMap<&'static str, bool> {
+        let models = self.inner.models();
+        [
+            ("diffusion", models.seeder.is_some()),
+            ("policy", models.policy.is_some()),
+        ]
+        .into()
+    }
+
+    /// Plans the task `(p0, d, n)` (3 floats each, base frame).
+    ///
+    /// `seed`: `"dp"`, `"generating"`, `"home"`, `"q_mu"`, `"q_jl"` or 7 joint angles (rad);
+    /// `None` picks `"dp"` when the seeder is loaded, else `"home"`. `controller`: `"hybrid"`,
+    /// `"rl"` or `"classical"`. `planner`: `"controller"` (the paper's pipeline: one seed, one
+    /// rollout; the default) or `"search"` (many starts within a step budget, never shorter).
+    /// `reach`: also compute the task's reachability bound (`Plan.reachable_m`). The GIL is
+    /// released while planning.
+    #[pyo3(signature = (p0, d, n, seed = None, controller = "hybrid", planner = None, reach = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn plan(
+        &self,
+        py: Python<'_>,
+        p0: [f64; 3],
+        d: [f64; 3],
+        n: [f64; 3],
+        seed: Option<&Bound<'_, PyAny>>,
+        controller: &str,
+        planner: Option<&str>,
+        reach: bool,
+    ) -> PyResult<Plan> {
+        let request = Request::parse(seed, controller, planner, reach)?;
+        let task = self.task(p0, d, n, None)?;
+        let planned = py
+            .detach(|| self.plan_one(&task, &request))
+            .map_err(|e| plan_error(e, &request.request, None))?;
+        Ok(self.wrap(task, &request, planned))
+    }
+
+    /// Plans every task of `tasks` (`Task` objects, e.g. from `load_tasks`, or `(p0, d, n)`
+    /// triples) in parallel on all cores with the GIL released; the plans come in task order
+    /// and do not depend on the number of threads. Arguments as for `plan`; the first task
+    /// that fails raises, naming its index.
+    #[pyo3(signature = (tasks, seed = None, controller = "hybrid", planner = None, reach = false))]
+    fn plan_many(
+        &self,
+        py: Python<'_>,
+        tasks: &Bound<'_, PyAny>,
+        seed: Option<&Bound<'_, PyAny>>,
+        controller: &str,
+        planner: Option<&str>,
+        reach: bool,
+    ) -> PyResult<Vec<Plan>> {
+        let request = Request::parse(seed, controller, planner, reach)?;
+        let mut parsed = Vec::new();
+        for (index, item) in tasks.try_iter()?.enumerate() {
+            let item = item?;
+            let task = match item.cast::<Task>() {
+                Ok(task) => {
+                    let task = &task.get().inner;
+                    let q0 = task.q0_seed.map(|q| std::array::from_fn(|i| q[i]));
+                    self.task(task.p0.into(), task.d.into(), task.n.into(), q0)
+                }
+                Err(_) => match item.extract::<([f64; 3], [f64; 3], [f64; 3])>() {
+                    Ok((p0, d, n)) => self.task(p0, d, n, None),
+                    Err(_) => Err(InputError::new_err(
+                        "give a Task or a (p0, d, n) triple of 3 floats each",
+                    )),
+                },
+            };
+            parsed.push(
+                task.map_err(|e| InputError::new_err(format!("tasks[{index}]: {}", e.value(py))))?,
+            );
+        }
+        let planned: Vec<Result<Planned, PlanError>> = py.detach(|| {
+            parsed
+                .par_iter()
+                .map(|task| self.plan_one(task, &request))
+                .collect()
+        });
+        parsed
+            .into_iter()
+            .zip(planned)
+            .enumerate()
+            .map(|(index, (task, planned))| match planned {
+                Ok(planned) => Ok(self.wrap(task, &request, planned)),
+                Err(error) => Err(plan_error(error, &request.request, Some(index))),
+            })
+            .collect()
+    }
+
+    /// The reachability bound of the task `(p0, d, n)` (m): how far along the line the arm can
+    /// be placed at all (every point within the line tolerance, tool in the cone, within the
+    /// joint limits, collision-free); an upper bound on any plan's path length, only as good as
+    /// its IK sampling.
+    fn reach(&self, py: Python<'_>, p0: [f64; 3], d: [f64; 3], n: [f64; 3]) -> PyResult<f64> {
+        let task = self.task(p0, d, n, None)?;
+        Ok(py.detach(|| self.inner.reach(&task, &[]).reachable_m))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Planner(robot={:?})",
+            self.robot.get().file.display().to_string()
+        )
+    }
+}
+
+fn trajectory(plan: &Plan) -> &Trajectory {
+    &plan.plan.trajectory
+}
+
+#[pymethods]
+impl Plan {
+    /// Joint configurations (rad), shape (T, 7).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let steps = &trajectory(self).steps;
+        array2(
+            py,
+            steps
+                .iter()
+                .map(|s| std::array::from_fn::<f64, 7, _>(|i| s.q[i])),
+        )
+    }
+
+    /// Times since the start (s), shape (T,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, trajectory(self).steps.iter().map(|s| s.time_s))
+    }
+
+    /// Tool-centre-point positions (m, base frame), shape (T, 3).
+    #[getter]
+    fn tcp<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let steps = &trajectory(self).steps;
+        array2(py, steps.iter().map(|s| [s.tcp.x, s.tcp.y, s.tcp.z]))
+    }
+
+    /// Angle between the tool axis and the surface normal (degrees), shape (T,).
+    #[getter]
+    fn tool_angle_deg<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, trajectory(self).steps.iter().map(|s| s.tool_angle_deg))
+    }
+
+    /// Joint-limit proximity ρ(q) per step, shape (T,).
+    #[getter]
+    fn rho<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, trajectory(self).steps.iter().map(|s| s.rho))
+    }
+
+    /// The controller acting from each step (`"classical"`, `"learned"`, `"search"`; `None` on a
+    /// final step that issued no command).
+    #[getter]
+    fn controllers(&self) -> Vec<Option<&'static str>> {
+        trajectory(self)
+            .steps
+            .iter()
+            .map(|s| s.controller.map(|c| c.name()))
+            .collect()
+    }
+
+    /// Path length `(p_T − p0)·d` (m).
+    #[getter]
+    fn path_length_m(&self) -> f64 {
+        trajectory(self).path_length_m
+    }
+
+    /// Why the motion ended (the constraint that stopped it, the step cap, …).
+    #[getter]
+    fn termination(&self) -> String {
+        trajectory(self).termination.to_string()
+    }
+
+    /// The seed configuration the motion started from (rad), shape (7,).
+    #[getter]
+    fn seed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.plan.seed.q.iter().copied())
+    }
+
+    /// Where the seed came from (`dp`, `generating`, `home`, `given`, `q_mu`, `q_jl`).
+    #[getter]
+    fn seed_source(&self) -> &'static str {
+        self.plan.seed.source
+    }
+
+    /// The task's reachability bound (m) when `reach=True` was asked, else `None`.
+    #[getter]
+    fn reachable_m(&self) -> Option<f64> {
+        self.reachable_m
+    }
+
+    /// The task.
+    #[getter]
+    fn task(&self) -> Task {
+        Task {
+            inner: self.task.clone(),
+        }
+    }
+
+    /// Writes the files `emg plan --out STEM` writes, byte for byte: `STEM.json`
+    /// (emg-trajectory/1), `STEM.csv` and `STEM.joint_trajectory.json`; returns their paths.
+    fn save(&self, stem: PathBuf) -> PyResult<Vec<PathBuf>> {
+        let record = PlanRecord {
+            robot: &self.robot,
+            request: &self.request,
+            reachable_m: self.reachable_m,
+        };
+        let files = PlanFiles::new(&self.planner, &self.task, &self.plan, &record)
+            .map_err(|e| input_error("plan", &e))?;
+        let paths = PlanPaths::new(&stem, None);
+        files
+            .write(&paths)
+            .map_err(|e| PyOSError::new_err(message(&e)))?;
+        Ok(vec![paths.json, paths.csv, paths.joint_trajectory])
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Plan(path_length_m={:.4}, steps={}, termination={:?})",
+            trajectory(self).path_length_m,
+            trajectory(self).steps.len(),
+            trajectory(self).termination.to_string()
+        )
+    }
+}
+
+#[pymethods]
+impl Task {
+    /// Start point `p0` (m), shape (3,).
+    #[getter]
+    fn p0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.inner.p0.iter().copied())
+    }
+
+    /// Unit direction `d`, shape (3,).
+    #[getter]
+    fn d<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.inner.d.iter().copied())
+    }
+
+    /// Unit surface normal `n`, shape (3,).
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.inner.n.iter().copied())
+    }
+
+    /// The configuration the task was generated from (rad), shape (7,), or `None`.
+    #[getter]
+    fn q0_seed<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.inner.q0_seed.map(|q| array1(py, q.iter().copied()))
+    }
+
+    fn __repr__(&self) -> String {
+        let v = |v: &Vec3| format!("[{}, {}, {}]", v.x, v.y, v.z);
+        format!(
+            "Task(p0={}, d={}, n={})",
+            v(&self.inner.p0),
+            v(&self.inner.d),
+            v(&self.inner.n)
+        )
+    }
+}
+
+/// The tasks of a task file (JSON or the binary `EMGTASKS` set, told apart by the content),
+/// each validated for `robot` (a shipped robot's name or a robot file).
+#[pyfunction]
+#[pyo3(signature = (path, robot = PathBuf::from("fr3")))]
+pub fn load_tasks(path: PathBuf, robot: PathBuf) -> PyResult<Vec<Task>> {
+    let robot = Robot::load(&robot)?;
+    let tasks = emg_io::read_tasks(&path, &robot.inner)
+        .map_err(|e| input_error(format!("task file {}", path.display()), &e))?;
+    Ok(tasks.into_iter().map(|inner| Task { inner }).collect())
+}

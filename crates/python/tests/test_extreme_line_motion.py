@@ -1,0 +1,226 @@
+"""Tests of the extreme_line_motion module against the `emg` CLI and the library's own checks.
+
+EMG_CLI names the `emg` binary to compare with (default: target/debug/emg of this checkout).
+"""
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import extreme_line_motion as elm
+
+ROOT = Path(__file__).resolve().parents[3]
+CLI = Path(os.environ.get("EMG_CLI", ROOT / "target" / "debug" / "emg"))
+EVAL_TASKS = ROOT / "data" / "tasks" / "eval-v1.tasks"
+FILES = (".json", ".csv", ".joint_trajectory.json")
+
+
+@pytest.fixture(scope="module")
+def planner():
+    return elm.Planner("fr3")
+
+
+@pytest.fixture(scope="module")
+def tasks():
+    return elm.load_tasks(EVAL_TASKS)
+
+
+def vector(values):
+    return ",".join(repr(float(v)) for v in values)
+
+
+def run_cli(*args):
+    assert CLI.is_file(), f"{CLI} is missing: build it with `cargo build -p emg-cli` or set EMG_CLI"
+    done = subprocess.run([str(CLI), *map(str, args)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done
+
+
+def assert_same_files(python_stem, cli_stem):
+    for suffix in FILES:
+        ours = Path(f"{python_stem}{suffix}").read_bytes()
+        theirs = Path(f"{cli_stem}{suffix}").read_bytes()
+        assert ours == theirs, f"{python_stem}{suffix} differs from the CLI's {cli_stem}{suffix}"
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"seed": "dp", "controller": "hybrid", "planner": "controller", "reach": True},
+        {"seed": "home", "controller": "classical", "planner": "controller", "reach": False},
+        {"seed": "dp", "controller": "rl", "planner": "search", "reach": True},
+    ],
+)
+def test_plan_and_save_equal_the_cli_byte_for_byte(tmp_path, planner, tasks, options):
+    task = tasks[3]
+    plan = planner.plan(task.p0, task.d, task.n, **options)
+    written = plan.save(tmp_path / "python")
+    assert [Path(p).name for p in written] == [f"python{s}" for s in FILES]
+    run_cli(
+        "plan", "--p0", vector(task.p0), "--d", vector(task.d), "--n", vector(task.n),
+        "--seed", options["seed"], "--controller", options["controller"],
+        "--planner", options["planner"], "--reach", "on" if options["reach"] else "off",
+        "--out", tmp_path / "cli",
+    )
+    assert_same_files(tmp_path / "python", tmp_path / "cli")
+    record = json.loads((tmp_path / "python.json").read_text())
+    assert record["path_length_m"] == plan.path_length_m
+    assert ("reachable_m" in record) == options["reach"]
+
+
+def test_plan_many_equals_the_cli_on_a_task_file(tmp_path, planner, tasks):
+    chosen = tasks[:4]
+    task_file = tmp_path / "tasks.json"
+    task_file.write_text(json.dumps([
+        {"p0": t.p0.tolist(), "d": t.d.tolist(), "n": t.n.tolist(), "q0_seed": t.q0_seed.tolist()}
+        for t in chosen
+    ]))
+    plans = planner.plan_many(chosen, controller="hybrid", planner="controller")
+    run_cli("plan", "--task-file", task_file, "--controller", "hybrid", "--planner", "controller",
+            "--reach", "off", "--out", tmp_path / "cli")
+    for index, plan in enumerate(plans):
+        plan.save(tmp_path / f"python-{index:05}")
+        assert_same_files(tmp_path / f"python-{index:05}", tmp_path / f"cli-{index:05}")
+
+
+def test_plan_arrays_describe_the_motion(planner, tasks):
+    task = tasks[0]
+    plan = planner.plan(task.p0, task.d, task.n, reach=True)
+    steps = plan.q.shape[0]
+    assert plan.q.shape == (steps, 7) and plan.tcp.shape == (steps, 3)
+    assert plan.t.shape == plan.tool_angle_deg.shape == plan.rho.shape == (steps,)
+    assert len(plan.controllers) == steps and steps > 1
+    assert np.all(np.diff(plan.t) > 0)
+    assert plan.path_length_m == pytest.approx(float((plan.tcp[-1] - task.p0) @ task.d), abs=1e-9)
+    assert 0 < plan.path_length_m <= plan.reachable_m + 0.02
+    np.testing.assert_array_equal(plan.q[0], plan.seed)
+    assert plan.seed_source == "dp"
+    assert plan.termination
+    np.testing.assert_array_equal(plan.task.p0, task.p0)
+
+
+def test_robot_kinematics_agree_with_the_plan_and_finite_differences(planner, tasks):
+    robot = planner.robot
+    plan = planner.plan(tasks[1].p0, tasks[1].d, tasks[1].n, controller="classical")
+    for q, tcp in zip(plan.q[::10], plan.tcp[::10]):
+        pose = robot.fk(q)
+        assert pose.shape == (4, 4)
+        np.testing.assert_allclose(pose[:3, 3], tcp, atol=1e-12)
+        np.testing.assert_allclose(pose[:3, :3] @ pose[:3, :3].T, np.eye(3), atol=1e-12)
+        jacobian = robot.jacobian(q)
+        assert jacobian.shape == (3, 7)
+        h = 1e-6
+        for joint in range(7):
+            step = np.zeros(7)
+            step[joint] = h
+            numeric = (robot.fk(q + step)[:3, 3] - robot.fk(q - step)[:3, 3]) / (2 * h)
+            np.testing.assert_allclose(jacobian[:, joint], numeric, atol=1e-8)
+    assert len(robot.joint_names) == 7
+    assert np.all(robot.lower_limits < robot.upper_limits)
+
+
+def test_check_reports_a_saved_plan_and_refuses_a_tampered_one(tmp_path, planner, tasks):
+    plan = planner.plan(tasks[2].p0, tasks[2].d, tasks[2].n)
+    plan.save(tmp_path / "line")
+    report = elm.check(tmp_path / "line.json")
+    assert report.points == plan.q.shape[0]
+    assert report.path_length_m == pytest.approx(plan.path_length_m, abs=1e-9)
+    assert report.max_line_deviation_m <= 0.02 and report.recorded_end_verified
+    joint = elm.check(tmp_path / "line.joint_trajectory.json")
+    assert joint.layout == "emg-joint-trajectory/1" and not joint.recorded_end_verified
+
+    tampered = json.loads((tmp_path / "line.joint_trajectory.json").read_text())
+    point = len(tampered["points"]) // 2
+    tampered["points"][point]["positions"][1] += 0.5
+    (tmp_path / "bad.joint_trajectory.json").write_text(json.dumps(tampered))
+    with pytest.raises(elm.CheckFailed, match=f"point {point} of"):
+        elm.check(tmp_path / "bad.joint_trajectory.json")
+    with pytest.raises(elm.InputError, match="carries no task"):
+        elm.check(tmp_path / "line.csv")
+    with pytest.raises(OSError):
+        elm.check(tmp_path / "missing.json")
+
+
+def test_bad_input_raises_with_the_librarys_message(tmp_path, planner):
+    p0, d, n = [0.4, 0.0, 0.3], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]
+    with pytest.raises(elm.InputError, match="controller"):
+        planner.plan(p0, d, n, controller="fast")
+    with pytest.raises(elm.InputError, match="planner"):
+        planner.plan(p0, d, n, planner="beam")
+    with pytest.raises(elm.InputError, match="seed"):
+        planner.plan(p0, d, n, seed="best")
+    with pytest.raises(elm.InputError, match="seed"):
+        planner.plan(p0, d, n, seed=[0.0, 1.0])
+    with pytest.raises(elm.InputError, match="task"):
+        planner.plan(p0, [0.0, 0.0, 0.0], n)
+    with pytest.raises(elm.InputError, match="task"):
+        planner.plan(p0, [0.0, 0.0, 1.0], n)
+    with pytest.raises((TypeError, ValueError), match="'n'"):
+        planner.plan(p0, d, [0.0, 0.0])
+    with pytest.raises(elm.InputError, match="no_such_robot.urdf"):
+        elm.Planner(tmp_path / "no_such_robot.urdf")
+    with pytest.raises(elm.InputError, match="models"):
+        elm.Planner("fr3", models=tmp_path / "none")
+    with pytest.raises(elm.InputError, match="lateral_gain"):
+        elm.Planner("fr3", config={"rollout": {"lateral_gain_per_s": -1.0}})
+    with pytest.raises(elm.InputError, match="config"):
+        elm.Planner("fr3", config={"rollout": {"no_such_field": 1}})
+    with pytest.raises(elm.InputError, match=r"tasks\[1\]"):
+        planner.plan_many([(p0, d, n), (p0, d, d)])
+    with pytest.raises(elm.InputError, match="task file"):
+        elm.load_tasks(tmp_path / "none.tasks")
+    assert issubclass(elm.InputError, elm.Error) and issubclass(elm.CheckFailed, elm.Error)
+
+
+def test_a_robot_file_without_models_plans_classically_and_refuses_learned_controllers(tmp_path):
+    robot_file = tmp_path / "arm.urdf"
+    shutil.copy(ROOT / "data" / "robots" / "iiwa14_pen.urdf", robot_file)
+    planner = elm.Planner(robot_file)
+    assert planner.models == {"diffusion": False, "policy": False}
+    task = elm.load_tasks(ROOT / "data" / "iiwa14" / "tasks" / "eval-v1.tasks", robot_file)[0]
+    p0, d, n = task.p0, task.d, task.n
+    plan = planner.plan(p0, d, n, controller="classical")
+    assert plan.seed_source == "home" and plan.path_length_m > 0
+    with pytest.raises(elm.InputError, match="ppo-v1.weights"):
+        planner.plan(p0, d, n, controller="hybrid")
+    with pytest.raises(elm.InputError, match=r"tasks\[0\]: controller \"rl\""):
+        planner.plan_many([task, task], controller="rl")
+    with pytest.raises(elm.PlanningError, match="dp"):
+        planner.plan(p0, d, n, seed="dp", controller="classical")
+
+
+def test_plan_many_releases_the_gil_and_matches_plan(planner, tasks):
+    chosen = tasks[:1000]
+    result = {}
+
+    def work():
+        result["started"] = time.perf_counter()
+        result["plans"] = planner.plan_many(chosen)
+        result["ended"] = time.perf_counter()
+
+    worker = threading.Thread(target=work)
+    ticks = []
+    worker.start()
+    while worker.is_alive():
+        ticks.append(time.perf_counter())
+        time.sleep(0.001)
+    worker.join()
+    plans = result["plans"]
+    assert len(plans) == 1000
+    # The main thread ran Python code while the batch was being planned: had plan_many held the
+    # GIL, no tick could fall inside it.
+    started, ended = result["started"], result["ended"]
+    middle = [t for t in ticks if started + 0.25 * (ended - started) < t < ended - 0.25 * (ended - started)]
+    assert len(middle) >= 10, f"{len(middle)} ticks in the middle half of {ended - started:.2f} s of plan_many"
+    for index in (0, 499, 999):
+        alone = planner.plan_many([chosen[index]])[0]
+        np.testing.assert_array_equal(alone.q, plans[index].q)
+    assert all(math.isfinite(p.path_length_m) for p in plans)
