@@ -31,6 +31,15 @@ fail() {
     exit 1
 }
 step() { echo "[slurm test +$((SECONDS - started_at))s] $*"; }
+# Runs "${@:3}" every 50 ms until it succeeds; after $1 seconds fails saying it did not: $2.
+wait_until() {
+    local deadline=$((SECONDS + $1)) what=$2
+    shift 2
+    until "$@"; do
+        [[ $SECONDS -lt $deadline ]] || fail "$what"
+        sleep 0.05
+    done
+}
 
 # --- Root, packages -----------------------------------------------------------------------------
 as_root=()
@@ -133,7 +142,7 @@ munged --foreground --force --socket="$socket" --key-file="$state/munge/munge.ke
     --pid-file="$state/run/munged.pid" --seed-file="$state/munge/seed" \
     --log-file="$state/log/munged.log" >>"$state/log/munged.log" 2>&1 &
 daemons+=($!)
-for _ in $(seq 50); do [[ -S "$socket" ]] && break; sleep 0.1; done
+wait_until 10 "munged created no socket $socket within 10 s" test -S "$socket"
 munge --socket="$socket" --no-input | unmunge --socket="$socket" >/dev/null \
     || fail "munged does not answer on $socket"
 
@@ -179,13 +188,8 @@ export SLURM_CONF="$state/slurm.conf"
 daemons+=($!)
 "${as_root[@]}" slurmd -D -f "$SLURM_CONF" >>"$state/log/slurmd.log" 2>&1 &
 daemons+=($!)
-node_state=""
-for _ in $(seq 150); do
-    node_state="$(sinfo -h -n "$host" -o %t 2>/dev/null || true)"
-    [[ "$node_state" == "idle" ]] && break
-    sleep 0.2
-done
-[[ "$node_state" == "idle" ]] || fail "the node did not come up idle within 30 s (state '$node_state')"
+node_idle() { [[ "$(sinfo -h -n "$host" -o %t 2>/dev/null)" == "idle" ]]; }
+wait_until 30 "the node did not come up idle within 30 s" node_idle
 step "cluster up: node $host, $cpus CPUs, slurmctld on 127.0.0.1:$ctld_port"
 
 # --- Helpers ------------------------------------------------------------------------------------
@@ -214,11 +218,8 @@ wait_jobs() {
     shift
     local ids
     ids="$(IFS=,; echo "$*")"
-    local deadline=$((SECONDS + limit))
-    while squeue -h -j "$ids" -t PENDING,RUNNING,CONFIGURING,COMPLETING 2>/dev/null | grep -q .; do
-        [[ $SECONDS -lt $deadline ]] || fail "jobs $ids still queued or running after ${limit} s"
-        sleep 0.5
-    done
+    jobs_over() { ! squeue -h -j "$ids" -t PENDING,RUNNING,CONFIGURING,COMPLETING 2>/dev/null | grep -q .; }
+    wait_until "$limit" "jobs $ids still queued or running after ${limit} s" jobs_over
 }
 expect_completed() {
     local states
@@ -253,11 +254,8 @@ step "label-seeds: array $array, merge $merge"
 # is written, while the rest of its 12 are still to do.
 shard0_chunks() { find "$journal/eval-v1" -name 'chunk-*.labels' 2>/dev/null \
     | sed 's/.*chunk-0*\([0-9]*\)\.labels/\1/' | awk '$1 % 20 == 0' | wc -l; }
-deadline=$((SECONDS + 120))
-until [[ "$(shard0_chunks)" -ge 1 ]]; do
-    [[ $SECONDS -lt $deadline ]] || fail "shard 0 wrote no chunk within 120 s"
-    sleep 0.05
-done
+first_chunk() { [[ "$(shard0_chunks)" -ge 1 ]]; }
+wait_until 120 "shard 0 wrote no chunk within 120 s" first_chunk
 scancel "${array}_0"
 wait_jobs 300 "$array"
 killed_at="$(shard0_chunks)"
@@ -266,14 +264,8 @@ killed_at="$(shard0_chunks)"
 step "label-seeds: shard 0 cancelled after $killed_at of 12 chunks"
 # The first merge job can never run now (afterok on a cancelled element): Slurm says so, and it
 # is cancelled as submit.sh tells users to.
-reason=""
-for _ in $(seq 120); do
-    reason="$(squeue -h -j "$merge" -o %r 2>/dev/null || true)"
-    [[ "$reason" == "DependencyNeverSatisfied" ]] && break
-    sleep 0.5
-done
-[[ "$reason" == "DependencyNeverSatisfied" ]] \
-    || fail "the merge job is '$(job_states "$merge")' ($reason), not waiting on a failed dependency"
+merge_blocked() { [[ "$(squeue -h -j "$merge" -o %r 2>/dev/null)" == "DependencyNeverSatisfied" ]]; }
+wait_until 60 "the first merge job is not waiting on a failed dependency" merge_blocked
 scancel "$merge"
 [[ ! -e "$out/labels/eval-v1.labels" ]] || fail "a label file was written before every shard finished"
 submit label-seeds 4 -- "${slurm_label_args[@]}"
