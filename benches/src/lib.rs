@@ -22,20 +22,20 @@ impl Fixture {
     pub fn load() -> Self {
         let robot = Robot::from_urdf_file(fr3_path(), "link0", "pen_tip")
             .expect("shipped robot file loads");
-        let path = data_dir().join("tasks/eval-v1.tasks");
+        let path = Self::data_dir().join("tasks/eval-v1.tasks");
         let mut tasks = read_tasks(&path, &robot)
             .expect("shipped evaluation set loads (cargo xtask make-tasks)");
         tasks.truncate(100);
         Self { robot, tasks }
     }
-}
 
-/// The workspace's shipped data directory.
-fn data_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data")
+    /// The workspace's shipped data directory.
+    pub fn data_dir() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data")
+    }
 }
 
 /// The shipped FR3 robot file.
 fn fr3_path() -> std::path::PathBuf {
-    data_dir().join("robots/fr3_pen.urdf")
+    Fixture::data_dir().join("robots/fr3_pen.urdf")
 }
