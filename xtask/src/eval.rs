@@ -156,11 +156,11 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
             merged
         }
         None => {
-            let inputs = ShardInputs::of(args)?;
-            if let Some(s) = args.shard {
+            let inputs = args.shard.map(|_| ShardInputs::of(args)).transpose()?;
+            if let (Some(s), Some(inputs)) = (args.shard, &inputs) {
                 let path = shard_path(s.index, s.count);
                 match ShardFile::read(&path)? {
-                    Some(done) if done.inputs == inputs => {
+                    Some(done) if done.inputs == *inputs => {
                         println!(
                             "shard {}/{} is already done ({}); skipped (remove the file to redo it)",
                             s.index,
@@ -199,7 +199,7 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
                     shard,
                 )?);
             }
-            if let Some(s) = args.shard {
+            if let (Some(s), Some(inputs)) = (args.shard, inputs) {
                 let path = shard_path(s.index, s.count);
                 let file = ShardFile { inputs, sets };
                 emg_io::write_atomically(&path, serde_json::to_string(&file)?)?;
