@@ -1,0 +1,32 @@
+//! Rest-to-rest timing of planned joint paths, for robots that enforce acceleration and jerk
+//! limits (libfranka stops a motion whose acceleration jumps):
+//!
+//! 1. [`SmoothPath`]: a natural cubic spline ([`JointSpline`], C²) through the planned
+//!    waypoints, checked against every task constraint on a dense sampling and refined where it
+//!    fails;
+//! 2. [`topp_ra`]: the time-optimal path speed under joint velocity and acceleration limits and
+//!    a tool-speed cap (Pham & Pham 2018), from rest to rest;
+//! 3. [`SmoothedProfile`]: jerk limiting by a moving average of the path position in time;
+//! 4. [`time_motion`]: all of it, sampled at a fixed rate, slowed down locally wherever a sample
+//!    still breaks a limit ([`first_breach`]).
+//!
+//! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
+
+mod dynamics;
+mod limits;
+mod path;
+mod profile;
+mod retime;
+mod spline;
+mod topp;
+
+pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
+pub use limits::{DynamicLimits, LimitsError, Scaling};
+pub use path::{CHECKS_PER_SEGMENT, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
+pub use profile::{PathState, SmoothedProfile, SpeedProfile};
+pub use retime::{
+    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SLOWDOWNS, MIN_GRID_INTERVALS, SLOWDOWN,
+    TimedMotion, TimingError, TimingReport, TimingRequest, time_motion,
+};
+pub use spline::{JointSpline, PathPoint};
+pub use topp::{GridPoint, profile_duration, topp_ra};

@@ -1,0 +1,141 @@
+//! The smooth joint path of a planned motion: a natural cubic spline through the waypoints,
+//! parametrised by the distance the TCP travels between them, checked against every task
+//! constraint on a dense sampling and refined where it fails.
+
+use emg_control::{ConstraintConfig, Task, Violation, first_violation};
+use emg_kinematics::{JointVector, Robot};
+
+use crate::spline::JointSpline;
+
+/// Points checked inside each spline segment (besides its two knots, which are waypoints).
+pub const CHECKS_PER_SEGMENT: usize = 16;
+
+/// Knots inserted at most, in all, while refining a path.
+pub const MAX_REFINEMENTS: usize = 64;
+
+/// Smallest path-parameter step between waypoints (m): waypoints whose TCPs lie closer than
+/// this are a step apart by this much, so the knots increase strictly.
+pub const MIN_KNOT_STEP_M: f64 = 1e-6;
+
+/// A joint path `q(s)` that holds the task's constraints at every checked point.
+#[derive(Clone, Debug)]
+pub struct SmoothPath {
+    /// The spline; `None` for a path of a single configuration (no motion).
+    spline: Option<JointSpline>,
+    /// The configuration of a path without motion.
+    start: JointVector,
+    /// Knots inserted to make the spline hold the constraints.
+    pub refined_knots: usize,
+    /// Where the spline had to end early: the waypoint (index into the given waypoints) it ends
+    /// at, and the constraint the spline broke beyond it.
+    pub cut: Option<(usize, Violation)>,
+}
+
+impl SmoothPath {
+    /// The smooth path through `waypoints` (each holding the constraints, as a rollout's steps
+    /// do). The knot of waypoint `k` is the TCP distance travelled along the polyline of the
+    /// waypoints' TCPs (at least [`MIN_KNOT_STEP_M`] per step). The spline is checked at
+    /// [`CHECKS_PER_SEGMENT`] points inside each segment; a segment that breaks a constraint
+    /// gets its chord midpoint as a new knot (when that midpoint holds the constraints, up to
+    /// [`MAX_REFINEMENTS`] knots in all), else the path ends at the segment's first waypoint.
+    ///
+    /// # Panics
+    ///
+    /// If `waypoints` is empty.
+    pub fn fit(
+        robot: &Robot,
+        task: &Task,
+        constraints: &ConstraintConfig,
+        waypoints: &[JointVector],
+    ) -> Self {
+        assert!(!waypoints.is_empty(), "a path needs a waypoint");
+        let valid = |q: &JointVector| {
+            first_violation(robot, task, q, &robot.forward(q), constraints).is_none()
+        };
+        let mut knots = Vec::with_capacity(waypoints.len());
+        let mut previous = robot.forward(&waypoints[0]).tcp();
+        let mut s = 0.0;
+        for q in waypoints {
+            let tcp = robot.forward(q).tcp();
+            if !knots.is_empty() {
+                s += (tcp - previous).norm().max(MIN_KNOT_STEP_M);
+            }
+            knots.push(s);
+            previous = tcp;
+        }
+        // Which given waypoint each knot is (None for an inserted knot).
+        let mut origin: Vec<Option<usize>> = (0..waypoints.len()).map(Some).collect();
+        let mut values = waypoints.to_vec();
+        let mut refined_knots = 0;
+        let mut cut = None;
+        while values.len() >= 2 {
+            let spline = JointSpline::natural(knots.clone(), values.clone());
+            let Some((segment, violation)) =
+                first_failing_segment(robot, task, constraints, &spline)
+            else {
+                return Self {
+                    spline: Some(spline),
+                    start: waypoints[0],
+                    refined_knots,
+                    cut,
+                };
+            };
+            let midpoint = (values[segment] + values[segment + 1]) / 2.0;
+            if refined_knots < MAX_REFINEMENTS && valid(&midpoint) {
+                knots.insert(segment + 1, (knots[segment] + knots[segment + 1]) / 2.0);
+                values.insert(segment + 1, midpoint);
+                origin.insert(segment + 1, None);
+                refined_knots += 1;
+                continue;
+            }
+            // End at the last given waypoint at or before the failing segment.
+            let keep = (0..=segment)
+                .rev()
+                .find(|&k| origin[k].is_some())
+                .expect("the first knot is a waypoint");
+            cut = Some((origin[keep].expect("a waypoint"), violation));
+            knots.truncate(keep + 1);
+            values.truncate(keep + 1);
+            origin.truncate(keep + 1);
+        }
+        Self {
+            spline: None,
+            start: waypoints[0],
+            refined_knots,
+            cut,
+        }
+    }
+
+    /// The spline, unless the path is a single configuration.
+    pub fn spline(&self) -> Option<&JointSpline> {
+        self.spline.as_ref()
+    }
+
+    /// The first configuration of the path.
+    pub fn start(&self) -> JointVector {
+        self.start
+    }
+
+    /// The path parameter at the end (m of TCP travel; 0 without motion).
+    pub fn length(&self) -> f64 {
+        self.spline.as_ref().map_or(0.0, JointSpline::end)
+    }
+}
+
+/// The first segment of `spline` with a checked inside point that breaks a constraint.
+fn first_failing_segment(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    spline: &JointSpline,
+) -> Option<(usize, Violation)> {
+    let knots = spline.knots();
+    (0..knots.len() - 1).find_map(|k| {
+        (1..CHECKS_PER_SEGMENT + 1).find_map(|j| {
+            let s =
+                knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64;
+            let q = spline.eval(s).q;
+            first_violation(robot, task, &q, &robot.forward(&q), constraints).map(|v| (k, v))
+        })
+    })
+}

@@ -1,0 +1,299 @@
+//! From planned waypoints to a rest-to-rest motion sampled at a fixed rate: the smooth path
+//! ([`SmoothPath`]), TOPP-RA under the joint velocity and acceleration limits and the tool-speed
+//! cap ([`topp_ra`]), the jerk-limiting moving average ([`SmoothedProfile`]), and local slow-downs
+//! wherever the samples still break a limit ([`breaches`]).
+
+use emg_control::{ConstraintConfig, Task};
+use emg_kinematics::{JointVector, Robot};
+
+use crate::dynamics::{LimitBreach, TimedSample, breaches};
+use crate::limits::DynamicLimits;
+use crate::path::SmoothPath;
+use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::topp::{GridPoint, profile_duration, topp_ra};
+
+/// Longest grid step of TOPP-RA along the path (m of TCP travel).
+pub const GRID_STEP_M: f64 = 1e-3;
+
+/// Fewest grid intervals of TOPP-RA on a moving path.
+pub const MIN_GRID_INTERVALS: usize = 50;
+
+/// Factor on the local speed bound (and acceleration limits) around a sample that breaks a
+/// limit, per slow-down round.
+pub const SLOWDOWN: f64 = 0.8;
+
+/// Share of the acceleration limits TOPP-RA plans for: the rest absorbs the grid's
+/// discretization and the moving average's mixing of neighbouring path points.
+pub const ACCELERATION_MARGIN: f64 = 0.97;
+
+/// Slow-down rounds at most before giving up.
+pub const MAX_SLOWDOWNS: usize = 60;
+
+/// Share of the requested tool speed above which the tool counts as moving at it.
+pub const AT_TOOL_SPEED: f64 = 0.99;
+
+/// What the timing is asked for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimingRequest {
+    /// Joint limits, already scaled (and capped by the robot file's velocity limits).
+    pub limits: DynamicLimits,
+    /// Largest tool (TCP) speed (m/s): the tool moves at it wherever the joints allow.
+    pub tool_speed_m_per_s: f64,
+    /// Samples per second of the output.
+    pub rate_hz: f64,
+}
+
+/// What the timing did and how the motion turned out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimingReport {
+    /// Time from rest to rest of the output (s).
+    pub duration_s: f64,
+    /// Time of the fastest motion along the same path under the velocity, acceleration and
+    /// tool-speed limits alone (TOPP-RA without jerk limits or slow-downs) (s).
+    pub time_optimal_s: f64,
+    /// Share of the motion's duration during which the tool moves at ≥ [`AT_TOOL_SPEED`] × the
+    /// requested speed.
+    pub tool_speed_share: f64,
+    /// TCP travel along the path (m).
+    pub path_travel_m: f64,
+    /// Knots the smooth path gained to hold the task constraints.
+    pub refined_knots: usize,
+    /// When the smooth path had to end before the last waypoint: the waypoint it ends at and
+    /// the constraint the spline broke beyond it.
+    pub cut: Option<(usize, String)>,
+    /// TOPP-RA grid points.
+    pub grid_points: usize,
+    /// Rounds of local slow-down the limits needed.
+    pub slowdowns: usize,
+}
+
+/// A rest-to-rest motion at a fixed rate, with its path and report.
+#[derive(Clone, Debug)]
+pub struct TimedMotion {
+    /// Samples at `k / rate` (rounded to whole nanoseconds), from rest to rest.
+    pub samples: Vec<TimedSample>,
+    /// The smooth path the samples follow.
+    pub path: SmoothPath,
+    /// Path parameters of the TOPP-RA grid.
+    pub grid_s: Vec<f64>,
+    /// What the timing did.
+    pub report: TimingReport,
+}
+
+/// Why a motion could not be timed.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TimingError {
+    /// A request field is unusable.
+    #[error("{field} must be {allowed}, got {value}")]
+    Request {
+        /// The field.
+        field: &'static str,
+        /// What it must be.
+        allowed: &'static str,
+        /// The value given.
+        value: f64,
+    },
+    /// The samples still broke a limit after [`MAX_SLOWDOWNS`] rounds.
+    #[error("the motion still breaks a limit after {MAX_SLOWDOWNS} slow-downs: {0}")]
+    LimitsNotMet(LimitBreach),
+}
+
+impl TimingRequest {
+    fn validate(&self) -> Result<(), TimingError> {
+        let positive = |field, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(())
+            } else {
+                Err(TimingError::Request {
+                    field,
+                    allowed: "a positive finite number",
+                    value,
+                })
+            }
+        };
+        positive("tool_speed_m_per_s", self.tool_speed_m_per_s)?;
+        positive("rate_hz", self.rate_hz)?;
+        for (field, values) in [
+            ("max_velocity", &self.limits.velocity),
+            ("max_acceleration", &self.limits.acceleration),
+            ("max_jerk", &self.limits.jerk),
+        ] {
+            for v in values.iter() {
+                positive(field, *v)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The rest-to-rest motion through `waypoints` (each holding `constraints` for `task`, the
+/// first the start): the smooth path, then TOPP-RA on a grid of at most [`GRID_STEP_M`], the
+/// moving average over `w = 2 max_j a_j / j_j`, samples at the requested rate, and, while a
+/// sample breaks a limit, the speed and acceleration bounds around it lowered by
+/// [`SLOWDOWN`].
+pub fn time_motion(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    waypoints: &[JointVector],
+    request: &TimingRequest,
+) -> Result<TimedMotion, TimingError> {
+    request.validate()?;
+    let path = SmoothPath::fit(robot, task, constraints, waypoints);
+    let cut = path
+        .cut
+        .as_ref()
+        .map(|(waypoint, violation)| (*waypoint, violation.to_string()));
+    let Some(spline) = path.spline() else {
+        let start = path.start();
+        return Ok(TimedMotion {
+            samples: vec![TimedSample {
+                time_ns: 0,
+                q: start,
+                qd: JointVector::zeros(),
+                qdd: JointVector::zeros(),
+            }],
+            grid_s: Vec::new(),
+            report: TimingReport {
+                duration_s: 0.0,
+                time_optimal_s: 0.0,
+                tool_speed_share: 0.0,
+                path_travel_m: 0.0,
+                refined_knots: path.refined_knots,
+                cut,
+                grid_points: 0,
+                slowdowns: 0,
+            },
+            path,
+        });
+    };
+    let length = spline.end();
+    let intervals = ((length / GRID_STEP_M).ceil() as usize).max(MIN_GRID_INTERVALS);
+    let limits = &request.limits;
+    let mut tool_gain = Vec::with_capacity(intervals + 1);
+    let grid: Vec<GridPoint> = (0..=intervals)
+        .map(|i| {
+            let s = if i == intervals {
+                length
+            } else {
+                length * i as f64 / intervals as f64
+            };
+            let point = spline.eval(s);
+            let gain = (robot.forward(&point.q).jacobian() * point.dq).norm();
+            tool_gain.push(gain);
+            let mut x_max = (request.tool_speed_m_per_s / gain).powi(2);
+            for j in 0..limits.velocity.len() {
+                x_max = x_max.min((limits.velocity[j] / point.dq[j].abs()).powi(2));
+            }
+            GridPoint {
+                s,
+                dq: point.dq,
+                ddq: point.ddq,
+                x_max,
+            }
+        })
+        .collect();
+    let window = 2.0
+        * limits
+            .acceleration
+            .iter()
+            .zip(limits.jerk.iter())
+            .map(|(a, j)| a / j)
+            .fold(0.0, f64::max);
+    let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
+    let mut factor = vec![1.0; grid.len()];
+    let time_optimal_s = profile_duration(&grid, &topp_ra(&grid, &limits.acceleration, &factor));
+    for slowdowns in 0..=MAX_SLOWDOWNS {
+        let x = topp_ra(&grid, &planned_acceleration, &factor);
+        let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
+        let samples = sample(spline, &profile, request.rate_hz);
+        let found = breaches(&samples, limits);
+        let Some(first) = found.first() else {
+            let duration_s = samples[samples.len() - 1].time_s();
+            let tool_speed_share = tool_speed_share(&samples, &profile, &grid, &tool_gain, request);
+            return Ok(TimedMotion {
+                samples,
+                grid_s: grid.iter().map(|g| g.s).collect(),
+                report: TimingReport {
+                    duration_s,
+                    time_optimal_s,
+                    tool_speed_share,
+                    path_travel_m: length,
+                    refined_knots: path.refined_knots,
+                    cut,
+                    grid_points: grid.len(),
+                    slowdowns,
+                },
+                path,
+            });
+        };
+        if slowdowns == MAX_SLOWDOWNS {
+            return Err(TimingError::LimitsNotMet(first.clone()));
+        }
+        // Lower the bounds on the stretches of path the breaching samples' windows cover.
+        let margin = 2.0 * window + 3.0 / request.rate_hz;
+        let mut lowered = vec![false; grid.len()];
+        for breach in &found {
+            let t = samples[breach.sample].time_s();
+            let from = profile.state(t - margin).s;
+            let to = profile.state(t + margin).s;
+            let first = grid.partition_point(|g| g.s < from).saturating_sub(2);
+            let last = (grid.partition_point(|g| g.s <= to) + 2).min(grid.len());
+            lowered[first..last].fill(true);
+        }
+        for (f, lowered) in factor.iter_mut().zip(lowered) {
+            if lowered {
+                *f *= SLOWDOWN;
+            }
+        }
+    }
+    unreachable!("the loop returns by its last round")
+}
+
+/// The motion sampled at `k / rate_hz` (rounded to whole nanoseconds) for `k = 0, 1, …` up to
+/// the first sample at or after the end.
+fn sample(
+    spline: &crate::spline::JointSpline,
+    profile: &SmoothedProfile,
+    rate_hz: f64,
+) -> Vec<TimedSample> {
+    let duration = profile.duration();
+    let count = (duration * rate_hz - 1e-9).ceil().max(1.0) as u64;
+    (0..=count)
+        .map(|k| {
+            let time_ns = (k as f64 * 1e9 / rate_hz).round() as u64;
+            let state = profile.state(time_ns as f64 * 1e-9);
+            let point = spline.eval(state.s);
+            TimedSample {
+                time_ns,
+                q: point.q,
+                qd: point.dq * state.sd,
+                qdd: point.dq * state.sdd + point.ddq * (state.sd * state.sd),
+            }
+        })
+        .collect()
+}
+
+/// Share of the sampling intervals in which the tool speed `|p'(s)| ṡ` (with `|p'|`
+/// interpolated between grid points) is at least [`AT_TOOL_SPEED`] × the requested speed.
+fn tool_speed_share(
+    samples: &[TimedSample],
+    profile: &SmoothedProfile,
+    grid: &[GridPoint],
+    tool_gain: &[f64],
+    request: &TimingRequest,
+) -> f64 {
+    let fast = samples
+        .iter()
+        .filter(|sample| {
+            let state = profile.state(sample.time_s());
+            let i = grid
+                .partition_point(|g| g.s <= state.s)
+                .clamp(1, grid.len() - 1);
+            let w = (state.s - grid[i - 1].s) / (grid[i].s - grid[i - 1].s);
+            let gain = tool_gain[i - 1] + (tool_gain[i] - tool_gain[i - 1]) * w;
+            gain * state.sd >= AT_TOOL_SPEED * request.tool_speed_m_per_s
+        })
+        .count();
+    fast as f64 / samples.len() as f64
+}
