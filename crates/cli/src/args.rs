@@ -20,7 +20,7 @@ pub struct Cli {
 pub enum Command {
     /// Plan straight-line motions: seed, roll out a controller, write the trajectories.
     Plan(PlanArgs),
-    /// Verify a trajectory file (emg-trajectory/1 JSON, emg-joint-trajectory/1 JSON or the CSV)
+    /// Verify a trajectory file (emg-trajectory/1 JSON, emg-joint-trajectory/2 JSON or the CSV)
     /// with the independent checker; exit status 1 names the point and the constraint.
     #[command(visible_alias = "replay")]
     Check(CheckArgs),
@@ -44,7 +44,7 @@ pub struct CheckArgs {
     #[arg(long, requires = "base_link")]
     pub tip_link: Option<String>,
     /// Take the task (and, without --config, the constraints) from this emg-trajectory/1 or
-    /// emg-joint-trajectory/1 file instead of FILE (a CSV carries none).
+    /// emg-joint-trajectory/2 file instead of FILE (a CSV carries none).
     #[arg(long, value_name = "JSON", conflicts_with = "p0")]
     pub task_from: Option<PathBuf>,
     /// A task given on the command line instead of the file's.
@@ -53,6 +53,31 @@ pub struct CheckArgs {
     /// JSON file as for `plan --config`: its `rollout.constraints` replace the file's.
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
+    /// Check a joint-trajectory file against these joint limits (MoveIt joint_limits.yaml,
+    /// scaled by --velocity-scaling and --acceleration-scaling) instead of the file's own.
+    #[arg(long, value_name = "YAML")]
+    pub limits: Option<PathBuf>,
+    /// Scaling of the --limits file.
+    #[command(flatten)]
+    pub scaling: ScalingArgs,
+}
+
+/// Velocity and acceleration scaling of joint limits, as MoveIt and Pilz take them.
+#[derive(Debug, Args)]
+pub struct ScalingArgs {
+    /// Factor in (0, 1] on the joint velocity limits.
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub velocity_scaling: f64,
+    /// Factor in (0, 1] on the joint acceleration and jerk limits.
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub acceleration_scaling: f64,
+}
+
+impl ScalingArgs {
+    /// The factors, checked to lie in (0, 1].
+    pub fn scaling(&self) -> Result<emg_timing::Scaling, emg_timing::LimitsError> {
+        emg_timing::Scaling::new(self.velocity_scaling, self.acceleration_scaling)
+    }
 }
 
 /// A task line on the command line: all three of `--p0`, `--d` and `--n`, or none.
@@ -105,7 +130,8 @@ pub struct PlanArgs {
     /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
-    /// Output path stem: writes STEM.json, STEM.csv and STEM.joint_trajectory.json
+    /// Output path stem: writes STEM.json and STEM.csv (the planned path) and
+    /// STEM.joint_trajectory.json (the motion timed rest to rest within the joint limits)
     /// (STEM-00000.json, ... for a task file holding several tasks).
     #[arg(long, value_name = "STEM", default_value = "trajectory")]
     pub out: PathBuf,
@@ -132,6 +158,21 @@ pub struct PlanArgs {
     /// `reachable_m`.
     #[arg(long, value_name = "on|off", default_value = "on")]
     pub reach: OnOff,
+    /// Joint limits the joint trajectory is timed for (MoveIt joint_limits.yaml with velocity,
+    /// acceleration and jerk limits). Default: <robot file stem>.joint_limits.yaml beside the
+    /// robot file.
+    #[arg(long, value_name = "YAML")]
+    pub limits: Option<PathBuf>,
+    /// Scaling of the joint limits.
+    #[command(flatten)]
+    pub scaling: ScalingArgs,
+    /// Largest tool speed of the timed motion (m/s): the tool moves at it wherever the joints
+    /// allow. Default: the rollout's line speed (`rollout.speed_m_per_s`, 0.2).
+    #[arg(long, value_name = "M_PER_S")]
+    pub tool_speed: Option<f64>,
+    /// Samples per second of the joint trajectory (1000 for libfranka).
+    #[arg(long, value_name = "HZ", default_value_t = emg_planner::DEFAULT_RATE_HZ)]
+    pub rate_hz: f64,
 }
 
 /// A feature switched on or off on the command line.
@@ -149,6 +190,13 @@ impl PlanArgs {
         self.weights.clone().or_else(|| {
             crate::robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE)
         })
+    }
+
+    /// The joint limits file: `--limits`, else the one beside the robot file.
+    pub fn limits_path(&self) -> PathBuf {
+        self.limits
+            .clone()
+            .unwrap_or_else(|| emg_planner::limits_file_beside(&self.robot))
     }
 
     /// The policy weights: `--policy`, else those shipped for the robot (if any).

@@ -1,6 +1,6 @@
 //! `emg check`: read a trajectory file back and verify it with the independent checker.
 //!
-//! Reads `emg-trajectory/1` JSON, `emg-joint-trajectory/1` JSON or the CSV (told apart by the
+//! Reads `emg-trajectory/1` JSON, `emg-joint-trajectory/2` JSON or the CSV (told apart by the
 //! content: JSON starts with `{`, and its `format` field names the layout), resolves the robot,
 //! the task and the constraints, and runs [`emg_verify::check_replay`]. The layouts and what is
 //! verified are documented in `docs/joint-trajectory-format.md`.
@@ -11,10 +11,10 @@ use anyhow::{Context, Result, bail};
 use emg_control::{ConstraintConfig, Task};
 use emg_io::{Carried, TrajectoryContents};
 use emg_kinematics::{Robot, Vec3};
-use emg_verify::ReplayReport;
+use emg_verify::{JointDynamics, ReplayReport};
 
 use crate::args::CheckArgs;
-use emg_planner::PlannerConfig;
+use emg_planner::{MotionTiming, PlannerConfig};
 
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
 pub fn run_check(args: &CheckArgs) -> Result<()> {
@@ -74,11 +74,22 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         (None, None, None) => (ConstraintConfig::default(), "the defaults".to_string()),
     };
 
+    let limits = match &args.limits {
+        Some(path) => Some(checked_limits(path, args, &robot, &constraints)?),
+        None => None,
+    };
     // The recorded trajectory is verified as recorded (its TCP, tool angles, path length and
     // end) only against its own task.
     let own_task = args.line.p0.is_none() && task_from.is_none();
     let report = contents
-        .verify(&model, robot.joint_names(), &task, &constraints, own_task)
+        .verify(
+            &model,
+            robot.joint_names(),
+            &task,
+            &constraints,
+            own_task,
+            limits.as_ref(),
+        )
         .map_err(|failure| anyhow::anyhow!("{} does not hold up: {failure}", file.display()))?;
     let recorded = match &contents {
         TrajectoryContents::Rollout(rollout) if own_task => Some(&rollout.trajectory),
@@ -95,7 +106,12 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         "  task from {task_origin}; constraints from {constraints_origin}: {}",
         describe(&constraints)
     );
-    print_report(&report);
+    let limits_origin = match (&args.limits, &contents) {
+        (Some(path), _) => Some(format!("--limits {}", path.display())),
+        (None, TrajectoryContents::Joint(_)) => Some("the file".to_string()),
+        _ => None,
+    };
+    print_report(&report, limits_origin.as_deref());
     println!(
         "  {}",
         match recorded {
@@ -105,6 +121,25 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     );
     println!("OK");
     Ok(())
+}
+
+/// The joint limits of `--limits` (scaled), each velocity limit at most the robot file's times
+/// the constraints' fraction: the bounds a timed motion for these constraints holds.
+fn checked_limits(
+    path: &Path,
+    args: &CheckArgs,
+    robot: &Robot,
+    constraints: &ConstraintConfig,
+) -> Result<JointDynamics> {
+    let scaling = args.scaling.scaling()?;
+    // Tool speed and rate play no part in the limits.
+    let timing = MotionTiming::new(robot, path, scaling, 1.0, 1.0, constraints)?;
+    let limits = &timing.request().limits;
+    Ok(JointDynamics {
+        velocity: limits.velocity,
+        acceleration: limits.acceleration,
+        jerk: limits.jerk,
+    })
 }
 
 /// Task and constraints of a `--task-from` file (either JSON layout).
@@ -148,31 +183,52 @@ fn describe(constraints: &ConstraintConfig) -> String {
     )
 }
 
-fn print_report(report: &ReplayReport) {
+fn print_report(report: &ReplayReport, limits_origin: Option<&str>) {
     println!(
         "  {} points, {:.3} s, path length {:.4} m",
         report.points, report.duration_s, report.path_length_m
     );
-    let peaks: Vec<String> = report
-        .peak_speed_fraction
-        .iter()
-        .map(|f| format!("{f:.3}"))
-        .collect();
-    println!("  peak joint speed / limit: {}", peaks.join(" "));
-    let accelerations: Vec<String> = report
-        .peak_acceleration_rad_s2
-        .iter()
-        .map(|a| format!("{a:.2}"))
-        .collect();
-    println!(
-        "  peak joint acceleration between points (rad/s², not bounded by the planner): {}",
-        accelerations.join(" ")
-    );
-    let [first, last] = report.boundary_speed_fraction;
-    println!(
-        "  fastest joint at the first point {first:.3} × its limit, at the last point {last:.3} × \
-         (the file starts and ends at those speeds)"
-    );
+    let fractions = |values: &[f64]| -> String {
+        let text: Vec<String> = values.iter().map(|f| format!("{f:.3}")).collect();
+        text.join(" ")
+    };
+    match (&report.dynamics, limits_origin) {
+        (Some(dynamics), Some(origin)) => {
+            println!("  joint limits from {origin}; rest at both ends");
+            println!(
+                "  peak joint velocity / limit: {}",
+                fractions(&dynamics.peak_velocity_fraction)
+            );
+            println!(
+                "  peak joint acceleration / limit: {}",
+                fractions(&dynamics.peak_acceleration_fraction)
+            );
+            println!(
+                "  peak joint jerk / limit: {}",
+                fractions(&dynamics.peak_jerk_fraction)
+            );
+        }
+        _ => {
+            println!(
+                "  peak joint speed / limit: {}",
+                fractions(&report.peak_speed_fraction)
+            );
+            println!(
+                "  peak joint acceleration between points (rad/s², not bounded by the planner): {}",
+                report
+                    .peak_acceleration_rad_s2
+                    .iter()
+                    .map(|a| format!("{a:.2}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            );
+            let [first, last] = report.boundary_speed_fraction;
+            println!(
+                "  fastest joint at the first point {first:.3} × its limit, at the last point \
+                 {last:.3} × (the file starts and ends at those speeds)"
+            );
+        }
+    }
     let (clearance, a, b) = &report.min_clearance;
     println!(
         "  max line deviation {:.3} mm, max tool angle {:.2}°, min clearance {:.1} mm ({a}, {b})",

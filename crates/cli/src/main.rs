@@ -63,7 +63,8 @@ use clap::Parser;
 use emg_control::{Task, Trajectory};
 use emg_io::{PlanPaths, html_path};
 use emg_planner::{
-    Models, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig, SeedSource,
+    Models, MotionTiming, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest, Planner,
+    PlannerConfig, SeedSource,
 };
 
 use crate::args::{Cli, Command, OnOff, PlanArgs};
@@ -107,6 +108,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         policy_weights(args)?.as_deref(),
     )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
+    let timing = motion_timing(args, &robot, &config)?;
     let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
         planner: args.planner,
@@ -133,7 +135,11 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
             .plan(task, &request)
             .map_err(|error| plan_error(error, &request))
             .and_then(|plan| {
-                write_plan(&planner, args, &request, task, &plan, many.then_some(index))
+                let record = Record {
+                    request: &request,
+                    timing: &timing,
+                };
+                write_plan(&planner, args, &record, task, &plan, many.then_some(index))
             });
         match planned {
             Ok(report) => println!("{label}{report}"),
@@ -146,6 +152,47 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     }
     anyhow::ensure!(failures == 0, "{failures} of {} tasks failed", tasks.len());
     Ok(())
+}
+
+/// How the joint trajectories are timed: the limits file (`--limits`, else the one beside the
+/// robot file), scaling, tool speed and rate.
+fn motion_timing(
+    args: &PlanArgs,
+    robot: &emg_kinematics::Robot,
+    config: &PlannerConfig,
+) -> Result<MotionTiming> {
+    let limits = args.limits_path();
+    if args.limits.is_none() && !limits.exists() {
+        anyhow::bail!(
+            "no joint limits for robot {}: {} does not exist; write one in MoveIt's \
+             joint_limits.yaml layout (velocity, acceleration and jerk limits per joint) or give \
+             --limits FILE",
+            args.robot.display(),
+            limits.display()
+        );
+    }
+    let tool_speed = args.tool_speed.unwrap_or(config.rollout.speed_m_per_s);
+    Ok(MotionTiming::new(
+        robot,
+        &limits,
+        args.scaling.scaling()?,
+        tool_speed,
+        args.rate_hz,
+        &config.rollout.constraints,
+    )
+    .map_err(|error| match error {
+        emg_planner::TimingSetupError::Request(e) => anyhow::anyhow!("{e}").context(format!(
+            "--tool-speed {tool_speed} / --rate-hz {}",
+            args.rate_hz
+        )),
+        other => anyhow::Error::new(other),
+    })?)
+}
+
+/// What a plan was asked for beyond the task: the request and the timing.
+struct Record<'a> {
+    request: &'a PlanRequest,
+    timing: &'a MotionTiming,
 }
 
 /// A planning error with the option it comes from.
@@ -194,7 +241,7 @@ fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
 fn write_plan(
     planner: &Planner,
     args: &PlanArgs,
-    request: &PlanRequest,
+    record: &Record<'_>,
     task: &Task,
     plan: &Plan,
     index: Option<usize>,
@@ -203,12 +250,25 @@ fn write_plan(
     let reach = (args.reach == OnOff::On).then(|| planner.reach(task, &[plan.seed.q]));
     let paths = PlanPaths::new(&args.out, index);
     let robot = args.robot.display().to_string();
-    let record = PlanRecord {
-        robot: &robot,
-        request,
-        reachable_m: reach.as_ref().map(|r| r.reachable_m),
+    let files = PlanFiles::new(
+        planner,
+        task,
+        plan,
+        &PlanRecord {
+            robot: &robot,
+            request: record.request,
+            reachable_m: reach.as_ref().map(|r| r.reachable_m),
+            timing: record.timing,
+        },
+    )?;
+    files.write(&paths)?;
+    let timed = &files.timing;
+    let cut = match (&timed.cut_at_point, &timed.cut_reason) {
+        (Some(point), Some(reason)) => {
+            format!("; the smooth path ends at planned point {point} ({reason} beyond it)")
+        }
+        _ => String::new(),
     };
-    PlanFiles::new(planner, task, plan, &record)?.write(&paths)?;
     let viewer = match &args.html {
         Some(html) => write_viewer(planner, args, task, trajectory, &html_path(html, index))?,
         None => String::new(),
@@ -225,10 +285,18 @@ fn write_plan(
     };
     Ok(format!(
         "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}\n  \
-         seed: {}{projected}\n  wrote {}, {} and {}{viewer}",
+         seed: {}{projected}\n  \
+         timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
+         requested speed {:.0} % of the time, {} points at {} Hz{cut}\n  \
+         wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,
+        timed.duration_s,
+        timed.time_optimal_s,
+        timed.tool_speed_share * 100.0,
+        (timed.duration_s * timed.rate_hz).round() as usize + 1,
+        timed.rate_hz,
         paths.json.display(),
         paths.csv.display(),
         paths.joint_trajectory.display()

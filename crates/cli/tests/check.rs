@@ -92,7 +92,7 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
         "{out}"
     );
     let out = check_ok(&[joint.to_str().unwrap()]);
-    assert!(out.contains("emg-joint-trajectory/1"), "{out}");
+    assert!(out.contains("emg-joint-trajectory/2"), "{out}");
     assert!(out.contains("declared velocities agree"), "{out}");
     assert!(
         out.contains("not verifiable from this file: why the motion ended"),

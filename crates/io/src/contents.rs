@@ -5,8 +5,8 @@ use std::path::Path;
 
 use emg_control::{ConstraintConfig, Task};
 use emg_verify::{
-    JointSamples, Recording, ReferenceModel, ReplayError, ReplayReport, check_joint_names,
-    check_replay,
+    JointDynamics, JointSamples, Recording, ReferenceModel, ReplayError, ReplayReport,
+    check_joint_names, check_replay,
 };
 use serde_json::Value;
 
@@ -20,7 +20,7 @@ use crate::rollout_file::{RolloutRecord, TRAJECTORY_FORMAT};
 pub enum TrajectoryContents {
     /// `emg-trajectory/1`: the rollout as recorded.
     Rollout(RolloutRecord),
-    /// `emg-joint-trajectory/1`.
+    /// `emg-joint-trajectory/2`.
     Joint(JointTrajectory),
     /// The CSV: times, positions and declared velocities only.
     Csv(JointSamples),
@@ -159,7 +159,8 @@ impl TrajectoryContents {
     /// declares must be the robot's, and every point must hold every constraint. With
     /// `own_task` (the task is the one the file was planned for), a rollout file's recorded TCP,
     /// tool angles, path length and end are verified too; its tool angles are measured from
-    /// that task's normal, so against any other task they are not.
+    /// that task's normal, so against any other task they are not. A joint-trajectory file is
+    /// verified against joint dynamics limits too: `limits` when given, else the file's own.
     pub fn verify(
         &self,
         model: &ReferenceModel,
@@ -167,6 +168,7 @@ impl TrajectoryContents {
         task: &Task,
         constraints: &ConstraintConfig,
         own_task: bool,
+        limits: Option<&JointDynamics>,
     ) -> Result<ReplayReport, VerifyFailure> {
         let samples = self.samples();
         let failure = |error| VerifyFailure {
@@ -184,12 +186,18 @@ impl TrajectoryContents {
             Self::Rollout(file) if own_task => Some(Recording::from(&file.trajectory)),
             _ => None,
         };
+        let dynamics = match (limits, self) {
+            (Some(limits), _) => Some(limits.clone()),
+            (None, Self::Joint(file)) => Some(file.limits.dynamics()),
+            (None, _) => None,
+        };
         check_replay(
             model,
             &task.into(),
             &constraints.into(),
             &samples,
             recording.as_ref(),
+            dynamics.as_ref(),
         )
         .map_err(failure)
     }

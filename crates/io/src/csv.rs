@@ -20,6 +20,7 @@ pub fn samples_from_steps(steps: &[StepRecord]) -> JointSamples {
         time_s: steps.iter().map(|s| s.time_s).collect(),
         q: steps.iter().map(|s| s.q).collect(),
         qd: None,
+        qdd: None,
     }
 }
 
@@ -118,5 +119,6 @@ pub fn read_csv(text: &str) -> Result<JointSamples, FormatError> {
         time_s,
         q,
         qd: Some(qd),
+        qdd: None,
     })
 }

@@ -1,23 +1,20 @@
-//! The `emg-joint-trajectory/1` JSON layout, modelled on ROS `trajectory_msgs/JointTrajectory`:
-//! joint names, points with positions, velocities (by [`point_velocities`]) and a
-//! `time_from_start` in whole nanoseconds, carrying the task and the constraints so that the
-//! file alone can be verified. The layout is documented in `docs/joint-trajectory-format.md`.
+//! The `emg-joint-trajectory/2` JSON layout, modelled on ROS `trajectory_msgs/JointTrajectory`:
+//! joint names and a rest-to-rest motion sampled at a fixed rate (positions, velocities,
+//! accelerations, `time_from_start` in whole nanoseconds), carrying the task, the constraints
+//! and the joint limits it was timed for, so that the file alone can be verified. The layout is
+//! documented in `docs/joint-trajectory-format.md`.
 
-use emg_control::{ConstraintConfig, Task, Trajectory};
+use emg_control::{ConstraintConfig, Task};
 use emg_kinematics::{DOF, JointVector};
-use emg_verify::{JointSamples, point_velocities};
+use emg_timing::{TimedMotion, TimingReport};
+use emg_verify::{JointDynamics, JointSamples};
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 
 use crate::error::{FormatError, field_error};
 
 /// Value of the `format` field of every joint-trajectory file.
-pub const JOINT_TRAJECTORY_FORMAT: &str = "emg-joint-trajectory/1";
-
-/// A gap between consecutive times that lies this little (ns) above a whole number of
-/// nanoseconds is float noise of the accumulated times and is rounded down to it; any larger
-/// excess is rounded up (see [`times_from_start`]).
-pub const GAP_ROUNDING_NOISE_NS: f64 = 1e-3;
+pub const JOINT_TRAJECTORY_FORMAT: &str = "emg-joint-trajectory/2";
 
 /// A time since the start in whole nanoseconds, as ROS `builtin_interfaces/Duration`
 /// (`sec` + `nanosec`, `0 ≤ nanosec < 10⁹`).
@@ -35,76 +32,104 @@ impl TimeFromStart {
         f64::from(self.sec) + f64::from(self.nanosec) / 1e9
     }
 
-    fn from_nanoseconds(total: u64) -> Option<Self> {
+    /// The time `total` ns after the start; `None` past 2³¹ s.
+    pub fn from_nanoseconds(total: u64) -> Option<Self> {
         Some(Self {
             sec: i32::try_from(total / 1_000_000_000).ok()?,
             nanosec: u32::try_from(total % 1_000_000_000).ok()?,
         })
     }
+}
 
-    fn nanoseconds(&self) -> u64 {
-        u64::try_from(self.sec).expect("sec ≥ 0") * 1_000_000_000 + u64::from(self.nanosec)
+/// The joint limits a motion was timed for, as its file records them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimingLimits {
+    /// The MoveIt `joint_limits.yaml` the limits were read from (the path as given).
+    pub joint_limits_file: String,
+    /// Factor on the file's velocity limits.
+    pub velocity_scaling: f64,
+    /// Factor on the file's acceleration and jerk limits.
+    pub acceleration_scaling: f64,
+    /// Largest tool speed asked for (m/s).
+    pub tool_speed_m_per_s: f64,
+    /// The velocity limits every point holds (rad/s): the file's, scaled, and at most the robot
+    /// file's times the constraints' `velocity_limit_fraction`.
+    pub max_velocity: Vec<f64>,
+    /// The acceleration limits every point holds (rad/s²), scaled.
+    pub max_acceleration: Vec<f64>,
+    /// The jerk limits every point holds (rad/s³), scaled.
+    pub max_jerk: Vec<f64>,
+}
+
+impl TimingLimits {
+    /// The limits as the checker takes them.
+    pub fn dynamics(&self) -> JointDynamics {
+        let vector = |values: &[f64]| JointVector::from_column_slice(values);
+        JointDynamics {
+            velocity: vector(&self.max_velocity),
+            acceleration: vector(&self.max_acceleration),
+            jerk: vector(&self.max_jerk),
+        }
     }
 }
 
-/// The `time_from_start` of points planned at `time_s` (s): the first time rounded to the
-/// nearest nanosecond, then each gap `t_k − t_{k−1}` rounded **up** to whole nanoseconds (at
-/// least 1 ns; a gap within [`GAP_ROUNDING_NOISE_NS`] above a whole number of nanoseconds is
-/// rounded down to it) and summed. No gap is shorter than planned (beyond that noise), so joint
-/// speeds computed from the file's positions and times never exceed the planned ones; point
-/// `k` lies between `k · 0.001` ns before and `k` ns after its planned time.
-///
-/// Fails, naming the point, on a time that is not finite, a negative first time, times that do
-/// not increase, or a time past 2³¹ s.
-pub fn times_from_start(time_s: &[f64]) -> Result<Vec<TimeFromStart>, FormatError> {
-    let mut out: Vec<TimeFromStart> = Vec::with_capacity(time_s.len());
-    for (k, t) in time_s.iter().enumerate() {
-        let total = match out.last() {
-            None if t.is_finite() && *t >= 0.0 && *t < 1e18 => Some((t * 1e9).round() as u64),
-            None => None,
-            Some(previous) => {
-                let gap = t - time_s[k - 1];
-                if gap.is_nan() || gap <= 0.0 {
-                    return Err(field_error(
-                        format!("points[{k}].time_from_start"),
-                        format!(
-                            "cannot be made from time {t} s: it does not come after the previous \
-                             point's {} s",
-                            time_s[k - 1]
-                        ),
-                    ));
-                }
-                let gap_ns = (gap * 1e9 - GAP_ROUNDING_NOISE_NS).ceil().max(1.0);
-                (gap_ns < 1e18).then(|| previous.nanoseconds() + gap_ns as u64)
-            }
-        };
-        let time = total
-            .and_then(TimeFromStart::from_nanoseconds)
-            .ok_or_else(|| {
-                field_error(
-                    format!("points[{k}].time_from_start"),
-                    format!("cannot be made from time {t} s (it must be finite, ≥ 0, < 2^31 s)"),
-                )
-            })?;
-        out.push(time);
+/// How a motion was timed, as its file records it (a report: the checker does not rely on it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimingSummary {
+    /// Samples per second.
+    pub rate_hz: f64,
+    /// Time from rest to rest (s).
+    pub duration_s: f64,
+    /// Time of the fastest motion along the same path under the velocity, acceleration and
+    /// tool-speed limits alone, without jerk limits (s).
+    pub time_optimal_s: f64,
+    /// Share of the duration with the tool at ≥ 99 % of the requested speed.
+    pub tool_speed_share: f64,
+    /// TCP travel along the smooth path (m).
+    pub path_travel_m: f64,
+    /// Knots the smooth path gained to hold the task constraints.
+    pub refined_knots: usize,
+    /// When the smooth path ends before the last planned point: the planned point it ends at.
+    pub cut_at_point: Option<usize>,
+    /// And the constraint the spline broke beyond it.
+    pub cut_reason: Option<String>,
+    /// Rounds of local slow-down the limits needed.
+    pub slowdowns: usize,
+}
+
+impl TimingSummary {
+    /// The summary of a timing `report` at `rate_hz`.
+    pub fn new(report: &TimingReport, rate_hz: f64) -> Self {
+        Self {
+            rate_hz,
+            duration_s: report.duration_s,
+            time_optimal_s: report.time_optimal_s,
+            tool_speed_share: report.tool_speed_share,
+            path_travel_m: report.path_travel_m,
+            refined_knots: report.refined_knots,
+            cut_at_point: report.cut.as_ref().map(|(point, _)| *point),
+            cut_reason: report.cut.as_ref().map(|(_, reason)| reason.clone()),
+            slowdowns: report.slowdowns,
+        }
     }
-    Ok(out)
 }
 
 /// One point of a [`JointTrajectory`], as ROS `trajectory_msgs/JointTrajectoryPoint` (without
-/// accelerations and efforts).
+/// efforts).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JointTrajectoryPoint {
     /// Joint positions (rad), in `joint_names` order.
     pub positions: Vec<f64>,
-    /// Joint velocities (rad/s) by [`point_velocities`], in `joint_names` order.
+    /// Joint velocities (rad/s), in `joint_names` order.
     pub velocities: Vec<f64>,
+    /// Joint accelerations (rad/s²), in `joint_names` order.
+    pub accelerations: Vec<f64>,
     /// Time since the first point.
     pub time_from_start: TimeFromStart,
 }
 
-/// A planned motion as a robot stack replays it (`emg-joint-trajectory/1`), with the task and
-/// constraints it was planned for.
+/// A planned motion as a robot stack replays it (`emg-joint-trajectory/2`): rest to rest at a
+/// fixed rate, with the task, constraints and joint limits it holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JointTrajectory {
     /// Always [`JOINT_TRAJECTORY_FORMAT`].
@@ -117,22 +142,26 @@ pub struct JointTrajectory {
     pub task: Task,
     /// The constraints every point holds.
     pub constraints: ConstraintConfig,
-    /// The points, the seed first.
+    /// The joint limits every point holds.
+    pub limits: TimingLimits,
+    /// How the motion was timed.
+    pub timing: TimingSummary,
+    /// The samples, from rest at the seed to rest at the end.
     pub points: Vec<JointTrajectoryPoint>,
 }
 
 impl JointTrajectory {
-    /// The joint trajectory of `trajectory` (every recorded step, the seed first): positions as
-    /// recorded, times by [`times_from_start`], and velocities by [`point_velocities`] from those
-    /// positions and the file's own times.
+    /// The file of `motion` (timed for `limits`, at `rate_hz`).
     ///
-    /// Fails when there are not seven joint names or the times cannot be written.
+    /// Fails when there are not seven joint names or a sample lies past 2³¹ s.
     pub fn new(
         robot: &str,
         joint_names: &[String],
         task: &Task,
         constraints: &ConstraintConfig,
-        trajectory: &Trajectory,
+        limits: TimingLimits,
+        motion: &TimedMotion,
+        rate_hz: f64,
     ) -> Result<Self, FormatError> {
         if joint_names.len() != DOF {
             return Err(field_error(
@@ -140,27 +169,31 @@ impl JointTrajectory {
                 format!("has {} entries, expected {DOF}", joint_names.len()),
             ));
         }
-        let planned: Vec<f64> = trajectory.steps.iter().map(|s| s.time_s).collect();
-        let times = times_from_start(&planned)?;
-        let seconds: Vec<f64> = times.iter().map(TimeFromStart::seconds).collect();
-        let q: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
-        let velocities = point_velocities(&seconds, &q);
-        let points = q
+        let points = motion
+            .samples
             .iter()
-            .zip(&velocities)
-            .zip(times)
-            .map(|((q, qd), time_from_start)| JointTrajectoryPoint {
-                positions: q.as_slice().to_vec(),
-                velocities: qd.as_slice().to_vec(),
-                time_from_start,
+            .enumerate()
+            .map(|(k, sample)| {
+                let time_from_start =
+                    TimeFromStart::from_nanoseconds(sample.time_ns).ok_or_else(|| {
+                        field_error(format!("points[{k}].time_from_start"), "is past 2^31 s")
+                    })?;
+                Ok(JointTrajectoryPoint {
+                    positions: sample.q.as_slice().to_vec(),
+                    velocities: sample.qd.as_slice().to_vec(),
+                    accelerations: sample.qdd.as_slice().to_vec(),
+                    time_from_start,
+                })
             })
-            .collect();
+            .collect::<Result<_, FormatError>>()?;
         Ok(Self {
             format: JOINT_TRAJECTORY_FORMAT.to_string(),
             robot: robot.to_string(),
             joint_names: joint_names.to_vec(),
             task: task.clone(),
             constraints: constraints.clone(),
+            limits,
+            timing: TimingSummary::new(&motion.report, rate_hz),
             points,
         })
     }
@@ -170,10 +203,10 @@ impl JointTrajectory {
         serde_json::to_string(self).expect("a joint trajectory serialises")
     }
 
-    /// Reads a file's text. Checks the `format`, that there are seven joint names, that every
-    /// point has seven finite positions and velocities and a `time_from_start` with
-    /// `nanosec < 10⁹`; the error names the field. Fields other than those of the layout are
-    /// ignored.
+    /// Reads a file's text. Checks the `format`, that there are seven joint names, that the
+    /// limits hold seven positive numbers each, that every point has seven finite positions,
+    /// velocities and accelerations and a `time_from_start` with `nanosec < 10⁹`; the error
+    /// names the field. Fields other than those of the layout are ignored.
     pub fn from_json(text: &str) -> Result<Self, FormatError> {
         let value: Value =
             serde_json::from_str(text).map_err(|e| FormatError::Json(e.to_string()))?;
@@ -205,6 +238,22 @@ impl JointTrajectory {
         let constraints =
             serde_json::from_value(member(top, "constraints", "constraints")?.clone())
                 .map_err(|e| field_error("constraints", format!("is not a constraint set: {e}")))?;
+        let limits: TimingLimits = serde_json::from_value(member(top, "limits", "limits")?.clone())
+            .map_err(|e| field_error("limits", format!("is not a set of limits: {e}")))?;
+        for (name, values) in [
+            ("max_velocity", &limits.max_velocity),
+            ("max_acceleration", &limits.max_acceleration),
+            ("max_jerk", &limits.max_jerk),
+        ] {
+            if values.len() != DOF || !values.iter().all(|v| v.is_finite() && *v > 0.0) {
+                return Err(field_error(
+                    format!("limits.{name}"),
+                    format!("is {values:?}, expected {DOF} positive numbers"),
+                ));
+            }
+        }
+        let timing = serde_json::from_value(member(top, "timing", "timing")?.clone())
+            .map_err(|e| field_error("timing", format!("is not a timing summary: {e}")))?;
         let points = array(member(top, "points", "points")?, "points")?
             .iter()
             .enumerate()
@@ -216,12 +265,14 @@ impl JointTrajectory {
             joint_names,
             task,
             constraints,
+            limits,
+            timing,
             points,
         })
     }
 
     /// The points as [`JointSamples`]: times from `time_from_start`, positions, and the declared
-    /// velocities.
+    /// velocities and accelerations.
     pub fn samples(&self) -> JointSamples {
         let vector = |values: &[f64]| JointVector::from_column_slice(values);
         JointSamples {
@@ -232,6 +283,12 @@ impl JointTrajectory {
                 .collect(),
             q: self.points.iter().map(|p| vector(&p.positions)).collect(),
             qd: Some(self.points.iter().map(|p| vector(&p.velocities)).collect()),
+            qdd: Some(
+                self.points
+                    .iter()
+                    .map(|p| vector(&p.accelerations))
+                    .collect(),
+            ),
         }
     }
 }
@@ -306,6 +363,10 @@ fn read_point(value: &Value, path: &str) -> Result<JointTrajectoryPoint, FormatE
         member(object, "velocities", &at("velocities"))?,
         &at("velocities"),
     )?;
+    let accelerations = joint_values(
+        member(object, "accelerations", &at("accelerations"))?,
+        &at("accelerations"),
+    )?;
     let time_path = at("time_from_start");
     let time = member(object, "time_from_start", &time_path)?
         .as_object()
@@ -340,6 +401,7 @@ fn read_point(value: &Value, path: &str) -> Result<JointTrajectoryPoint, FormatE
     Ok(JointTrajectoryPoint {
         positions,
         velocities,
+        accelerations,
         time_from_start: TimeFromStart { sec, nanosec },
     })
 }

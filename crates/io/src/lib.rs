@@ -2,8 +2,9 @@
 //!
 //! * [`TrajectoryFile`] / [`RolloutRecord`]: the `emg-trajectory/1` JSON of a planned task (task,
 //!   settings, every step, why it ended), written and read back.
-//! * [`JointTrajectory`]: the `emg-joint-trajectory/1` JSON a robot stack replays (ROS
-//!   `trajectory_msgs/JointTrajectory`-like, times in whole nanoseconds).
+//! * [`JointTrajectory`]: the `emg-joint-trajectory/2` JSON a robot stack replays (ROS
+//!   `trajectory_msgs/JointTrajectory`-like: a rest-to-rest motion at a fixed rate with
+//!   positions, velocities and accelerations, times in whole nanoseconds).
 //! * [`trajectory_csv`] / [`read_csv`]: the CSV table of a rollout.
 //! * [`TrajectoryContents`]: any of the three, told apart by content, as the independent
 //!   checker's [`emg_verify::JointSamples`].
@@ -12,8 +13,8 @@
 //!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
 //!   for one job's identity.
 //!
-//! Velocities in every file follow [`emg_verify::point_velocities`], so the checker recomputes
-//! exactly what the writers declare.
+//! Velocities in the rollout files follow [`emg_verify::point_velocities`], so the checker
+//! recomputes exactly what the writers declare.
 //!
 //! ```
 //! use emg_control::{ClassicalController, RolloutConfig, Task, rollout};
@@ -27,15 +28,31 @@
 //! let config = RolloutConfig { max_steps: 20, ..RolloutConfig::default() };
 //! let trajectory = rollout(&robot, &task, &seed, &mut ClassicalController::default(), &config);
 //!
+//! let limits_file = path.with_file_name("fr3_pen.joint_limits.yaml");
+//! let limits = emg_timing::DynamicLimits::read(&limits_file, &robot)?;
+//! let request = emg_timing::TimingRequest {
+//!     limits: limits.clone(), tool_speed_m_per_s: 0.2, rate_hz: 1000.0,
+//! };
+//! let waypoints: Vec<_> = trajectory.steps.iter().map(|s| s.q).collect();
+//! let motion = emg_timing::time_motion(&robot, &task, &config.constraints, &waypoints, &request)?;
+//! let record = emg_io::TimingLimits {
+//!     joint_limits_file: limits_file.display().to_string(),
+//!     velocity_scaling: 1.0, acceleration_scaling: 1.0, tool_speed_m_per_s: 0.2,
+//!     max_velocity: limits.velocity.as_slice().to_vec(),
+//!     max_acceleration: limits.acceleration.as_slice().to_vec(),
+//!     max_jerk: limits.jerk.as_slice().to_vec(),
+//! };
 //! let file = JointTrajectory::new("fr3", robot.joint_names(), &task, &config.constraints,
-//!                                 &trajectory)?;
+//!                                 record, &motion, 1000.0)?;
 //! let back = JointTrajectory::from_json(&file.to_json())?;
 //! assert_eq!(back, file);
 //!
 //! let checker = emg_verify::ReferenceModel::from_urdf_file(&path, "link0", "pen_tip")?;
 //! let report = emg_verify::check_replay(&checker, &(&back.task).into(),
-//!                                       &(&back.constraints).into(), &back.samples(), None)?;
-//! assert_eq!(report.points, 21);
+//!                                       &(&back.constraints).into(), &back.samples(), None,
+//!                                       Some(&back.limits.dynamics()))?;
+//! assert_eq!(report.points, motion.samples.len());
+//! assert!(report.dynamics.is_some());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -53,8 +70,8 @@ pub use contents::{Carried, ReadError, TrajectoryContents, VerifyFailure};
 pub use csv::{CSV_HEADER, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;
 pub use joint_trajectory::{
-    GAP_ROUNDING_NOISE_NS, JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint,
-    TimeFromStart, times_from_start,
+    JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint, TimeFromStart, TimingLimits,
+    TimingSummary,
 };
 pub use paths::{PlanPaths, html_path};
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};

@@ -12,7 +12,7 @@ pub struct PlanPaths {
     pub json: PathBuf,
     /// The CSV table.
     pub csv: PathBuf,
-    /// `emg-joint-trajectory/1` JSON.
+    /// `emg-joint-trajectory/2` JSON.
     pub joint_trajectory: PathBuf,
 }
 

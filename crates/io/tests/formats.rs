@@ -5,10 +5,10 @@ use emg_control::{
     ClassicalController, RolloutConfig, Task, Trajectory, VelocityLimitFraction, rollout,
 };
 use emg_io::{
-    CSV_HEADER, FormatError, JointTrajectory, TimeFromStart, read_csv, times_from_start,
-    trajectory_csv,
+    CSV_HEADER, FormatError, JointTrajectory, TimeFromStart, TimingLimits, read_csv, trajectory_csv,
 };
-use emg_kinematics::{DOF, Robot, Vec3};
+use emg_kinematics::{DOF, JointVector, Robot, Vec3};
+use emg_timing::{DynamicLimits, TimingRequest, time_motion};
 use emg_verify::{JointSamples, ReferenceModel, check_joint_names, check_replay, point_velocities};
 use serde_json::Value;
 
@@ -28,6 +28,7 @@ fn replay(
         &(&file.constraints).into(),
         samples,
         None,
+        Some(&file.limits.dynamics()),
     )
 }
 
@@ -63,60 +64,112 @@ fn checker() -> ReferenceModel {
     ReferenceModel::from_urdf_file(&robot_path(), "link0", "pen_tip").unwrap()
 }
 
+/// Samples per second of [`export`].
+const RATE_HZ: f64 = 1000.0;
+
+/// [`planned`] timed rest to rest within the shipped FR3 limits (velocities capped at
+/// [`FRACTION`] of the robot file's, as the rollout's steps are) and written as a file.
 fn export() -> (JointTrajectory, Trajectory) {
     let (robot, task, config, trajectory) = planned();
+    let limits_file = robot_path().with_file_name("fr3_pen.joint_limits.yaml");
+    let limits = DynamicLimits::read(&limits_file, &robot)
+        .unwrap()
+        .with_velocity_ceiling(&(robot.limits().velocity * FRACTION));
+    let request = TimingRequest {
+        limits: limits.clone(),
+        tool_speed_m_per_s: 0.2,
+        rate_hz: RATE_HZ,
+    };
+    let waypoints: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
+    let motion = time_motion(&robot, &task, &config.constraints, &waypoints, &request).unwrap();
+    let record = TimingLimits {
+        joint_limits_file: limits_file.display().to_string(),
+        velocity_scaling: 1.0,
+        acceleration_scaling: 1.0,
+        tool_speed_m_per_s: 0.2,
+        max_velocity: limits.velocity.as_slice().to_vec(),
+        max_acceleration: limits.acceleration.as_slice().to_vec(),
+        max_jerk: limits.jerk.as_slice().to_vec(),
+    };
     let file = JointTrajectory::new(
         "fr3_pen.urdf",
         robot.joint_names(),
         &task,
         &config.constraints,
-        &trajectory,
+        record,
+        &motion,
+        RATE_HZ,
     )
     .unwrap();
     (file, trajectory)
 }
 
 #[test]
-fn json_round_trip_keeps_every_position_bit_for_bit() {
+fn json_round_trip_keeps_every_value_bit_for_bit() {
     let (file, trajectory) = export();
-    let gaps: Vec<f64> = trajectory
-        .steps
-        .windows(2)
-        .map(|w| w[1].time_s - w[0].time_s)
-        .collect();
-    assert!(
-        gaps.iter().any(|g| (g - 0.05).abs() > 1e-6),
-        "the slowed steps make the times non-uniform: {gaps:?}"
-    );
     let text = file.to_json();
     assert!(!text.contains('\n'));
     let back = JointTrajectory::from_json(&text).unwrap();
     assert_eq!(back, file);
-    assert_eq!(back.points.len(), trajectory.steps.len());
-    for (point, step) in back.points.iter().zip(&trajectory.steps) {
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(&point.positions), bits(step.q.as_slice()));
-        // Never shorter than planned, at most 1 ns per point later.
-        let drift = point.time_from_start.seconds() - step.time_s;
-        assert!(drift > -1e-12 && drift < 1e-9 * trajectory.steps.len() as f64);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let (first, last) = (&back.points[0], &back.points[back.points.len() - 1]);
+    assert_eq!(
+        bits(&first.positions),
+        bits(trajectory.steps[0].q.as_slice())
+    );
+    let end = trajectory.steps.last().unwrap();
+    assert_eq!(bits(&last.positions), bits(end.q.as_slice()));
+    for point in [first, last] {
+        assert!(
+            point
+                .velocities
+                .iter()
+                .chain(&point.accelerations)
+                .all(|v| *v == 0.0)
+        );
+    }
+    for (k, point) in back.points.iter().enumerate() {
+        assert_eq!(
+            point.time_from_start,
+            TimeFromStart::from_nanoseconds(k as u64 * 1_000_000).unwrap()
+        );
     }
     let report = replay(&checker(), &back, &back.samples()).unwrap();
-    assert_eq!(report.points, trajectory.steps.len());
-    assert_eq!(report.max_declared_velocity_error, Some(0.0));
+    assert_eq!(report.points, back.points.len());
+    assert_eq!(report.max_declared_velocity_error, None);
     assert!((report.path_length_m - trajectory.path_length_m).abs() < 1e-12);
+    // Joint speeds stay within the fraction of the robot file's limits the steps hold.
     let peak = report
         .peak_speed_fraction
         .iter()
         .copied()
         .fold(0.0, f64::max);
     assert!(
-        peak > 0.99 * FRACTION && peak <= FRACTION * (1.0 + 1e-9),
+        peak > 0.9 * FRACTION && peak <= FRACTION * (1.0 + 1e-9),
         "{peak}"
     );
-    // The first and last points move at their segment's speed, within the peak.
-    let [first, last] = report.boundary_speed_fraction;
-    assert!(first > 0.0 && first <= peak && last > 0.0 && last <= peak);
-    assert!(report.peak_acceleration_rad_s2.iter().all(|a| *a > 0.0));
+    let dynamics = report.dynamics.unwrap();
+    assert!(
+        dynamics
+            .peak_velocity_fraction
+            .iter()
+            .all(|f| *f <= 1.0 + 1e-6)
+    );
+    assert!(
+        dynamics
+            .peak_acceleration_fraction
+            .iter()
+            .all(|f| *f <= 1.0 + 1e-6)
+    );
+    assert!(dynamics.peak_jerk_fraction.iter().all(|f| *f <= 1.0 + 1e-6));
+}
+
+#[test]
+fn time_from_start_splits_whole_seconds() {
+    let time = TimeFromStart::from_nanoseconds(2_500_000_001).unwrap();
+    assert_eq!((time.sec, time.nanosec), (2, 500_000_001));
+    assert_eq!(time.seconds(), 2.500000001);
+    assert_eq!(TimeFromStart::from_nanoseconds(u64::MAX), None);
 }
 
 #[test]
@@ -140,41 +193,6 @@ fn csv_round_trip_keeps_times_and_positions_bit_for_bit() {
 }
 
 #[test]
-fn times_are_rounded_up_per_gap_to_whole_nanoseconds() {
-    // Accumulated 0.05 s steps land exactly on the grid despite float noise.
-    let mut t = vec![0.0];
-    for _ in 0..10 {
-        t.push(t.last().unwrap() + 0.05);
-    }
-    t.push(t.last().unwrap() + 1.0 / 30.0);
-    let times = times_from_start(&t).unwrap();
-    assert_eq!(
-        times[10],
-        TimeFromStart {
-            sec: 0,
-            nanosec: 500_000_000
-        }
-    );
-    assert_eq!(
-        times[11],
-        TimeFromStart {
-            sec: 0,
-            nanosec: 533_333_334
-        }
-    );
-    for k in 1..t.len() {
-        assert!(times[k].seconds() - times[k - 1].seconds() >= (t[k] - t[k - 1]) - 1e-12);
-    }
-    let error = times_from_start(&[0.0, 0.1, 0.1]).unwrap_err().to_string();
-    assert!(
-        error.contains("points[2]") && error.contains("does not come after"),
-        "{error}"
-    );
-    let error = times_from_start(&[-0.1]).unwrap_err().to_string();
-    assert!(error.contains("points[0]"), "{error}");
-}
-
-#[test]
 fn malformed_json_names_the_field() {
     let (file, _) = export();
     let good: Value = serde_json::from_str(&file.to_json()).unwrap();
@@ -185,9 +203,23 @@ fn malformed_json_names_the_field() {
             .unwrap_err()
             .to_string()
     };
-    let e = error(&|d| d["format"] = "emg-trajectory/1".into());
+    let e = error(&|d| d["format"] = "emg-joint-trajectory/1".into());
     assert!(
-        e.contains("'format'") && e.contains("emg-joint-trajectory/1"),
+        e.contains("'format'") && e.contains("emg-joint-trajectory/2"),
+        "{e}"
+    );
+    let e = error(&|d| {
+        d["points"][2]
+            .as_object_mut()
+            .unwrap()
+            .remove("accelerations");
+    });
+    assert!(e.contains("'points[2].accelerations' is missing"), "{e}");
+    let e = error(&|d| {
+        d["limits"]["max_jerk"].as_array_mut().unwrap().pop();
+    });
+    assert!(
+        e.contains("'limits.max_jerk'") && e.contains("7 positive numbers"),
         "{e}"
     );
     let e = error(&|d| {
@@ -250,17 +282,26 @@ fn check_replay_blames_the_point_and_the_constraint() {
     samples.qd.as_mut().unwrap()[5][3] += 0.01;
     let e = run(&samples);
     assert!(
-        e.starts_with("point 5: declared velocity of joint 4"),
+        e.starts_with("point 5: joint 4: position change") && e.contains("declared velocities"),
         "{e}"
     );
 
     let mut samples = file.samples();
-    samples.time_s[7] = samples.time_s[6] + 0.5 * (samples.time_s[7] - samples.time_s[6]);
+    samples.qdd.as_mut().unwrap()[0][1] = 1e-3;
     let e = run(&samples);
     assert!(
-        e.starts_with("point 7: joint") && e.contains("rad/s, above"),
+        e.starts_with("point 0: the first point is not at rest"),
         "{e}"
     );
+
+    // A point moved in time: its neighbours' joint speeds, from positions and times, break
+    // the fraction of the limits.
+    let mut samples = file.samples();
+    let middle = samples.len() / 2;
+    samples.time_s[middle] =
+        samples.time_s[middle - 1] + 0.01 * (samples.time_s[middle] - samples.time_s[middle - 1]);
+    let e = run(&samples);
+    assert!(e.starts_with(&format!("point {middle}: joint")), "{e}");
 
     let mut samples = file.samples();
     samples.time_s[4] = samples.time_s[3];

@@ -1,13 +1,16 @@
 //! The files of one planned task, built and written the same way by every front end (`emg plan`,
-//! the Python package): `emg-trajectory/1` JSON, the CSV table and `emg-joint-trajectory/1` JSON.
+//! the Python package): `emg-trajectory/1` JSON, the CSV table and `emg-joint-trajectory/2` JSON
+//! (the plan timed rest to rest by [`MotionTiming`]).
 
 use emg_control::Task;
 use emg_io::{
-    FormatError, JointTrajectory, PlanPaths, TRAJECTORY_FORMAT, TrajectoryFile, trajectory_csv,
-    write_atomically,
+    FormatError, JointTrajectory, PlanPaths, TRAJECTORY_FORMAT, TimingSummary, TrajectoryFile,
+    trajectory_csv, write_atomically,
 };
+use emg_timing::TimingError;
 
 use crate::planner::{Plan, PlanRequest, Planner};
+use crate::timing::MotionTiming;
 
 /// How a plan was asked for, as its files record it.
 #[derive(Clone, Copy, Debug)]
@@ -18,17 +21,21 @@ pub struct PlanRecord<'a> {
     pub request: &'a PlanRequest,
     /// The task's reachability bound (m), when it was computed.
     pub reachable_m: Option<f64>,
+    /// How the joint trajectory is timed.
+    pub timing: &'a MotionTiming,
 }
 
 /// The text of the three files of one planned task.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct PlanFiles {
     /// `emg-trajectory/1` JSON: task, settings, every step, why it ended.
     pub json: String,
     /// The CSV table of the steps.
     pub csv: String,
-    /// `emg-joint-trajectory/1` JSON, for a robot stack to replay.
+    /// `emg-joint-trajectory/2` JSON, for a robot stack to replay.
     pub joint_trajectory: String,
+    /// How the joint trajectory was timed.
+    pub timing: TimingSummary,
 }
 
 /// Why a plan's files could not be written.
@@ -37,6 +44,9 @@ pub enum PlanFilesError {
     /// The trajectory does not make a valid joint trajectory.
     #[error("cannot build the joint trajectory: {0}")]
     JointTrajectory(#[from] FormatError),
+    /// The trajectory could not be timed within the limits.
+    #[error("cannot time the joint trajectory: {0}")]
+    Timing(#[from] TimingError),
     /// Writing a file failed.
     #[error("cannot write {path}: {source}")]
     Write {
@@ -73,18 +83,23 @@ impl PlanFiles {
             path_length_m: trajectory.path_length_m,
             reachable_m: record.reachable_m,
         };
+        let constraints = &config.rollout.constraints;
+        let motion = record.timing.time(robot, task, constraints, trajectory)?;
         let joint = JointTrajectory::new(
             record.robot,
             robot.joint_names(),
             task,
-            &config.rollout.constraints,
-            trajectory,
+            constraints,
+            record.timing.record(),
+            &motion,
+            record.timing.request().rate_hz,
         )?;
         let mut joint_trajectory = joint.to_json();
         joint_trajectory.push('\n');
         Ok(Self {
             json: file.to_json(),
             csv: trajectory_csv(&trajectory.steps),
+            timing: joint.timing.clone(),
             joint_trajectory,
         })
     }

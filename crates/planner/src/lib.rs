@@ -6,7 +6,8 @@
 //! A plan is the paper's pipeline: a seed ([`SeedSource`]: the diffusion seeder by default,
 //! Sec. 4.1) put exactly on the start pose, then one rollout of the chosen null-space controller
 //! ([`ControllerKind`]: classical, RL or the hybrid of Sec. 4.3) through the shared step.
-//! [`PlanFiles`] turns a plan into the files `emg plan` writes.
+//! [`PlanFiles`] turns a plan into the files `emg plan` writes, its joint trajectory timed rest to
+//! rest within the joint limits by [`MotionTiming`].
 //!
 //! ```
 //! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
@@ -32,6 +33,7 @@ mod reach;
 mod search;
 mod seed;
 mod shipped;
+mod timing;
 
 pub use config::{ConfigError, PlannerConfig};
 pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
@@ -47,3 +49,4 @@ pub use reach::{MAX_REACH_RESTARTS, Reach, ReachConfig, reach};
 pub use search::{MAX_SEARCH_BUDGET_STEPS, SearchConfig};
 pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
+pub use timing::{DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside};

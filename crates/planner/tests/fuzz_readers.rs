@@ -25,10 +25,11 @@ use emg_io::{
 };
 use emg_kinematics::{JointVector, Robot};
 use emg_planner::{
-    ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SeedSource,
-    ShippedRobot, demo_task, robot_stamp,
+    ControllerKind, DataDir, Models, MotionTiming, PlanRequest, Planner, PlannerConfig,
+    PlannerKind, SeedSource, ShippedRobot, demo_task, limits_file_beside, robot_stamp,
 };
 use emg_seeding::{Label, LabelSet, Shard, TaskLabels};
+use emg_timing::Scaling;
 use emg_verify::{Recording, ReferenceModel, check_joint_names, check_replay};
 use proptest::prelude::*;
 use proptest::sample::Index;
@@ -347,12 +348,17 @@ fn check_contents(robot: &Robot, model: &ReferenceModel, contents: &TrajectoryCo
         TrajectoryContents::Rollout(rollout) => Some(Recording::from(&rollout.trajectory)),
         _ => None,
     };
+    let limits = match contents {
+        TrajectoryContents::Joint(file) => Some(file.limits.dynamics()),
+        _ => None,
+    };
     let _ = check_replay(
         model,
         &(&task).into(),
         &(&constraints).into(),
         &contents.samples(),
         recording.as_ref(),
+        limits.as_ref(),
     );
 }
 
@@ -437,12 +443,27 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
         path_length_m: trajectory.path_length_m,
         reachable_m: Some(0.5),
     };
+    // A low rate keeps the timed file small enough to mutate many times.
+    let timing = MotionTiming::new(
+        robot,
+        &limits_file_beside(&robot_file("fr3")),
+        Scaling::default(),
+        0.2,
+        20.0,
+        &config.rollout.constraints,
+    )
+    .expect("the shipped limits");
+    let motion = timing
+        .time(robot, &task, &config.rollout.constraints, trajectory)
+        .expect("the plan times");
     let joint = JointTrajectory::new(
         "fr3",
         robot.joint_names(),
         &task,
         &config.rollout.constraints,
-        trajectory,
+        timing.record(),
+        &motion,
+        20.0,
     )
     .expect("joint trajectory");
     vec![

@@ -13,7 +13,7 @@ use crate::{CheckFailed, InputError, input_error, message};
 /// What the independent checker measured on a trajectory file that holds up.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]
 pub struct CheckReport {
-    /// The file's layout (`emg-trajectory/1`, `emg-joint-trajectory/1`).
+    /// The file's layout (`emg-trajectory/1`, `emg-joint-trajectory/2`).
     layout: &'static str,
     /// The robot file it was checked with.
     robot: PathBuf,
@@ -91,6 +91,7 @@ pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
             &task,
             &carried.constraints,
             true,
+            None,
         )
         .map_err(|failure| {
             CheckFailed::new_err(format!("{} does not hold up: {failure}", path.display()))

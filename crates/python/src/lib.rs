@@ -3,8 +3,9 @@
 //!
 //! * [`planner::Planner`]: a robot (shipped name or robot file), its models and a configuration;
 //!   `plan(p0, d, n, …)` one task, `plan_many(tasks, …)` many in parallel with the GIL released;
-//! * [`planner::Plan`]: the planned motion as numpy arrays, `save(stem)` writing the files
-//!   `emg plan` writes, byte for byte;
+//! * [`planner::Plan`]: the planned motion as numpy arrays, `timed(…)` the motion timed rest to
+//!   rest ([`timing::Motion`]), `save(stem, …)` writing the files `emg plan` writes, byte for
+//!   byte;
 //! * [`robot::Robot`]: forward kinematics and the position Jacobian;
 //! * [`check::check`]: a trajectory file verified by the independent checker, as a report;
 //! * [`planner::load_tasks`]: a task file (JSON or `EMGTASKS`).
@@ -16,6 +17,7 @@
 mod check;
 mod planner;
 mod robot;
+mod timing;
 
 use std::path::{Path, PathBuf};
 
@@ -95,6 +97,7 @@ fn extreme_line_motion(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<planner::Planner>()?;
     module.add_class::<planner::Plan>()?;
     module.add_class::<planner::Task>()?;
+    module.add_class::<timing::Motion>()?;
     module.add_class::<robot::Robot>()?;
     module.add_class::<check::CheckReport>()?;
     module.add_function(wrap_pyfunction!(planner::load_tasks, module)?)?;

@@ -18,6 +18,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 
 use crate::robot::{Robot, joint_vector};
+use crate::timing::{Motion, TimingArgs};
 use crate::{InputError, PlanningError, data_dir, input_error, message};
 
 /// Plans extreme straight-line motions for one robot with its models and configuration.
@@ -201,7 +202,7 @@ fn model_files(robot_file: &Path, models: Option<&Path>) -> PyResult<[Option<Pat
     Ok([pick(DIFFUSION_WEIGHTS_FILE), pick(POLICY_WEIGHTS_FILE)])
 }
 
-fn array2<'py, const N: usize>(
+pub(crate) fn array2<'py, const N: usize>(
     py: Python<'py>,
     rows: impl ExactSizeIterator<Item = [f64; N]>,
 ) -> Bound<'py, PyArray2<f64>> {
@@ -212,7 +213,10 @@ fn array2<'py, const N: usize>(
         .into_pyarray(py)
 }
 
-fn array1<'py>(py: Python<'py>, values: impl Iterator<Item = f64>) -> Bound<'py, PyArray1<f64>> {
+pub(crate) fn array1<'py>(
+    py: Python<'py>,
+    values: impl Iterator<Item = f64>,
+) -> Bound<'py, PyArray1<f64>> {
     values.collect::<Vec<_>>().into_pyarray(py)
 }
 
@@ -447,13 +451,67 @@ impl Plan {
         }
     }
 
+    /// The motion timed rest to rest: `limits` a MoveIt joint_limits.yaml (default: the one
+    /// beside the robot file), `velocity_scaling` and `acceleration_scaling` in (0, 1],
+    /// `tool_speed` (m/s; default: the rollout's line speed), `rate_hz` samples per second.
+    #[pyo3(signature = (limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = emg_planner::DEFAULT_RATE_HZ))]
+    fn timed(
+        &self,
+        py: Python<'_>,
+        limits: Option<PathBuf>,
+        velocity_scaling: f64,
+        acceleration_scaling: f64,
+        tool_speed: Option<f64>,
+        rate_hz: f64,
+    ) -> PyResult<Motion> {
+        let timing = TimingArgs {
+            limits,
+            velocity_scaling,
+            acceleration_scaling,
+            tool_speed,
+            rate_hz,
+        }
+        .resolve(&self.planner, Path::new(&self.robot))?;
+        let constraints = &self.planner.config().rollout.constraints;
+        let motion = py
+            .detach(|| {
+                timing.time(
+                    self.planner.robot(),
+                    &self.task,
+                    constraints,
+                    trajectory(self),
+                )
+            })
+            .map_err(|e| PlanningError::new_err(format!("timing: {}", message(&e))))?;
+        Ok(Motion { motion, timing })
+    }
+
     /// Writes the files `emg plan --out STEM` writes, byte for byte: `STEM.json`
-    /// (emg-trajectory/1), `STEM.csv` and `STEM.joint_trajectory.json`; returns their paths.
-    fn save(&self, stem: PathBuf) -> PyResult<Vec<PathBuf>> {
+    /// (emg-trajectory/1), `STEM.csv` and `STEM.joint_trajectory.json` (timed as `timed` says,
+    /// with the same keyword arguments as `emg plan`'s options); returns their paths.
+    #[pyo3(signature = (stem, limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = emg_planner::DEFAULT_RATE_HZ))]
+    fn save(
+        &self,
+        stem: PathBuf,
+        limits: Option<PathBuf>,
+        velocity_scaling: f64,
+        acceleration_scaling: f64,
+        tool_speed: Option<f64>,
+        rate_hz: f64,
+    ) -> PyResult<Vec<PathBuf>> {
+        let timing = TimingArgs {
+            limits,
+            velocity_scaling,
+            acceleration_scaling,
+            tool_speed,
+            rate_hz,
+        }
+        .resolve(&self.planner, Path::new(&self.robot))?;
         let record = PlanRecord {
             robot: &self.robot,
             request: &self.request,
             reachable_m: self.reachable_m,
+            timing: &timing,
         };
         let files = PlanFiles::new(&self.planner, &self.task, &self.plan, &record)
             .map_err(|e| input_error("plan", &e))?;

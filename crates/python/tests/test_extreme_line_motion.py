@@ -135,7 +135,7 @@ def test_check_reports_a_saved_plan_and_refuses_a_tampered_one(tmp_path, planner
     assert report.path_length_m == pytest.approx(plan.path_length_m, abs=1e-9)
     assert report.max_line_deviation_m <= 0.02 and report.recorded_end_verified
     joint = elm.check(tmp_path / "line.joint_trajectory.json")
-    assert joint.layout == "emg-joint-trajectory/1" and not joint.recorded_end_verified
+    assert joint.layout == "emg-joint-trajectory/2" and not joint.recorded_end_verified
 
     tampered = json.loads((tmp_path / "line.joint_trajectory.json").read_text())
     point = len(tampered["points"]) // 2

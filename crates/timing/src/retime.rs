@@ -99,7 +99,8 @@ pub enum TimingError {
 }
 
 impl TimingRequest {
-    fn validate(&self) -> Result<(), TimingError> {
+    /// Checks the tool speed, the rate and every limit are positive and finite.
+    pub fn validate(&self) -> Result<(), TimingError> {
         let positive = |field, value: f64| {
             if value.is_finite() && value > 0.0 {
                 Ok(())

@@ -27,11 +27,16 @@
 //! ```
 
 mod check;
+mod dynamics;
 mod model;
 mod record;
 mod replay;
 
 pub use check::{CheckFailure, FailedCheck};
+pub use dynamics::{
+    DYNAMICS_LIMIT_SLACK, DynamicsCheck, DynamicsFailure, DynamicsReport, JointDynamics,
+    REST_TOLERANCE, check_dynamics,
+};
 pub use model::{ModelError, ReferenceModel};
 pub use record::{Blame, Bounds, Ending, JOINTS, Joints, Line, RecordedStep, Recording};
 pub use replay::{

@@ -2,6 +2,7 @@
 //! bounds, joint speeds from positions and times, and the velocities the file declares.
 
 use crate::check::FailedCheck;
+use crate::dynamics::{DynamicsCheck, DynamicsReport, JointDynamics, check_dynamics};
 use crate::model::{ReferenceModel, angle_deg, within};
 use crate::record::{Bounds, Ending, JOINTS, Joints, Line, RecordedStep, Recording};
 
@@ -23,6 +24,8 @@ pub struct JointSamples {
     pub q: Vec<Joints>,
     /// Velocities the file declares at each point (rad/s), if it declares any.
     pub qd: Option<Vec<Joints>>,
+    /// Accelerations the file declares at each point (rad/s²), if it declares any.
+    pub qdd: Option<Vec<Joints>>,
 }
 
 impl JointSamples {
@@ -129,8 +132,11 @@ pub struct ReplayReport {
     /// Smallest clearance between checked capsule pairs (m), with the pair's links.
     pub min_clearance: (f64, String, String),
     /// Largest difference between a declared velocity and the velocity rule (rad/s); `None`
-    /// when the file declares no velocities.
+    /// when the file declares no velocities or declares accelerations too (then the dynamic
+    /// check verifies the declared values).
     pub max_declared_velocity_error: Option<f64>,
+    /// What the dynamic check measured, when joint dynamics limits were given.
+    pub dynamics: Option<DynamicsReport>,
 }
 
 /// Which check a point of a file fails.
@@ -150,6 +156,8 @@ pub enum ReplayCheck {
         /// 1-based joint number.
         joint: usize,
     },
+    /// A check of rest, velocity, acceleration and jerk limits ([`check_dynamics`]).
+    Dynamics(DynamicsCheck),
 }
 
 /// Why a trajectory file does not hold up: the joint names, or a point and the check it fails.
@@ -199,8 +207,11 @@ pub fn check_joint_names(file: &[String], robot: &[String]) -> Result<(), Replay
 ///    `velocity_limit_fraction · v_max` (when the bounds enforce it), and the records a
 ///    recorded motion carries (TCP, tool angle, path length, why it ended);
 /// 3. declared velocities, if any: `|q̇_i| ≤ fraction · v_max,i · (1 + VELOCITY_LIMIT_SLACK)`
-///    (when enforced) and within [`DECLARED_VELOCITY_TOLERANCE`] of [`point_velocities`] of the
-///    file's own positions and times.
+///    (when enforced) and, for samples that declare no accelerations, within
+///    [`DECLARED_VELOCITY_TOLERANCE`] of [`point_velocities`] of the file's own positions and
+///    times;
+/// 4. with `dynamics`: [`check_dynamics`] (rest at both ends, velocity, acceleration and jerk
+///    limits, declared values that agree with the positions).
 ///
 /// # Panics
 ///
@@ -211,6 +222,7 @@ pub fn check_replay(
     bounds: &Bounds,
     samples: &JointSamples,
     recorded: Option<&Recording>,
+    dynamics: Option<&JointDynamics>,
 ) -> Result<ReplayReport, ReplayError> {
     let fail = |point: usize, check: ReplayCheck, problem: String| {
         Err(ReplayError::Point {
@@ -287,6 +299,9 @@ pub fn check_replay(
                         ),
                     );
                 }
+                if samples.qdd.is_some() {
+                    continue;
+                }
                 let error = (qd[i] - expected[i]).abs();
                 if !within(
                     error,
@@ -308,8 +323,22 @@ pub fn check_replay(
                 worst = worst.max(error);
             }
         }
-        max_declared_velocity_error = Some(worst);
+        if samples.qdd.is_none() {
+            max_declared_velocity_error = Some(worst);
+        }
     }
+    let dynamics = match dynamics {
+        Some(limits) => {
+            Some(
+                check_dynamics(samples, limits).map_err(|failure| ReplayError::Point {
+                    point: failure.sample,
+                    check: ReplayCheck::Dynamics(failure.check),
+                    problem: failure.problem,
+                })?,
+            )
+        }
+        None => None,
+    };
 
     let mut peak_speed_fraction = vec![0.0_f64; JOINTS];
     for k in 1..samples.len() {
@@ -358,6 +387,7 @@ pub fn check_replay(
         max_tool_angle_deg,
         min_clearance,
         max_declared_velocity_error,
+        dynamics,
     })
 }
 

@@ -1,0 +1,105 @@
+//! How planned motions are timed for a robot: the joint limits a URDF cannot hold (a MoveIt
+//! `joint_limits.yaml`, by default beside the robot file), the scaling and tool speed asked
+//! for, and the output rate.
+
+use std::path::{Path, PathBuf};
+
+use emg_control::{ConstraintConfig, Task, Trajectory};
+use emg_io::TimingLimits;
+use emg_kinematics::{JointVector, Robot};
+use emg_timing::{
+    DynamicLimits, LimitsError, Scaling, TimedMotion, TimingError, TimingRequest, time_motion,
+};
+
+/// Output rate when none is asked for (Hz): libfranka's 1 kHz.
+pub const DEFAULT_RATE_HZ: f64 = 1000.0;
+
+/// The joint limits file of robot file `robot`: `<stem>.joint_limits.yaml` beside it
+/// (`data/robots/fr3_pen.joint_limits.yaml` for `data/robots/fr3_pen.urdf`).
+pub fn limits_file_beside(robot: &Path) -> PathBuf {
+    let stem = robot.file_stem().unwrap_or_default().to_string_lossy();
+    robot.with_file_name(format!("{stem}.joint_limits.yaml"))
+}
+
+/// Why timing could not be set up: the limits file, or a request value.
+#[derive(Debug, thiserror::Error)]
+pub enum TimingSetupError {
+    /// The joint limits file is missing or unusable.
+    #[error("{0}")]
+    Limits(#[from] LimitsError),
+    /// A rate, speed or limit is unusable.
+    #[error("{0}")]
+    Request(#[from] TimingError),
+}
+
+/// Everything a plan's timing needs, resolved once for a robot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionTiming {
+    limits_file: String,
+    scaling: Scaling,
+    request: TimingRequest,
+}
+
+impl MotionTiming {
+    /// Timing for `robot` with the limits of `limits_file` scaled by `scaling`, each velocity
+    /// limit at most the robot file's times `constraints.velocity_limit_fraction` (the bound
+    /// every planned step holds), the tool at most `tool_speed_m_per_s`, sampled at `rate_hz`.
+    pub fn new(
+        robot: &Robot,
+        limits_file: &Path,
+        scaling: Scaling,
+        tool_speed_m_per_s: f64,
+        rate_hz: f64,
+        constraints: &ConstraintConfig,
+    ) -> Result<Self, TimingSetupError> {
+        let fraction = constraints
+            .velocity_limit_fraction
+            .map_or(1.0, |fraction| fraction.get());
+        let ceiling: JointVector = robot.limits().velocity * fraction;
+        let limits = DynamicLimits::read(limits_file, robot)?
+            .scaled(scaling)
+            .with_velocity_ceiling(&ceiling);
+        let request = TimingRequest {
+            limits,
+            tool_speed_m_per_s,
+            rate_hz,
+        };
+        request.validate()?;
+        Ok(Self {
+            limits_file: limits_file.display().to_string(),
+            scaling,
+            request,
+        })
+    }
+
+    /// What the timing asks for (the effective limits, tool speed and rate).
+    pub fn request(&self) -> &TimingRequest {
+        &self.request
+    }
+
+    /// The rest-to-rest motion along `trajectory`'s steps.
+    pub fn time(
+        &self,
+        robot: &Robot,
+        task: &Task,
+        constraints: &ConstraintConfig,
+        trajectory: &Trajectory,
+    ) -> Result<TimedMotion, TimingError> {
+        let waypoints: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
+        time_motion(robot, task, constraints, &waypoints, &self.request)
+    }
+
+    /// The limits as a joint-trajectory file records them.
+    pub fn record(&self) -> TimingLimits {
+        let limits = &self.request.limits;
+        TimingLimits {
+            joint_limits_file: self.limits_file.clone(),
+            velocity_scaling: self.scaling.velocity,
+            acceleration_scaling: self.scaling.acceleration,
+            tool_speed_m_per_s: self.request.tool_speed_m_per_s,
+            max_velocity: limits.velocity.as_slice().to_vec(),
+            max_acceleration: limits.acceleration.as_slice().to_vec(),
+            max_jerk: limits.jerk.as_slice().to_vec(),
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! `Motion`: a plan timed rest to rest within joint limits, as numpy arrays.
+
+use std::path::{Path, PathBuf};
+
+use emg_planner::{MotionTiming, limits_file_beside};
+use emg_timing::{Scaling, TimedMotion};
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+
+use crate::input_error;
+use crate::planner::{array1, array2};
+
+/// How a plan is timed, from the keyword arguments of `Plan.timed` and `Plan.save`.
+pub struct TimingArgs {
+    /// `limits`: a MoveIt joint_limits.yaml (default: the one beside the robot file).
+    pub limits: Option<PathBuf>,
+    /// `velocity_scaling` in (0, 1].
+    pub velocity_scaling: f64,
+    /// `acceleration_scaling` in (0, 1].
+    pub acceleration_scaling: f64,
+    /// `tool_speed` (m/s; default: the rollout's line speed).
+    pub tool_speed: Option<f64>,
+    /// `rate_hz`.
+    pub rate_hz: f64,
+}
+
+impl TimingArgs {
+    /// The timing these arguments ask for, for `planner`'s robot read from `robot_file`.
+    pub fn resolve(
+        &self,
+        planner: &emg_planner::Planner,
+        robot_file: &Path,
+    ) -> PyResult<MotionTiming> {
+        let limits = self
+            .limits
+            .clone()
+            .unwrap_or_else(|| limits_file_beside(robot_file));
+        let scaling = Scaling::new(self.velocity_scaling, self.acceleration_scaling)
+            .map_err(|e| input_error("scaling", &e))?;
+        let config = planner.config();
+        MotionTiming::new(
+            planner.robot(),
+            &limits,
+            scaling,
+            self.tool_speed.unwrap_or(config.rollout.speed_m_per_s),
+            self.rate_hz,
+            &config.rollout.constraints,
+        )
+        .map_err(|e| input_error("timing", &e))
+    }
+}
+
+/// A plan timed rest to rest: a C² path through the planned steps, time-optimal within the
+/// joint velocity and acceleration limits and the tool-speed cap, jerk-limited, sampled at a
+/// fixed rate. Arrays have one row per sample.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct Motion {
+    pub(crate) motion: TimedMotion,
+    pub(crate) timing: MotionTiming,
+}
+
+#[pymethods]
+impl Motion {
+    /// Sample times (s), shape (N,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.motion.samples.iter().map(|s| s.time_s()))
+    }
+
+    /// Joint positions (rad), shape (N, 7).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array2(py, self.motion.samples.iter().map(|s| s.q.into()))
+    }
+
+    /// Joint velocities (rad/s), shape (N, 7).
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array2(py, self.motion.samples.iter().map(|s| s.qd.into()))
+    }
+
+    /// Joint accelerations (rad/s²), shape (N, 7).
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array2(py, self.motion.samples.iter().map(|s| s.qdd.into()))
+    }
+
+    /// Time from rest to rest (s).
+    #[getter]
+    fn duration_s(&self) -> f64 {
+        self.motion.report.duration_s
+    }
+
+    /// Time of the fastest motion along the same path within the velocity, acceleration and
+    /// tool-speed limits, without jerk limits (TOPP-RA on `grid`) (s).
+    #[getter]
+    fn time_optimal_s(&self) -> f64 {
+        self.motion.report.time_optimal_s
+    }
+
+    /// Share of the duration with the tool at ≥ 99 % of the requested speed.
+    #[getter]
+    fn tool_speed_share(&self) -> f64 {
+        self.motion.report.tool_speed_share
+    }
+
+    /// The path's knots: its parameter (m of TCP travel) at each waypoint, shape (K,).
+    #[getter]
+    fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let knots = self.motion.path.spline().map_or(&[][..], |s| s.knots());
+        array1(py, knots.iter().copied())
+    }
+
+    /// The waypoints the path passes through at its knots (rad), shape (K, 7): the path is the
+    /// natural cubic spline through them (`scipy.interpolate.CubicSpline(knots, waypoints,
+    /// bc_type="natural")`).
+    #[getter]
+    fn waypoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let values = self.motion.path.spline().map_or(&[][..], |s| s.values());
+        array2(py, values.iter().map(|q| (*q).into()))
+    }
+
+    /// Path parameters of the TOPP-RA grid, shape (M,).
+    #[getter]
+    fn grid<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array1(py, self.motion.grid_s.iter().copied())
+    }
+
+    /// The joint limits the samples hold (after scaling, at most the robot file's velocity
+    /// limits): `{"velocity": (7,), "acceleration": (7,), "jerk": (7,)}`.
+    #[getter]
+    fn limits<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> std::collections::BTreeMap<&'static str, Bound<'py, PyArray1<f64>>> {
+        let limits = &self.timing.request().limits;
+        [
+            ("velocity", array1(py, limits.velocity.iter().copied())),
+            (
+                "acceleration",
+                array1(py, limits.acceleration.iter().copied()),
+            ),
+            ("jerk", array1(py, limits.jerk.iter().copied())),
+        ]
+        .into()
+    }
+
+    /// Largest tool speed asked for (m/s).
+    #[getter]
+    fn tool_speed(&self) -> f64 {
+        self.timing.request().tool_speed_m_per_s
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Motion(duration_s={:.3}, samples={}, time_optimal_s={:.3})",
+            self.motion.report.duration_s,
+            self.motion.samples.len(),
+            self.motion.report.time_optimal_s
+        )
+    }
+}
