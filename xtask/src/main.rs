@@ -24,6 +24,7 @@ mod protocol;
 mod report;
 mod search_eval;
 mod stamp_weights;
+mod timing;
 mod train_diffusion;
 mod train_ppo;
 mod velocity_limits;
@@ -69,6 +70,9 @@ enum Command {
     /// Best-known lengths (a large search) and reachability bounds of an evaluation subset
     /// (resumable, --shard i/n, --merge → docs/results/limit.*).
     Limit(limit::Args),
+    /// Every task planned as `emg plan` plans it, timed rest to rest within the joint limits,
+    /// written and checked as `emg check` checks it (docs/results/timing.*).
+    Timing(timing::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -87,5 +91,6 @@ fn main() -> anyhow::Result<()> {
         Command::StampWeights(args) => stamp_weights::run(&args),
         Command::SearchEval(args) => search_eval::run(&args),
         Command::Limit(args) => limit::run(&args),
+        Command::Timing(args) => timing::run(&args),
     }
 }

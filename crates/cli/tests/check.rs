@@ -93,20 +93,30 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     );
     let out = check_ok(&[joint.to_str().unwrap()]);
     assert!(out.contains("emg-joint-trajectory/2"), "{out}");
-    assert!(out.contains("declared velocities agree"), "{out}");
+    assert!(
+        out.contains("joint limits from the file; rest at both ends"),
+        "{out}"
+    );
     assert!(
         out.contains("not verifiable from this file: why the motion ended"),
         "{out}"
     );
-    // The slowed steps run at the limit fraction: the peak is reported as such.
+    // The timed motion runs at the velocity limits (the fraction of the robot file's) somewhere.
+    assert!(
+        out.contains("peak joint velocity / limit") && out.contains("1.000"),
+        "{out}"
+    );
+    assert!(out.contains("peak joint jerk / limit"), "{out}");
+    let points = read_json(&joint)["points"].as_array().unwrap().len();
+    assert!(out.contains(&format!("{points} points")), "{out}");
+    let out = check_ok(&[json.to_str().unwrap()]);
+    // The planned steps: the slowed ones run at the limit fraction.
     assert!(out.contains(&format!("{FRACTION:.3}")), "{out}");
     assert!(
         out.contains("peak joint acceleration between points")
             && out.contains("fastest joint at the first point"),
         "{out}"
     );
-    let points = read_json(&joint)["points"].as_array().unwrap().len();
-    assert!(out.contains(&format!("{points} points")), "{out}");
     // `replay` is an alias.
     let output = emg(&["replay", joint.to_str().unwrap()]);
     assert!(output.status.success(), "{}", text(&output.stderr));
@@ -135,7 +145,7 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     let (p0, d, n) = (vec3("p0"), vec3("d"), vec3("n"));
     check_ok(&[csv.to_str().unwrap(), "--p0", &p0, "--d", &d, "--n", &n]);
 
-    // Timestamps are non-uniform (slowed steps) and on the nanosecond grid.
+    // The samples lie 1 ms apart, from rest to rest.
     let good = read_json(&joint);
     let seconds = |point: &Value| {
         let t = &point["time_from_start"];
@@ -146,7 +156,7 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
         .windows(2)
         .map(|w| seconds(&w[1]) - seconds(&w[0]))
         .collect();
-    assert!(gaps.iter().any(|g| (g - 0.05).abs() > 1e-3), "{gaps:?}");
+    assert!(gaps.iter().all(|g| (g - 1e-3).abs() < 1e-12), "{gaps:?}");
     let k = pts.len() / 2;
 
     let tamper = |name: &str, edit: &dyn Fn(&mut Value)| {
@@ -197,10 +207,28 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     );
     let err = tamper("declared.json", &|doc| {
         let v = doc["points"][k]["velocities"][3].as_f64().unwrap();
-        doc["points"][k]["velocities"][3] = (v + 0.001).into();
+        doc["points"][k]["velocities"][3] = (v + 0.01).into();
     });
     assert!(
-        err.contains(&format!("point {k} of")) && err.contains("declared velocity of joint 4"),
+        err.contains(&format!("point {k} of"))
+            && err.contains("joint 4: position change")
+            && err.contains("declared velocities"),
+        "{err}"
+    );
+    let err = tamper("moving-start.json", &|doc| {
+        doc["points"][0]["accelerations"][5] = 0.5.into();
+    });
+    assert!(
+        err.contains("point 0 of") && err.contains("the first point is not at rest"),
+        "{err}"
+    );
+    let err = tamper("jerk.json", &|doc| {
+        let a = doc["points"][k]["accelerations"][1].as_f64().unwrap();
+        doc["points"][k]["accelerations"][1] = (a + 8.0).into();
+    });
+    assert!(
+        err.contains(&format!("point {k} of"))
+            && err.contains("joint 2 jerk (from declared accelerations"),
         "{err}"
     );
     let err = tamper("declared-fast.json", &|doc| {
@@ -211,9 +239,10 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
         "{err}"
     );
 
-    // A too-fast step in the CSV: the time of point k moves close to point k - 1.
+    // A too-fast step in the CSV: the time of step k moves close to step k - 1.
     let table = std::fs::read_to_string(&csv).unwrap();
     let mut lines: Vec<String> = table.lines().map(str::to_string).collect();
+    let k = lines.len() / 2;
     let time = |line: &str| line.split(',').next().unwrap().parse::<f64>().unwrap();
     let (before, at) = (time(&lines[k]), time(&lines[k + 1]));
     let rest = lines[k + 1].split_once(',').unwrap().1.to_string();
@@ -239,7 +268,7 @@ fn malformed_files_name_the_file_and_the_field() {
     let joint = read_json(&with_ext(&stem, ".joint_trajectory.json"));
 
     let mut doc = joint.clone();
-    doc["format"] = "emg-joint-trajectory/2".into();
+    doc["format"] = "emg-joint-trajectory/1".into();
     let path = write_json(dir, "format.json", &doc);
     let err = check_err(&[&path]);
     assert!(

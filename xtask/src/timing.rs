@@ -1,0 +1,352 @@
+//! `cargo xtask timing`: every task of a task set planned as `emg plan` plans it (search planner,
+//! hybrid controller), its joint trajectory timed rest to rest within the robot's joint limits
+//! and written as `emg plan` writes it, read back and verified as `emg check` verifies it; the
+//! duration statistics with and without jerk limits (`docs/results/timing.{json,md}`,
+//! `docs/figures/timing-durations.svg`).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use emg_eval::{Summary, four};
+use emg_io::{TrajectoryContents, write_atomically};
+use emg_planner::{
+    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, limits_file_beside,
+};
+use emg_timing::Scaling;
+use plotters::prelude::*;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::{progress, workspace};
+
+/// Options of `timing`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Tasks: the first this many of the task set (default: all).
+    #[arg(long)]
+    tasks: Option<usize>,
+    /// Samples per second of the joint trajectories.
+    #[arg(long, default_value_t = DEFAULT_RATE_HZ)]
+    rate_hz: f64,
+    /// Worker threads (0 = one per core); the results other than times do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Task set.
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
+    task_file: PathBuf,
+    /// Robot file (its joint limits are the `.joint_limits.yaml` beside it).
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
+    robot: PathBuf,
+    /// Output directory of timing.{json,md}.
+    #[arg(long, default_value_os_t = workspace::results_dir())]
+    out_dir: PathBuf,
+    /// Output figure.
+    #[arg(long, default_value_os_t = workspace::figure("timing-durations.svg"))]
+    figure: PathBuf,
+}
+
+/// One task's timed motion, as written and verified.
+struct Outcome {
+    /// Rest to rest (s).
+    duration_s: f64,
+    /// TOPP-RA within the velocity, acceleration and tool-speed limits, no jerk limit (s).
+    time_optimal_s: f64,
+    tool_speed_share: f64,
+    path_travel_m: f64,
+    points: usize,
+    file_bytes: usize,
+    refined: bool,
+    cut: bool,
+    slowdowns: usize,
+    /// Wall time of the timing alone (ms).
+    timing_ms: f64,
+    /// What `emg check` says when the file does not hold up.
+    failure: Option<String>,
+}
+
+/// The whole record written to `timing.json`.
+#[derive(Serialize)]
+struct Record {
+    robot: String,
+    joint_limits: String,
+    tasks: String,
+    task_count: usize,
+    rate_hz: f64,
+    tool_speed_m_per_s: f64,
+    machine: String,
+    threads: usize,
+    /// Rest to rest, jerk-limited: what the files hold (s).
+    duration_s: Summary,
+    /// The time-optimal motion without jerk limits along the same paths (s).
+    time_optimal_s: Summary,
+    /// duration / time-optimal − 1, per task.
+    jerk_limited_overhead: Summary,
+    /// Share of each motion with the tool at ≥ 99 % of the requested speed.
+    tool_speed_share: Summary,
+    /// TCP travel along each path (m).
+    path_travel_m: Summary,
+    points_per_trajectory: Summary,
+    file_megabytes: Summary,
+    /// Tasks whose smooth path needed extra knots to hold the task constraints.
+    tasks_refined: usize,
+    /// Tasks whose smooth path ends before the last planned point.
+    tasks_cut: usize,
+    /// Rounds of local slow-down per task.
+    slowdowns: Summary,
+    /// Wall time of the timing per trajectory (ms): median and 95th percentile.
+    timing_ms_median: f64,
+    timing_ms_p95: f64,
+    /// Files `emg check` rejects (must be 0), and the first few messages.
+    checker_failures: usize,
+    failure_examples: Vec<String>,
+}
+
+/// Plans, times, writes, reads back and checks every task; writes the record and its figure.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let count = match args.tasks {
+        Some(count) => count,
+        None => emg_io::read_tasks(&args.task_file, &workspace::load_robot(&args.robot)?)?.len(),
+    };
+    let workspace::PlannerSetup {
+        planner,
+        checker,
+        tasks,
+    } = workspace::planner_setup(&args.robot, &args.task_file, count, "timing")?;
+    let pool = workspace::thread_pool(args.threads)?;
+    let threads = pool.current_num_threads();
+    let config = planner.config().clone();
+    let limits_file = limits_file_beside(&args.robot);
+    let timing = MotionTiming::new(
+        planner.robot(),
+        &limits_file,
+        Scaling::default(),
+        config.rollout.speed_m_per_s,
+        args.rate_hz,
+        &config.rollout.constraints,
+    )
+    .with_context(|| format!("the joint limits {}", limits_file.display()))?;
+    let request = PlanRequest::default();
+    let robot_name = args.robot.display().to_string();
+    let bar = progress::bar(tasks.len() as u64, "timing");
+    let outcomes: Vec<Outcome> = pool.install(|| {
+        tasks
+            .par_iter()
+            .map(|task| {
+                let plan = planner.plan(task, &request)?;
+                let started = Instant::now();
+                let motion = timing.time(planner.robot(), task, &config.rollout.constraints, &plan.trajectory)?;
+                let timing_ms = started.elapsed().as_secs_f64() * 1e3;
+                let record = PlanRecord {
+                    robot: &robot_name,
+                    request: &request,
+                    reachable_m: None,
+                    timing: &timing,
+                };
+                let files = PlanFiles::new(&planner, task, &plan, &record)?;
+                let contents = TrajectoryContents::parse(&files.joint_trajectory)?;
+                let failure = contents
+                    .verify(
+                        &checker,
+                        planner.robot().joint_names(),
+                        task,
+                        &config.rollout.constraints,
+                        true,
+                        None,
+                    )
+                    .err()
+                    .map(|failure| failure.to_string());
+                let report = &motion.report;
+                bar.inc(1);
+                Ok(Outcome {
+                    duration_s: report.duration_s,
+                    time_optimal_s: report.time_optimal_s,
+                    tool_speed_share: report.tool_speed_share,
+                    path_travel_m: report.path_travel_m,
+                    points: motion.samples.len(),
+                    file_bytes: files.joint_trajectory.len(),
+                    refined: report.refined_knots > 0,
+                    cut: report.cut.is_some(),
+                    slowdowns: report.slowdowns,
+                    timing_ms,
+                    failure,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()
+    })?;
+    bar.finish();
+
+    let summary = |value: fn(&Outcome) -> f64| {
+        Summary::of(&outcomes.iter().map(value).collect::<Vec<_>>()).context("no tasks")
+    };
+    let moving: Vec<&Outcome> = outcomes.iter().filter(|o| o.time_optimal_s > 0.0).collect();
+    let overhead: Vec<f64> = moving
+        .iter()
+        .map(|o| o.duration_s / o.time_optimal_s - 1.0)
+        .collect();
+    let mut timing_ms: Vec<f64> = outcomes.iter().map(|o| o.timing_ms).collect();
+    timing_ms.sort_by(f64::total_cmp);
+    let quantile = |q: f64| timing_ms[((timing_ms.len() - 1) as f64 * q).round() as usize];
+    let failures: Vec<String> = outcomes.iter().filter_map(|o| o.failure.clone()).collect();
+    let record = Record {
+        robot: planner.robot().name().to_string(),
+        joint_limits: workspace::relative(&limits_file),
+        tasks: workspace::relative(&args.task_file),
+        task_count: tasks.len(),
+        rate_hz: args.rate_hz,
+        tool_speed_m_per_s: config.rollout.speed_m_per_s,
+        machine: workspace::machine(),
+        threads,
+        duration_s: summary(|o| o.duration_s)?,
+        time_optimal_s: summary(|o| o.time_optimal_s)?,
+        jerk_limited_overhead: Summary::of(&overhead).context("no moving task")?,
+        tool_speed_share: summary(|o| o.tool_speed_share)?,
+        path_travel_m: summary(|o| o.path_travel_m)?,
+        points_per_trajectory: summary(|o| o.points as f64)?,
+        file_megabytes: summary(|o| o.file_bytes as f64 / 1e6)?,
+        tasks_refined: outcomes.iter().filter(|o| o.refined).count(),
+        tasks_cut: outcomes.iter().filter(|o| o.cut).count(),
+        slowdowns: summary(|o| o.slowdowns as f64)?,
+        timing_ms_median: quantile(0.5),
+        timing_ms_p95: quantile(0.95),
+        checker_failures: failures.len(),
+        failure_examples: failures.iter().take(5).cloned().collect(),
+    };
+    write_record(&record, &args.out_dir)?;
+    draw(&outcomes, &record, &args.figure)?;
+    println!("wrote {}", args.figure.display());
+    anyhow::ensure!(
+        record.checker_failures == 0,
+        "{} of {} timed trajectories fail the check, e.g. {}",
+        record.checker_failures,
+        record.task_count,
+        failures[0]
+    );
+    Ok(())
+}
+
+fn write_record(record: &Record, out_dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out_dir)?;
+    let json = out_dir.join("timing.json");
+    write_atomically(
+        &json,
+        (serde_json::to_string_pretty(record)? + "\n").as_bytes(),
+    )?;
+    let md = out_dir.join("timing.md");
+    write_atomically(&md, markdown(record).as_bytes())?;
+    println!("wrote {} and {}", json.display(), md.display());
+    Ok(())
+}
+
+fn markdown(record: &Record) -> String {
+    let rows = [
+        ("duration, rest to rest, jerk-limited (s)", four(&record.duration_s, 3)),
+        (
+            "time-optimal duration without jerk limits (s)",
+            four(&record.time_optimal_s, 3),
+        ),
+        (
+            "jerk-limited overhead (duration / time-optimal − 1)",
+            four(&record.jerk_limited_overhead, 4),
+        ),
+        (
+            "share of the time at the requested tool speed",
+            four(&record.tool_speed_share, 3),
+        ),
+        ("TCP travel along the path (m)", four(&record.path_travel_m, 3)),
+        ("points per trajectory", four(&record.points_per_trajectory, 0)),
+        ("file size (MB)", four(&record.file_megabytes, 2)),
+        ("slow-down rounds", four(&record.slowdowns, 2)),
+    ];
+    let mut md = format!(
+        "# Rest-to-rest timing of planned motions\n\nWritten by `cargo xtask timing`. Do not \
+         edit by hand. Robot `{}`, joint limits `{}`, {} tasks of `{}`, planned as `emg plan` \
+         plans them (search planner, hybrid controller, DP seeds), each joint trajectory timed \
+         at {} Hz with the tool at most {} m/s, written as `emg plan` writes it, read back and \
+         verified as `emg check` verifies it (velocity, acceleration and jerk limits, rest at \
+         both ends, every task constraint at every sample).\n\n\
+         **Checker failures: {} of {}.**\n\n\
+         | quantity | mean / std / min / max |\n|---|---|\n",
+        record.robot,
+        record.joint_limits,
+        record.task_count,
+        record.tasks,
+        record.rate_hz,
+        record.tool_speed_m_per_s,
+        record.checker_failures,
+        record.task_count,
+    );
+    for (name, value) in rows {
+        md += &format!("| {name} | {value} |\n");
+    }
+    md += &format!(
+        "\nSmooth paths that needed extra knots to hold the task constraints: {}; paths that end \
+         before the last planned point: {}.\n\nTiming alone (smooth path, TOPP-RA, jerk \
+         limiting, samples and their limit checks) takes {:.2} ms per trajectory (median; 95th \
+         percentile {:.2} ms) of wall time on {} with {} threads busy; the criterion bench \
+         `timing` measures it on one idle core.\n",
+        record.tasks_refined,
+        record.tasks_cut,
+        record.timing_ms_median,
+        record.timing_ms_p95,
+        record.machine,
+        record.threads,
+    );
+    for example in &record.failure_examples {
+        md += &format!("\n* {example}");
+    }
+    md
+}
+
+/// Each task's jerk-limited duration against its time-optimal duration without jerk limits.
+fn draw(outcomes: &[Outcome], record: &Record, path: &Path) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let top = outcomes
+        .iter()
+        .map(|o| o.duration_s)
+        .fold(0.0, f64::max)
+        .max(1e-3)
+        * 1.05;
+    let root = SVGBackend::new(path, (640, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!(
+                "{}: duration rest to rest, {} tasks at {} Hz",
+                record.robot, record.task_count, record.rate_hz
+            ),
+            ("sans-serif", 18),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(56)
+        .build_cartesian_2d(0.0..top, 0.0..top)?;
+    chart
+        .configure_mesh()
+        .light_line_style(WHITE)
+        .x_desc("time-optimal without jerk limits (s)")
+        .y_desc("jerk-limited, as written (s)")
+        .draw()?;
+    chart
+        .draw_series(LineSeries::new([(0.0, 0.0), (top, top)], BLACK.stroke_width(1)))?
+        .label("equal")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
+    chart
+        .draw_series(
+            outcomes
+                .iter()
+                .map(|o| Circle::new((o.time_optimal_s, o.duration_s), 2, BLUE.mix(0.4).filled())),
+        )?
+        .label("one task")
+        .legend(|(x, y)| Circle::new((x + 8, y), 3, BLUE.filled()));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerRight)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
