@@ -111,8 +111,67 @@ class Plan:
     @property
     def task(self) -> Task:
         """The task."""
-    def save(self, stem: PathLike) -> list[Path]:
-        """Writes STEM.json, STEM.csv and STEM.joint_trajectory.json as ``emg plan`` does."""
+    def timed(
+        self,
+        limits: Optional[PathLike] = None,
+        velocity_scaling: float = 1.0,
+        acceleration_scaling: float = 1.0,
+        tool_speed: Optional[float] = None,
+        rate_hz: float = 1000.0,
+    ) -> Motion:
+        """The motion timed rest to rest within the joint limits (a MoveIt joint_limits.yaml,
+        by default the one beside the robot file), sampled at ``rate_hz``."""
+    def save(
+        self,
+        stem: PathLike,
+        limits: Optional[PathLike] = None,
+        velocity_scaling: float = 1.0,
+        acceleration_scaling: float = 1.0,
+        tool_speed: Optional[float] = None,
+        rate_hz: float = 1000.0,
+    ) -> list[Path]:
+        """Writes STEM.json, STEM.csv and STEM.joint_trajectory.json (timed as ``timed`` says)
+        as ``emg plan`` does."""
+
+class Motion:
+    """A plan timed rest to rest; arrays have one row per sample."""
+
+    @property
+    def t(self) -> FloatArray:
+        """Sample times (s), shape (N,)."""
+    @property
+    def q(self) -> FloatArray:
+        """Joint positions (rad), shape (N, 7)."""
+    @property
+    def qd(self) -> FloatArray:
+        """Joint velocities (rad/s), shape (N, 7)."""
+    @property
+    def qdd(self) -> FloatArray:
+        """Joint accelerations (rad/s²), shape (N, 7)."""
+    @property
+    def duration_s(self) -> float:
+        """Time from rest to rest (s)."""
+    @property
+    def time_optimal_s(self) -> float:
+        """TOPP-RA within the velocity, acceleration and tool-speed limits, no jerk limit (s)."""
+    @property
+    def tool_speed_share(self) -> float:
+        """Share of the duration with the tool at >= 99 % of the requested speed."""
+    @property
+    def knots(self) -> FloatArray:
+        """The path parameter (m of TCP travel) at each waypoint, shape (K,)."""
+    @property
+    def waypoints(self) -> FloatArray:
+        """The waypoints of the natural cubic spline path (rad), shape (K, 7)."""
+    @property
+    def grid(self) -> FloatArray:
+        """The TOPP-RA grid along the path, shape (M,)."""
+    @property
+    def limits(self) -> dict[str, FloatArray]:
+        """The limits the samples hold: velocity, acceleration, jerk, shape (7,) each."""
+    @property
+    def tool_speed(self) -> float:
+        """The largest tool speed asked for (m/s)."""
 
 SeedArg = Union[Literal["dp", "generating", "home", "q_mu", "q_jl"], Vector7, None]
 ControllerArg = Literal["hybrid", "rl", "classical"]

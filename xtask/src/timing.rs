@@ -135,7 +135,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .map(|task| {
                 let plan = planner.plan(task, &request)?;
                 let started = Instant::now();
-                let motion = timing.time(planner.robot(), task, &config.rollout.constraints, &plan.trajectory)?;
+                let motion = timing.time(
+                    planner.robot(),
+                    task,
+                    &config.rollout.constraints,
+                    &plan.trajectory,
+                )?;
                 let timing_ms = started.elapsed().as_secs_f64() * 1e3;
                 let record = PlanRecord {
                     robot: &robot_name,
@@ -240,7 +245,10 @@ fn write_record(record: &Record, out_dir: &Path) -> anyhow::Result<()> {
 
 fn markdown(record: &Record) -> String {
     let rows = [
-        ("duration, rest to rest, jerk-limited (s)", four(&record.duration_s, 3)),
+        (
+            "duration, rest to rest, jerk-limited (s)",
+            four(&record.duration_s, 3),
+        ),
         (
             "time-optimal duration without jerk limits (s)",
             four(&record.time_optimal_s, 3),
@@ -253,8 +261,14 @@ fn markdown(record: &Record) -> String {
             "share of the time at the requested tool speed",
             four(&record.tool_speed_share, 3),
         ),
-        ("TCP travel along the path (m)", four(&record.path_travel_m, 3)),
-        ("points per trajectory", four(&record.points_per_trajectory, 0)),
+        (
+            "TCP travel along the path (m)",
+            four(&record.path_travel_m, 3),
+        ),
+        (
+            "points per trajectory",
+            four(&record.points_per_trajectory, 0),
+        ),
         ("file size (MB)", four(&record.file_megabytes, 2)),
         ("slow-down rounds", four(&record.slowdowns, 2)),
     ];
@@ -330,7 +344,10 @@ fn draw(outcomes: &[Outcome], record: &Record, path: &Path) -> anyhow::Result<()
         .y_desc("jerk-limited, as written (s)")
         .draw()?;
     chart
-        .draw_series(LineSeries::new([(0.0, 0.0), (top, top)], BLACK.stroke_width(1)))?
+        .draw_series(LineSeries::new(
+            [(0.0, 0.0), (top, top)],
+            BLACK.stroke_width(1),
+        ))?
         .label("equal")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
     chart

@@ -409,22 +409,45 @@ fn robot_by_name_and_by_file() {
     let limited = [&classical[..], &["--limits", limits.to_str().unwrap()]].concat();
     plan_ok(&limited);
     let message = plan_err(&[&limited[..], &["--velocity-scaling", "0"]].concat());
-    assert!(message.contains("velocity_scaling must be in (0, 1], got 0"), "{message}");
+    assert!(
+        message.contains("velocity_scaling must be in (0, 1], got 0"),
+        "{message}"
+    );
     let message = plan_err(&[&limited[..], &["--rate-hz", "0"]].concat());
-    assert!(message.contains("rate_hz") && message.contains("got 0"), "{message}");
+    assert!(
+        message.contains("rate_hz") && message.contains("got 0"),
+        "{message}"
+    );
     // Half the acceleration limits and 100 Hz: a slower motion in fewer points, still within
     // the halved limits by `emg check`.
     let full = read_json(&dir.join("iiwa.joint_trajectory.json"));
-    plan_ok(&[&limited[..], &["--acceleration-scaling", "0.5", "--rate-hz", "100"]].concat());
+    plan_ok(
+        &[
+            &limited[..],
+            &["--acceleration-scaling", "0.5", "--rate-hz", "100"],
+        ]
+        .concat(),
+    );
     let slow = read_json(&dir.join("iiwa.joint_trajectory.json"));
     assert_eq!(slow["limits"]["acceleration_scaling"], 0.5);
     assert_eq!(slow["limits"]["max_acceleration"][0], 2.5);
     assert_eq!(slow["timing"]["rate_hz"], 100.0);
     let duration = |doc: &Value| doc["timing"]["duration_s"].as_f64().unwrap();
-    assert!(duration(&slow) > duration(&full), "{} vs {}", duration(&slow), duration(&full));
+    assert!(
+        duration(&slow) > duration(&full),
+        "{} vs {}",
+        duration(&slow),
+        duration(&full)
+    );
     let points = |doc: &Value| doc["points"].as_array().unwrap().len();
-    assert_eq!(points(&slow), (duration(&slow) * 100.0).round() as usize + 1);
-    let output = common::emg(&["check", dir.join("iiwa.joint_trajectory.json").to_str().unwrap()]);
+    assert_eq!(
+        points(&slow),
+        (duration(&slow) * 100.0).round() as usize + 1
+    );
+    let output = common::emg(&[
+        "check",
+        dir.join("iiwa.joint_trajectory.json").to_str().unwrap(),
+    ]);
     assert!(output.status.success(), "{}", text(&output.stderr));
 }
 

@@ -121,21 +121,36 @@ fn scan(
             }
         }
     }
+    // Divided differences of the padded positions, all three orders ending at point k + 1:
+    // f[t_k, t_{k+1}], f[t_{k−1}, …, t_{k+1}], f[t_{k−2}, …, t_{k+1}].
     let padded = padded(samples);
-    let orders = [
-        ("velocity from positions", &limits.velocity),
-        ("acceleration from positions", &limits.acceleration),
-        ("jerk from positions", &limits.jerk),
-    ];
-    for (order, (quantity, limit)) in orders.into_iter().enumerate() {
-        let order = order + 1;
-        for start in 0..padded.len() - order {
-            let derivative = divided_difference(&padded[start..=start + order]) * factorial(order);
-            let sample = (start + order).saturating_sub(PAD).min(samples.len() - 1);
-            if !check(sample, quantity, &derivative, limit) {
+    let (mut first, mut second): (Option<JointVector>, Option<JointVector>) = (None, None);
+    for k in 0..padded.len() - 1 {
+        let sample = (k + 1).saturating_sub(PAD).min(samples.len() - 1);
+        let (t, q) = (|i: usize| padded[i].0, |i: usize| padded[i].1);
+        let d1 = (q(k + 1) - q(k)) / (t(k + 1) - t(k));
+        if !check(sample, "velocity from positions", &d1, &limits.velocity) {
+            return;
+        }
+        if let Some(p1) = first {
+            let d2 = (d1 - p1) / (t(k + 1) - t(k - 1));
+            if !check(
+                sample,
+                "acceleration from positions",
+                &(d2 * 2.0),
+                &limits.acceleration,
+            ) {
                 return;
             }
+            if let Some(p2) = second {
+                let d3 = (d2 - p2) / (t(k + 1) - t(k - 2));
+                if !check(sample, "jerk from positions", &(d3 * 6.0), &limits.jerk) {
+                    return;
+                }
+            }
+            second = Some(d2);
         }
+        first = Some(d1);
     }
 }
 
@@ -161,22 +176,4 @@ fn padded(samples: &[TimedSample]) -> Vec<(f64, JointVector)> {
         )
     }));
     out
-}
-
-/// The divided difference `f[t_0, …, t_m]` of at most four points.
-fn divided_difference(points: &[(f64, JointVector)]) -> JointVector {
-    let mut table = [JointVector::zeros(); 4];
-    for (entry, point) in table.iter_mut().zip(points) {
-        *entry = point.1;
-    }
-    for level in 1..points.len() {
-        for i in 0..points.len() - level {
-            table[i] = (table[i + 1] - table[i]) / (points[i + level].0 - points[i].0);
-        }
-    }
-    table[0]
-}
-
-fn factorial(n: usize) -> f64 {
-    (1..=n).product::<usize>() as f64
 }

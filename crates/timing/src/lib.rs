@@ -22,7 +22,7 @@ mod topp;
 
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
 pub use limits::{DynamicLimits, LimitsError, Scaling};
-pub use path::{CHECKS_PER_SEGMENT, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
+pub use path::{CHECKS_PER_SEGMENT, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
     ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SLOWDOWNS, MIN_GRID_INTERVALS, SLOWDOWN,

@@ -1,11 +1,16 @@
-//! The smooth joint path of a planned motion: a natural cubic spline through the waypoints,
-//! parametrised by the distance the TCP travels between them, checked against every task
-//! constraint on a dense sampling and refined where it fails.
+//! The smooth joint path of a planned motion: a natural cubic spline through every
+//! [`KNOT_STRIDE`]-th waypoint (the controller's step-to-step jitter left out, so the joints'
+//! accelerations along the path stay low), parametrised by the distance the TCP travels between
+//! waypoints, checked against every task constraint on a dense sampling and refined where it
+//! fails.
 
 use emg_control::{ConstraintConfig, Task, Violation, first_violation};
 use emg_kinematics::{JointVector, Robot};
 
 use crate::spline::JointSpline;
+
+/// The spline passes through every this many waypoints (and the last).
+pub const KNOT_STRIDE: usize = 3;
 
 /// Points checked inside each spline segment (besides its two knots, which are waypoints).
 pub const CHECKS_PER_SEGMENT: usize = 16;
@@ -24,7 +29,8 @@ pub struct SmoothPath {
     spline: Option<JointSpline>,
     /// The configuration of a path without motion.
     start: JointVector,
-    /// Knots inserted to make the spline hold the constraints.
+    /// Knots added (skipped waypoints put back, chord midpoints) to make the spline hold the
+    /// constraints.
     pub refined_knots: usize,
     /// Where the spline had to end early: the waypoint (index into the given waypoints) it ends
     /// at, and the constraint the spline broke beyond it.
@@ -33,11 +39,14 @@ pub struct SmoothPath {
 
 impl SmoothPath {
     /// The smooth path through `waypoints` (each holding the constraints, as a rollout's steps
-    /// do). The knot of waypoint `k` is the TCP distance travelled along the polyline of the
-    /// waypoints' TCPs (at least [`MIN_KNOT_STEP_M`] per step). The spline is checked at
+    /// do). The parameter of waypoint `k` is the TCP distance travelled along the polyline of
+    /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`] per step); the spline passes through
+    /// the first, every [`KNOT_STRIDE`]-th and the last waypoint. It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment; a segment that breaks a constraint
-    /// gets its chord midpoint as a new knot (when that midpoint holds the constraints, up to
-    /// [`MAX_REFINEMENTS`] knots in all), else the path ends at the segment's first waypoint.
+    /// gets back the middle waypoint it skipped, or, between consecutive waypoints, their chord
+    /// midpoint as a new knot (when that midpoint holds the constraints, up to
+    /// [`MAX_REFINEMENTS`] midpoints in all), else the path ends at the segment's first
+    /// waypoint.
     ///
     /// # Panics
     ///
@@ -52,21 +61,33 @@ impl SmoothPath {
         let valid = |q: &JointVector| {
             first_violation(robot, task, q, &robot.forward(q), constraints).is_none()
         };
-        let mut knots = Vec::with_capacity(waypoints.len());
+        let mut params = Vec::with_capacity(waypoints.len());
         let mut previous = robot.forward(&waypoints[0]).tcp();
         let mut s = 0.0;
         for q in waypoints {
             let tcp = robot.forward(q).tcp();
-            if !knots.is_empty() {
+            if !params.is_empty() {
                 s += (tcp - previous).norm().max(MIN_KNOT_STEP_M);
             }
-            knots.push(s);
+            params.push(s);
             previous = tcp;
         }
-        // Which given waypoint each knot is (None for an inserted knot).
-        let mut origin: Vec<Option<usize>> = (0..waypoints.len()).map(Some).collect();
-        let mut values = waypoints.to_vec();
+        let last = waypoints.len() - 1;
+        // The knots: which given waypoint each is (None for a chord midpoint), parameter, value.
+        let mut origin: Vec<Option<usize>> = (0..=last)
+            .filter(|k| k % KNOT_STRIDE == 0 || *k == last)
+            .map(Some)
+            .collect();
+        let mut values: Vec<JointVector> = origin
+            .iter()
+            .map(|k| waypoints[k.expect("a waypoint")])
+            .collect();
+        let mut knots: Vec<f64> = origin
+            .iter()
+            .map(|k| params[k.expect("a waypoint")])
+            .collect();
         let mut refined_knots = 0;
+        let mut midpoints = 0;
         let mut cut = None;
         while values.len() >= 2 {
             let spline = JointSpline::natural(knots.clone(), values.clone());
@@ -80,11 +101,23 @@ impl SmoothPath {
                     cut,
                 };
             };
+            // Put back the middle waypoint the segment skips.
+            if let (Some(a), Some(b)) = (origin[segment], origin[segment + 1])
+                && b > a + 1
+            {
+                let middle = (a + b) / 2;
+                origin.insert(segment + 1, Some(middle));
+                values.insert(segment + 1, waypoints[middle]);
+                knots.insert(segment + 1, params[middle]);
+                refined_knots += 1;
+                continue;
+            }
             let midpoint = (values[segment] + values[segment + 1]) / 2.0;
-            if refined_knots < MAX_REFINEMENTS && valid(&midpoint) {
+            if midpoints < MAX_REFINEMENTS && valid(&midpoint) {
                 knots.insert(segment + 1, (knots[segment] + knots[segment + 1]) / 2.0);
                 values.insert(segment + 1, midpoint);
                 origin.insert(segment + 1, None);
+                midpoints += 1;
                 refined_knots += 1;
                 continue;
             }

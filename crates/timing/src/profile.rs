@@ -78,6 +78,12 @@ impl SpeedProfile {
 
     /// `(∫₀ᵗ s, s, ṡ, s̈)` at `t`, with rest at 0 before the start and at the end after it.
     fn at(&self, t: f64) -> [f64; 4] {
+        self.at_from(t, &mut 0)
+    }
+
+    /// As [`Self::at`], searching forward from piece `*hint` (which it updates): times that
+    /// increase from call to call cost O(1) each.
+    fn at_from(&self, t: f64, hint: &mut usize) -> [f64; 4] {
         if t <= 0.0 {
             return [0.0; 4];
         }
@@ -89,8 +95,13 @@ impl SpeedProfile {
                 0.0,
             ];
         }
-        let k = self.pieces.partition_point(|p| p.t0 <= t) - 1;
-        let p = &self.pieces[k];
+        if *hint >= self.pieces.len() || self.pieces[*hint].t0 > t {
+            *hint = self.pieces.partition_point(|p| p.t0 <= t) - 1;
+        }
+        while *hint + 1 < self.pieces.len() && self.pieces[*hint + 1].t0 <= t {
+            *hint += 1;
+        }
+        let p = &self.pieces[*hint];
         let tau = t - p.t0;
         [
             p.integral0 + (p.s0 + (p.v0 / 2.0 + p.u * tau / 6.0) * tau) * tau,
@@ -146,6 +157,12 @@ impl SmoothedProfile {
     /// `s` and its derivatives at `t`; exactly the path's end and at rest from the end of the
     /// motion on.
     pub fn state(&self, t: f64) -> PathState {
+        self.state_from(t, &mut [0, 0])
+    }
+
+    /// As [`Self::state`], searching forward from the pieces `hints` (which it updates) for
+    /// `t` and `t − w`: times that increase from call to call cost O(1) each.
+    pub fn state_from(&self, t: f64, hints: &mut [usize; 2]) -> PathState {
         if t >= self.duration() {
             return PathState {
                 s: self.profile.end,
@@ -155,7 +172,9 @@ impl SmoothedProfile {
             };
         }
         let w = self.window;
-        let (now, before) = (self.profile.at(t), self.profile.at(t - w));
+        let [now_hint, before_hint] = hints;
+        let now = self.profile.at_from(t, now_hint);
+        let before = self.profile.at_from(t - w, before_hint);
         PathState {
             s: ((now[0] - before[0]) / w).clamp(0.0, self.profile.end),
             sd: (now[1] - before[1]) / w,

@@ -9,11 +9,11 @@ use emg_kinematics::{JointVector, Robot};
 use crate::dynamics::{LimitBreach, TimedSample, breaches};
 use crate::limits::DynamicLimits;
 use crate::path::SmoothPath;
-use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::profile::{PathState, SmoothedProfile, SpeedProfile};
 use crate::topp::{GridPoint, profile_duration, topp_ra};
 
 /// Longest grid step of TOPP-RA along the path (m of TCP travel).
-pub const GRID_STEP_M: f64 = 1e-3;
+pub const GRID_STEP_M: f64 = 2e-3;
 
 /// Fewest grid intervals of TOPP-RA on a moving path.
 pub const MIN_GRID_INTERVALS: usize = 50;
@@ -207,11 +207,11 @@ pub fn time_motion(
     for slowdowns in 0..=MAX_SLOWDOWNS {
         let x = topp_ra(&grid, &planned_acceleration, &factor);
         let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
-        let samples = sample(spline, &profile, request.rate_hz);
+        let (samples, states) = sample(spline, &profile, request.rate_hz);
         let found = breaches(&samples, limits);
         let Some(first) = found.first() else {
             let duration_s = samples[samples.len() - 1].time_s();
-            let tool_speed_share = tool_speed_share(&samples, &profile, &grid, &tool_gain, request);
+            let tool_speed_share = tool_speed_share(&states, &grid, &tool_gain, request);
             return Ok(TimedMotion {
                 samples,
                 grid_s: grid.iter().map(|g| g.s).collect(),
@@ -252,42 +252,42 @@ pub fn time_motion(
 }
 
 /// The motion sampled at `k / rate_hz` (rounded to whole nanoseconds) for `k = 0, 1, …` up to
-/// the first sample at or after the end.
+/// the first sample at or after the end, with the path state of each sample.
 fn sample(
     spline: &crate::spline::JointSpline,
     profile: &SmoothedProfile,
     rate_hz: f64,
-) -> Vec<TimedSample> {
+) -> (Vec<TimedSample>, Vec<PathState>) {
     let duration = profile.duration();
     let count = (duration * rate_hz - 1e-9).ceil().max(1.0) as u64;
+    let (mut profile_hints, mut segment) = ([0, 0], 0);
     (0..=count)
         .map(|k| {
             let time_ns = (k as f64 * 1e9 / rate_hz).round() as u64;
-            let state = profile.state(time_ns as f64 * 1e-9);
-            let point = spline.eval(state.s);
-            TimedSample {
+            let state = profile.state_from(time_ns as f64 * 1e-9, &mut profile_hints);
+            let point = spline.eval_from(state.s, &mut segment);
+            let sample = TimedSample {
                 time_ns,
                 q: point.q,
                 qd: point.dq * state.sd,
                 qdd: point.dq * state.sdd + point.ddq * (state.sd * state.sd),
-            }
+            };
+            (sample, state)
         })
-        .collect()
+        .unzip()
 }
 
 /// Share of the sampling intervals in which the tool speed `|p'(s)| ṡ` (with `|p'|`
 /// interpolated between grid points) is at least [`AT_TOOL_SPEED`] × the requested speed.
 fn tool_speed_share(
-    samples: &[TimedSample],
-    profile: &SmoothedProfile,
+    states: &[PathState],
     grid: &[GridPoint],
     tool_gain: &[f64],
     request: &TimingRequest,
 ) -> f64 {
-    let fast = samples
+    let fast = states
         .iter()
-        .filter(|sample| {
-            let state = profile.state(sample.time_s());
+        .filter(|state| {
             let i = grid
                 .partition_point(|g| g.s <= state.s)
                 .clamp(1, grid.len() - 1);
@@ -296,5 +296,5 @@ fn tool_speed_share(
             gain * state.sd >= AT_TOOL_SPEED * request.tool_speed_m_per_s
         })
         .count();
-    fast as f64 / samples.len() as f64
+    fast as f64 / states.len() as f64
 }

@@ -86,7 +86,21 @@ impl JointSpline {
     /// `q(s)` and its derivatives; `s` outside the knots extends the end segments. At the last
     /// knot `q` is the last waypoint exactly.
     pub fn eval(&self, s: f64) -> PathPoint {
-        let k = self.segment(s);
+        let mut hint = usize::MAX;
+        self.eval_from(s, &mut hint)
+    }
+
+    /// As [`Self::eval`], searching forward from segment `*hint` (which it updates): parameters
+    /// that increase from call to call cost O(1) each.
+    pub fn eval_from(&self, s: f64, hint: &mut usize) -> PathPoint {
+        let last = self.knots.len() - 2;
+        if *hint > last || self.knots[*hint] > s {
+            *hint = self.segment(s);
+        }
+        while *hint < last && self.knots[*hint + 1] <= s {
+            *hint += 1;
+        }
+        let k = *hint;
         let h = self.knots[k + 1] - self.knots[k];
         let t = s - self.knots[k];
         let (m0, m1) = (self.second[k], self.second[k + 1]);

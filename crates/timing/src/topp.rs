@@ -4,9 +4,10 @@
 //! `K_i = [0, k_i]` (every `x_i` from which rest at `s_N` can be reached within the limits) and
 //! a forward pass from rest takes the largest `u_i` that keeps `x_{i+1}` in `K_{i+1}`.
 //!
-//! Constraints at each grid point (collocation): joint speeds `|q'_j| ṡ ≤ v_j`, the tool speed
-//! `|p'(s)| ṡ ≤ v_tool` (both bound `x` alone: the maximum velocity curve), and joint
-//! accelerations `|q'_j u + q''_j x| ≤ a_j`. Each backward step is a two-variable LP in `(x, u)`,
+//! Constraints: joint speeds `|q'_j| ṡ ≤ v_j` and the tool speed `|p'(s)| ṡ ≤ v_tool` at each
+//! grid point (both bound `x` alone: the maximum velocity curve), and joint accelerations
+//! `|q'_j u + q''_j x| ≤ a_j` at both ends of each interval (toppra's interpolation scheme:
+//! `(u_i, x_i)` at `s_i` and `(u_i, x_i + 2Δ_i u_i)` at `s_{i+1}`). Each backward step is a two-variable LP in `(x, u)`,
 //! solved exactly: for fixed `x` the admissible `u` is an interval whose ends are linear in `x`,
 //! and the largest `x` is the smallest crossing of a lower end above an upper end.
 
@@ -36,39 +37,64 @@ struct Bound {
     beta: f64,
 }
 
-/// The `u` bounds at a grid point from the acceleration limits (scaled by `factor`), and the
-/// largest `x` the joints with negligible `q'_j` allow.
-fn acceleration_bounds(
-    point: &GridPoint,
-    acceleration: &JointVector,
-    factor: f64,
-) -> ([Bound; DOF], [Bound; DOF], usize, f64) {
-    let mut lower = [Bound {
-        alpha: 0.0,
-        beta: 0.0,
-    }; DOF];
-    let mut upper = lower;
-    let mut count = 0;
-    let mut x_max = f64::INFINITY;
-    for j in 0..DOF {
-        let (a, b, limit) = (point.dq[j], point.ddq[j], acceleration[j] * factor);
-        if a.abs() < NEGLIGIBLE_DERIVATIVE {
-            if b != 0.0 {
-                x_max = x_max.min(limit / b.abs());
-            }
-            continue;
+/// The bounds on `u` over grid interval `i` from the acceleration limits: at `s_i` on
+/// `(u, x)` and, as toppra's interpolation scheme does, at `s_{i+1}` on `(u, x + 2Δu)` (so the
+/// acceleration at both ends of the interval holds), each lower and upper bound a line in `x`.
+struct AccelerationBounds {
+    lower: [Bound; 2 * DOF],
+    upper: [Bound; 2 * DOF],
+    count: usize,
+    /// The largest `x` the constraints whose `u` coefficient is negligible allow.
+    x_max: f64,
+}
+
+impl AccelerationBounds {
+    /// Interval `i` of `grid`, the limits at each end scaled by its factor.
+    fn new(grid: &[GridPoint], i: usize, acceleration: &JointVector, factor: &[f64]) -> Self {
+        let mut bounds = Self {
+            lower: [Bound {
+                alpha: 0.0,
+                beta: 0.0,
+            }; 2 * DOF],
+            upper: [Bound {
+                alpha: 0.0,
+                beta: 0.0,
+            }; 2 * DOF],
+            count: 0,
+            x_max: f64::INFINITY,
+        };
+        let delta = grid[i + 1].s - grid[i].s;
+        let (here, next) = (&grid[i], &grid[i + 1]);
+        for j in 0..DOF {
+            // −a ≤ c_u u + c_x x ≤ a.
+            bounds.push(here.dq[j], here.ddq[j], acceleration[j] * factor[i]);
+            bounds.push(
+                next.dq[j] + 2.0 * delta * next.ddq[j],
+                next.ddq[j],
+                acceleration[j] * factor[i + 1],
+            );
         }
-        lower[count] = Bound {
-            alpha: -limit / a.abs(),
-            beta: -b / a,
-        };
-        upper[count] = Bound {
-            alpha: limit / a.abs(),
-            beta: -b / a,
-        };
-        count += 1;
+        bounds
     }
-    (lower, upper, count, x_max)
+
+    fn push(&mut self, c_u: f64, c_x: f64, limit: f64) {
+        if c_u.abs() < NEGLIGIBLE_DERIVATIVE {
+            if c_x != 0.0 {
+                self.x_max = self.x_max.min(limit / c_x.abs());
+            }
+            return;
+        }
+        let beta = -c_x / c_u;
+        self.lower[self.count] = Bound {
+            alpha: -limit / c_u.abs(),
+            beta,
+        };
+        self.upper[self.count] = Bound {
+            alpha: limit / c_u.abs(),
+            beta,
+        };
+        self.count += 1;
+    }
 }
 
 /// Path speeds `x_i = ṡ²` at the grid points of the fastest motion from rest at `s_0` to rest
@@ -91,8 +117,8 @@ pub fn topp_ra(grid: &[GridPoint], acceleration: &JointVector, factor: &[f64]) -
     for i in (0..n).rev() {
         let delta = grid[i + 1].s - grid[i].s;
         assert!(delta > 0.0, "grid increases strictly");
-        let (lower, upper, count, x_joint) = acceleration_bounds(&grid[i], acceleration, factor[i]);
-        let mut bound = (grid[i].x_max * factor[i]).min(x_joint);
+        let bounds = AccelerationBounds::new(grid, i, acceleration, factor);
+        let mut bound = (grid[i].x_max * factor[i]).min(bounds.x_max);
         // x + 2Δu ∈ [0, k_{i+1}].
         let step = Bound {
             alpha: 0.0,
@@ -102,12 +128,14 @@ pub fn topp_ra(grid: &[GridPoint], acceleration: &JointVector, factor: &[f64]) -
             alpha: reach[i + 1] / (2.0 * delta),
             ..step
         };
-        for l in lower[..count].iter().chain([&step]) {
-            for m in upper[..count].iter().chain([&upper_step]) {
+        for l in bounds.lower[..bounds.count].iter().chain([&step]) {
+            for m in bounds.upper[..bounds.count].iter().chain([&upper_step]) {
                 // Feasible while α_l + β_l x ≤ α_m + β_m x; at x = 0 it holds (u = 0 is
                 // admissible), so only β_l > β_m bounds x.
-                if l.beta > m.beta {
-                    bound = bound.min((m.alpha - l.alpha) / (l.beta - m.beta));
+                // (α_m − α_l) / (β_l − β_m) < bound, without dividing unless it is.
+                let slope = l.beta - m.beta;
+                if slope > 0.0 && m.alpha - l.alpha < bound * slope {
+                    bound = (m.alpha - l.alpha) / slope;
                 }
             }
         }
@@ -117,8 +145,8 @@ pub fn topp_ra(grid: &[GridPoint], acceleration: &JointVector, factor: &[f64]) -
     let mut x = vec![0.0; n + 1];
     for i in 0..n {
         let delta = grid[i + 1].s - grid[i].s;
-        let (_, upper, count, _) = acceleration_bounds(&grid[i], acceleration, factor[i]);
-        let u = upper[..count]
+        let bounds = AccelerationBounds::new(grid, i, acceleration, factor);
+        let u = bounds.upper[..bounds.count]
             .iter()
             .map(|m| m.alpha + m.beta * x[i])
             .fold((reach[i + 1] - x[i]) / (2.0 * delta), f64::min);
