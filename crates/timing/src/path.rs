@@ -156,6 +156,9 @@ impl SmoothPath {
 }
 
 /// The first segment of `spline` with a checked inside point that breaks a constraint.
+/// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points and every joint's turning points
+/// (where a joint's extreme values inside the segment lie, so the joint limits hold on the
+/// whole segment).
 fn first_failing_segment(
     robot: &Robot,
     task: &Task,
@@ -164,9 +167,10 @@ fn first_failing_segment(
 ) -> Option<(usize, Violation)> {
     let knots = spline.knots();
     (0..knots.len() - 1).find_map(|k| {
-        (1..CHECKS_PER_SEGMENT + 1).find_map(|j| {
-            let s =
-                knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64;
+        let even = (1..CHECKS_PER_SEGMENT + 1).map(|j| {
+            knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64
+        });
+        even.chain(spline.turning_points(k)).find_map(|s| {
             let q = spline.eval(s).q;
             first_violation(robot, task, &q, &robot.forward(&q), constraints).map(|v| (k, v))
         })

@@ -121,6 +121,39 @@ impl JointSpline {
     }
 }
 
+impl JointSpline {
+    /// The parameters strictly inside segment `k` where some joint's `q'` is zero: with the
+    /// segment's ends, where each joint takes its extreme values on the segment.
+    pub fn turning_points(&self, k: usize) -> impl Iterator<Item = f64> + '_ {
+        let (s0, h) = (self.knots[k], self.knots[k + 1] - self.knots[k]);
+        let (m0, m1) = (self.second[k], self.second[k + 1]);
+        let b = (self.values[k + 1] - self.values[k]) / h - (m0 * 2.0 + m1) * (h / 6.0);
+        (0..b.len()).flat_map(move |j| {
+            // q'(t) = b + m0 t + (m1 − m0)/(2h) t² on t ∈ (0, h).
+            let (c2, c1, c0) = ((m1[j] - m0[j]) / (2.0 * h), m0[j], b[j]);
+            let roots = if c2.abs() < 1e-12 * (c1.abs() + c0.abs()).max(1e-300) {
+                [(c1 != 0.0).then(|| -c0 / c1), None]
+            } else {
+                let discriminant = c1 * c1 - 4.0 * c2 * c0;
+                if discriminant < 0.0 {
+                    [None, None]
+                } else {
+                    let root = discriminant.sqrt();
+                    [
+                        Some((-c1 + root) / (2.0 * c2)),
+                        Some((-c1 - root) / (2.0 * c2)),
+                    ]
+                }
+            };
+            roots
+                .into_iter()
+                .flatten()
+                .filter(move |t| *t > 0.0 && *t < h)
+                .map(move |t| s0 + t)
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -177,6 +210,29 @@ mod tests {
         for j in 20..=80 {
             let s = j as f64 / 100.0 * spline.end();
             assert!((spline.eval(s).q - wave(s)).norm() < 1e-4, "at {s}");
+        }
+    }
+
+    #[test]
+    fn turning_points_are_where_joints_peak() {
+        let spline = spline(6);
+        for k in 0..6 {
+            let (a, b) = (spline.knots()[k], spline.knots()[k + 1]);
+            for s in spline.turning_points(k) {
+                assert!(s > a && s < b);
+                let dq = spline.eval(s).dq;
+                assert!(dq.iter().any(|v| v.abs() < 1e-9), "{dq} at {s}");
+            }
+            // Every joint's largest value on the segment, sampled finely, is at most the
+            // largest at the ends and turning points.
+            for j in 0..7 {
+                let candidates = [a, b].into_iter().chain(spline.turning_points(k));
+                let best = candidates.map(|s| spline.eval(s).q[j]).fold(f64::MIN, f64::max);
+                let sampled = (0..=1000)
+                    .map(|i| spline.eval(a + (b - a) * i as f64 / 1000.0).q[j])
+                    .fold(f64::MIN, f64::max);
+                assert!(sampled <= best + 1e-12, "joint {j}: {sampled} > {best}");
+            }
         }
     }
 
