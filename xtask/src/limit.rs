@@ -269,16 +269,7 @@ fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
         buckets_by_limit: buckets,
         rows,
     };
-    std::fs::create_dir_all(&args.out_dir)?;
-    let json = args.out_dir.join("limit.json");
-    emg_io::write_atomically(
-        &json,
-        (serde_json::to_string_pretty(&record)? + "\n").as_bytes(),
-    )?;
-    let md = args.out_dir.join("limit.md");
-    emg_io::write_atomically(&md, markdown(&record).as_bytes())?;
-    println!("wrote {} and {}", json.display(), md.display());
-    Ok(())
+    workspace::write_results(&args.out_dir, "limit", &record, &markdown(&record))
 }
 
 fn markdown(record: &Record) -> String {

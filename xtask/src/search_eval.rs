@@ -8,7 +8,6 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{Summary, four};
-use emg_io::write_atomically;
 use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
@@ -174,7 +173,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         reachability_bound_m: Summary::of(&bounds).context("no tasks")?,
         rows,
     };
-    write_record(&record, &args.out_dir)?;
+    workspace::write_results(&args.out_dir, "search", &record, &markdown(&record))?;
     draw(&record, &args.figure)?;
     println!("wrote {}", args.figure.display());
     Ok(())
@@ -189,19 +188,6 @@ fn mean_ratio(values: &[f64], of: &[f64]) -> f64 {
         .map(|(v, o)| v / o)
         .collect();
     ratios.iter().sum::<f64>() / ratios.len().max(1) as f64
-}
-
-fn write_record(record: &Record, out_dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(out_dir)?;
-    let json = out_dir.join("search.json");
-    write_atomically(
-        &json,
-        (serde_json::to_string_pretty(record)? + "\n").as_bytes(),
-    )?;
-    let md = out_dir.join("search.md");
-    write_atomically(&md, markdown(record).as_bytes())?;
-    println!("wrote {} and {}", json.display(), md.display());
-    Ok(())
 }
 
 fn markdown(record: &Record) -> String {

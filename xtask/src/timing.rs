@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use emg_eval::{Summary, four};
-use emg_io::{TrajectoryContents, write_atomically};
+use emg_io::TrajectoryContents;
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, limits_file_beside,
 };
@@ -217,7 +217,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         checker_failures: failures.len(),
         failure_examples: failures.iter().take(5).cloned().collect(),
     };
-    write_record(&record, &args.out_dir)?;
+    workspace::write_results(&args.out_dir, "timing", &record, &markdown(&record))?;
     draw(&outcomes, &record, &args.figure)?;
     println!("wrote {}", args.figure.display());
     anyhow::ensure!(
@@ -227,19 +227,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         record.task_count,
         failures[0]
     );
-    Ok(())
-}
-
-fn write_record(record: &Record, out_dir: &Path) -> anyhow::Result<()> {
-    std::fs::create_dir_all(out_dir)?;
-    let json = out_dir.join("timing.json");
-    write_atomically(
-        &json,
-        (serde_json::to_string_pretty(record)? + "\n").as_bytes(),
-    )?;
-    let md = out_dir.join("timing.md");
-    write_atomically(&md, markdown(record).as_bytes())?;
-    println!("wrote {} and {}", json.display(), md.display());
     Ok(())
 }
 
@@ -312,57 +299,58 @@ fn markdown(record: &Record) -> String {
     md
 }
 
-/// Each task's jerk-limited duration against its time-optimal duration without jerk limits.
+/// Each task's duration against its path's TCP travel, with the line of a motion at the
+/// requested tool speed throughout: how far the joint limits keep the tool below it.
 fn draw(outcomes: &[Outcome], record: &Record, path: &Path) -> anyhow::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let top = outcomes
-        .iter()
-        .map(|o| o.duration_s)
-        .fold(0.0, f64::max)
-        .max(1e-3)
-        * 1.05;
-    let root = SVGBackend::new(path, (640, 560)).into_drawing_area();
+    let axis_end = |value: fn(&Outcome) -> f64| {
+        outcomes.iter().map(value).fold(0.0, f64::max).max(1e-3) * 1.05
+    };
+    let (longest, slowest) = (axis_end(|o| o.path_travel_m), axis_end(|o| o.duration_s));
+    let speed = record.tool_speed_m_per_s;
+    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!(
-                "{}: duration rest to rest, {} tasks at {} Hz",
-                record.robot, record.task_count, record.rate_hz
+                "{}: rest-to-rest duration of {} planned motions",
+                record.robot, record.task_count
             ),
             ("sans-serif", 18),
         )
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(56)
-        .build_cartesian_2d(0.0..top, 0.0..top)?;
+        .build_cartesian_2d(0.0..longest, 0.0..slowest)?;
     chart
         .configure_mesh()
         .light_line_style(WHITE)
-        .x_desc("time-optimal without jerk limits (s)")
-        .y_desc("jerk-limited, as written (s)")
+        .x_desc("TCP travel along the path (m)")
+        .y_desc("duration, jerk-limited (s)")
         .draw()?;
-    chart
-        .draw_series(LineSeries::new(
-            [(0.0, 0.0), (top, top)],
-            BLACK.stroke_width(1),
-        ))?
-        .label("equal")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
     chart
         .draw_series(
             outcomes
                 .iter()
-                .map(|o| Circle::new((o.time_optimal_s, o.duration_s), 2, BLUE.mix(0.4).filled())),
+                .map(|o| Circle::new((o.path_travel_m, o.duration_s), 2, BLUE.mix(0.3).filled())),
         )?
         .label("one task")
         .legend(|(x, y)| Circle::new((x + 8, y), 3, BLUE.filled()));
+    let end = longest.min(slowest * speed);
+    chart
+        .draw_series(LineSeries::new(
+            [(0.0, 0.0), (end, end / speed)],
+            BLACK.stroke_width(2),
+        ))?
+        .label(format!("the tool at {speed} m/s throughout"))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerRight)
+        .position(SeriesLabelPosition::UpperLeft)
         .draw()?;
     root.present()?;
     Ok(())

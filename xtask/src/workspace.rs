@@ -193,6 +193,23 @@ pub fn thread_pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
         .build()?)
 }
 
+/// Writes a pipeline's results as `<out_dir>/<name>.json` (the record, pretty-printed) and
+/// `<out_dir>/<name>.md` (its table), each atomically, creating the directory; says so.
+pub fn write_results(
+    out_dir: &Path,
+    name: &str,
+    record: &impl serde::Serialize,
+    markdown: &str,
+) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out_dir)?;
+    let json = out_dir.join(format!("{name}.json"));
+    emg_io::write_atomically(&json, serde_json::to_string_pretty(record)? + "\n")?;
+    let md = out_dir.join(format!("{name}.md"));
+    emg_io::write_atomically(&md, markdown)?;
+    println!("wrote {} and {}", json.display(), md.display());
+    Ok(())
+}
+
 /// CPU model and core count of this machine.
 pub fn machine() -> String {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();

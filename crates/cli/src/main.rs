@@ -172,7 +172,7 @@ fn motion_timing(
         );
     }
     let tool_speed = args.tool_speed.unwrap_or(config.rollout.speed_m_per_s);
-    Ok(MotionTiming::new(
+    MotionTiming::new(
         robot,
         &limits,
         args.scaling.scaling()?,
@@ -186,7 +186,7 @@ fn motion_timing(
             args.rate_hz
         )),
         other => anyhow::Error::new(other),
-    })?)
+    })
 }
 
 /// What a plan was asked for beyond the task: the request and the timing.

@@ -18,8 +18,9 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 
 use crate::robot::{Robot, joint_vector};
-use crate::timing::{Motion, TimingArgs};
+use crate::timing::{Motion, motion_timing};
 use crate::{InputError, PlanningError, data_dir, input_error, message};
+use emg_timing::Scaling;
 
 /// Plans extreme straight-line motions for one robot with its models and configuration.
 ///
@@ -464,14 +465,15 @@ impl Plan {
         tool_speed: Option<f64>,
         rate_hz: f64,
     ) -> PyResult<Motion> {
-        let timing = TimingArgs {
+        let timing = motion_timing(
+            &self.planner,
+            Path::new(&self.robot),
             limits,
-            velocity_scaling,
-            acceleration_scaling,
+            Scaling::new(velocity_scaling, acceleration_scaling)
+                .map_err(|e| input_error("scaling", &e))?,
             tool_speed,
             rate_hz,
-        }
-        .resolve(&self.planner, Path::new(&self.robot))?;
+        )?;
         let constraints = &self.planner.config().rollout.constraints;
         let motion = py
             .detach(|| {
@@ -499,14 +501,15 @@ impl Plan {
         tool_speed: Option<f64>,
         rate_hz: f64,
     ) -> PyResult<Vec<PathBuf>> {
-        let timing = TimingArgs {
+        let timing = motion_timing(
+            &self.planner,
+            Path::new(&self.robot),
             limits,
-            velocity_scaling,
-            acceleration_scaling,
+            Scaling::new(velocity_scaling, acceleration_scaling)
+                .map_err(|e| input_error("scaling", &e))?,
             tool_speed,
             rate_hz,
-        }
-        .resolve(&self.planner, Path::new(&self.robot))?;
+        )?;
         let record = PlanRecord {
             robot: &self.robot,
             request: &self.request,

@@ -10,44 +10,28 @@ use pyo3::prelude::*;
 use crate::input_error;
 use crate::planner::{array1, array2};
 
-/// How a plan is timed, from the keyword arguments of `Plan.timed` and `Plan.save`.
-pub struct TimingArgs {
-    /// `limits`: a MoveIt joint_limits.yaml (default: the one beside the robot file).
-    pub limits: Option<PathBuf>,
-    /// `velocity_scaling` in (0, 1].
-    pub velocity_scaling: f64,
-    /// `acceleration_scaling` in (0, 1].
-    pub acceleration_scaling: f64,
-    /// `tool_speed` (m/s; default: the rollout's line speed).
-    pub tool_speed: Option<f64>,
-    /// `rate_hz`.
-    pub rate_hz: f64,
-}
-
-impl TimingArgs {
-    /// The timing these arguments ask for, for `planner`'s robot read from `robot_file`.
-    pub fn resolve(
-        &self,
-        planner: &emg_planner::Planner,
-        robot_file: &Path,
-    ) -> PyResult<MotionTiming> {
-        let limits = self
-            .limits
-            .clone()
-            .unwrap_or_else(|| limits_file_beside(robot_file));
-        let scaling = Scaling::new(self.velocity_scaling, self.acceleration_scaling)
-            .map_err(|e| input_error("scaling", &e))?;
-        let config = planner.config();
-        MotionTiming::new(
-            planner.robot(),
-            &limits,
-            scaling,
-            self.tool_speed.unwrap_or(config.rollout.speed_m_per_s),
-            self.rate_hz,
-            &config.rollout.constraints,
-        )
-        .map_err(|e| input_error("timing", &e))
-    }
+/// The timing the keyword arguments of `Plan.timed` and `Plan.save` ask for, for `planner`'s
+/// robot read from `robot_file`: `limits` a MoveIt joint_limits.yaml (default: the one beside
+/// the robot file), `tool_speed` in m/s (default: the rollout's line speed).
+pub fn motion_timing(
+    planner: &emg_planner::Planner,
+    robot_file: &Path,
+    limits: Option<PathBuf>,
+    scaling: Scaling,
+    tool_speed: Option<f64>,
+    rate_hz: f64,
+) -> PyResult<MotionTiming> {
+    let limits = limits.unwrap_or_else(|| limits_file_beside(robot_file));
+    let config = planner.config();
+    MotionTiming::new(
+        planner.robot(),
+        &limits,
+        scaling,
+        tool_speed.unwrap_or(config.rollout.speed_m_per_s),
+        rate_hz,
+        &config.rollout.constraints,
+    )
+    .map_err(|e| input_error("timing", &e))
 }
 
 /// A plan timed rest to rest: a C² path through the planned steps, time-optimal within the

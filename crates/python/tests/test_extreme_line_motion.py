@@ -23,16 +23,6 @@ EVAL_TASKS = ROOT / "data" / "tasks" / "eval-v1.tasks"
 FILES = (".json", ".csv", ".joint_trajectory.json")
 
 
-@pytest.fixture(scope="module")
-def planner():
-    return elm.Planner("fr3")
-
-
-@pytest.fixture(scope="module")
-def tasks():
-    return elm.load_tasks(EVAL_TASKS)
-
-
 def vector(values):
     return ",".join(repr(float(v)) for v in values)
 

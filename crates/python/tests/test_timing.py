@@ -15,22 +15,10 @@ import toppra
 import toppra.algorithm
 import toppra.constraint
 
-ROOT = Path(__file__).resolve().parents[3]
-EVAL_TASKS = ROOT / "data" / "tasks" / "eval-v1.tasks"
 
 
-@pytest.fixture(scope="module")
-def planner():
-    return elm.Planner("fr3")
-
-
-@pytest.fixture(scope="module")
-def tasks():
-    return elm.load_tasks(EVAL_TASKS)
-
-
-def test_timed_motion_rests_at_both_ends_and_matches_the_saved_file(planner, tmp_path):
-    task = elm.load_tasks(EVAL_TASKS)[3]
+def test_timed_motion_rests_at_both_ends_and_matches_the_saved_file(planner, tasks, tmp_path):
+    task = tasks[3]
     plan = planner.plan(task.p0, task.d, task.n, controller="classical", planner="controller")
     motion = plan.timed(acceleration_scaling=0.5, rate_hz=200)
     assert motion.q.shape == (len(motion.t), 7) and motion.qdd.shape == motion.q.shape

@@ -25,8 +25,9 @@ pub use limits::{DynamicLimits, LimitsError, Scaling};
 pub use path::{CHECKS_PER_SEGMENT, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
-    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SLOWDOWNS, MIN_GRID_INTERVALS, SLOWDOWN,
-    TimedMotion, TimingError, TimingReport, TimingRequest, time_motion,
+    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SAMPLES, MAX_SLOWDOWNS,
+    MIN_GRID_INTERVALS, SLOWDOWN, TimedMotion, TimingError, TimingReport, TimingRequest,
+    time_motion,
 };
 pub use spline::{JointSpline, PathPoint};
 pub use topp::{GridPoint, profile_duration, topp_ra};

@@ -29,6 +29,10 @@ pub const ACCELERATION_MARGIN: f64 = 0.97;
 /// Slow-down rounds at most before giving up.
 pub const MAX_SLOWDOWNS: usize = 60;
 
+/// Most samples one motion may have: a rate or tool speed that would give more is refused
+/// (ten million samples are almost three hours at 1 kHz).
+pub const MAX_SAMPLES: f64 = 1e7;
+
 /// Share of the requested tool speed above which the tool counts as moving at it.
 pub const AT_TOOL_SPEED: f64 = 0.99;
 
@@ -92,6 +96,19 @@ pub enum TimingError {
         allowed: &'static str,
         /// The value given.
         value: f64,
+    },
+    /// The motion would need more than [`MAX_SAMPLES`] samples.
+    #[error(
+        "the motion takes {duration_s:.1} s: {samples:.0} samples at {rate_hz} Hz, more than \
+         {MAX_SAMPLES:.0}; lower the rate or raise the tool speed"
+    )]
+    TooManySamples {
+        /// Duration of the motion (s).
+        duration_s: f64,
+        /// Samples it would take.
+        samples: f64,
+        /// The rate asked for.
+        rate_hz: f64,
     },
     /// The samples still broke a limit after [`MAX_SLOWDOWNS`] rounds.
     #[error("the motion still breaks a limit after {MAX_SLOWDOWNS} slow-downs: {0}")]
@@ -207,6 +224,14 @@ pub fn time_motion(
     for slowdowns in 0..=MAX_SLOWDOWNS {
         let x = topp_ra(&grid, &planned_acceleration, &factor);
         let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
+        let samples = profile.duration() * request.rate_hz;
+        if samples > MAX_SAMPLES {
+            return Err(TimingError::TooManySamples {
+                duration_s: profile.duration(),
+                samples,
+                rate_hz: request.rate_hz,
+            });
+        }
         let (samples, states) = sample(spline, &profile, request.rate_hz);
         let found = breaches(&samples, limits);
         let Some(first) = found.first() else {

@@ -227,7 +227,9 @@ mod tests {
             // largest at the ends and turning points.
             for j in 0..7 {
                 let candidates = [a, b].into_iter().chain(spline.turning_points(k));
-                let best = candidates.map(|s| spline.eval(s).q[j]).fold(f64::MIN, f64::max);
+                let best = candidates
+                    .map(|s| spline.eval(s).q[j])
+                    .fold(f64::MIN, f64::max);
                 let sampled = (0..=1000)
                     .map(|i| spline.eval(a + (b - a) * i as f64 / 1000.0).q[j])
                     .fold(f64::MIN, f64::max);

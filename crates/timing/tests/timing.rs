@@ -117,6 +117,15 @@ fn scaling_slows_the_motion_down() {
         assert_eq!(first_breach(&motion.samples, &request.limits), None);
         motion.report.duration_s
     };
+    let request = TimingRequest {
+        limits: shipped_limits(&robot),
+        tool_speed_m_per_s: 0.2,
+        rate_hz: 1e8,
+    };
+    let error = time_motion(&robot, &task, &config.constraints, &waypoints, &request)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("lower the rate"), "{error}");
     let full = time(Scaling::default(), 2.0);
     let slow = time(Scaling::new(0.1, 0.05).unwrap(), 2.0);
     let slow_tool = time(Scaling::default(), 0.05);
