@@ -148,11 +148,6 @@ impl SmoothPath {
     pub fn start(&self) -> JointVector {
         self.start
     }
-
-    /// The path parameter at the end (m of TCP travel; 0 without motion).
-    pub fn length(&self) -> f64 {
-        self.spline.as_ref().map_or(0.0, JointSpline::end)
-    }
 }
 
 /// The first segment of `spline` with a checked inside point that breaks a constraint.

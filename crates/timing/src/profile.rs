@@ -5,7 +5,7 @@
 
 use crate::topp::GridPoint;
 
-/// The path position and its first three time derivatives at one instant.
+/// The path position and its first two time derivatives at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathState {
     /// `s` (path parameter).
@@ -14,8 +14,6 @@ pub struct PathState {
     pub sd: f64,
     /// `s̈`.
     pub sdd: f64,
-    /// `s⃛`.
-    pub sddd: f64,
 }
 
 /// One stretch of constant `s̈` between two grid points.
@@ -76,22 +74,17 @@ impl SpeedProfile {
         self.duration
     }
 
-    /// `(∫₀ᵗ s, s, ṡ, s̈)` at `t`, with rest at 0 before the start and at the end after it.
-    fn at(&self, t: f64) -> [f64; 4] {
-        self.at_from(t, &mut 0)
-    }
-
-    /// As [`Self::at`], searching forward from piece `*hint` (which it updates): times that
-    /// increase from call to call cost O(1) each.
-    fn at_from(&self, t: f64, hint: &mut usize) -> [f64; 4] {
+    /// `(∫₀ᵗ s, s, ṡ)` at `t`, with rest at 0 before the start and at the end after it,
+    /// searching forward from piece `*hint` (which it updates): times that increase from call
+    /// to call cost O(1) each.
+    fn at_from(&self, t: f64, hint: &mut usize) -> [f64; 3] {
         if t <= 0.0 {
-            return [0.0; 4];
+            return [0.0; 3];
         }
         if t >= self.duration {
             return [
                 self.integral_end + self.end * (t - self.duration),
                 self.end,
-                0.0,
                 0.0,
             ];
         }
@@ -107,19 +100,7 @@ impl SpeedProfile {
             p.integral0 + (p.s0 + (p.v0 / 2.0 + p.u * tau / 6.0) * tau) * tau,
             p.s0 + (p.v0 + p.u * tau / 2.0) * tau,
             p.v0 + p.u * tau,
-            p.u,
         ]
-    }
-
-    /// The profile itself at `t` (`s⃛` is 0 between grid points, unbounded at them).
-    pub fn state(&self, t: f64) -> PathState {
-        let [_, s, sd, sdd] = self.at(t);
-        PathState {
-            s,
-            sd,
-            sdd,
-            sddd: 0.0,
-        }
     }
 }
 
@@ -144,16 +125,6 @@ impl SmoothedProfile {
         self.profile.duration + self.window
     }
 
-    /// The unsmoothed profile.
-    pub fn profile(&self) -> &SpeedProfile {
-        &self.profile
-    }
-
-    /// The averaging window (s).
-    pub fn window(&self) -> f64 {
-        self.window
-    }
-
     /// `s` and its derivatives at `t`; exactly the path's end and at rest from the end of the
     /// motion on.
     pub fn state(&self, t: f64) -> PathState {
@@ -168,7 +139,6 @@ impl SmoothedProfile {
                 s: self.profile.end,
                 sd: 0.0,
                 sdd: 0.0,
-                sddd: 0.0,
             };
         }
         let w = self.window;
@@ -179,7 +149,6 @@ impl SmoothedProfile {
             s: ((now[0] - before[0]) / w).clamp(0.0, self.profile.end),
             sd: (now[1] - before[1]) / w,
             sdd: (now[2] - before[2]) / w,
-            sddd: (now[3] - before[3]) / w,
         }
     }
 }
