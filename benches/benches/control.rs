@@ -1,7 +1,9 @@
 //! Hot-path benchmarks: forward kinematics with the Jacobian, one classical control step, one
-//! constraint check, and one full classical rollout.
+//! constraint check, one full classical rollout, and the full step (`full_step`: everything one
+//! accepted step of a rollout costs, measured over a long rollout).
 
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use emg_benches::Fixture;
@@ -39,6 +41,41 @@ fn benches(c: &mut Criterion) {
         b.iter(|| {
             let mut controller = ClassicalController::default();
             rollout(robot, black_box(task), &q, &mut controller, &config).path_length_m
+        })
+    });
+
+    // The first-100 task whose classical rollout from its seed takes the most steps, so that
+    // the per-rollout set-up is a small share of the time per step.
+    let (long_task, long_seed, steps) = fixture
+        .tasks
+        .iter()
+        .filter_map(|task| {
+            let seed = task.q0_seed?;
+            let mut controller = ClassicalController::default();
+            let steps = rollout(robot, task, &seed, &mut controller, &config)
+                .steps
+                .len()
+                - 1;
+            Some((task, seed, steps))
+        })
+        .max_by_key(|&(_, _, steps)| steps)
+        .expect("evaluation tasks keep their seed");
+    c.bench_function("full_step", |b| {
+        b.iter_custom(|iterations| {
+            let mut elapsed = Duration::ZERO;
+            for _ in 0..iterations {
+                let mut controller = ClassicalController::default();
+                let start = Instant::now();
+                black_box(rollout(
+                    robot,
+                    black_box(long_task),
+                    &long_seed,
+                    &mut controller,
+                    &config,
+                ));
+                elapsed += start.elapsed();
+            }
+            elapsed / steps as u32
         })
     });
 }

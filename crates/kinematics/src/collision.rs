@@ -1,5 +1,7 @@
 //! Capsule self-collision between bodies of the chain.
 
+use arrayvec::ArrayVec;
+
 use crate::Vec3;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
@@ -39,49 +41,93 @@ pub struct CollisionHit {
     pub clearance: f64,
 }
 
+/// Most capsules a robot may carry: the placed capsules of one check live on the stack.
+pub const MAX_CAPSULES: usize = 64;
+
+/// Slack (m) kept by the bounding-sphere tests, far above their rounding error: a pair is
+/// skipped only when its spheres are clearly apart.
+const SPHERE_SLACK_M: f64 = 1e-9;
+
+/// A capsule placed at one configuration: its axis end points in the base frame and twice the
+/// centre of its bounding sphere.
+#[derive(Clone, Copy, Debug)]
+struct PlacedCapsule {
+    start: Vec3,
+    end: Vec3,
+    doubled_centre: Vec3,
+}
+
+/// Every capsule of the robot placed at one configuration, each transformed once.
+type PlacedCapsules = ArrayVec<PlacedCapsule, MAX_CAPSULES>;
+
 impl Robot {
+    /// Places every capsule at `kin` into `placed` (cleared first).
+    fn place_capsules(&self, kin: &Kinematics, placed: &mut PlacedCapsules) {
+        placed.clear();
+        for capsule in &self.capsules {
+            let start = kin.segment_point(capsule.segment, &capsule.start);
+            let end = kin.segment_point(capsule.segment, &capsule.end);
+            placed.push(PlacedCapsule {
+                start,
+                end,
+                doubled_centre: start + end,
+            });
+        }
+    }
+
+    /// Whether the bounding spheres of `pair` may be less than `threshold` apart (compared
+    /// squared: no square root). `false` proves the pair's clearance exceeds `threshold`.
+    #[inline]
+    fn spheres_within(&self, placed: &PlacedCapsules, pair: CollisionPair, threshold: f64) -> bool {
+        let reach = self.bounding_radii[pair.first] + self.bounding_radii[pair.second];
+        let limit = 2.0 * (reach + threshold + SPHERE_SLACK_M);
+        let gap = placed[pair.first].doubled_centre - placed[pair.second].doubled_centre;
+        !(limit > 0.0 && gap.norm_squared() > limit * limit)
+    }
+
+    /// Surface clearance of `pair` (m), negative when the capsules interpenetrate.
+    #[inline]
+    fn placed_clearance(&self, placed: &PlacedCapsules, pair: CollisionPair) -> f64 {
+        let (a, b) = (&placed[pair.first], &placed[pair.second]);
+        let radii = self.capsules[pair.first].radius + self.capsules[pair.second].radius;
+        segment_distance(&a.start, &a.end, &b.start, &b.end) - radii
+    }
+
     /// The first checked capsule pair whose clearance is below `margin` (m), if any.
     ///
-    /// Allocation-free; a bounding-sphere test skips pairs that are clearly apart.
+    /// Allocation-free: each capsule is placed once, and a bounding-sphere test skips the pairs
+    /// that are clearly apart before the segment distance.
     pub fn first_collision(&self, kin: &Kinematics, margin: f64) -> Option<CollisionHit> {
+        let mut placed = PlacedCapsules::new();
+        self.place_capsules(kin, &mut placed);
         self.pairs.iter().find_map(|&pair| {
-            let clearance = self.pair_clearance(kin, pair, margin)?;
+            if !self.spheres_within(&placed, pair, margin) {
+                return None;
+            }
+            let clearance = self.placed_clearance(&placed, pair);
             (clearance < margin).then_some(CollisionHit { pair, clearance })
         })
     }
 
-    /// Smallest clearance (m) over all checked pairs and the pair that attains it.
+    /// Smallest clearance (m) over all checked pairs and the first pair that attains it.
+    ///
+    /// Allocation-free; pairs whose bounding spheres are farther apart than the smallest
+    /// clearance found so far are skipped.
     pub fn min_clearance(&self, kin: &Kinematics) -> Option<CollisionHit> {
-        self.pairs
-            .iter()
-            .map(|&pair| CollisionHit {
-                pair,
-                clearance: self
-                    .pair_clearance(kin, pair, f64::INFINITY)
-                    .unwrap_or(f64::INFINITY),
-            })
-            .min_by(|a, b| a.clearance.total_cmp(&b.clearance))
-    }
-
-    /// Clearance of one pair, or `None` when bounding spheres already show it exceeds `margin`.
-    fn pair_clearance(&self, kin: &Kinematics, pair: CollisionPair, margin: f64) -> Option<f64> {
-        let (a, b) = (&self.capsules[pair.first], &self.capsules[pair.second]);
-        let (a0, a1) = (
-            kin.segment_point(a.segment, &a.start),
-            kin.segment_point(a.segment, &a.end),
-        );
-        let (b0, b1) = (
-            kin.segment_point(b.segment, &b.start),
-            kin.segment_point(b.segment, &b.end),
-        );
-        let radii = a.radius + b.radius;
-        let spheres_apart = ((a0 + a1) - (b0 + b1)).norm() * 0.5
-            - 0.5 * ((a1 - a0).norm() + (b1 - b0).norm())
-            - radii;
-        if spheres_apart > margin {
-            return None;
+        let mut placed = PlacedCapsules::new();
+        self.place_capsules(kin, &mut placed);
+        let mut best: Option<CollisionHit> = None;
+        for &pair in &self.pairs {
+            let bound = best.map_or(f64::INFINITY, |hit| hit.clearance);
+            if bound.is_finite() && !self.spheres_within(&placed, pair, bound) {
+                continue;
+            }
+            let clearance = self.placed_clearance(&placed, pair);
+            if best.is_none_or(|hit| clearance.total_cmp(&hit.clearance).is_lt()) {
+                best = Some(CollisionHit { pair, clearance });
+            }
         }
-        Some(segment_distance(&a0, &a1, &b0, &b1) - radii)
+        best
     }
 }
 

@@ -36,7 +36,7 @@ mod projection;
 mod pseudo_inverse;
 mod robot;
 
-pub use collision::{Capsule, CollisionHit, CollisionPair, segment_distance};
+pub use collision::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
 pub use fk::{Kinematics, PositionJacobian};
 pub use manipulability::{directional_manipulability, tool_alignment_gradient};
 pub use nullspace::{BasisConfig, NullSpaceBasis, TaskBasis, null_space_basis, task_aligned_basis};

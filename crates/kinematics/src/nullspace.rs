@@ -94,27 +94,25 @@ pub fn task_aligned_basis(
 
 /// Householder QR `Jᵀ = Q R`: returns `N` = the last four columns of `Q` and the sign of
 /// `det[J; Nᵀ] = det(R₃ₓ₃)·det(Q)` (each proper reflector contributes `det = −1`).
+///
+/// Plain arrays, every sum accumulated in index order; the independent dot products of one
+/// reflector (one per column it is applied to) run side by side.
 fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) {
-    let mut a = jacobian.transpose();
-    let mut reflectors = [JointVector::zeros(); 3];
+    // Column c of Jᵀ is row c of J.
+    let mut columns: [[f64; DOF]; 3] =
+        std::array::from_fn(|c| std::array::from_fn(|r| jacobian[(c, r)]));
+    let mut reflectors = [[0.0; DOF]; 3];
     let mut sign = 1.0;
     for k in 0..3 {
-        let mut v = JointVector::zeros();
-        for r in k..DOF {
-            v[r] = a[(r, k)];
-        }
-        let norm = v.norm();
+        let mut v = [0.0; DOF];
+        v[k..].copy_from_slice(&columns[k][k..]);
+        let norm = dot(&v, &v).sqrt();
         let alpha = if v[k] > 0.0 { -norm } else { norm };
         v[k] -= alpha;
-        let length = v.norm();
+        let length = dot(&v, &v).sqrt();
         if length > 0.0 {
-            v /= length;
-            for c in k..3 {
-                let projection = (0..DOF).map(|r| v[r] * a[(r, c)]).sum::<f64>();
-                for r in k..DOF {
-                    a[(r, c)] -= 2.0 * projection * v[r];
-                }
-            }
+            v.iter_mut().for_each(|x| *x /= length);
+            reflect(&v, &mut columns[k..], k);
             sign = -sign;
         }
         if alpha < 0.0 {
@@ -122,15 +120,38 @@ fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) 
         }
         reflectors[k] = v;
     }
-    let mut null = NullSpaceBasis::zeros();
-    for c in 0..NULL_DIM {
-        let mut column = JointVector::ith(3 + c, 1.0);
-        for v in reflectors.iter().rev() {
-            column -= v * (2.0 * v.dot(&column));
-        }
-        null.set_column(c, &column);
+    let mut null: [[f64; DOF]; NULL_DIM] = std::array::from_fn(|c| {
+        let mut column = [0.0; DOF];
+        column[3 + c] = 1.0;
+        column
+    });
+    for v in reflectors.iter().rev() {
+        reflect(v, &mut null, 0);
     }
-    (null, sign)
+    (NullSpaceBasis::from_fn(|r, c| null[c][r]), sign)
+}
+
+/// `x ← x − 2 v (v·x)` for every column `x` (rows from `first` on; `v` is zero above it).
+fn reflect(v: &[f64; DOF], columns: &mut [[f64; DOF]], first: usize) {
+    let mut projections = [0.0; NULL_DIM];
+    for (projection, column) in projections.iter_mut().zip(columns.iter()) {
+        *projection = dot(v, column);
+    }
+    for (projection, column) in projections.iter().zip(columns.iter_mut()) {
+        for r in first..DOF {
+            column[r] -= v[r] * (2.0 * projection);
+        }
+    }
+}
+
+/// `a·b`, summed in index order from zero.
+#[inline]
+fn dot(a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
+    let mut sum = 0.0;
+    for r in 0..DOF {
+        sum += a[r] * b[r];
+    }
+    sum
 }
 
 /// The unit vector `x` with `det[a b c x] = 1` for orthonormal `a`, `b`, `c` in R⁴ (the

@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaterni
 use std::collections::HashMap;
 use std::path::Path;
 
-use crate::collision::{Capsule, CollisionPair};
+use crate::collision::{Capsule, CollisionPair, MAX_CAPSULES};
 use crate::{DOF, JointVector, Vec3};
 
 /// Smallest chain-index separation of two bodies whose capsules are checked against each other
@@ -105,6 +105,12 @@ pub enum RobotError {
         /// What is wrong with it.
         problem: String,
     },
+    /// The chain carries more collision capsules than a check places on the stack.
+    #[error("the chain has {found} collision capsules; at most {MAX_CAPSULES} are supported")]
+    TooManyCapsules {
+        /// Capsules found along the chain.
+        found: usize,
+    },
     /// A collision element uses geometry other than a capsule or sphere.
     #[error("link '{link}': collision geometry {kind} is not supported; use <capsule> or <sphere>")]
     UnsupportedGeometry {
@@ -180,6 +186,8 @@ pub struct Robot {
     pub(crate) tcp_offset: JointFrame,
     pub(crate) limits: JointLimits,
     pub(crate) capsules: Vec<Capsule>,
+    /// Radius of each capsule's bounding sphere (half its axis length plus its radius).
+    pub(crate) bounding_radii: Vec<f64>,
     pub(crate) pairs: Vec<CollisionPair>,
     pub(crate) reach_centre: Vec3,
     pub(crate) reach_radius: f64,
@@ -287,6 +295,15 @@ impl Robot {
             });
         }
         let capsules = chain_capsules(&chain)?;
+        if capsules.len() > MAX_CAPSULES {
+            return Err(RobotError::TooManyCapsules {
+                found: capsules.len(),
+            });
+        }
+        let bounding_radii = capsules
+            .iter()
+            .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
+            .collect();
         let pairs = collision_pairs(&capsules);
         let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
         let reach_centre = joints[0].translation;
@@ -311,6 +328,7 @@ impl Robot {
                 velocity: JointVector::from_column_slice(&velocity),
             },
             capsules,
+            bounding_radii,
             pairs,
             reach_centre,
             reach_radius,

@@ -58,7 +58,7 @@ fn sigma_min_matches_svd_and_well_conditioned_inverse_is_exact() {
         let j = kin.jacobian();
         let pinv = damped_pseudo_inverse(j, &cfg);
         let sigma = svd_sigma_min(j);
-        worst_sigma = worst_sigma.max((pinv.sigma_min - sigma).abs());
+        worst_sigma = worst_sigma.max((pinv.sigma_min() - sigma).abs());
         worst_lambda = worst_lambda.max((pinv.lambda - expected_lambda(sigma)).abs());
         worst_svd_form =
             worst_svd_form.max((pinv.matrix - svd_pseudo_inverse(j, pinv.lambda)).amax());
@@ -113,7 +113,7 @@ fn damping_follows_the_schedule_near_singularities() {
             pinv.lambda > 0.0,
             "damping must be active below the threshold"
         );
-        worst_sigma = worst_sigma.max((pinv.sigma_min - sigma).abs());
+        worst_sigma = worst_sigma.max((pinv.sigma_min() - sigma).abs());
         worst_lambda = worst_lambda.max((pinv.lambda - expected_lambda(sigma)).abs());
         worst_svd_form =
             worst_svd_form.max((pinv.matrix - svd_pseudo_inverse(&j, pinv.lambda)).amax());
@@ -150,7 +150,7 @@ fn exact_singularity_gets_full_damping() {
     let row = j.row(0).into_owned();
     j.set_row(1, &row);
     let pinv = damped_pseudo_inverse(&j, &DampingConfig::default());
-    assert!(pinv.sigma_min < 1e-7, "σ_min = {}", pinv.sigma_min);
+    assert!(pinv.sigma_min() < 1e-7, "σ_min = {}", pinv.sigma_min());
     assert!((pinv.lambda - 0.05).abs() < 1e-9, "λ = {}", pinv.lambda);
     assert!(pinv.matrix.iter().all(|v| v.is_finite()));
     assert!((pinv.matrix - svd_pseudo_inverse(&j, pinv.lambda)).amax() < 1e-6);
@@ -179,10 +179,10 @@ fn sigma_min_is_accurate_for_clustered_singular_values() {
         // σ_min comes from the eigenvalues of JJᵀ, whose absolute error is ~ε·σ₁²; at an
         // exact singularity that is √ε·σ₁ ≈ 1e-8 in σ (harmless: dλ/dσ = 0 there). Away from
         // it σ_min must be accurate to 1e-9; everywhere σ_min² must be accurate to 1e-14·σ₁².
-        let squared_error = (pinv.sigma_min.powi(2) - sigma * sigma).abs() / (large * large);
+        let squared_error = (pinv.sigma_min().powi(2) - sigma * sigma).abs() / (large * large);
         worst_squared = worst_squared.max(squared_error);
         if sigma >= 1e-6 {
-            worst = worst.max((pinv.sigma_min - sigma).abs());
+            worst = worst.max((pinv.sigma_min() - sigma).abs());
         }
     }
     println!(
@@ -190,4 +190,30 @@ fn sigma_min_is_accurate_for_clustered_singular_values() {
     );
     assert!(worst < 1e-9, "σ_min off by {worst:e}");
     assert!(worst_squared < 1e-14, "σ_min² off by {worst_squared:e} σ₁²");
+}
+
+#[test]
+fn damping_decision_at_the_threshold_follows_the_eigenvalue() {
+    // Jacobians with singular values (1, 0.5, σ) for σ swept across σ_0 = 0.05, in a rotated
+    // frame: the well-conditioned shortcut must give the λ the eigenvalue gives.
+    let cfg = DampingConfig::default();
+    let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+    let mut damped = 0;
+    for k in -200..=200 {
+        let sigma = cfg.sigma_threshold * (1.0 + f64::from(k) * 1e-8);
+        let mut j = PositionJacobian::zeros();
+        j[(0, 1)] = 1.0;
+        j[(1, 4)] = 0.5;
+        j[(2, 6)] = sigma;
+        let j = rotation * j;
+        let pinv = damped_pseudo_inverse(&j, &cfg);
+        let from_eigenvalue = if pinv.sigma_min() < cfg.sigma_threshold {
+            cfg.lambda_max * (1.0 - (pinv.sigma_min() / cfg.sigma_threshold).powi(2)).sqrt()
+        } else {
+            0.0
+        };
+        assert_eq!(pinv.lambda, from_eigenvalue, "σ = {sigma}");
+        damped += usize::from(pinv.lambda > 0.0);
+    }
+    assert!((150..=250).contains(&damped), "{damped} of 401 damped");
 }
