@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use emg_control::{Task, rollout};
-use emg_eval::{EvalRecord, SetResult, four};
+use emg_eval::{BucketConfig, CellStats, EvalRecord, SetResult, bucket_members, cell_stats, four};
 use emg_hybrid::count_switches;
 use emg_io::read_tasks;
 use emg_planner::{ControllerKind, Executor, SHIPPED_ROBOTS, SeedSource};
@@ -16,6 +16,7 @@ use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::ablate_control::{SwitchingAblation, WeightsAblation};
+use crate::search_eval;
 use crate::{protocol, workspace};
 
 /// Options of `report`.
@@ -122,8 +123,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          Do not edit by hand. Ours: FR3 with pen, 10,000 evaluation tasks never seen in training; every \
          trajectory behind every table passed the independent constraint checker.\n\n",
     );
-    md += &table1(unseen, &paper);
-    md += &table2(unseen, &paper);
+    let search = SearchRows::read(&args.results, unseen, &eval.buckets)?;
+    md += &table1(unseen, &paper, &search);
+    md += &table2(unseen, &paper, &search);
     md += &figures(args, unseen)?;
     md += &table3(&args.results, &paper)?;
     md += &included(
@@ -179,9 +181,107 @@ fn dp_mean(set: &SetResult, controller: ControllerKind) -> f64 {
         .map_or(f64::NAN, |c| c.stats.length_m.mean)
 }
 
-fn table1(set: &SetResult, paper: &PaperTables) -> String {
+/// The search planner's rows of Tables 1 and 2 (not in the paper): its default-budget run of
+/// `cargo xtask search-eval` over the same tasks as the unseen set, bucketed by the same ℓ_ref.
+enum SearchRows {
+    /// `search.json` covers the unseen set.
+    Present {
+        /// The step budget.
+        budget_steps: u64,
+        /// Statistics per task group (`all` and each bucket).
+        groups: BTreeMap<String, CellStats>,
+        /// CPU time per task (ms, this machine).
+        cpu_ms_per_task: f64,
+        /// Mean length / Hybrid + DP's mean length on the same tasks.
+        ratio_to_pipeline: f64,
+        /// Task mean of length / reachability bound.
+        share_of_bound: f64,
+        /// Plans the checker rejected.
+        checker_failures: usize,
+        /// Task mean of length / ℓ* over the limit subset (`limit.json`), when present.
+        share_of_limit: Option<f64>,
+    },
+    /// Why there are no Search rows.
+    Missing(String),
+}
+
+/// The "All" row of `limit.json` (`cargo xtask limit --merge`).
+#[derive(Deserialize)]
+struct LimitFile {
+    rows: Vec<LimitRow>,
+}
+
+/// One bucket of `limit.json`.
+#[derive(Deserialize)]
+struct LimitRow {
+    bucket: String,
+    search_share_of_limit: f64,
+}
+
+impl SearchRows {
+    /// Reads `search.json` (and `limit.json`) from `results`.
+    fn read(results: &Path, set: &SetResult, buckets: &BucketConfig) -> anyhow::Result<Self> {
+        let path = results.join("search.json");
+        if !path.exists() {
+            return Ok(Self::Missing(
+                "no `search.json`: run `cargo xtask search-eval --tasks 10000`".into(),
+            ));
+        }
+        let record: search_eval::Record = read(&path)?;
+        if record.tasks != set.tasks || record.task_count != set.task_count {
+            return Ok(Self::Missing(format!(
+                "`search.json` covers the first {} tasks of `{}`, not the {} of `{}`: run `cargo \
+                 xtask search-eval --tasks {}`",
+                record.task_count, record.tasks, set.task_count, set.tasks, set.task_count
+            )));
+        }
+        let Some(row) = record.default_budget_row() else {
+            return Ok(Self::Missing(
+                "`search.json` lacks the default budget: run `cargo xtask search-eval` with it"
+                    .into(),
+            ));
+        };
+        let references = &set.references_m;
+        let all: Vec<usize> = (0..references.len()).collect();
+        let mut groups = BTreeMap::new();
+        let members = std::iter::once(("all".to_string(), all)).chain(
+            bucket_members(references, buckets)
+                .into_iter()
+                .map(|(bucket, members)| (bucket.name().to_lowercase(), members)),
+        );
+        for (group, members) in members {
+            if let Some(stats) = cell_stats(&row.lengths_m, references, &members) {
+                groups.insert(group, stats);
+            }
+        }
+        let limit_path = results.join("limit.json");
+        let share_of_limit = if limit_path.exists() {
+            let limit: LimitFile = read(&limit_path)?;
+            limit
+                .rows
+                .iter()
+                .find(|r| r.bucket == "All")
+                .map(|r| r.search_share_of_limit)
+        } else {
+            None
+        };
+        Ok(Self::Present {
+            budget_steps: row.budget_steps.unwrap_or_default(),
+            groups,
+            cpu_ms_per_task: row.cpu_ms_per_task,
+            ratio_to_pipeline: row.ratio_to_pipeline,
+            share_of_bound: row.share_of_bound,
+            checker_failures: row.checker_failures,
+            share_of_limit,
+        })
+    }
+}
+
+fn table1(set: &SetResult, paper: &PaperTables, search: &SearchRows) -> String {
     let mut md = String::from(
         "## Table 1: three controllers from DP seeds, by difficulty\n\n\
+         The search rows (not in the paper) are the search planner of `emg plan` at its default \
+         budget, from its own starts (`cargo xtask search-eval`).\n\n\
          | tasks | π | ours: path length (m) | paper | ours: ratio to ℓ_ref (%) | paper |\n|---|---|---|---|---|---|\n",
     );
     for group in ["all", "easy", "medium", "difficult"] {
@@ -198,6 +298,21 @@ fn table1(set: &SetResult, paper: &PaperTables) -> String {
                 paper_four(&theirs[1], 1)
             );
         }
+        if let SearchRows::Present {
+            budget_steps,
+            groups,
+            ..
+        } = search
+            && let Some(stats) = groups.get(group)
+        {
+            md += &format!(
+                "| {group} (ours n = {}, paper n = {}) | search ({budget_steps} steps) | {} | — | {} | — |\n",
+                stats.length_m.count,
+                paper.table1_counts[group],
+                four(&stats.length_m, 3),
+                four(&stats.ratio_percent, 1),
+            );
+        }
     }
     let ratio = set
         .cell(dp(), ControllerKind::Hybrid, "all")
@@ -210,6 +325,27 @@ fn table1(set: &SetResult, paper: &PaperTables) -> String {
         100.0 * (dp_mean(set, ControllerKind::Hybrid) / classical - 1.0),
         100.0 * (dp_mean(set, ControllerKind::Rl) / classical - 1.0),
     );
+    md += &match search {
+        SearchRows::Present {
+            groups,
+            ratio_to_pipeline,
+            share_of_bound,
+            checker_failures,
+            share_of_limit,
+            ..
+        } => format!(
+            "Search vs Hybrid + DP: **×{ratio_to_pipeline:.3}** mean path length (goal ≥ ×1.35); \
+             it reaches **{:.1} %** of ℓ_ref on average, {:.1} % of the reachability bound{}; \
+             {checker_failures} checker failures.\n\n",
+            groups.get("all").map_or(f64::NAN, |s| s.ratio_percent.mean),
+            100.0 * share_of_bound,
+            share_of_limit.map_or(String::new(), |s| format!(
+                " and {:.1} % of the best-known length ℓ* on the 1,000-task subset of `cargo xtask limit`",
+                100.0 * s
+            )),
+        ),
+        SearchRows::Missing(why) => format!("No search rows: {why}.\n\n"),
+    };
     md
 }
 
@@ -278,9 +414,10 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
     Ok(md)
 }
 
-fn table2(set: &SetResult, paper: &PaperTables) -> String {
+fn table2(set: &SetResult, paper: &PaperTables, search: &SearchRows) -> String {
     let mut md = String::from(
-        "## Table 2: seeds × controllers (all tasks)\n\nt = mean per-task seed time on this machine (ms; the paper's on its own hardware).\n\n\
+        "## Table 2: seeds × controllers (all tasks)\n\nt = mean per-task seed time on this machine (ms; the paper's on its own hardware); \
+         for the search row, its whole planning time (CPU ms per task: its starts, their rollouts and repairs).\n\n\
          | π | q₀* | ours t (ms) | paper t | ours: path length (m) | paper | ours: ratio (%) | paper |\n|---|---|---|---|---|---|---|---|\n",
     );
     for controller in ControllerKind::ALL {
@@ -304,6 +441,20 @@ fn table2(set: &SetResult, paper: &PaperTables) -> String {
                 theirs.map_or("—".into(), |t| paper_four(&t.2, 1))
             );
         }
+    }
+    if let SearchRows::Present {
+        groups,
+        cpu_ms_per_task,
+        budget_steps,
+        ..
+    } = search
+        && let Some(stats) = groups.get("all")
+    {
+        md += &format!(
+            "| Search ({budget_steps} steps) | its own starts | {cpu_ms_per_task:.2} | — | {} | — | {} | — |\n",
+            four(&stats.length_m, 3),
+            four(&stats.ratio_percent, 1),
+        );
     }
     md + "\n"
 }

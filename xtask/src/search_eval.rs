@@ -11,15 +11,16 @@ use emg_eval::{Summary, four};
 use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
 /// Options of `search-eval`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Tasks: the first this many of the task set.
-    #[arg(long, default_value_t = 200)]
+    /// Tasks: the first this many of the task set (the report's Search rows need the whole
+    /// evaluation set).
+    #[arg(long, default_value_t = 10_000)]
     tasks: usize,
     /// Step budgets of the search, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 10_000, 20_000, 50_000])]
@@ -46,36 +47,55 @@ pub struct Args {
 }
 
 /// One planner setting over the tasks.
-#[derive(Serialize)]
-struct Row {
+#[derive(Serialize, Deserialize)]
+pub struct Row {
     /// `pipeline` or `search`.
-    planner: &'static str,
+    pub planner: String,
     /// The search's step budget (none for the pipeline).
-    budget_steps: Option<u64>,
-    path_length_m: Summary,
+    pub budget_steps: Option<u64>,
+    /// Path length statistics over the tasks.
+    pub path_length_m: Summary,
     /// Mean length / the pipeline's mean length.
-    ratio_to_pipeline: f64,
+    pub ratio_to_pipeline: f64,
     /// Mean over tasks of length / reachability bound (tasks with a bound above 0).
-    share_of_bound: f64,
+    pub share_of_bound: f64,
     /// Steps actually taken by the returned plans, mean.
-    plan_steps: f64,
+    pub plan_steps: f64,
     /// Wall time × threads per task on this machine (ms): the CPU time a task takes.
-    cpu_ms_per_task: f64,
+    pub cpu_ms_per_task: f64,
     /// Plans the independent checker rejected.
-    checker_failures: usize,
+    pub checker_failures: usize,
+    /// Path length of every task (m), in task order (the report's Search rows per bucket).
+    pub lengths_m: Vec<f64>,
 }
 
 /// The whole record written to `search.json`.
-#[derive(Serialize)]
-struct Record {
-    robot: String,
-    tasks: String,
-    task_count: usize,
-    machine: String,
-    threads: usize,
-    search: SearchConfig,
-    reachability_bound_m: Summary,
-    rows: Vec<Row>,
+#[derive(Serialize, Deserialize)]
+pub struct Record {
+    /// Robot name.
+    pub robot: String,
+    /// Task file, relative to the workspace.
+    pub tasks: String,
+    /// Tasks planned: the first this many of the file.
+    pub task_count: usize,
+    /// Machine the times were measured on.
+    pub machine: String,
+    /// Worker threads.
+    pub threads: usize,
+    /// Search settings (`budget_steps` per row).
+    pub search: SearchConfig,
+    /// Reachability bounds of the tasks.
+    pub reachability_bound_m: Summary,
+    /// The pipeline, then the search at each budget.
+    pub rows: Vec<Row>,
+}
+
+impl Record {
+    /// The search row at the default budget of `emg plan`, if it was run.
+    pub fn default_budget_row(&self) -> Option<&Row> {
+        let budget = PlannerConfig::default().search.budget_steps;
+        self.rows.iter().find(|r| r.budget_steps == Some(budget))
+    }
 }
 
 /// Runs the comparison and writes the record, its table and its figure.
@@ -152,7 +172,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 "search"
             } else {
                 "pipeline"
-            },
+            }
+            .to_string(),
             budget_steps: budget,
             ratio_to_pipeline: summary.mean / pipeline_mean,
             path_length_m: summary,
@@ -160,6 +181,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             plan_steps: steps as f64 / tasks.len() as f64,
             cpu_ms_per_task: cpu_ms / tasks.len() as f64,
             checker_failures: failures,
+            lengths_m: lengths,
         });
     }
 

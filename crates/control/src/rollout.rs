@@ -181,10 +181,19 @@ impl<'a> Episode<'a> {
         acting: ActingController,
     ) -> StepOutcome {
         debug_assert!(self.termination.is_none(), "apply after the episode ended");
+        debug_assert_eq!(context.q, self.q, "the context of another step");
         let action = action.map(|a| a.clamp(-1.0, 1.0));
         let velocity = context.joint_velocity(&action);
         let next = self.q + velocity * self.config.dt_s;
-        self.record(Some(acting));
+        // The context already holds this configuration's tool angle and ρ.
+        self.steps.push(StepRecord {
+            time_s: self.time_s,
+            q: self.q,
+            tcp: self.kinematics.tcp(),
+            tool_angle_deg: context.tool_angle_deg,
+            rho: context.rho,
+            controller: Some(acting),
+        });
         let next_kinematics = self.robot.forward(&next);
         if let Some(violation) = first_violation(
             self.robot,

@@ -111,8 +111,20 @@ pub enum RobotError {
         /// Capsules found along the chain.
         found: usize,
     },
-    /// A collision element uses geometry other than a capsule or sphere.
-    #[error("link '{link}': collision geometry {kind} is not supported; use <capsule> or <sphere>")]
+    /// A `<cylinder>` lacks a sphere of its radius on one of its ends.
+    #[error(
+        "link '{link}': a collision cylinder needs a sphere of its radius on each end (a capsule \
+         is written as a cylinder plus two sphere caps)"
+    )]
+    UncappedCylinder {
+        /// Link carrying the cylinder.
+        link: String,
+    },
+    /// A collision element uses geometry other than a capsule, a capped cylinder or a sphere.
+    #[error(
+        "link '{link}': collision geometry {kind} is not supported; use a cylinder with a \
+         sphere cap on each end, a <capsule> or a <sphere>"
+    )]
     UnsupportedGeometry {
         /// Link carrying the geometry.
         link: String,
@@ -563,51 +575,116 @@ fn position_range(joint: &urdf_rs::Joint) -> Result<(f64, f64), RobotError> {
     Ok((lo, hi))
 }
 
+/// Distance (m) within which a sphere counts as the cap of a cylinder end: a capsule written
+/// the standard way, as a cylinder plus a sphere of the same radius at each end, reads back as
+/// one capsule.
+const CAP_TOLERANCE_M: f64 = 1e-6;
+
+/// One collision element of a link, in its segment's frame.
+struct CollisionShape {
+    /// Axis end points (equal for a sphere).
+    start: Vec3,
+    end: Vec3,
+    radius: f64,
+    /// A `<cylinder>`: it needs a sphere cap at each end.
+    cylinder: bool,
+}
+
 fn chain_capsules(chain: &[ChainLink<'_>]) -> Result<Vec<Capsule>, RobotError> {
     let mut capsules = Vec::new();
     for (chain_index, entry) in chain.iter().enumerate() {
-        for collision in &entry.link.collision {
-            let (radius, half_length) = match collision.geometry {
-                urdf_rs::Geometry::Capsule { radius, length } => (radius, 0.5 * length),
-                urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
-                ref other => {
-                    return Err(RobotError::UnsupportedGeometry {
-                        link: entry.link.name.clone(),
-                        kind: match other {
-                            urdf_rs::Geometry::Box { .. } => "box",
-                            urdf_rs::Geometry::Cylinder { .. } => "cylinder",
-                            _ => "mesh",
-                        },
+        let shapes = entry
+            .link
+            .collision
+            .iter()
+            .map(|collision| collision_shape(entry, collision))
+            .collect::<Result<Vec<_>, _>>()?;
+        for (index, shape) in shapes.iter().enumerate() {
+            if is_cap(shape, &shapes) {
+                continue;
+            }
+            if shape.cylinder {
+                for end in [&shape.start, &shape.end] {
+                    let capped = shapes.iter().enumerate().any(|(other, cap)| {
+                        other != index && !cap.cylinder && caps(cap, end, shape.radius)
                     });
+                    if !capped {
+                        return Err(RobotError::UncappedCylinder {
+                            link: entry.link.name.clone(),
+                        });
+                    }
                 }
-            };
-            let bad = |field, problem| RobotError::BadGeometry {
-                link: entry.link.name.clone(),
-                field,
-                problem,
-            };
-            if !(radius.is_finite() && radius >= 0.0) {
-                return Err(bad("radius", format!("{radius} must be a number ≥ 0")));
             }
-            if !(half_length.is_finite() && half_length >= 0.0) {
-                let length = 2.0 * half_length;
-                return Err(bad("length", format!("{length} must be a number ≥ 0")));
-            }
-            let origin = pose_to_isometry(&collision.origin).map_err(|p| bad("origin", p))?;
-            let frame = entry.offset * origin;
-            let a = frame * Point3::new(0.0, 0.0, -half_length);
-            let b = frame * Point3::new(0.0, 0.0, half_length);
             capsules.push(Capsule {
                 link: entry.link.name.clone(),
                 chain_index,
                 segment: entry.segment,
-                start: a.coords,
-                end: b.coords,
-                radius,
+                start: shape.start,
+                end: shape.end,
+                radius: shape.radius,
             });
         }
     }
     Ok(capsules)
+}
+
+/// Whether the sphere `cap` sits on the end point `end` of a cylinder of radius `radius`.
+fn caps(cap: &CollisionShape, end: &Vec3, radius: f64) -> bool {
+    (cap.start - end).norm() <= CAP_TOLERANCE_M && (cap.radius - radius).abs() <= CAP_TOLERANCE_M
+}
+
+/// Whether `shape` is a sphere capping an end of one of the link's cylinders.
+fn is_cap(shape: &CollisionShape, shapes: &[CollisionShape]) -> bool {
+    !shape.cylinder
+        && (shape.start - shape.end).norm() == 0.0
+        && shapes.iter().any(|cylinder| {
+            cylinder.cylinder
+                && [&cylinder.start, &cylinder.end]
+                    .into_iter()
+                    .any(|end| caps(shape, end, cylinder.radius))
+        })
+}
+
+/// A `<capsule>`, `<cylinder>` or `<sphere>` collision element in its segment's frame: an axis
+/// of the given length along the element's z-axis, swept by the radius.
+fn collision_shape(
+    entry: &ChainLink<'_>,
+    collision: &urdf_rs::Collision,
+) -> Result<CollisionShape, RobotError> {
+    let (radius, half_length, cylinder) = match collision.geometry {
+        urdf_rs::Geometry::Capsule { radius, length } => (radius, 0.5 * length, false),
+        urdf_rs::Geometry::Cylinder { radius, length } => (radius, 0.5 * length, true),
+        urdf_rs::Geometry::Sphere { radius } => (radius, 0.0, false),
+        ref other => {
+            return Err(RobotError::UnsupportedGeometry {
+                link: entry.link.name.clone(),
+                kind: match other {
+                    urdf_rs::Geometry::Box { .. } => "box",
+                    _ => "mesh",
+                },
+            });
+        }
+    };
+    let bad = |field, problem| RobotError::BadGeometry {
+        link: entry.link.name.clone(),
+        field,
+        problem,
+    };
+    if !(radius.is_finite() && radius >= 0.0) {
+        return Err(bad("radius", format!("{radius} must be a number ≥ 0")));
+    }
+    if !(half_length.is_finite() && half_length >= 0.0) {
+        let length = 2.0 * half_length;
+        return Err(bad("length", format!("{length} must be a number ≥ 0")));
+    }
+    let origin = pose_to_isometry(&collision.origin).map_err(|p| bad("origin", p))?;
+    let frame = entry.offset * origin;
+    Ok(CollisionShape {
+        start: (frame * Point3::new(0.0, 0.0, -half_length)).coords,
+        end: (frame * Point3::new(0.0, 0.0, half_length)).coords,
+        radius,
+        cylinder,
+    })
 }
 
 fn collision_pairs(capsules: &[Capsule]) -> Vec<CollisionPair> {

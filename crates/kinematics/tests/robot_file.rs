@@ -1,8 +1,9 @@
 //! Loading robot files: the shipped FR3 file's structure (joint names, limits), every load error
 //! (unreadable file, malformed XML, missing base/tip link, tip not below base, a branching
 //! chain, a loop of joints, a prismatic joint, six revolute joints, lower > upper, zero axis, bad
-//! velocity, non-finite origins or capsules, unsupported geometry) with a message naming the
-//! offending field or link, and the load-time axis alignment: joints given with a non-z axis and
+//! velocity, non-finite origins or capsules, unsupported geometry, a cylinder without its sphere
+//! caps) with a message naming the offending field or link; a capsule written as a cylinder plus
+//! two sphere caps reads back exactly as the `<capsule>` element it stands for; and the load-time axis alignment: joints given with a non-z axis and
 //! a compensating origin rotation must give the same FK and collision geometry as the z-axis
 //! original.
 
@@ -249,7 +250,7 @@ fn zero_axis_and_bad_velocity_are_rejected() {
 #[test]
 fn box_geometry_is_rejected() {
     let text = edited(
-        "<geometry><capsule radius=\"0.05\" length=\"0.08\"/></geometry>",
+        "<geometry><cylinder radius=\"0.05\" length=\"0.08\"/></geometry>",
         "<geometry><box size=\"0.1 0.1 0.1\"/></geometry>",
     );
     let (error, message) = error_message(load(&text));
@@ -311,7 +312,7 @@ fn kinematics_difference(
 fn non_z_joint_axis_is_aligned_at_load_time() {
     // Joint 1 about the local y axis of an origin turned +π/2 about x (which takes y onto z): the
     // same joint. Its child frame is then turned by Rx(π/2), so joint 2's origin and link1's
-    // capsule are expressed in that turned frame: Rx(−π/2)·(old pose).
+    // capsule (with its caps) are expressed in that turned frame: Rx(−π/2)·(old pose).
     let text = edited(
         "<origin xyz=\"0 0 0.333\" rpy=\"0 0 0\"/>\n    <axis xyz=\"0 0 1\"/>",
         "<origin xyz=\"0 0 0.333\" rpy=\"1.5707963267948966 0 0\"/>\n    <axis xyz=\"0 1 0\"/>",
@@ -326,6 +327,18 @@ fn non_z_joint_axis_is_aligned_at_load_time() {
         "<origin xyz=\"0 -0.1915 0\" rpy=\"-1.5707963267948966 0 0\"/>",
         1,
     );
+    // ... and so are its two sphere caps.
+    let text = text
+        .replacen(
+            "<origin xyz=\"0 0 -0.333\" rpy=\"0 0 0\"/>",
+            "<origin xyz=\"0 -0.333 0\" rpy=\"0 0 0\"/>",
+            1,
+        )
+        .replacen(
+            "<origin xyz=\"0 0 -0.05\" rpy=\"0 0 0\"/>",
+            "<origin xyz=\"0 -0.05 0\" rpy=\"0 0 0\"/>",
+            1,
+        );
     assert_ne!(text, robot_text());
     let reference = robot();
     let rotated = load(&text).expect("equivalent robot file loads");
@@ -380,8 +393,8 @@ fn non_finite_origins_and_capsules_are_rejected() {
     );
     assert!(message.contains("fr3_joint1"), "{message}");
     let text = edited(
-        "<geometry><capsule radius=\"0.05\" length=\"0.08\"/></geometry>",
-        "<geometry><capsule radius=\"NaN\" length=\"0.08\"/></geometry>",
+        "<geometry><cylinder radius=\"0.05\" length=\"0.08\"/></geometry>",
+        "<geometry><cylinder radius=\"NaN\" length=\"0.08\"/></geometry>",
     );
     let (error, message) = error_message(load(&text));
     assert!(
@@ -407,4 +420,74 @@ fn a_loop_of_joints_is_not_a_chain() {
     );
     let (error, _) = error_message(load(&text));
     assert!(matches!(error, RobotError::NotAChain { .. }), "{error:?}");
+}
+
+/// link6 of the shipped file: one capsule written as a cylinder plus a sphere cap on each end.
+const LINK6_CAPSULE: &str = r#"    <collision>
+      <origin xyz="0 0 -0.03" rpy="0 0 0"/>
+      <geometry><cylinder radius="0.05" length="0.08"/></geometry>
+    </collision>
+    <collision>
+      <origin xyz="0 0 -0.07" rpy="0 0 0"/>
+      <geometry><sphere radius="0.05"/></geometry>
+    </collision>
+    <collision>
+      <origin xyz="0 0 0.01" rpy="0 0 0"/>
+      <geometry><sphere radius="0.05"/></geometry>
+    </collision>
+"#;
+
+#[test]
+fn capped_cylinder_reads_back_as_the_capsule_it_stands_for() {
+    let shipped = robot();
+    assert_eq!(
+        shipped.capsules().len(),
+        13,
+        "one capsule per cylinder with its caps"
+    );
+    let as_capsule = edited(
+        LINK6_CAPSULE,
+        r#"    <collision>
+      <origin xyz="0 0 -0.03" rpy="0 0 0"/>
+      <geometry><capsule radius="0.05" length="0.08"/></geometry>
+    </collision>
+"#,
+    );
+    let robot = load(&as_capsule).expect("a <capsule> element loads");
+    assert_eq!(robot.capsules(), shipped.capsules());
+    assert_eq!(robot.collision_pairs(), shipped.collision_pairs());
+}
+
+#[test]
+fn cylinder_without_both_caps_is_rejected() {
+    let one_cap = edited(
+        LINK6_CAPSULE,
+        &LINK6_CAPSULE.replace(
+            r#"<origin xyz="0 0 0.01" rpy="0 0 0"/>"#,
+            r#"<origin xyz="0 0 0.02" rpy="0 0 0"/>"#,
+        ),
+    );
+    let (error, message) = error_message(load(&one_cap));
+    assert!(
+        matches!(error, RobotError::UncappedCylinder { .. }),
+        "{error:?}"
+    );
+    assert!(
+        message.contains("link6") && message.contains("sphere"),
+        "{message}"
+    );
+    // A cap of another radius does not close the cylinder either.
+    let wrong_radius = edited(
+        LINK6_CAPSULE,
+        &LINK6_CAPSULE.replacen(
+            r#"<sphere radius="0.05"/>"#,
+            r#"<sphere radius="0.04"/>"#,
+            1,
+        ),
+    );
+    let (error, _) = error_message(load(&wrong_radius));
+    assert!(
+        matches!(error, RobotError::UncappedCylinder { .. }),
+        "{error:?}"
+    );
 }

@@ -55,8 +55,14 @@ pub enum ModelError {
     /// A link of the chain is named by a joint but not defined.
     #[error("link '{0}' is not defined")]
     MissingLink(String),
-    /// A collision element is neither a capsule nor a sphere.
-    #[error("link '{0}': unsupported collision geometry (the checker reads capsules and spheres)")]
+    /// A collision cylinder lacks a sphere cap on one of its ends.
+    #[error("link '{0}': a collision cylinder needs a sphere of its radius on each end")]
+    UncappedCylinder(String),
+    /// A collision element is neither a capsule, a capped cylinder nor a sphere.
+    #[error(
+        "link '{0}': unsupported collision geometry (the checker reads capsules, cylinders \
+         with sphere caps and spheres)"
+    )]
     Geometry(String),
     /// The walk from the tip towards the base comes back to a link it has passed.
     #[error("the joints from the tip towards the base form a loop at link '{0}'")]
@@ -148,10 +154,12 @@ impl ReferenceModel {
                 .iter()
                 .find(|l| &l.name == name)
                 .ok_or_else(|| ModelError::MissingLink(name.clone()))?;
+            let mut elements = Vec::new();
             for collision in &link.collision {
-                let (radius, half) = match collision.geometry {
-                    urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0),
-                    urdf_rs::Geometry::Sphere { radius } => (radius, 0.0),
+                let (radius, half, cylinder) = match collision.geometry {
+                    urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0, false),
+                    urdf_rs::Geometry::Cylinder { radius, length } => (radius, length / 2.0, true),
+                    urdf_rs::Geometry::Sphere { radius } => (radius, 0.0, false),
                     _ => return Err(ModelError::Geometry(name.clone())),
                 };
                 let element = format!("link '{name}' collision");
@@ -170,14 +178,16 @@ impl ReferenceModel {
                 let rotation = Rotation3::from_euler_angles(r, p, yaw);
                 let centre = Vector3::new(x, y, z);
                 let axis = rotation * Vector3::z() * half;
-                capsules.push(ReferenceCapsule {
+                let capsule = ReferenceCapsule {
                     link: name.clone(),
                     chain_index,
                     start: centre - axis,
                     end: centre + axis,
                     radius,
-                });
+                };
+                elements.push((capsule, cylinder));
             }
+            capsules.extend(merge_sphere_caps(name, elements)?);
         }
         let revolute = joints.iter().filter(|j| j.axis.is_some()).count();
         if revolute != JOINTS {
@@ -319,4 +329,52 @@ fn finite(element: &str, groups: &[&[f64; 3]]) -> Result<(), ModelError> {
         element: element.to_string(),
         problem: format!("{groups:?} must be finite numbers"),
     })
+}
+
+/// Distance (m) within which a sphere sits on a cylinder end as its cap.
+const CAP_TOLERANCE: f64 = 1e-6;
+
+/// The capsules of one link's collision elements `(element, is a cylinder)`: a cylinder and the
+/// spheres of its radius centred on its two ends are one capsule (the standard way to write a
+/// capsule in URDF); a cylinder missing a cap is refused.
+fn merge_sphere_caps(
+    link: &str,
+    elements: Vec<(ReferenceCapsule, bool)>,
+) -> Result<Vec<ReferenceCapsule>, ModelError> {
+    let on_end = |sphere: &ReferenceCapsule, end: &Vector3<f64>, radius: f64| {
+        sphere.start == sphere.end
+            && (sphere.start - end).norm() <= CAP_TOLERANCE
+            && (sphere.radius - radius).abs() <= CAP_TOLERANCE
+    };
+    let cylinders: Vec<&ReferenceCapsule> = elements
+        .iter()
+        .filter(|(_, c)| *c)
+        .map(|(e, _)| e)
+        .collect();
+    let spheres: Vec<&ReferenceCapsule> = elements
+        .iter()
+        .filter(|(_, c)| !*c)
+        .map(|(e, _)| e)
+        .collect();
+    for cylinder in &cylinders {
+        for end in [&cylinder.start, &cylinder.end] {
+            if !spheres.iter().any(|s| on_end(s, end, cylinder.radius)) {
+                return Err(ModelError::UncappedCylinder(link.to_string()));
+            }
+        }
+    }
+    let is_cap = |element: &ReferenceCapsule| {
+        cylinders
+            .iter()
+            .any(|c| on_end(element, &c.start, c.radius) || on_end(element, &c.end, c.radius))
+    };
+    let keep: Vec<bool> = elements
+        .iter()
+        .map(|(element, cylinder)| *cylinder || !is_cap(element))
+        .collect();
+    Ok(elements
+        .into_iter()
+        .zip(keep)
+        .filter_map(|((element, _), keep)| keep.then_some(element))
+        .collect())
 }

@@ -74,3 +74,50 @@ fn a_loop_of_joints_and_unusable_numbers_are_refused() {
         }
     }
 }
+
+/// link6 of the shipped file: one capsule written as a cylinder plus a sphere cap on each end.
+const LINK6_CAPSULE: &str = r#"    <collision>
+      <origin xyz="0 0 -0.03" rpy="0 0 0"/>
+      <geometry><cylinder radius="0.05" length="0.08"/></geometry>
+    </collision>
+    <collision>
+      <origin xyz="0 0 -0.07" rpy="0 0 0"/>
+      <geometry><sphere radius="0.05"/></geometry>
+    </collision>
+    <collision>
+      <origin xyz="0 0 0.01" rpy="0 0 0"/>
+      <geometry><sphere radius="0.05"/></geometry>
+    </collision>
+"#;
+
+#[test]
+fn a_capped_cylinder_is_the_capsule_it_stands_for_and_an_uncapped_one_is_refused() {
+    let shipped_text = fr3_text();
+    assert_eq!(shipped_text.matches(LINK6_CAPSULE).count(), 1);
+    let as_capsule = shipped_text.replace(
+        LINK6_CAPSULE,
+        r#"    <collision>
+      <origin xyz="0 0 -0.03" rpy="0 0 0"/>
+      <geometry><capsule radius="0.05" length="0.08"/></geometry>
+    </collision>
+"#,
+    );
+    let shipped = ReferenceModel::from_urdf_str(&shipped_text, "link0", "pen_tip").unwrap();
+    let capsule = ReferenceModel::from_urdf_str(&as_capsule, "link0", "pen_tip").unwrap();
+    for k in 0..200 {
+        let t = f64::from(k) * 0.05;
+        let q = Joints::from_fn(|i, _| (t * (1.0 + i as f64)).sin() * 1.5);
+        assert_eq!(shipped.min_clearance(&q), capsule.min_clearance(&q));
+    }
+    let uncapped = shipped_text.replace(
+        LINK6_CAPSULE,
+        &LINK6_CAPSULE.replace(r#"xyz="0 0 0.01""#, r#"xyz="0 0 0.02""#),
+    );
+    let error = ReferenceModel::from_urdf_str(&uncapped, "link0", "pen_tip")
+        .err()
+        .expect("a cylinder with one cap is refused");
+    assert!(
+        matches!(error, ModelError::UncappedCylinder(ref link) if link == "link6"),
+        "{error}"
+    );
+}
