@@ -186,14 +186,7 @@ impl<'a> Episode<'a> {
         let velocity = context.joint_velocity(&action);
         let next = self.q + velocity * self.config.dt_s;
         // The context already holds this configuration's tool angle and ρ.
-        self.steps.push(StepRecord {
-            time_s: self.time_s,
-            q: self.q,
-            tcp: self.kinematics.tcp(),
-            tool_angle_deg: context.tool_angle_deg,
-            rho: context.rho,
-            controller: Some(acting),
-        });
+        self.push_record(Some(acting), context.tool_angle_deg, context.rho);
         let next_kinematics = self.robot.forward(&next);
         if let Some(violation) = first_violation(
             self.robot,
@@ -266,14 +259,21 @@ impl<'a> Episode<'a> {
         self.config.dt_s * stretch
     }
 
+    /// Records the current configuration, measuring its tool angle and `ρ`.
     fn record(&mut self, controller: Option<ActingController>) {
-        let kinematics = &self.kinematics;
+        let angle = tool_angle_deg(&self.kinematics.tool_axis(), &self.task.n);
+        let rho = self.robot.limits().limit_proximity(&self.q);
+        self.push_record(controller, angle, rho);
+    }
+
+    /// Records the current configuration with its tool angle and `ρ` already known.
+    fn push_record(&mut self, controller: Option<ActingController>, tool_angle_deg: f64, rho: f64) {
         self.steps.push(StepRecord {
             time_s: self.time_s,
             q: self.q,
-            tcp: kinematics.tcp(),
-            tool_angle_deg: tool_angle_deg(&kinematics.tool_axis(), &self.task.n),
-            rho: self.robot.limits().limit_proximity(&self.q),
+            tcp: self.kinematics.tcp(),
+            tool_angle_deg,
+            rho,
             controller,
         });
     }
