@@ -1,6 +1,6 @@
 //! Every constant of the rollout and the classical controller, with SPEC defaults (serde).
 
-use emg_kinematics::{BasisConfig, DampingConfig};
+use emg_kinematics::{BasisConfig, DampingConfig, Scene};
 use serde::{Deserialize, Serialize};
 
 /// The constraints a rollout must hold at every step (SPEC §2).
@@ -17,6 +17,15 @@ pub struct ConstraintConfig {
     /// `null`) leaves joint speeds unbounded, as the paper's runs do. Steps that would be faster
     /// are slowed down in time, not changed in shape (see [`crate::Episode`]).
     pub velocity_limit_fraction: Option<VelocityLimitFraction>,
+    /// Keep every capsule of the arm but the tool's off the task's work surface (SPEC §9: the
+    /// plane through `p0` with normal `n`, material on `(x − p0)·n > 0`). Off by default, as in
+    /// the paper's protocol; `emg plan` turns it on.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub work_surface: bool,
+    /// Obstacles of the cell; every capsule of the arm, the tool's included, keeps each one's
+    /// clearance.
+    #[serde(skip_serializing_if = "Scene::is_empty")]
+    pub scene: Scene,
 }
 
 impl Default for ConstraintConfig {
@@ -26,6 +35,8 @@ impl Default for ConstraintConfig {
             theta_max_deg: 30.0,
             collision_margin_m: 0.0,
             velocity_limit_fraction: Some(VelocityLimitFraction::FULL),
+            work_surface: false,
+            scene: Scene::default(),
         }
     }
 }

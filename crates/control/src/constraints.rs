@@ -1,6 +1,6 @@
 //! The constraints every step must hold, and which one a configuration breaks.
 
-use emg_kinematics::{JointVector, Kinematics, Robot, Vec3};
+use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::config::ConstraintConfig;
@@ -38,7 +38,20 @@ pub enum Violation {
         /// Surface clearance (m), negative when interpenetrating.
         clearance_m: f64,
     },
+    /// A capsule of the arm came closer to an obstacle of the scene, or to the task's work
+    /// surface, than its clearance.
+    SceneContact {
+        /// Link carrying the capsule.
+        link: String,
+        /// The obstacle's name ([`WORK_SURFACE`] for the work surface).
+        obstacle: String,
+        /// Surface distance (m) between capsule and obstacle, negative when they overlap.
+        clearance_m: f64,
+    },
 }
+
+/// The name the work surface goes by in violations and reports.
+pub const WORK_SURFACE: &str = "work surface";
 
 impl Violation {
     /// Short machine-readable name of the constraint (`joint_limit`, `line_tolerance`, ...).
@@ -48,6 +61,7 @@ impl Violation {
             Self::LineTolerance { .. } => "line_tolerance",
             Self::ToolCone { .. } => "tool_cone",
             Self::SelfCollision { .. } => "self_collision",
+            Self::SceneContact { .. } => "scene_contact",
         }
     }
 }
@@ -85,6 +99,15 @@ impl std::fmt::Display for Violation {
                 "self-collision between {first_link} and {second_link} (clearance {:.2} mm)",
                 clearance_m * 1e3
             ),
+            Self::SceneContact {
+                link,
+                obstacle,
+                clearance_m,
+            } => write!(
+                f,
+                "{link} touched the {obstacle} (clearance {:.2} mm)",
+                clearance_m * 1e3
+            ),
         }
     }
 }
@@ -94,7 +117,8 @@ pub fn tool_angle_deg(z: &Vec3, n: &Vec3) -> f64 {
     z.cross(n).norm().atan2(z.dot(n)).to_degrees()
 }
 
-/// The first constraint `q` breaks, checked in the order joint limits, line, cone, collision.
+/// The first constraint `q` breaks, checked in the order joint limits, line, cone, collision
+/// (self-collision, then the work surface, then the scene's obstacles).
 pub fn first_violation(
     robot: &Robot,
     task: &Task,
@@ -126,14 +150,45 @@ pub fn first_violation(
     if angle.is_nan() || angle > cfg.theta_max_deg {
         return Some(Violation::ToolCone { angle_deg: angle });
     }
-    robot
-        .first_collision(kin, cfg.collision_margin_m)
-        .map(|hit| {
-            let capsules = robot.capsules();
-            Violation::SelfCollision {
-                first_link: capsules[hit.pair.first].link.clone(),
-                second_link: capsules[hit.pair.second].link.clone(),
-                clearance_m: hit.clearance,
-            }
-        })
+    first_contact(robot, task, kin, cfg)
+}
+
+/// The first contact of the arm at `kin`: a capsule pair closer than the collision margin, a
+/// capsule other than the tool's on the far side of the work surface (when it is on), or a
+/// capsule closer to an obstacle of the scene than its clearance.
+pub fn first_contact(
+    robot: &Robot,
+    task: &Task,
+    kin: &Kinematics,
+    cfg: &ConstraintConfig,
+) -> Option<Violation> {
+    if let Some(hit) = robot.first_collision(kin, cfg.collision_margin_m) {
+        let capsules = robot.capsules();
+        return Some(Violation::SelfCollision {
+            first_link: capsules[hit.pair.first].link.clone(),
+            second_link: capsules[hit.pair.second].link.clone(),
+            clearance_m: hit.clearance,
+        });
+    }
+    let scene_contact = |obstacle: &str, hit: emg_kinematics::ContactHit| Violation::SceneContact {
+        link: robot.capsules()[hit.capsule].link.clone(),
+        obstacle: obstacle.to_string(),
+        clearance_m: hit.clearance,
+    };
+    if cfg.work_surface {
+        let surface = Shape::work_surface(&task.p0, &task.n);
+        if let Some(hit) = robot.first_contact(kin, &surface, 0.0, ToolContact::Allowed) {
+            return Some(scene_contact(WORK_SURFACE, hit));
+        }
+    }
+    cfg.scene.obstacles.iter().find_map(|obstacle| {
+        robot
+            .first_contact(
+                kin,
+                &obstacle.shape,
+                obstacle.clearance_m,
+                ToolContact::Forbidden,
+            )
+            .map(|hit| scene_contact(&obstacle.name, hit))
+    })
 }

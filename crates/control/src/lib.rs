@@ -39,7 +39,7 @@ pub use config::{
     ClassicalGains, ConstraintConfig, MAX_STEPS_CAP, OutOfRange, RolloutConfig,
     VelocityLimitFraction,
 };
-pub use constraints::{Violation, first_violation, tool_angle_deg};
+pub use constraints::{Violation, WORK_SURFACE, first_contact, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
 pub use rollout::{
     Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,

@@ -2,8 +2,10 @@
 //! recorded trajectory as the checker's plain data. Nothing here checks anything; the checker
 //! recomputes every quantity from the robot file.
 
+use emg_kinematics::Shape;
 use emg_verify::{
-    Blame, Bounds, CheckFailure, Ending, Line, RecordedStep, Recording, ReferenceModel,
+    Blame, Bounds, CheckFailure, Ending, Line, Obstacle, RecordedStep, Recording, ReferenceModel,
+    Solid,
 };
 
 use crate::config::ConstraintConfig;
@@ -28,7 +30,46 @@ impl From<&ConstraintConfig> for Bounds {
             theta_max_deg: constraints.theta_max_deg,
             collision_margin_m: constraints.collision_margin_m,
             velocity_limit_fraction: constraints.velocity_limit_fraction.map(|f| f.get()),
+            work_surface: constraints.work_surface,
+            obstacles: constraints
+                .scene
+                .obstacles
+                .iter()
+                .map(|obstacle| Obstacle {
+                    name: obstacle.name.clone(),
+                    solid: solid(&obstacle.shape),
+                    clearance_m: obstacle.clearance_m,
+                })
+                .collect(),
         }
+    }
+}
+
+/// The checker's plain description of a shape.
+fn solid(shape: &Shape) -> Solid {
+    match shape {
+        Shape::HalfSpace { point, normal } => Solid::HalfSpace {
+            point: *point,
+            outward: *normal,
+        },
+        Shape::Cuboid {
+            centre,
+            rotation,
+            half_extents,
+        } => Solid::Box {
+            centre: *centre,
+            axes: *rotation.matrix(),
+            half_extents: *half_extents,
+        },
+        Shape::Sphere { centre, radius } => Solid::Ball {
+            centre: *centre,
+            radius: *radius,
+        },
+        Shape::Capsule { start, end, radius } => Solid::Capsule {
+            a: *start,
+            b: *end,
+            radius: *radius,
+        },
     }
 }
 
@@ -39,6 +80,7 @@ impl From<&Violation> for Blame {
             Violation::LineTolerance { .. } => Self::LineTolerance,
             Violation::ToolCone { .. } => Self::ToolCone,
             Violation::SelfCollision { .. } => Self::SelfCollision,
+            Violation::SceneContact { .. } => Self::SceneContact,
         }
     }
 }

@@ -18,7 +18,7 @@ mod common;
 use emg_control::{
     ActingController, CheckRollout, ClassicalController, ClassicalGains, NullAction,
     NullSpaceController, RolloutConfig, StepContext, Task, Termination, Trajectory, Violation,
-    first_violation, rollout, tool_angle_deg,
+    first_contact, first_violation, rollout, tool_angle_deg,
 };
 use emg_kinematics::{JointVector, Robot, null_space_basis};
 use rand::RngExt;
@@ -122,6 +122,10 @@ fn assert_invariants(robot: &Robot, task: &Task, trajectory: &Trajectory, config
                             .first_collision(&kin, config.constraints.collision_margin_m)
                             .is_some()
                     );
+                }
+                Violation::SceneContact { .. } => {
+                    let contact = first_contact(robot, task, &kin, &config.constraints);
+                    assert_eq!(contact.as_ref(), Some(violation));
                 }
             }
         }

@@ -13,6 +13,8 @@
 //! * [`null_space_basis`] and [`task_aligned_basis`]: `N` and the Gram–Schmidt basis `B(q)`.
 //! * [`Robot::first_collision`] and [`Robot::min_clearance`]: capsule clearances between bodies at
 //!   least three links apart.
+//! * [`Robot::first_contact`]: capsule clearances from the obstacles of a [`Scene`] and from a
+//!   task's work surface ([`Shape::work_surface`]).
 //! * [`project_to_pose`]: Newton projection onto an exact `(p0, n[, roll])` pose within limits.
 //!
 //! ```
@@ -35,6 +37,7 @@ mod nullspace;
 mod projection;
 mod pseudo_inverse;
 mod robot;
+mod scene;
 
 pub use collision::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
 pub use fk::{Kinematics, PositionJacobian};
@@ -45,6 +48,7 @@ pub use projection::{
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
+pub use scene::{ContactHit, Obstacle, ObstacleError, Scene, Shape, ToolContact};
 
 /// Number of actuated joints of every supported arm.
 pub const DOF: usize = 7;

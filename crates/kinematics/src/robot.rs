@@ -200,6 +200,8 @@ pub struct Robot {
     pub(crate) capsules: Vec<Capsule>,
     /// Radius of each capsule's bounding sphere (half its axis length plus its radius).
     pub(crate) bounding_radii: Vec<f64>,
+    /// Index of the first of the tool's capsules (they close the list).
+    pub(crate) first_tool_capsule: usize,
     pub(crate) pairs: Vec<CollisionPair>,
     pub(crate) reach_centre: Vec3,
     pub(crate) reach_radius: f64,
@@ -317,6 +319,7 @@ impl Robot {
             .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
             .collect();
         let pairs = collision_pairs(&capsules);
+        let first_tool_capsule = first_tool_capsule(&capsules);
         let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
         let reach_centre = joints[0].translation;
         let reach_radius = joints[1..]
@@ -341,6 +344,7 @@ impl Robot {
             },
             capsules,
             bounding_radii,
+            first_tool_capsule,
             pairs,
             reach_centre,
             reach_radius,
@@ -400,6 +404,13 @@ impl Robot {
     /// The collision capsules of every body of the chain.
     pub fn capsules(&self) -> &[Capsule] {
         &self.capsules
+    }
+
+    /// Indices (into [`Robot::capsules`]) of the tool's capsules: those of the last link of the
+    /// chain that carries any, when that link moves with the last joint (the pen of the shipped
+    /// robots); empty when the last joint's segment carries no capsule.
+    pub fn tool_capsules(&self) -> std::ops::Range<usize> {
+        self.first_tool_capsule..self.capsules.len()
     }
 
     /// The capsule pairs checked for self-collision: bodies at least three links apart that
@@ -588,6 +599,18 @@ struct CollisionShape {
     radius: f64,
     /// A `<cylinder>`: it needs a sphere cap at each end.
     cylinder: bool,
+}
+
+/// Index of the first capsule of the tool (see [`Robot::tool_capsules`]); capsules come in chain
+/// order, so the tool's close the list.
+fn first_tool_capsule(capsules: &[Capsule]) -> usize {
+    match capsules.last() {
+        Some(last) if last.segment == DOF => capsules
+            .iter()
+            .position(|c| c.chain_index == last.chain_index)
+            .expect("the last capsule is in the list"),
+        _ => capsules.len(),
+    }
 }
 
 fn chain_capsules(chain: &[ChainLink<'_>]) -> Result<Vec<Capsule>, RobotError> {

@@ -2,7 +2,8 @@
 //!
 //! Every point `p0 + s·d` of a 1 cm grid is searched, in order from `s = 0`, for a configuration
 //! that puts the TCP on the point (or, failing that, within the line tolerance of it) with the
-//! tool axis inside the cone around `n`, inside the joint limits and free of self-collision. The
+//! tool axis inside the cone around `n`, inside the joint limits, free of self-collision and
+//! clear of the work surface and the scene's obstacles when the constraints hold them. The
 //! scan stops at the first grid point where none is found; the bound is the last point reached.
 //!
 //! It is a *necessary* condition: a motion along the line needs such a configuration at every
@@ -11,7 +12,7 @@
 //! good as its IK sampling (warm starts from the previous point's solutions, then seeded random
 //! restarts): a point the sampling misses ends the scan early.
 
-use emg_control::{ConstraintConfig, OutOfRange, Task};
+use emg_control::{ConstraintConfig, OutOfRange, Task, first_contact};
 use emg_kinematics::{JointVector, Robot, Vec3};
 use emg_seeding::{IkConfig, solve_cone_ik};
 use rand::{RngExt, SeedableRng};
@@ -164,10 +165,7 @@ impl Scan<'_> {
         let (robot, ik, config) = (self.robot, &self.ik, self.config);
         let valid = |start: &JointVector| {
             solve_cone_ik(robot, start, target, &self.task.n, ik).filter(|q| {
-                let kinematics = robot.forward(q);
-                robot
-                    .first_collision(&kinematics, self.constraints.collision_margin_m)
-                    .is_none()
+                first_contact(robot, self.task, &robot.forward(q), self.constraints).is_none()
             })
         };
         let mut found: Vec<JointVector> = Vec::new();

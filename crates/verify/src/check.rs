@@ -29,6 +29,9 @@ pub enum FailedCheck {
     ToolCone,
     /// Two capsules of the arm are closer than the margin.
     SelfCollision,
+    /// A capsule of the arm is nearer an obstacle (or, the tool's excepted, the work surface)
+    /// than its clearance.
+    SceneContact,
     /// Timestamps are not finite or do not increase.
     Timestamps,
     /// Joint `joint` (1-based) moves faster than its share of the velocity limit.
@@ -57,7 +60,8 @@ pub struct CheckFailure {
 
 impl ReferenceModel {
     /// Verifies every point of `recording` against `bounds` and its own records: joint limits,
-    /// TCP and tool angle as recorded, line tolerance, tool cone, no self-collision, increasing
+    /// TCP and tool angle as recorded, line tolerance, tool cone, no self-collision, the
+    /// clearance of every obstacle and of the work surface (when `bounds` hold them), increasing
     /// timestamps, joint speeds within the velocity limits (when `bounds` enforce them), the
     /// reported path length, and that a rejected configuration really breaks the constraint it
     /// is blamed on.
@@ -151,6 +155,15 @@ impl ReferenceModel {
                     format!("{a} and {b} collide (clearance {gap} m)"),
                 );
             }
+            if let Some((margin, link, obstacle)) = self.scene_margin(q, line, bounds)
+                && !within(-SLACK, margin)
+            {
+                return fail(
+                    k,
+                    FailedCheck::SceneContact,
+                    format!("{link} is {margin} m inside the clearance of the {obstacle}"),
+                );
+            }
             if !step.time_s.is_finite() {
                 return fail(
                     k,
@@ -238,6 +251,9 @@ impl ReferenceModel {
                 bounds.theta_max_deg - ANGLE_SLACK_DEG,
             ),
             Blame::SelfCollision => self.min_clearance(q).0 < bounds.collision_margin_m + SLACK,
+            Blame::SceneContact => self
+                .scene_margin(q, line, bounds)
+                .is_some_and(|(margin, ..)| !within(SLACK, margin)),
         }
     }
 }

@@ -19,6 +19,8 @@
 //!     theta_max_deg: 30.0,
 //!     collision_margin_m: 0.0,
 //!     velocity_limit_fraction: Some(1.0),
+//!     work_surface: false,
+//!     obstacles: Vec::new(),
 //! };
 //! let start = RecordedStep { time_s: 0.0, q, tcp, tool_angle_deg: 0.0 };
 //! let recording = Recording { steps: vec![start], ending: Ending::Stopped, path_length_m: 0.0 };
@@ -38,7 +40,9 @@ pub use dynamics::{
     REST_TOLERANCE, check_dynamics,
 };
 pub use model::{ModelError, ReferenceModel};
-pub use record::{Blame, Bounds, Ending, JOINTS, Joints, Line, RecordedStep, Recording};
+pub use record::{
+    Blame, Bounds, Ending, JOINTS, Joints, Line, Obstacle, RecordedStep, Recording, Solid,
+};
 pub use replay::{
     DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,
     VELOCITY_LIMIT_SLACK, check_joint_names, check_replay, point_velocities,

@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix4, Rotation3, Unit, Vector3, Vector4};
 
-use crate::record::{JOINTS, Joints};
+use crate::record::{Bounds, JOINTS, Joints, Line, Solid};
 
 /// The position range (rad) the planners give a `continuous` joint, as documented: a full turn
 /// each way of zero.
@@ -32,7 +32,17 @@ struct ReferenceJoint {
 pub struct ReferenceModel {
     joints: Vec<ReferenceJoint>,
     capsules: Vec<ReferenceCapsule>,
+    /// Chain index of the link whose capsules are the tool (the last link carrying capsules,
+    /// when no revolute joint follows it), if any.
+    tool_link: Option<usize>,
 }
+
+/// The name the work surface goes by in failures.
+const WORK_SURFACE: &str = "work surface";
+
+/// Golden-section iterations when minimising a convex distance along a capsule's axis: the
+/// bracket shrinks to 0.618^200 of the axis, far below rounding.
+const GOLDEN_SECTION_STEPS: usize = 200;
 
 /// Why the checker cannot read a robot file.
 #[derive(Debug, thiserror::Error)]
@@ -193,7 +203,22 @@ impl ReferenceModel {
         if revolute != JOINTS {
             return Err(ModelError::JointCount(revolute));
         }
-        Ok(Self { joints, capsules })
+        // Link i + 1 is the child of joint i: the links from the last revolute joint's child on
+        // move rigidly with the last joint.
+        let last_moving_link = joints
+            .iter()
+            .rposition(|j| j.axis.is_some())
+            .map_or(0, |i| i + 1);
+        let tool_link = capsules
+            .iter()
+            .map(|c| c.chain_index)
+            .max()
+            .filter(|&link| link >= last_moving_link);
+        Ok(Self {
+            joints,
+            capsules,
+            tool_link,
+        })
     }
 
     /// Reads the chain from `base` to `tip` of a URDF file.
@@ -276,6 +301,95 @@ impl ReferenceModel {
             }
         }
         best
+    }
+}
+
+impl ReferenceModel {
+    /// Smallest margin (m) over the obstacles of `bounds` and, when `bounds` ask for it, the
+    /// work surface of `line` (which the tool's capsules may touch): a capsule's surface
+    /// distance from the solid minus the clearance asked for, with the capsule's link and the
+    /// obstacle's name; `None` when there is nothing to keep away from.
+    pub fn scene_margin(
+        &self,
+        q: &Joints,
+        line: &Line,
+        bounds: &Bounds,
+    ) -> Option<(f64, String, String)> {
+        let frames = self.link_frames(q);
+        let surface = Solid::HalfSpace {
+            point: line.p0,
+            outward: -line.n,
+        };
+        let surface = bounds
+            .work_surface
+            .then_some((&surface, 0.0, WORK_SURFACE, true));
+        let obstacles = bounds
+            .obstacles
+            .iter()
+            .map(|o| (&o.solid, o.clearance_m, o.name.as_str(), false));
+        let mut worst: Option<(f64, String, String)> = None;
+        for (solid, clearance, name, tool_may_touch) in surface.into_iter().chain(obstacles) {
+            for capsule in &self.capsules {
+                if tool_may_touch && Some(capsule.chain_index) == self.tool_link {
+                    continue;
+                }
+                let frame = &frames[capsule.chain_index];
+                let world = |v: &Vector3<f64>| (frame * Vector4::new(v.x, v.y, v.z, 1.0)).xyz();
+                let margin = axis_depth(solid, &world(&capsule.start), &world(&capsule.end))
+                    - capsule.radius
+                    - clearance;
+                // NaN is the worst margin of all.
+                if worst
+                    .as_ref()
+                    .is_none_or(|w| margin.is_nan() || margin < w.0)
+                {
+                    worst = Some((margin, capsule.link.clone(), name.to_string()));
+                }
+            }
+        }
+        worst
+    }
+}
+
+/// Smallest signed distance from the segment `a`–`b` to `solid`: the gap when apart, minus the
+/// depth of the deepest point when inside. Each solid's signed distance is convex, so along the
+/// segment it is a convex function of the parameter: planes at an end, balls and capsules by
+/// closest points, boxes by golden-section search on their signed distance.
+fn axis_depth(solid: &Solid, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    match solid {
+        Solid::HalfSpace { point, outward } => {
+            (a - point).dot(outward).min((b - point).dot(outward))
+        }
+        Solid::Ball { centre, radius } => segments_gap(a, b, centre, centre) - radius,
+        Solid::Capsule {
+            a: start,
+            b: end,
+            radius,
+        } => segments_gap(a, b, start, end) - radius,
+        Solid::Box {
+            centre,
+            axes,
+            half_extents,
+        } => {
+            let signed = |t: f64| {
+                let local = axes.transpose() * (a + (b - a) * t - centre);
+                let excess = local.abs() - half_extents;
+                let outside = excess.map(|e| e.max(0.0)).norm();
+                outside + excess.max().min(0.0)
+            };
+            let golden = (5.0_f64.sqrt() - 1.0) / 2.0;
+            let (mut lo, mut hi) = (0.0, 1.0);
+            for _ in 0..GOLDEN_SECTION_STEPS {
+                let left = hi - golden * (hi - lo);
+                let right = lo + golden * (hi - lo);
+                if signed(left) <= signed(right) {
+                    hi = right;
+                } else {
+                    lo = left;
+                }
+            }
+            signed(0.0).min(signed(1.0)).min(signed(0.5 * (lo + hi)))
+        }
     }
 }
 

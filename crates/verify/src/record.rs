@@ -1,7 +1,7 @@
 //! What the checker is given: the task line, the bounds, and a recorded motion, as plain data
 //! that any planner (or any file reader) fills in.
 
-use nalgebra::{SVector, Vector3};
+use nalgebra::{Matrix3, SVector, Vector3};
 
 /// Number of revolute joints of every arm the checker verifies.
 pub const JOINTS: usize = 7;
@@ -46,6 +46,59 @@ pub struct Bounds {
     /// Joint speeds stay within this fraction of the robot file's velocity limits; `None` when
     /// joint speeds are not bounded.
     pub velocity_limit_fraction: Option<f64>,
+    /// Whether every capsule but the tool's stays on the free side of the line's work surface:
+    /// the plane through `p0` with normal `n`, the material where `(x − p0)·n > 0`.
+    pub work_surface: bool,
+    /// Obstacles every capsule of the arm keeps its distance from.
+    pub obstacles: Vec<Obstacle>,
+}
+
+/// A solid in the base frame that the arm must not come near.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Solid {
+    /// The points `x` with `(x − point)·outward < 0`.
+    HalfSpace {
+        /// A point of the boundary plane (m).
+        point: Vector3<f64>,
+        /// Unit normal pointing away from the solid.
+        outward: Vector3<f64>,
+    },
+    /// The points `centre + axes·x` with `|x_i| ≤ half_extents_i`; `axes` is a rotation.
+    Box {
+        /// Centre (m).
+        centre: Vector3<f64>,
+        /// The box's axes as columns.
+        axes: Matrix3<f64>,
+        /// Half edge lengths (m).
+        half_extents: Vector3<f64>,
+    },
+    /// The points within `radius` of `centre`.
+    Ball {
+        /// Centre (m).
+        centre: Vector3<f64>,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// The points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// First end of the axis (m).
+        a: Vector3<f64>,
+        /// Second end of the axis (m).
+        b: Vector3<f64>,
+        /// Radius (m).
+        radius: f64,
+    },
+}
+
+/// A named solid and the distance every capsule of the arm keeps from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Obstacle {
+    /// Name used in failures.
+    pub name: String,
+    /// The solid.
+    pub solid: Solid,
+    /// Smallest allowed surface distance (m).
+    pub clearance_m: f64,
 }
 
 /// One recorded point of a motion, with what the planner says it measured there.
@@ -75,6 +128,8 @@ pub enum Blame {
     ToolCone,
     /// Two capsules of the arm touch.
     SelfCollision,
+    /// A capsule of the arm came too near an obstacle or the work surface.
+    SceneContact,
 }
 
 /// Why a recorded motion ended, as its planner claims.

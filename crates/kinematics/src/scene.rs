@@ -1,0 +1,453 @@
+//! The cell around the arm: obstacles (half-spaces, boxes, spheres, capsules in the base frame,
+//! each with the clearance it asks for) and the clearance of the arm's capsules from them.
+
+use nalgebra::Rotation3;
+use serde::{Deserialize, Serialize};
+
+use crate::Vec3;
+use crate::collision::segment_distance;
+use crate::fk::Kinematics;
+use crate::robot::Robot;
+
+/// A solid the arm keeps clear of, in the base frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// Everything behind a plane: the points `x` with `(x − point)·normal < 0`; the unit
+    /// `normal` points out of the solid, into free space (a floor at height 0 has `point`
+    /// `(0, 0, 0)` and `normal` `(0, 0, 1)`).
+    HalfSpace {
+        /// A point of the plane (m).
+        point: Vec3,
+        /// Unit normal pointing into free space.
+        normal: Vec3,
+    },
+    /// A box: `centre + rotation·x` for `|x_i| ≤ half_extents_i`.
+    Cuboid {
+        /// Centre (m).
+        centre: Vec3,
+        /// Orientation of the box's axes in the base frame.
+        rotation: Rotation3<f64>,
+        /// Half the edge lengths along the box's own axes (m).
+        half_extents: Vec3,
+    },
+    /// A ball.
+    Sphere {
+        /// Centre (m).
+        centre: Vec3,
+        /// Radius (m).
+        radius: f64,
+    },
+    /// The segment `start`–`end` swept by `radius`.
+    Capsule {
+        /// First end of the axis (m).
+        start: Vec3,
+        /// Second end of the axis (m).
+        end: Vec3,
+        /// Radius (m).
+        radius: f64,
+    },
+}
+
+impl Shape {
+    /// The work surface of a task (SPEC §9): the plane through `p0` with normal `n`, the
+    /// material on the side `(x − p0)·n > 0` (`n` points from the tool into the surface).
+    pub fn work_surface(p0: &Vec3, n: &Vec3) -> Self {
+        Self::HalfSpace {
+            point: *p0,
+            normal: -n,
+        }
+    }
+
+    /// Signed distance (m) between the segment `a`–`b` and the solid: the gap between them when
+    /// apart, minus the depth of the segment's deepest point when it enters the solid.
+    pub fn segment_distance(&self, a: &Vec3, b: &Vec3) -> f64 {
+        match self {
+            Self::HalfSpace { point, normal } => {
+                (a - point).dot(normal).min((b - point).dot(normal))
+            }
+            Self::Cuboid {
+                centre,
+                rotation,
+                half_extents,
+            } => {
+                let local = |p: &Vec3| rotation.inverse_transform_vector(&(p - centre));
+                cuboid_segment_distance(&local(a), &local(b), half_extents)
+            }
+            Self::Sphere { centre, radius } => segment_distance(a, b, centre, centre) - radius,
+            Self::Capsule { start, end, radius } => segment_distance(a, b, start, end) - radius,
+        }
+    }
+}
+
+/// Signed distance between the segment `a`–`b` and the box `|x_i| ≤ h_i` (all in the box's
+/// frame). Inside, the depth `min_i (h_i − |x_i|)` is the minimum of six functions linear along
+/// the segment, so its largest value lies at an end or where two of them cross; outside, the
+/// nearest box point of a nearest pair lies on an edge unless a segment end is nearest.
+fn cuboid_segment_distance(a: &Vec3, b: &Vec3, h: &Vec3) -> f64 {
+    let u = b - a;
+    // depth(t) = min_k (offset_k + slope_k·t), t ∈ [0, 1].
+    let mut lines = [(0.0, 0.0); 6];
+    for i in 0..3 {
+        lines[2 * i] = (h[i] - a[i], -u[i]);
+        lines[2 * i + 1] = (h[i] + a[i], u[i]);
+    }
+    let depth = |t: f64| {
+        lines
+            .iter()
+            .map(|(offset, slope)| offset + slope * t)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut deepest = depth(0.0).max(depth(1.0));
+    for (j, (offset_j, slope_j)) in lines.iter().enumerate() {
+        for (offset_k, slope_k) in &lines[j + 1..] {
+            if slope_j != slope_k {
+                let t = (offset_k - offset_j) / (slope_j - slope_k);
+                if t > 0.0 && t < 1.0 {
+                    deepest = deepest.max(depth(t));
+                }
+            }
+        }
+    }
+    if deepest > 0.0 {
+        return -deepest;
+    }
+    let outside = |p: &Vec3| p.abs().zip_map(h, |v, half| (v - half).max(0.0)).norm();
+    let mut gap = outside(a).min(outside(b));
+    for axis in 0..3 {
+        let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+        for (sj, sk) in [(-1.0, -1.0), (-1.0, 1.0), (1.0, -1.0), (1.0, 1.0)] {
+            let mut from = Vec3::zeros();
+            from[j] = sj * h[j];
+            from[k] = sk * h[k];
+            let mut to = from;
+            from[axis] = -h[axis];
+            to[axis] = h[axis];
+            gap = gap.min(segment_distance(a, b, &from, &to));
+        }
+    }
+    gap
+}
+
+/// One obstacle of the cell: a named solid and the clearance the arm keeps from it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Obstacle {
+    /// Name used in messages (the file's `name`, else `obstacles[i]`).
+    pub name: String,
+    /// The solid.
+    pub shape: Shape,
+    /// Smallest surface distance (m) every capsule of the arm keeps from it.
+    pub clearance_m: f64,
+}
+
+/// The obstacles of a cell, read from a scene file (JSON):
+///
+/// ```json
+/// {"obstacles": [
+///   {"name": "table", "half_space": {"point": [0, 0, 0], "normal": [0, 0, 1]}},
+///   {"name": "fixture", "clearance_m": 0.01,
+///    "box": {"centre": [0.5, 0.3, 0.1], "size": [0.2, 0.1, 0.2], "rpy": [0, 0, 0.3]}},
+///   {"sphere": {"centre": [0.4, -0.4, 0.5], "radius": 0.05}},
+///   {"capsule": {"start": [0.3, 0.5, 0], "end": [0.3, 0.5, 0.8], "radius": 0.04}}
+/// ]}
+/// ```
+///
+/// Positions are in the base frame (m); a half-space's `normal` points out of the solid; a box
+/// has its full edge lengths `size` and the URDF roll–pitch–yaw `rpy` of its axes (default 0);
+/// `clearance_m` defaults to 0 (not touching).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "SceneFile", into = "SceneFile")]
+pub struct Scene {
+    /// The obstacles, each checked against every capsule of the arm.
+    pub obstacles: Vec<Obstacle>,
+}
+
+impl Scene {
+    /// Whether the scene holds no obstacle.
+    pub fn is_empty(&self) -> bool {
+        self.obstacles.is_empty()
+    }
+}
+
+/// Which capsules of the arm an obstacle may touch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToolContact {
+    /// The tool's capsules ([`Robot::tool_capsules`]) are not checked: the work surface, which
+    /// the pen touches by design.
+    Allowed,
+    /// Every capsule is checked.
+    Forbidden,
+}
+
+/// A capsule of the arm closer to an obstacle than its clearance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactHit {
+    /// Index into [`Robot::capsules`].
+    pub capsule: usize,
+    /// Surface distance (m) between the capsule and the solid, negative when they overlap.
+    pub clearance: f64,
+}
+
+impl Robot {
+    /// The first capsule (base to tip) whose surface distance from `shape` is below `clearance`
+    /// (m), skipping the tool's capsules when `tool` allows them to touch.
+    pub fn first_contact(
+        &self,
+        kin: &Kinematics,
+        shape: &Shape,
+        clearance: f64,
+        tool: ToolContact,
+    ) -> Option<ContactHit> {
+        let checked = match tool {
+            ToolContact::Allowed => 0..self.tool_capsules().start,
+            ToolContact::Forbidden => 0..self.capsules.len(),
+        };
+        checked.into_iter().find_map(|index| {
+            let capsule = &self.capsules[index];
+            let start = kin.segment_point(capsule.segment, &capsule.start);
+            let end = kin.segment_point(capsule.segment, &capsule.end);
+            let distance = shape.segment_distance(&start, &end) - capsule.radius;
+            // NaN counts as a contact.
+            (distance.is_nan() || distance < clearance).then_some(ContactHit {
+                capsule: index,
+                clearance: distance,
+            })
+        })
+    }
+}
+
+/// The serialised form of a [`Scene`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    obstacles: Vec<ObstacleFile>,
+}
+
+impl TryFrom<SceneFile> for Scene {
+    type Error = ObstacleError;
+
+    fn try_from(file: SceneFile) -> Result<Self, ObstacleError> {
+        let obstacles = file
+            .obstacles
+            .into_iter()
+            .enumerate()
+            .map(|(index, obstacle)| obstacle.into_obstacle(index))
+            .collect::<Result<_, _>>()?;
+        Ok(Self { obstacles })
+    }
+}
+
+impl From<Scene> for SceneFile {
+    fn from(scene: Scene) -> Self {
+        Self {
+            obstacles: scene
+                .obstacles
+                .into_iter()
+                .map(ObstacleFile::from)
+                .collect(),
+        }
+    }
+}
+
+/// The serialised form of an [`Obstacle`]: a name, a clearance and exactly one shape.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObstacleFile {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    name: Option<String>,
+    #[serde(default)]
+    clearance_m: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    half_space: Option<HalfSpaceFile>,
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    cuboid: Option<BoxFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sphere: Option<SphereFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    capsule: Option<CapsuleFile>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HalfSpaceFile {
+    point: [f64; 3],
+    normal: [f64; 3],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoxFile {
+    centre: [f64; 3],
+    size: [f64; 3],
+    #[serde(default)]
+    rpy: [f64; 3],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SphereFile {
+    centre: [f64; 3],
+    radius: f64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CapsuleFile {
+    start: [f64; 3],
+    end: [f64; 3],
+    radius: f64,
+}
+
+/// An obstacle of a scene file that cannot be used: names the obstacle, the field and what is
+/// wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{obstacle}: {field} {problem}")]
+pub struct ObstacleError {
+    /// Where the obstacle is, with its name when it has one: `obstacles[2] ('fixture')`.
+    pub obstacle: String,
+    /// The field, e.g. `box.size`.
+    pub field: &'static str,
+    /// What is wrong with it.
+    pub problem: String,
+}
+
+impl ObstacleFile {
+    /// The obstacle at `index` of its file, checked: finite positions, one shape, a direction as
+    /// a half-space's normal, sizes and clearance ≥ 0. Unnamed, it is called `obstacles[index]`.
+    fn into_obstacle(self, index: usize) -> Result<Obstacle, ObstacleError> {
+        let file = self;
+        let place = format!("obstacles[{index}]");
+        let obstacle = match &file.name {
+            Some(name) => format!("{place} ('{name}')"),
+            None => place.clone(),
+        };
+        let name = file.name.clone().unwrap_or(place);
+        let error = |field: &'static str, problem: String| ObstacleError {
+            obstacle: obstacle.clone(),
+            field,
+            problem,
+        };
+        let finite = |field: &'static str, v: [f64; 3]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(Vec3::from(v))
+            } else {
+                Err(error(
+                    field,
+                    format!("must be three finite numbers, got {v:?}"),
+                ))
+            }
+        };
+        let size = |field: &'static str, value: f64| {
+            if value.is_finite() && value >= 0.0 {
+                Ok(value)
+            } else {
+                Err(error(field, format!("must be a number ≥ 0, got {value}")))
+            }
+        };
+        let clearance_m = size("clearance_m", file.clearance_m)?;
+        let given = [
+            file.half_space.is_some(),
+            file.cuboid.is_some(),
+            file.sphere.is_some(),
+            file.capsule.is_some(),
+        ];
+        if given.iter().filter(|g| **g).count() != 1 {
+            return Err(error(
+                "shape",
+                "must be exactly one of 'half_space', 'box', 'sphere' and 'capsule'".into(),
+            ));
+        }
+        let shape = if let Some(plane) = file.half_space {
+            let normal = finite("half_space.normal", plane.normal)?;
+            if normal.norm() <= 1e-9 {
+                return Err(error(
+                    "half_space.normal",
+                    format!("must be a direction, got {:?}", plane.normal),
+                ));
+            }
+            Shape::HalfSpace {
+                point: finite("half_space.point", plane.point)?,
+                normal: normal.normalize(),
+            }
+        } else if let Some(cuboid) = file.cuboid {
+            let edges = finite("box.size", cuboid.size)?;
+            if edges.iter().any(|e| *e < 0.0) {
+                return Err(error(
+                    "box.size",
+                    format!("must be three lengths ≥ 0, got {:?}", cuboid.size),
+                ));
+            }
+            let [roll, pitch, yaw] = finite("box.rpy", cuboid.rpy)?.into();
+            Shape::Cuboid {
+                centre: finite("box.centre", cuboid.centre)?,
+                rotation: Rotation3::from_euler_angles(roll, pitch, yaw),
+                half_extents: edges * 0.5,
+            }
+        } else if let Some(sphere) = file.sphere {
+            Shape::Sphere {
+                centre: finite("sphere.centre", sphere.centre)?,
+                radius: size("sphere.radius", sphere.radius)?,
+            }
+        } else if let Some(capsule) = file.capsule {
+            Shape::Capsule {
+                start: finite("capsule.start", capsule.start)?,
+                end: finite("capsule.end", capsule.end)?,
+                radius: size("capsule.radius", capsule.radius)?,
+            }
+        } else {
+            unreachable!("exactly one shape is given")
+        };
+        Ok(Obstacle {
+            name,
+            shape,
+            clearance_m,
+        })
+    }
+}
+
+impl From<Obstacle> for ObstacleFile {
+    fn from(obstacle: Obstacle) -> Self {
+        let array = |v: &Vec3| [v.x, v.y, v.z];
+        let mut file = Self {
+            name: Some(obstacle.name),
+            clearance_m: obstacle.clearance_m,
+            half_space: None,
+            cuboid: None,
+            sphere: None,
+            capsule: None,
+        };
+        match &obstacle.shape {
+            Shape::HalfSpace { point, normal } => {
+                file.half_space = Some(HalfSpaceFile {
+                    point: array(point),
+                    normal: array(normal),
+                });
+            }
+            Shape::Cuboid {
+                centre,
+                rotation,
+                half_extents,
+            } => {
+                let (roll, pitch, yaw) = rotation.euler_angles();
+                file.cuboid = Some(BoxFile {
+                    centre: array(centre),
+                    size: array(&(half_extents * 2.0)),
+                    rpy: [roll, pitch, yaw],
+                });
+            }
+            Shape::Sphere { centre, radius } => {
+                file.sphere = Some(SphereFile {
+                    centre: array(centre),
+                    radius: *radius,
+                });
+            }
+            Shape::Capsule { start, end, radius } => {
+                file.capsule = Some(CapsuleFile {
+                    start: array(start),
+                    end: array(end),
+                    radius: *radius,
+                });
+            }
+        }
+        file
+    }
+}
