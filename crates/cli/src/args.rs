@@ -153,6 +153,16 @@ pub struct PlanArgs {
     /// robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub policy: Option<PathBuf>,
+    /// Keep the arm, all but the pen, off the task's work surface: the plane through p0 with
+    /// normal n, the material on the far side (where the pen points). `off` plans as the
+    /// paper's protocol does. Replaces the --config file's `rollout.constraints.work_surface`.
+    #[arg(long, value_name = "on|off", default_value = "on")]
+    pub surface: OnOff,
+    /// Scene file (JSON) of obstacles the whole arm, pen included, keeps clear of: half-spaces,
+    /// boxes, spheres and capsules in the base frame, each with its clearance (see
+    /// docs/scene.md). Replaces the --config file's `rollout.constraints.scene`.
+    #[arg(long, value_name = "JSON")]
+    pub scene: Option<PathBuf>,
     /// Also scan the task's reachability bound (how far along the line the arm can be placed
     /// at all, on a 1 cm grid), print it beside the path length and record it as
     /// `reachable_m`.

@@ -38,6 +38,11 @@
 //! * `--reach on|off` (default on): also the task's reachability bound, how far along the line
 //!   the arm can be placed at all (`emg_planner::reach`), printed beside the path length and
 //!   recorded as `reachable_m`.
+//! * `--surface on|off` (default on): keep the arm, all but the pen, off the task's work
+//!   surface (the plane through `p0` with normal `n`, material where the pen points);
+//!   `--scene <json>`: obstacles (half-spaces, boxes, spheres, capsules, each with a clearance)
+//!   the whole arm keeps clear of (`docs/scene.md`). Both are constraints of every step, of the
+//!   search and of the checker, and are recorded in the written files.
 //! * `--html <path>`: also a self-contained HTML page that animates the motion in 3D
 //!   (`<path without extension>-00000.html`, ... for several tasks).
 //!
@@ -98,10 +103,14 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         args.base_link.as_deref(),
         args.tip_link.as_deref(),
     )?;
-    let config = match &args.config {
+    let mut config = match &args.config {
         Some(path) => PlannerConfig::read(path)?,
         None => PlannerConfig::default(),
     };
+    config.rollout.constraints.work_surface = args.surface == OnOff::On;
+    if let Some(path) = &args.scene {
+        config.rollout.constraints.scene = emg_io::read_scene(path)?;
+    }
     let models = Models::load(
         &robot,
         diffusion_weights(args)?.as_deref(),

@@ -9,6 +9,7 @@
 //! * [`TrajectoryContents`]: any of the three, told apart by content, as the independent
 //!   checker's [`emg_verify::JointSamples`].
 //! * [`read_tasks`] / [`write_task_set`]: task sets (binary `EMGTASKS` or JSON).
+//! * [`read_scene`]: the obstacles of a cell (JSON, see [`emg_kinematics::Scene`]).
 //! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
 //!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
 //!   for one job's identity.
@@ -63,6 +64,7 @@ mod error;
 mod joint_trajectory;
 mod paths;
 mod rollout_file;
+mod scene_file;
 mod task_file;
 
 pub use atomic::{JournalError, open_journal, write_atomically};
@@ -75,6 +77,7 @@ pub use joint_trajectory::{
 };
 pub use paths::{PlanPaths, html_path};
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
+pub use scene_file::{SceneFileError, read_scene};
 pub use task_file::{
     TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_tasks, write_task_set,
 };
