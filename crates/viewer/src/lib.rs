@@ -6,6 +6,7 @@
 //! The page draws on a Canvas 2D (no WebGL) with its own perspective projection:
 //!
 //! * the arm as its collision capsules, the joint origins and the pen highlighted;
+//! * the work surface around the line (when it is a constraint) and the obstacles of the cell;
 //! * the task line `p0 + s·d` with its start and its lateral tolerance, the tool cone of
 //!   half-angle `θ_max` around `n` at the TCP, the current tool axis and the TCP trace so far;
 //! * a timeline coloured by the controller that acted at each step, play/pause, scrubbing,
@@ -60,7 +61,8 @@ pub struct ViewerInput<'a> {
     pub task: &'a Task,
     /// The planned rollout; its timestamps drive the playback.
     pub trajectory: &'a Trajectory,
-    /// The constraints it was planned under (line tolerance and tool-cone half-angle are drawn).
+    /// The constraints it was planned under (line tolerance, tool-cone half-angle, work surface
+    /// and obstacles are drawn).
     pub constraints: &'a ConstraintConfig,
     /// Page title and heading (plain text; escaped as needed).
     pub title: &'a str,

@@ -1,7 +1,7 @@
 //! The data blob a page animates: world-frame geometry of every recorded step.
 
 use emg_control::{ActingController, StepRecord};
-use emg_kinematics::{DOF, Vec3};
+use emg_kinematics::{DOF, Shape, Vec3};
 use serde::Serialize;
 
 use crate::ViewerInput;
@@ -21,6 +21,7 @@ pub(crate) struct Scene<'a> {
     robot: &'a str,
     task: SceneTask,
     constraints: SceneConstraints,
+    obstacles: Vec<SceneObstacle<'a>>,
     capsules: Vec<SceneCapsule<'a>>,
     path_length_m: f64,
     termination: String,
@@ -38,6 +39,73 @@ struct SceneTask {
 struct SceneConstraints {
     line_tolerance_m: f64,
     theta_max_deg: f64,
+    /// Whether the work surface (the plane through `p0` with normal `n`) is a constraint.
+    work_surface: bool,
+}
+
+/// One obstacle of the cell, in world coordinates.
+#[derive(Debug, Serialize)]
+struct SceneObstacle<'a> {
+    name: &'a str,
+    clearance_m: f64,
+    #[serde(flatten)]
+    solid: SceneSolid,
+}
+
+/// An obstacle's solid as the page draws it.
+#[derive(Debug, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+enum SceneSolid {
+    /// The solid behind the plane through `point`; `normal` points into free space.
+    HalfSpace { point: [f64; 3], normal: [f64; 3] },
+    /// The eight corners, corner `i` at `+` half extent along box axis `k` where bit `k` of `i`
+    /// is set.
+    Box { corners: Vec<[f64; 3]> },
+    /// A ball.
+    Sphere { centre: [f64; 3], radius: f64 },
+    /// A capsule.
+    Capsule {
+        start: [f64; 3],
+        end: [f64; 3],
+        radius: f64,
+    },
+}
+
+impl SceneSolid {
+    fn new(shape: &Shape) -> Self {
+        match shape {
+            Shape::HalfSpace { point: p, normal } => Self::HalfSpace {
+                point: point(p),
+                normal: point(normal),
+            },
+            Shape::Cuboid {
+                centre,
+                rotation,
+                half_extents,
+            } => Self::Box {
+                corners: (0..8)
+                    .map(|i| {
+                        let sign = |k: usize| if i & (1 << k) != 0 { 1.0 } else { -1.0 };
+                        let local = Vec3::new(
+                            sign(0) * half_extents.x,
+                            sign(1) * half_extents.y,
+                            sign(2) * half_extents.z,
+                        );
+                        point(&(centre + rotation * local))
+                    })
+                    .collect(),
+            },
+            Shape::Sphere { centre, radius } => Self::Sphere {
+                centre: point(centre),
+                radius: length(*radius),
+            },
+            Shape::Capsule { start, end, radius } => Self::Capsule {
+                start: point(start),
+                end: point(end),
+                radius: length(*radius),
+            },
+        }
+    }
 }
 
 /// One capsule of the arm; its end points per step are in [`SceneStep::capsules`].
@@ -45,7 +113,7 @@ struct SceneConstraints {
 struct SceneCapsule<'a> {
     link: &'a str,
     radius: f64,
-    /// Part of the pen (the last link with capsules, after the last joint): drawn highlighted.
+    /// Part of the pen ([`emg_kinematics::Robot::tool_capsules`]): drawn highlighted.
     pen: bool,
 }
 
@@ -77,20 +145,25 @@ impl<'a> Scene<'a> {
             constraints,
             title,
         } = *input;
-        // The pen: the capsules of the chain's last link that has any, on the last segment.
-        let tip_link = robot
-            .capsules()
-            .iter()
-            .filter(|c| c.segment == DOF)
-            .map(|c| c.chain_index)
-            .max();
+        let tool = robot.tool_capsules();
         let capsules = robot
             .capsules()
             .iter()
-            .map(|c| SceneCapsule {
+            .enumerate()
+            .map(|(index, c)| SceneCapsule {
                 link: &c.link,
                 radius: c.radius,
-                pen: c.segment == DOF && Some(c.chain_index) == tip_link,
+                pen: tool.contains(&index),
+            })
+            .collect();
+        let obstacles = constraints
+            .scene
+            .obstacles
+            .iter()
+            .map(|obstacle| SceneObstacle {
+                name: &obstacle.name,
+                clearance_m: length(obstacle.clearance_m),
+                solid: SceneSolid::new(&obstacle.shape),
             })
             .collect();
         let steps = trajectory
@@ -109,7 +182,9 @@ impl<'a> Scene<'a> {
             constraints: SceneConstraints {
                 line_tolerance_m: constraints.line_tolerance_m,
                 theta_max_deg: constraints.theta_max_deg,
+                work_surface: constraints.work_surface,
             },
+            obstacles,
             capsules,
             path_length_m: length(trajectory.path_length_m),
             termination: trajectory.termination.to_string(),

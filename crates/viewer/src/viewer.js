@@ -35,6 +35,14 @@ window.addEventListener("unhandledrejection", function (event) {
   const AXIS_OUT_COLOUR = "#b3261e";
   const GRID_COLOUR = "#d3d9e2";
   const SHADOW_COLOUR = "rgba(30, 40, 60, 0.10)";
+  const SURFACE_FILL = "rgba(150, 110, 70, 0.16)";
+  const SURFACE_EDGE = "rgba(120, 85, 50, 0.35)";
+  const OBSTACLE_FILL = "rgba(90, 105, 130, 0.30)";
+  const OBSTACLE_EDGE = "rgba(50, 60, 80, 0.75)";
+  const OBSTACLE_SHINE = "rgba(220, 228, 240, 0.55)";
+  // Planes (the work surface, half-spaces) are drawn as patches of square tiles this wide, so
+  // that painter's order sorts them among the links.
+  const TILE = 0.1;
   const CONTROLLER_COLOURS = {
     classical: "#2b6cb0",
     learned: "#d53f8c",
@@ -269,6 +277,73 @@ window.addEventListener("unhandledrejection", function (event) {
     stroke({ x: a.x + o * ra, y: a.y + o * ra }, { x: b.x + o * rb, y: b.y + o * rb }, 0.25 * (ra + rb), shine);
   }
 
+  // A planar polygon (world corners), filled and edged, queued at its mean depth.
+  function queuePolygon(cam, queue, corners, fill, edge) {
+    const projected = corners.map((c) => project(cam, c));
+    if (projected.some((p) => !p)) return;
+    const depth = projected.reduce((sum, p) => sum + p.z, 0) / projected.length;
+    queue(depth, () => {
+      ctx.beginPath();
+      ctx.moveTo(projected[0].x, projected[0].y);
+      for (const p of projected.slice(1)) ctx.lineTo(p.x, p.y);
+      ctx.closePath();
+      ctx.fillStyle = fill;
+      ctx.fill();
+      ctx.lineWidth = 0.8;
+      ctx.strokeStyle = edge;
+      ctx.stroke();
+    });
+  }
+
+  // The patch of the plane through `origin` spanned by unit vectors u, v over [u0, u1] x [v0, v1],
+  // as square tiles.
+  function queuePlane(cam, queue, origin, u, v, [u0, u1], [v0, v1], fill, edge) {
+    const nu = Math.max(1, Math.ceil((u1 - u0) / TILE));
+    const nv = Math.max(1, Math.ceil((v1 - v0) / TILE));
+    const at = (a, b) => add(origin, add(scale(u, a), scale(v, b)));
+    for (let i = 0; i < nu; i++) {
+      for (let j = 0; j < nv; j++) {
+        const a0 = mix(u0, u1, i / nu);
+        const a1 = mix(u0, u1, (i + 1) / nu);
+        const b0 = mix(v0, v1, j / nv);
+        const b1 = mix(v0, v1, (j + 1) / nv);
+        queuePolygon(cam, queue, [at(a0, b0), at(a1, b0), at(a1, b1), at(a0, b1)], fill, edge);
+      }
+    }
+  }
+
+  // The work surface around the line and the obstacles of the cell.
+  const BOX_FACES = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]];
+  function queueCell(cam, queue) {
+    if (data.constraints.work_surface) {
+      const margin = extension + 0.1;
+      queuePlane(cam, queue, task.p0, task.d, lateralDir, [sMin - margin, sMax + margin], [-0.2, 0.2],
+        SURFACE_FILL, SURFACE_EDGE);
+    }
+    const middle = scale(add(bounds.lo, bounds.hi), 0.5);
+    const half = Math.max(0.4, 0.6 * norm(sub(bounds.hi, bounds.lo)));
+    for (const obstacle of data.obstacles) {
+      if (obstacle.kind === "half_space") {
+        const u = perpendicular(obstacle.normal);
+        const v = cross(obstacle.normal, u);
+        const foot = sub(middle, scale(obstacle.normal, dot(sub(middle, obstacle.point), obstacle.normal)));
+        queuePlane(cam, queue, foot, u, v, [-half, half], [-half, half], OBSTACLE_FILL, OBSTACLE_EDGE);
+      } else if (obstacle.kind === "box") {
+        for (const face of BOX_FACES) {
+          queuePolygon(cam, queue, face.map((k) => obstacle.corners[k]), OBSTACLE_FILL, OBSTACLE_EDGE);
+        }
+      } else {
+        const [a, b] = obstacle.kind === "sphere" ? [obstacle.centre, obstacle.centre] : [obstacle.start, obstacle.end];
+        const pa = project(cam, a);
+        const pb = project(cam, b);
+        if (!(pa && pb)) continue;
+        const ra = (obstacle.radius * cam.focal) / pa.z;
+        const rb = (obstacle.radius * cam.focal) / pb.z;
+        queue((pa.z + pb.z) / 2, () => drawCapsule(pa, ra, pb, rb, [OBSTACLE_FILL, OBSTACLE_EDGE, OBSTACLE_SHINE]));
+      }
+    }
+  }
+
   // Splits the segment a-b into pieces no longer than `piece` so painter's order sorts them
   // well; calls emit(pa, pb, depth) with projected ends.
   function pieces(cam, a, b, piece, emit) {
@@ -330,6 +405,8 @@ window.addEventListener("unhandledrejection", function (event) {
         ctx.fillText("p0", start.x + 9, start.y - 7);
       });
     }
+    queueCell(cam, queue);
+
     // Tolerance ring around the line at the TCP's foot point.
     const foot = onLine(frame.s);
     const ring = [];
@@ -478,6 +555,10 @@ window.addEventListener("unhandledrejection", function (event) {
     entry(LINE_COLOUR, "task line (p0 + s\u00b7d) and tolerance");
     entry(CONE_EDGE, "tool cone (" + thetaMax + "\u00b0 about n)");
     entry(AXIS_COLOUR, "tool axis");
+    if (data.constraints.work_surface) entry(SURFACE_EDGE, "work surface (only the pen may touch it)");
+    if (data.obstacles.length > 0) {
+      entry(OBSTACLE_EDGE, "obstacles: " + data.obstacles.map((o) => o.name).join(", "));
+    }
   }
 
   // ---------------------------------------------------------------- playback

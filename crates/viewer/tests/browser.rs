@@ -66,22 +66,27 @@ fn temp_dir(name: &str) -> tempfile::TempDir {
 /// A classical rollout of at most `max_steps` steps of a line along +y from the mid-range
 /// configuration, and its page.
 fn page_of(max_steps: usize, title: &str) -> (Trajectory, String) {
+    let config = RolloutConfig {
+        max_steps,
+        ..RolloutConfig::default()
+    };
+    page_with(&config, title)
+}
+
+/// The classical rollout of [`page_of`]'s line under `config`, and its page.
+fn page_with(config: &RolloutConfig, title: &str) -> (Trajectory, String) {
     let robot =
         Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("the FR3 robot file loads");
     let seed = robot.mid_range();
     let kin = robot.forward(&seed);
     let task =
         Task::new(&robot, kin.tcp(), Vec3::y(), kin.tool_axis(), Some(seed)).expect("a valid task");
-    let config = RolloutConfig {
-        max_steps,
-        ..RolloutConfig::default()
-    };
     let trajectory = rollout(
         &robot,
         &task,
         &seed,
         &mut ClassicalController::default(),
-        &config,
+        config,
     );
     let page = render_html(&ViewerInput {
         robot: &robot,
@@ -312,6 +317,56 @@ fn screenshot_shows_the_arm() {
             dir.display()
         );
     }
+}
+
+/// The planned motion's page with the work surface on and one obstacle of each kind beside the
+/// arm.
+fn cell_page() -> (Trajectory, String) {
+    let scene = r#"{"obstacles": [
+        {"name": "floor", "half_space": {"point": [0, 0, -0.1], "normal": [0, 0, 1]}},
+        {"name": "fixture", "box": {"centre": [0.2, -0.45, 0.2], "size": [0.2, 0.1, 0.3],
+                                    "rpy": [0, 0, 0.4]}},
+        {"name": "post", "capsule": {"start": [-0.3, 0.4, 0], "end": [-0.3, 0.4, 0.6],
+                                     "radius": 0.05}},
+        {"name": "ball", "sphere": {"centre": [-0.3, -0.4, 0.5], "radius": 0.08}}
+    ]}"#;
+    let mut config = RolloutConfig::default();
+    config.constraints.work_surface = true;
+    config.constraints.scene = serde_json::from_str(scene).expect("a valid scene");
+    page_with(&config, "FR3 line in a cell")
+}
+
+#[test]
+fn the_cell_is_drawn() {
+    let Some(browser) = browser() else { return };
+    let tmp = temp_dir("cell");
+    let dir = tmp.path();
+    let (trajectory, page) = cell_page();
+    assert!(trajectory.steps.len() > 1, "{}", trajectory.termination);
+    for name in ["floor", "fixture", "post", "ball"] {
+        assert!(
+            page.contains(&format!(r#""name":"{name}""#)),
+            "{name} missing"
+        );
+    }
+    assert!(page.contains(r#""work_surface":true"#));
+    let run = dump_dom(&browser, dir, &page);
+    if let Err(problems) = page_problems(&run) {
+        panic!("the cell page did not run cleanly:\n{problems}");
+    }
+    let (_, _, with_cell) = screenshot(&browser, dir, &page);
+    let (_, plain) = planned_page();
+    let (_, _, without) = screenshot(&browser, dir, &plain);
+    let changed = with_cell
+        .iter()
+        .zip(&without)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        changed > 20_000,
+        "only {changed} pixels show the cell (page in {})",
+        dir.display()
+    );
 }
 
 #[test]
