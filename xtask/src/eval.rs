@@ -78,10 +78,37 @@ pub struct Args {
     /// down in time) or `off` (unbounded joint speeds, the paper's setting).
     #[arg(long, value_enum, default_value_t = VelocityLimits::On)]
     velocity_limits: VelocityLimits,
+    /// The work surface of each task (the plane through p0 with normal n): `on` keeps every link
+    /// but the pen off it at every step, in the seeds, the references and the checks; `off` is
+    /// the paper's protocol.
+    #[arg(long, value_enum, default_value_t = Surface::Off)]
+    surface: Surface,
+    /// Evaluate only the tasks whose work surface clears the arm (all but the pen) at q0_seed
+    /// by M metres: the tasks a real cell can pose, as `make-tasks --surface-clearance` samples
+    /// them (protocol; not with --shard).
+    #[arg(long, value_name = "M", value_parser = workspace::non_negative, conflicts_with_all = ["shard", "merge"])]
+    surface_clearance: Option<f64>,
     /// Instead of the protocol: DP seeds × every controller with the velocity limits off and on,
     /// path length and duration compared (docs/results/velocity-limits.{json,md}).
     #[arg(long, conflicts_with_all = ["controller", "shard", "merge"])]
     compare_velocity_limits: bool,
+}
+
+/// Whether the work surface is a constraint of an evaluation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum Surface {
+    /// The arm keeps off the work surface.
+    On,
+    /// The paper's protocol: the surface is ignored.
+    Off,
+}
+
+impl Surface {
+    /// Sets the constraint in `constraints`.
+    fn apply(self, constraints: &mut emg_control::ConstraintConfig) {
+        constraints.work_surface = self == Self::On;
+    }
 }
 
 /// The numbers of one evaluation: identical for any thread count.
@@ -180,14 +207,18 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
             }
             let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
             args.velocity_limits.apply(&mut setup.rollout.constraints);
-            let shard = args.shard.map(|s| (s.index, s.count));
+            args.surface.apply(&mut setup.rollout.constraints);
+            let selection = Selection {
+                shard: args.shard.map(|s| (s.index, s.count)),
+                surface_clearance_m: args.surface_clearance,
+            };
             let mut sets = vec![protocol_set(
                 &setup,
                 "unseen",
                 &args.tasks,
                 &args.labels,
                 args.limit,
-                shard,
+                &selection,
             )?];
             if args.seen_count > 0 {
                 sets.push(protocol_set(
@@ -196,7 +227,7 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
                     &args.seen_tasks,
                     &args.seen_labels,
                     Some(args.seen_count),
-                    shard,
+                    &selection,
                 )?);
             }
             if let (Some(s), Some(inputs)) = (args.shard, inputs) {
@@ -224,6 +255,7 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
     let json_path = args.out_dir.join(format!("{name}.json"));
     let mut rollout = RolloutConfig::default();
     args.velocity_limits.apply(&mut rollout.constraints);
+    args.surface.apply(&mut rollout.constraints);
     let record = EvalRecord {
         rollout,
         executor: ExecutorConfig::default(),
@@ -273,6 +305,14 @@ struct ShardInputs {
     seen_count: usize,
     /// `--velocity-limits`.
     velocity_limits: VelocityLimits,
+    /// `--surface`.
+    #[serde(default = "surface_off")]
+    surface: Surface,
+}
+
+/// The surface setting of shards written before it was an option.
+fn surface_off() -> Surface {
+    Surface::Off
 }
 
 impl ShardInputs {
@@ -302,6 +342,7 @@ impl ShardInputs {
             limit: args.limit,
             seen_count: args.seen_count,
             velocity_limits: args.velocity_limits,
+            surface: args.surface,
         })
     }
 }
@@ -489,7 +530,7 @@ fn protocol_set(
     tasks_path: &std::path::Path,
     labels_path: &std::path::Path,
     limit: Option<usize>,
-    shard: Option<(usize, usize)>,
+    selection: &Selection,
 ) -> anyhow::Result<RawSet> {
     let mut tasks = read_tasks(tasks_path, &setup.robot)?;
     if let Some(limit) = limit {
@@ -501,13 +542,44 @@ fn protocol_set(
             labels_path.display()
         )
     })?;
-    println!("{name}: {} tasks", tasks.len());
+    let indices = selection.indices(&setup.robot, &tasks)?;
+    println!("{name}: {} of {} tasks", indices.len(), tasks.len());
     Ok(run_set(
         setup,
         name,
         &workspace::relative(tasks_path),
         &tasks,
+        &indices,
         &labels,
-        shard,
     )?)
+}
+
+/// Which tasks of a set a protocol run evaluates.
+struct Selection {
+    /// Only the tasks with `index % n == i`.
+    shard: Option<(usize, usize)>,
+    /// Only the tasks whose work surface clears the arm at `q0_seed` by this much (m).
+    surface_clearance_m: Option<f64>,
+}
+
+impl Selection {
+    /// The indices of the selected tasks, in order.
+    fn indices(&self, robot: &emg_kinematics::Robot, tasks: &[Task]) -> anyhow::Result<Vec<usize>> {
+        let mut indices = Vec::new();
+        for (index, task) in tasks.iter().enumerate() {
+            if self.shard.is_some_and(|(i, n)| index % n != i) {
+                continue;
+            }
+            if let Some(clearance) = self.surface_clearance_m {
+                let seed = task.q0_seed.with_context(|| {
+                    format!("task {index} has no q0_seed to test its work surface against")
+                })?;
+                if !emg_control::surface_clears(robot, task, &robot.forward(&seed), clearance) {
+                    continue;
+                }
+            }
+            indices.push(index);
+        }
+        Ok(indices)
+    }
 }

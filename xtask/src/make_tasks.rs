@@ -31,6 +31,11 @@ pub struct Args {
     /// Robot file.
     #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
     robot: PathBuf,
+    /// Keep only tasks whose work surface clears the arm (all but the pen) at q0_seed by M
+    /// metres: the population a real cell can pose (SPEC §9). Without it, the paper's
+    /// population.
+    #[arg(long, value_name = "M", value_parser = workspace::non_negative)]
+    surface_clearance: Option<f64>,
 }
 
 /// What a task-set directory holds, written beside the sets as `tasks-v<version>.manifest.json`.
@@ -58,6 +63,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
     let sampler_config = SamplerConfig {
         seed: args.seed,
+        surface_clearance_m: args.surface_clearance,
         ..SamplerConfig::default()
     };
     let (rollout, gains) = (RolloutConfig::default(), ClassicalGains::default());

@@ -39,6 +39,14 @@ pub fn robot_file(value: &str) -> Result<PathBuf, String> {
     Ok(layout_of(value).urdf)
 }
 
+/// A length in metres that is a finite number ≥ 0 (a clearance).
+pub fn non_negative(value: &str) -> Result<f64, String> {
+    match value.parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("'{value}' is not a length ≥ 0 in metres")),
+    }
+}
+
 /// The layout of `--robot` (a shipped robot's name or a URDF path): a shipped robot's own, or
 /// `custom/<file stem>` directories for any other robot file.
 fn layout_of(value: &str) -> RobotLayout {

@@ -44,7 +44,7 @@ pub use controller::{ActingController, NullSpaceController};
 pub use rollout::{
     Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,
 };
-pub use sampler::{SamplerConfig, TaskSampler, candidate};
+pub use sampler::{SamplerConfig, TaskSampler, candidate, surface_clears};
 pub use step::{NullAction, StepContext};
 pub use task::{PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, Task, TaskError};
 pub use verification::CheckRollout;

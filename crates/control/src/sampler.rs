@@ -1,6 +1,6 @@
 //! The task population of SPEC §2: tasks generated from random collision-free configurations.
 
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -23,6 +23,12 @@ pub struct SamplerConfig {
     pub min_classical_length_m: f64,
     /// Candidates drawn per parallel batch (does not change the result; 0 counts as 1).
     pub batch_size: usize,
+    /// Keep only tasks a cell can pose: the work surface clears every capsule of the arm but
+    /// the tool's at `q0_seed` by this much (m) ([`surface_clears`]). `None` (the default)
+    /// keeps them all, as the paper's population does (about a quarter of its tasks have the
+    /// surface cutting the arm at `q0_seed`). Candidate `i` is otherwise the same either way.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub surface_clearance_m: Option<f64>,
 }
 
 impl Default for SamplerConfig {
@@ -32,6 +38,7 @@ impl Default for SamplerConfig {
             max_tilt_deg: 5.0,
             min_classical_length_m: 0.1,
             batch_size: 4096,
+            surface_clearance_m: None,
         }
     }
 }
@@ -113,7 +120,8 @@ impl<'a> TaskSampler<'a> {
     }
 }
 
-/// Candidate task `index` of the population, or `None` if its configuration self-collides.
+/// Candidate task `index` of the population, or `None` if its configuration self-collides (or,
+/// with [`SamplerConfig::surface_clearance_m`], its work surface comes too close to the arm).
 pub fn candidate(robot: &Robot, config: &SamplerConfig, index: u64) -> Option<Task> {
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     rng.set_stream(index);
@@ -129,7 +137,20 @@ pub fn candidate(robot: &Robot, config: &SamplerConfig, index: u64) -> Option<Ta
     let n =
         nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(tilt_axis), tilt) * z;
     let d = perpendicular_direction(&n, rng.random_range(0.0..std::f64::consts::TAU));
-    Task::new(robot, kinematics.tcp(), d, n, Some(q)).ok()
+    let task = Task::new(robot, kinematics.tcp(), d, n, Some(q)).ok()?;
+    match config.surface_clearance_m {
+        Some(clearance) if !surface_clears(robot, &task, &kinematics, clearance) => None,
+        _ => Some(task),
+    }
+}
+
+/// Whether the work surface of `task` (the plane through `p0` with normal `n`) keeps at least
+/// `clearance` (m) from every capsule of the arm but the tool's, placed at `kinematics`.
+pub fn surface_clears(robot: &Robot, task: &Task, kinematics: &Kinematics, clearance: f64) -> bool {
+    let surface = Shape::work_surface(&task.p0, &task.n);
+    robot
+        .first_contact(kinematics, &surface, clearance, ToolContact::Allowed)
+        .is_none()
 }
 
 /// The unit vector at angle `phi` in a fixed orthonormal frame of the plane ⟂ `axis`.

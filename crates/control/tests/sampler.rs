@@ -5,12 +5,14 @@
 //! the generating tool axis, `d ⟂ n`, `p0 = TCP(q0_seed)` and a collision-free seed inside the
 //! limits. `TaskSampler::take` gives the same tasks on 1 and 2 threads, in any batch size and
 //! when taken in pieces, keeps exactly the candidates whose classical rollout reaches 0.1 m, and
-//! stops once its candidate budget is spent.
+//! stops once its candidate budget is spent. With a surface clearance it keeps exactly the
+//! paper population's tasks whose work surface clears the arm at `q0_seed`.
 
 mod common;
 
 use emg_control::{
-    ClassicalGains, RolloutConfig, SamplerConfig, Task, TaskSampler, candidate, tool_angle_deg,
+    ClassicalController, ClassicalGains, ConstraintConfig, RolloutConfig, SamplerConfig, Task,
+    TaskSampler, Termination, candidate, rollout, surface_clears, tool_angle_deg,
 };
 use emg_kinematics::Robot;
 
@@ -199,4 +201,58 @@ fn a_candidate_budget_bounds_the_draw() {
     // The budget counts from where the previous draw stopped.
     bounded.take(1000, 25, &|_| {});
     assert_eq!(bounded.candidates_drawn(), 65);
+}
+
+#[test]
+fn the_realistic_population_is_the_paper_population_where_the_surface_clears_the_arm() {
+    let robot = robot();
+    let paper = SamplerConfig {
+        batch_size: 64,
+        ..SamplerConfig::default()
+    };
+    let realistic = SamplerConfig {
+        surface_clearance_m: Some(0.01),
+        ..paper.clone()
+    };
+    let (all, _) = take_in_pool(2, &robot, &paper, &[200]);
+    let (kept, _) = take_in_pool(2, &robot, &realistic, &[100]);
+    // The same tasks in the same order, minus those whose surface comes within 1 cm of the arm
+    // (the pen excepted) at q0_seed.
+    let clear: Vec<Task> = all
+        .into_iter()
+        .filter(|task| {
+            let kin = robot.forward(&task.q0_seed.unwrap());
+            surface_clears(&robot, task, &kin, 0.01)
+        })
+        .collect();
+    assert!(
+        clear.len() > 100 && clear.len() < 190,
+        "{} of 200 tasks clear",
+        clear.len()
+    );
+    assert_eq!(kept[..], clear[..100]);
+    // Every kept task's surface stays 1 cm from the arm, as the checker of a rollout with the
+    // surface on confirms at the seed.
+    let config = RolloutConfig {
+        max_steps: 1,
+        constraints: ConstraintConfig {
+            work_surface: true,
+            ..ConstraintConfig::default()
+        },
+        ..RolloutConfig::default()
+    };
+    for task in &kept {
+        let trajectory = rollout(
+            &robot,
+            task,
+            &task.q0_seed.unwrap(),
+            &mut ClassicalController::default(),
+            &config,
+        );
+        assert!(
+            !matches!(trajectory.termination, Termination::InvalidStart { .. }),
+            "{}",
+            trajectory.termination
+        );
+    }
 }

@@ -188,19 +188,17 @@ fn cell_key(seed: &SeedSource, controller: ControllerKind) -> String {
     format!("{}/{}", seed.name(), controller.name())
 }
 
-/// Runs the protocol on the tasks `all` (named `tasks` in the results) with their `labels`:
-/// every task, or those with `index % n == i` for `shard = Some((i, n))`.
+/// Runs the protocol on the tasks of `all` at `indices` (in order; a shard's, or those a cell can
+/// pose), named `tasks` in the results, with their `labels` (looked up by index into `all`).
 pub fn run_set(
     setup: &Setup,
     name: &str,
     tasks: &str,
     all: &[Task],
+    indices: &[usize],
     labels: &LabelSet,
-    shard: Option<(usize, usize)>,
 ) -> Result<RawSet, EvalError> {
-    let indices: Vec<usize> = (0..all.len())
-        .filter(|i| shard.is_none_or(|(k, n)| i % n == k))
-        .collect();
+    let indices = indices.to_vec();
     let picked: Vec<Task> = indices.iter().map(|&i| all[i].clone()).collect();
     let references_m = setup.references(&picked, &indices, labels)?;
     let tasks_name = tasks;
