@@ -263,13 +263,15 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
         policy: workspace::relative(&args.weights),
         diffusion: workspace::relative(&args.diffusion),
         sets,
+        surface_clearance_m: args.surface_clearance,
     };
     emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
     let mut md = format!(
         "# Evaluation protocol: seeds × controllers\n\nWritten by `cargo xtask eval`. Do not edit by hand. \
          Every trajectory behind these tables passed the independent checker. Unseen = the evaluation set \
-         (disjoint from every training set); seen = the first {} tasks of the training pool.\n\n",
-        args.seen_count
+         (disjoint from every training set); seen = the first {} tasks of the training pool.\n\n{}",
+        args.seen_count,
+        surface_note(args)
     );
     for set in &record.sets {
         md += &protocol_markdown(set);
@@ -290,6 +292,25 @@ fn run_protocol(args: &Args) -> anyhow::Result<()> {
     emg_io::write_atomically(&md_path, md)?;
     println!("wrote {} and {}", json_path.display(), md_path.display());
     Ok(())
+}
+
+/// What the run says about the work surface: a constraint or not, and which tasks it kept.
+fn surface_note(args: &Args) -> String {
+    let mut note = match args.surface {
+        Surface::On => "Work surface on: every link but the pen stays on the free side of the plane \
+                        through p0 with normal n, at every step, in the seeds and references and in \
+                        the checks. "
+            .to_string(),
+        Surface::Off => "Work surface off (the paper's protocol). ".to_string(),
+    };
+    if let Some(clearance) = args.surface_clearance {
+        note += &format!(
+            "Only the tasks whose work surface clears the arm (all but the pen) by {:.0} mm at \
+             q0_seed: those a real cell can pose. ",
+            clearance * 1e3
+        );
+    }
+    note + "\n\n"
 }
 
 /// What a protocol shard was computed from: rerunning a shard whose file holds the same inputs

@@ -24,6 +24,7 @@ mod protocol;
 mod report;
 mod search_eval;
 mod stamp_weights;
+mod surface_report;
 mod timing;
 mod train_diffusion;
 mod train_ppo;

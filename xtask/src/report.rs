@@ -90,7 +90,7 @@ struct PaperSwitchRow {
 }
 
 /// The typed record in the result file `path`.
-fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
+pub(crate) fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
     let text = std::fs::read_to_string(path).with_context(|| {
         format!(
             "reading {} (run the command that writes it first)",
@@ -151,6 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         md += &dp_rows(seen, "all");
     }
     md += &velocity_limits(&args.results)?;
+    md += &crate::surface_report::section(&args.results);
     md += &other_arms(&args.results)?;
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
@@ -158,7 +159,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 /// The name of the DP seed in result files.
-fn dp() -> &'static str {
+pub(crate) fn dp() -> &'static str {
     SeedSource::Dp.name()
 }
 

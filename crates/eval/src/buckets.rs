@@ -67,16 +67,24 @@ impl BucketConfig {
 pub struct CellStats {
     /// Path length (m).
     pub length_m: Summary,
-    /// `100 · L / ℓ_ref` (%).
+    /// `100 · L / ℓ_ref` (%), over the tasks with `ℓ_ref ≥` [`MIN_REFERENCE_M`].
     pub ratio_percent: Summary,
 }
 
+/// Shortest reference length (m) a ratio is taken against: the 1 cm grid of the reachability
+/// bound. A shorter `ℓ_ref` comes from a task whose labelled starts hold the constraints but
+/// hardly move (under the work surface, often none holds them and `ℓ_ref = 0`); a ratio to it
+/// says nothing.
+pub const MIN_REFERENCE_M: f64 = 0.01;
+
 /// Statistics of `lengths` over the tasks `members` (indices into `lengths` and `references`);
-/// `None` when `members` is empty. References must be positive.
+/// the ratios over those with `ℓ_ref ≥` [`MIN_REFERENCE_M`] only. `None` when no member has
+/// such a reference.
 pub fn cell_stats(lengths: &[f64], references: &[f64], members: &[usize]) -> Option<CellStats> {
     let picked: Vec<f64> = members.iter().map(|&i| lengths[i]).collect();
     let ratios: Vec<f64> = members
         .iter()
+        .filter(|&&i| references[i] >= MIN_REFERENCE_M)
         .map(|&i| 100.0 * lengths[i] / references[i])
         .collect();
     Some(CellStats {

@@ -18,7 +18,9 @@ mod protocol;
 mod setup;
 
 pub use batch::{Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram};
-pub use buckets::{BucketConfig, CellStats, Difficulty, bucket_members, cell_stats};
+pub use buckets::{
+    BucketConfig, CellStats, Difficulty, MIN_REFERENCE_M, bucket_members, cell_stats,
+};
 pub use progress::{Progress, Silent};
 pub use protocol::{
     Cell, EvalRecord, PROTOCOL_SEEDS, RawSet, SetResult, four, markdown, merge_sets, run_set,

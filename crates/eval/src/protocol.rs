@@ -11,7 +11,7 @@ use emg_seeding::LabelSet;
 use serde::{Deserialize, Serialize};
 
 use crate::batch::Summary;
-use crate::buckets::{BucketConfig, CellStats, bucket_members, cell_stats};
+use crate::buckets::{BucketConfig, CellStats, MIN_REFERENCE_M, bucket_members, cell_stats};
 use crate::setup::{EvalError, Setup};
 
 /// The whole result file of the protocol (`docs/results/eval.json`): the settings it ran with
@@ -30,6 +30,10 @@ pub struct EvalRecord {
     pub diffusion: String,
     /// Each task set's tables (`unseen`, then `seen` when run).
     pub sets: Vec<SetResult>,
+    /// When only the tasks a cell can pose were evaluated: the clearance (m) by which their work
+    /// surface clears the arm at `q0_seed`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_clearance_m: Option<f64>,
 }
 
 impl EvalRecord {
@@ -368,6 +372,18 @@ pub fn markdown(set: &SetResult) -> String {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    let stuck = set
+        .references_m
+        .iter()
+        .filter(|r| **r < MIN_REFERENCE_M)
+        .count();
+    if stuck > 0 {
+        md += &format!(
+            "{stuck} tasks have ℓ_ref < {:.0} cm (none of their labelled starts gets that far \
+             under the constraints): they count in the lengths, not in the ratios.\n\n",
+            MIN_REFERENCE_M * 100.0
+        );
+    }
     md += "**Table 1**: DP seed, three controllers, by difficulty.\n\n| tasks | π | path length (m) mean / std / min / max | ratio to ℓ_ref (%) mean / std / min / max | switches / episode |\n|---|---|---|---|---|\n";
     for group in ["all", "easy", "medium", "difficult"] {
         for cell in set

@@ -58,7 +58,7 @@ def test_plan_and_save_equal_the_cli_byte_for_byte(tmp_path, planner, tasks, opt
         "plan", "--p0", vector(task.p0), "--d", vector(task.d), "--n", vector(task.n),
         "--seed", options["seed"], "--controller", options["controller"],
         "--planner", options["planner"], "--reach", "on" if options["reach"] else "off",
-        "--out", tmp_path / "cli",
+        "--surface", "off", "--out", tmp_path / "cli",
     )
     assert_same_files(tmp_path / "python", tmp_path / "cli")
     record = json.loads((tmp_path / "python.json").read_text())
@@ -75,10 +75,37 @@ def test_plan_many_equals_the_cli_on_a_task_file(tmp_path, planner, tasks):
     ]))
     plans = planner.plan_many(chosen, controller="hybrid", planner="controller")
     run_cli("plan", "--task-file", task_file, "--controller", "hybrid", "--planner", "controller",
-            "--reach", "off", "--out", tmp_path / "cli")
+            "--reach", "off", "--surface", "off", "--out", tmp_path / "cli")
     for index, plan in enumerate(plans):
         plan.save(tmp_path / f"python-{index:05}")
         assert_same_files(tmp_path / f"python-{index:05}", tmp_path / f"cli-{index:05}")
+
+
+def test_the_work_surface_and_a_scene_plan_as_the_cli_plans_them(tmp_path, planner, tasks):
+    task = tasks[3]
+    free = planner.plan(task.p0, task.d, task.n, seed="dp", controller="hybrid",
+                        planner="controller")
+    assert len(free.t) > 12, free.termination
+    scene = {"obstacles": [{
+        "name": "ball", "clearance_m": 0.005,
+        "sphere": {"centre": free.tcp[10].tolist(), "radius": 0.015},
+    }]}
+    (tmp_path / "scene.json").write_text(json.dumps(scene))
+    cell = elm.Planner("fr3", config={
+        "rollout": {"constraints": {"work_surface": True, "scene": scene}},
+    })
+    plan = cell.plan(task.p0, task.d, task.n, seed="dp", controller="hybrid",
+                     planner="controller")
+    assert len(plan.t) <= 10
+    assert "ball" in plan.termination or "work surface" in plan.termination, plan.termination
+    plan.save(tmp_path / "python")
+    run_cli(
+        "plan", "--p0", vector(task.p0), "--d", vector(task.d), "--n", vector(task.n),
+        "--seed", "dp", "--controller", "hybrid", "--planner", "controller", "--reach", "off",
+        "--scene", tmp_path / "scene.json", "--out", tmp_path / "cli",
+    )
+    assert_same_files(tmp_path / "python", tmp_path / "cli")
+    assert elm.check(tmp_path / "python.joint_trajectory.json").points > 0
 
 
 def test_plan_arrays_describe_the_motion(planner, tasks):
