@@ -292,8 +292,9 @@ fn write_plan(
         Some(reach) => format!(" of at most {:.2} m reachable", reach.reachable_m),
         None => String::new(),
     };
+    let hint = fixed_contact_hint(planner.robot(), trajectory);
     Ok(format!(
-        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}\n  \
+        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{hint}\n  \
          seed: {}{projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
          requested speed {:.0} % of the time, {} points at {} Hz{cut}\n  \
@@ -310,6 +311,34 @@ fn write_plan(
         paths.csv.display(),
         paths.joint_trajectory.display()
     ))
+}
+
+/// Why no plan can start, when the start was refused for a contact of a link that never moves
+/// (its capsules ride on the base): no configuration clears it, so the cell must change.
+fn fixed_contact_hint(robot: &emg_kinematics::Robot, trajectory: &Trajectory) -> String {
+    let emg_control::Termination::InvalidStart {
+        violation: emg_control::Violation::SceneContact { link, obstacle, .. },
+    } = &trajectory.termination
+    else {
+        return String::new();
+    };
+    let fixed = robot
+        .capsules()
+        .iter()
+        .filter(|c| &c.link == link)
+        .all(|c| c.segment == 0);
+    if !fixed {
+        return String::new();
+    }
+    let option = if obstacle == emg_control::WORK_SURFACE {
+        ", or plan with --surface off"
+    } else {
+        ""
+    };
+    format!(
+        "\n  the {obstacle} cuts {link}, which never moves: no configuration clears it; move the \
+         part or the base{option}"
+    )
 }
 
 /// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.
