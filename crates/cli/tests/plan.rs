@@ -109,6 +109,74 @@ fn demo_task_writes_documented_json_and_csv() {
 }
 
 #[test]
+fn a_work_surface_cutting_the_base_is_named_and_the_scene_is_recorded() {
+    let tmp = temp_dir("surface");
+    let dir = tmp.path();
+    let line = [
+        "--planner",
+        "controller",
+        "--p0",
+        "0.45,0.0,0.35",
+        "--d",
+        "0,1,0",
+        "--n",
+        "0,0,-1",
+        "--weights",
+        NO_WEIGHTS,
+        "--reach",
+        "off",
+    ];
+    // Drawing downwards 35 cm above the base: the surface (on by default) cuts the base.
+    let stem = dir.join("cut");
+    let out = plan_ok(&[&line[..], &["--out", stem.to_str().unwrap()]].concat());
+    assert!(out.contains("link0 touched the work surface"), "{out}");
+    assert!(out.contains("which never moves"), "{out}");
+    assert!(out.contains("--surface off"), "{out}");
+    let doc = read_json(&dir.join("cut.json"));
+    assert_eq!(doc["config"]["constraints"]["work_surface"], true);
+    // A scene file is recorded in the constraints, and its obstacles end the motion.
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{"obstacles": [{"name": "ball", "sphere": {"centre": [0.45, 0.1, 0.35], "radius": 0.02}}]}"#,
+    )
+    .unwrap();
+    let stem = dir.join("ball");
+    let out = plan_ok(
+        &[
+            &line[..],
+            &[
+                "--surface",
+                "off",
+                "--scene",
+                scene.to_str().unwrap(),
+                "--out",
+                stem.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(out.contains("pen_tip touched the ball"), "{out}");
+    let doc = read_json(&dir.join("ball.json"));
+    assert_eq!(
+        doc["config"]["constraints"]["scene"]["obstacles"][0]["name"],
+        "ball"
+    );
+    assert!(doc["config"]["constraints"].get("work_surface").is_none());
+    // A bad scene file is refused naming the obstacle and the field.
+    std::fs::write(
+        &scene,
+        r#"{"obstacles": [{"name": "ball", "sphere": {"centre": [0, 0, 0], "radius": -1}}]}"#,
+    )
+    .unwrap();
+    let error = plan_err(&[&line[..], &["--scene", scene.to_str().unwrap()]].concat());
+    assert!(
+        error.contains("obstacles[0] ('ball'): sphere.radius must be a number ≥ 0"),
+        "{error}"
+    );
+}
+
+#[test]
 fn written_trajectory_passes_the_independent_checker() {
     let tmp = temp_dir("check");
     let dir = tmp.path();
@@ -122,6 +190,8 @@ fn written_trajectory_passes_the_independent_checker() {
         "0,1,0",
         "--n",
         "0,0,-1",
+        "--surface",
+        "off",
         "--out",
         stem.to_str().unwrap(),
         "--weights",
