@@ -1,7 +1,8 @@
 //! The search planner on the shipped FR3 models: it evaluates the pipeline's own plan first, so
 //! it never returns a shorter one, and it goes further on many tasks, some through the repair
 //! stage's detours (recorded as such); every plan passes the independent checker; results do not depend on the thread count; a budget spent by the
-//! pipeline's rollout gives exactly the pipeline's plan.
+//! pipeline's rollout gives exactly the pipeline's plan; with the work surface and an obstacle on
+//! the way, every plan still passes the checker told of them.
 
 use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
@@ -124,4 +125,40 @@ fn search_does_not_depend_on_the_thread_count() {
     let one: Vec<_> = on(1).into_iter().map(|p| p.expect("searches")).collect();
     let two: Vec<_> = on(2).into_iter().map(|p| p.expect("searches")).collect();
     assert_eq!(one, two);
+}
+
+#[test]
+fn search_holds_the_work_surface_and_the_scene() {
+    let mut config = small_search();
+    config.rollout.constraints.work_surface = true;
+    let free = planner(small_search());
+    let robot = free.robot();
+    let checker =
+        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+            .expect("checker");
+    let (mut scene_ends, mut moved) = (0, 0);
+    for (index, task) in tasks(robot, 12).into_iter().enumerate() {
+        // A ball where the unconstrained search's pen tip is a third of the way along.
+        let unconstrained = free.plan(&task, &search_request()).expect("searches");
+        let steps = &unconstrained.trajectory.steps;
+        let mut constrained = config.clone();
+        constrained.rollout.constraints.scene = serde_json::from_value(serde_json::json!({
+            "obstacles": [{"name": "ball", "clearance_m": 0.005,
+                           "sphere": {"centre": steps[steps.len() / 3].tcp, "radius": 0.01}}]
+        }))
+        .expect("a valid scene");
+        let planner = planner(constrained);
+        let searched = planner.plan(&task, &search_request()).expect("searches");
+        let constraints = &planner.config().rollout.constraints;
+        checker
+            .check(&task, &searched.trajectory, constraints)
+            .unwrap_or_else(|e| panic!("task {index}: {e}"));
+        let termination = searched.trajectory.termination.to_string();
+        scene_ends += usize::from(termination.contains("ball") || termination.contains("surface"));
+        moved += usize::from(searched.trajectory.path_length_m > 0.05);
+    }
+    assert!(
+        scene_ends > 0 && moved > 3,
+        "{scene_ends} plans end on the scene, {moved} move"
+    );
 }
