@@ -24,6 +24,42 @@ pub enum Command {
     /// with the independent checker; exit status 1 names the point and the constraint.
     #[command(visible_alias = "replay")]
     Check(CheckArgs),
+    /// Import a vendor robot description: fit capsules to every link's collision geometry
+    /// (boxes, cylinders, spheres, STL and OBJ meshes), attach the pen to the tool link, and
+    /// write a standard URDF the planners and the checker read (see docs/robot-import.md).
+    ImportRobot(ImportArgs),
+}
+
+/// Options of `emg import-robot`.
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// The vendor description (URDF).
+    #[arg(value_name = "URDF")]
+    pub file: PathBuf,
+    /// The URDF to write (capsules as a cylinder plus two sphere caps; the pen's link is
+    /// `pen_tip`, the TCP).
+    #[arg(long, value_name = "URDF")]
+    pub out: PathBuf,
+    /// Where `package://NAME/...` meshes are: a directory of packages (DIR/NAME, or a directory
+    /// below DIR whose package.xml names NAME), or NAME=DIR for one package. Repeatable.
+    #[arg(long, value_name = "DIR|NAME=DIR")]
+    pub package_path: Vec<emg_io::PackagePath>,
+    /// The link the pen attaches to, along its z axis (default: the file's only leaf link).
+    #[arg(long)]
+    pub tool_link: Option<String>,
+    /// The chain's base link, checked to reach the pen (default: the file's only root link).
+    #[arg(long)]
+    pub base_link: Option<String>,
+    /// Pen length from the tool link's origin to the tip (m).
+    #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().length_m)]
+    pub pen_length: f64,
+    /// Pen radius (m).
+    #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().radius_m)]
+    pub pen_radius: f64,
+    /// Most capsules fitted to one link (1 to 3): a loose single capsule is split along its
+    /// axis when that saves a quarter of its volume.
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=3))]
+    pub max_capsules: u8,
 }
 
 /// Options of `emg check`.

@@ -55,6 +55,7 @@
 
 mod args;
 mod check;
+mod import;
 mod interrupt;
 mod output;
 mod robot;
@@ -80,6 +81,7 @@ fn main() -> ExitCode {
     let result = match Cli::parse().command {
         Command::Plan(args) => run_plan(&args),
         Command::Check(args) => check::run_check(&args),
+        Command::ImportRobot(args) => import::run_import(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -223,7 +225,9 @@ fn diffusion_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
     match args.weights_path() {
         Some(path) if explicit || (args.seed.is_none() && path.exists()) => Ok(Some(path)),
         None if explicit => anyhow::bail!(
-            "--seed dp: no diffusion weights are shipped for robot {}; pass --weights",
+            "--seed dp: no diffusion weights are shipped for robot {0}; pass --weights, or train \
+             them with `cargo xtask make-tasks --robot {0}`, `cargo xtask label-seeds --robot {0}` \
+             and `cargo xtask train-diffusion --robot {0}`",
             args.robot.display()
         ),
         _ => Ok(None),
@@ -239,7 +243,9 @@ fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
     match args.policy_path() {
         Some(path) => Ok(Some(path)),
         None => anyhow::bail!(
-            "--controller {}: no policy is shipped for robot {}; pass --policy or use --controller classical",
+            "--controller {}: no policy is shipped for robot {1}; pass --policy, train one with \
+             `cargo xtask make-tasks --robot {1}` and `cargo xtask train-ppo --robot {1}`, or use \
+             --controller classical",
             args.controller,
             args.robot.display()
         ),

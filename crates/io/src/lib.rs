@@ -10,6 +10,8 @@
 //!   checker's [`emg_verify::JointSamples`].
 //! * [`read_tasks`] / [`write_task_set`]: task sets (binary `EMGTASKS` or JSON).
 //! * [`read_scene`]: the obstacles of a cell (JSON, see [`emg_kinematics::Scene`]).
+//! * [`import_robot`]: a vendor description (boxes, cylinders, STL/OBJ meshes) as a standard
+//!   capsule URDF with a pen, and [`read_mesh`]: mesh files as triangles.
 //! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
 //!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
 //!   for one job's identity.
@@ -62,7 +64,9 @@ mod contents;
 mod csv;
 mod error;
 mod joint_trajectory;
+mod mesh;
 mod paths;
+mod robot_import;
 mod rollout_file;
 mod scene_file;
 mod task_file;
@@ -75,7 +79,11 @@ pub use joint_trajectory::{
     JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint, TimeFromStart, TimingLimits,
     TimingSummary,
 };
+pub use mesh::{MeshError, mesh_volume, read_mesh};
 pub use paths::{PlanPaths, html_path};
+pub use robot_import::{
+    ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath, Pen, import_robot,
+};
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};
 pub use task_file::{

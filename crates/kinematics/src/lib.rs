@@ -31,6 +31,7 @@
 //! ```
 
 mod collision;
+mod fit;
 mod fk;
 mod manipulability;
 mod nullspace;
@@ -40,6 +41,7 @@ mod robot;
 mod scene;
 
 pub use collision::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
+pub use fit::{Ball, Covered, FittedCapsule, fit_capsules};
 pub use fk::{Kinematics, PositionJacobian};
 pub use manipulability::{directional_manipulability, tool_alignment_gradient};
 pub use nullspace::{BasisConfig, NullSpaceBasis, TaskBasis, null_space_basis, task_aligned_basis};
