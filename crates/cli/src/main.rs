@@ -49,6 +49,9 @@
 //! `emg check <FILE>` (alias `replay`) reads any of the three files back and verifies it with
 //! the independent checker (`--robot`, `--task-from`, `--p0/--d/--n`, `--config` as needed).
 //!
+//! `emg import-robot <URDF> --out <URDF>` turns a vendor description (meshes, boxes, cylinders)
+//! into a capsule URDF with a pen (`docs/robot-import.md`).
+//!
 //! The file layouts are documented in `docs/trajectory-format.md` and
 //! `docs/joint-trajectory-format.md`. Errors go to stderr with a
 //! nonzero exit status; with several tasks a failing task is reported and the rest still run.

@@ -1,8 +1,8 @@
 //! `emg import-robot` on a description nobody here wrote: the KUKA LBR iiwa 14 R820 of the
 //! `rtb-data` package (PyPI; Peter Corke's Robotics Toolbox data), with binary STL collision
 //! meshes behind `package://` paths. Imported, it loads in the planners and in the independent
-//! checker, plans end to end with the classical controller, passes `emg check`, is drawn by the
-//! viewer, and the learned controllers refuse it naming the missing model and how to train one.
+//! checker and urdfdom's `check_urdf`, plans end to end with the classical controller, passes
+//! `emg check`, is drawn by the viewer, and the learned controllers refuse it naming the missing model and how to train one.
 //!
 //! The package is found at `$EMG_RTB_DATA` (the unpacked wheel's `rtbdata` directory; `.ci/run`
 //! downloads it). Without it the test prints a notice and passes, unless `EMG_REQUIRE_RTB_DATA=1`.
@@ -86,6 +86,23 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
     );
     assert!(urdf.contains("pen_tip"));
 
+    // urdfdom, the parser of ROS and MoveIt, reads it whole (when installed; CI installs it).
+    let check_urdf =
+        std::env::var_os("EMG_CHECK_URDF").map_or_else(|| "check_urdf".into(), PathBuf::from);
+    match std::process::Command::new(&check_urdf).arg(&robot).output() {
+        Ok(output) => {
+            assert!(
+                output.status.success(),
+                "check_urdf: {}",
+                text(&output.stderr)
+            );
+            assert!(text(&output.stdout).contains("child(1):  pen_tip"));
+        }
+        Err(_) => assert!(
+            std::env::var("EMG_REQUIRE_URDFDOM").as_deref() != Ok("1"),
+            "EMG_REQUIRE_URDFDOM=1 but check_urdf was not found"
+        ),
+    }
     let limits = limits_for_vendor_joints(dir);
     let stem = dir.join("line");
     let html = dir.join("line.html");

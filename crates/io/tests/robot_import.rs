@@ -1,0 +1,336 @@
+//! Importing a description with every kind of collision geometry: boxes, cylinders, spheres, a
+//! binary STL behind `package://` (found through a `package.xml`), an OBJ beside the file, and a
+//! link hanging off the chain by a fixed joint. The fitted capsules contain every element; the
+//! written URDF keeps the kinematics (the TCP is the tool link's origin moved along its z by the
+//! pen), and the planners' loader and the independent checker read the same capsules from it.
+//! Missing meshes, moving side links and ambiguous tool links are refused with their names.
+
+use std::path::Path;
+
+use emg_io::{ImportError, ImportOptions, PEN_LINK, PackagePath, import_robot};
+use emg_kinematics::{JointVector, Robot, Vec3, segment_distance};
+use emg_verify::ReferenceModel;
+use rand::{RngExt, SeedableRng};
+
+const HALF_PI: &str = "1.5707963267948966";
+
+/// A 7-DoF description: links `l0`..`l7`, a fixed `flange` after `l7`, and `extra` (a side link
+/// of `l7`, joined by `side_joint`), each joint 0.15 m along the previous z, turned by ±90°.
+fn description(geometry: &[(&str, &str)], side_joint: &str) -> String {
+    let mut text = String::from("<robot name=\"vendor\">\n");
+    let names = [
+        "l0", "l1", "l2", "l3", "l4", "l5", "l6", "l7", "flange", "extra",
+    ];
+    for name in names {
+        text += &format!("  <link name=\"{name}\">\n");
+        for (link, element) in geometry {
+            if *link == name {
+                text += &format!("    <collision>{element}</collision>\n");
+            }
+        }
+        text += "  </link>\n";
+    }
+    for k in 1..=7 {
+        let sign = if k % 2 == 0 { "" } else { "-" };
+        text += &format!(
+            "  <joint name=\"j{k}\" type=\"revolute\"><parent link=\"l{}\"/><child link=\"l{k}\"/>\
+             <origin xyz=\"0 0 0.15\" rpy=\"{sign}{HALF_PI} 0 0\"/><axis xyz=\"0 0 1\"/>\
+             <limit lower=\"-2.8\" upper=\"2.8\" effort=\"1\" velocity=\"2\"/></joint>\n",
+            k - 1
+        );
+    }
+    text += "  <joint name=\"to_flange\" type=\"fixed\"><parent link=\"l7\"/><child link=\"flange\"/>\
+             <origin xyz=\"0 0 0.1\" rpy=\"0 0 0\"/></joint>\n";
+    text += &format!(
+        "  <joint name=\"to_extra\" type=\"{side_joint}\"><parent link=\"l7\"/><child link=\"extra\"/>\
+         <origin xyz=\"0.05 0 0.02\" rpy=\"0 0.3 0\"/><axis xyz=\"1 0 0\"/>\
+         <limit lower=\"0\" upper=\"0.01\" effort=\"1\" velocity=\"1\"/></joint>\n"
+    );
+    text + "</robot>\n"
+}
+
+/// Triangles of a box of half extents `h` centred at `c`, wound outwards.
+fn box_mesh(c: Vec3, h: Vec3) -> Vec<[Vec3; 3]> {
+    let corner = |i: usize| {
+        c + Vec3::new(
+            if i & 1 != 0 { h.x } else { -h.x },
+            if i & 2 != 0 { h.y } else { -h.y },
+            if i & 4 != 0 { h.z } else { -h.z },
+        )
+    };
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 3, 7, 5],
+    ];
+    let outwards = |[a, b, d]: [Vec3; 3]| {
+        if (b - a).cross(&(d - a)).dot(&(a - c)) < 0.0 {
+            [a, d, b]
+        } else {
+            [a, b, d]
+        }
+    };
+    faces
+        .iter()
+        .flat_map(|f| {
+            [
+                outwards([corner(f[0]), corner(f[1]), corner(f[2])]),
+                outwards([corner(f[0]), corner(f[2]), corner(f[3])]),
+            ]
+        })
+        .collect()
+}
+
+fn write_stl(path: &Path, triangles: &[[Vec3; 3]]) {
+    let vertex = |p: &Vec3| stl_io::Vector::new([p.x as f32, p.y as f32, p.z as f32]);
+    let stl: Vec<stl_io::Triangle> = triangles
+        .iter()
+        .map(|t| stl_io::Triangle {
+            normal: stl_io::Vector::new([0.0, 0.0, 0.0]),
+            vertices: [vertex(&t[0]), vertex(&t[1]), vertex(&t[2])],
+        })
+        .collect();
+    let mut file = std::fs::File::create(path).unwrap();
+    stl_io::write_stl(&mut file, stl.iter()).unwrap();
+}
+
+fn write_obj(path: &Path, triangles: &[[Vec3; 3]]) {
+    let mut text = String::new();
+    for t in triangles {
+        for p in t {
+            text += &format!("v {} {} {}\n", p.x, p.y, p.z);
+        }
+    }
+    for k in 0..triangles.len() {
+        text += &format!("f {} {} {}\n", 3 * k + 1, 3 * k + 2, 3 * k + 3);
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// The geometry of every link, and points each fitted capsule set must contain (link frame).
+struct Fixture {
+    dir: tempfile::TempDir,
+    geometry: Vec<(&'static str, String)>,
+    must_contain: Vec<(&'static str, Vec3, f64)>,
+}
+
+fn fixture() -> Fixture {
+    let dir = tempfile::tempdir().unwrap();
+    let package = dir.path().join("src/vendor_support");
+    std::fs::create_dir_all(package.join("meshes")).unwrap();
+    std::fs::write(
+        package.join("package.xml"),
+        "<package><name>vendor_description</name></package>",
+    )
+    .unwrap();
+    let stl = box_mesh(Vec3::new(0.0, 0.0, 0.07), Vec3::new(0.04, 0.05, 0.07));
+    write_stl(&package.join("meshes/l2.stl"), &stl);
+    std::fs::create_dir_all(dir.path().join("urdf/meshes")).unwrap();
+    let obj = box_mesh(Vec3::new(0.02, 0.0, 0.05), Vec3::new(0.06, 0.03, 0.05));
+    write_obj(&dir.path().join("urdf/meshes/l3.obj"), &obj);
+    let mut must_contain: Vec<(&str, Vec3, f64)> = Vec::new();
+    for t in &stl {
+        must_contain.extend(t.iter().map(|p| ("l2", *p * 1.0, 1e-6)));
+    }
+    for t in &obj {
+        // The OBJ is scaled by 2 along x in the description.
+        must_contain.extend(
+            t.iter()
+                .map(|p| ("l3", Vec3::new(2.0 * p.x, p.y, p.z), 1e-6)),
+        );
+    }
+    // Box corners, cylinder rims, sphere poles, the side link's box in l7's frame.
+    for i in 0..8 {
+        let s = |bit: usize| if i & (1 << bit) != 0 { 1.0 } else { -1.0 };
+        must_contain.push((
+            "l0",
+            Vec3::new(0.1 * s(0), 0.1 * s(1), 0.05 + 0.05 * s(2)),
+            1e-9,
+        ));
+    }
+    for k in 0..16 {
+        let a = std::f64::consts::TAU * k as f64 / 16.0;
+        for z in [-0.06, 0.06] {
+            must_contain.push(("l1", Vec3::new(0.04 * a.cos(), 0.04 * a.sin(), z), 1e-9));
+        }
+    }
+    must_contain.push(("l4", Vec3::new(0.0, 0.0, 0.11), 1e-9));
+    must_contain.push(("l4", Vec3::new(0.0, 0.05, 0.06), 1e-9));
+    let side = nalgebra::Isometry3::from_parts(
+        nalgebra::Translation3::new(0.05, 0.0, 0.02),
+        nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.3, 0.0),
+    );
+    for i in 0..8 {
+        let s = |bit: usize| if i & (1 << bit) != 0 { 0.02 } else { -0.02 };
+        let p = side
+            .transform_point(&nalgebra::Point3::new(s(0), s(1), s(2)))
+            .coords;
+        must_contain.push(("l7", p, 1e-9));
+    }
+    let geometry = vec![
+        (
+            "l0",
+            "<origin xyz=\"0 0 0.05\"/><geometry><box size=\"0.2 0.2 0.1\"/></geometry>".into(),
+        ),
+        (
+            "l1",
+            "<geometry><cylinder radius=\"0.04\" length=\"0.12\"/></geometry>".into(),
+        ),
+        (
+            "l2",
+            "<geometry><mesh filename=\"package://vendor_description/meshes/l2.stl\"/></geometry>"
+                .into(),
+        ),
+        (
+            "l3",
+            "<geometry><mesh filename=\"meshes/l3.obj\" scale=\"2 1 1\"/></geometry>".into(),
+        ),
+        (
+            "l4",
+            "<origin xyz=\"0 0 0.06\"/><geometry><sphere radius=\"0.05\"/></geometry>".into(),
+        ),
+        (
+            "l5",
+            format!(
+                "<origin xyz=\"0 0 0.05\" rpy=\"{HALF_PI} 0 0\"/><geometry><cylinder radius=\"0.03\" length=\"0.1\"/></geometry>"
+            ),
+        ),
+        (
+            "l6",
+            "<geometry><box size=\"0.06 0.06 0.12\"/></geometry>".into(),
+        ),
+        (
+            "l7",
+            "<geometry><cylinder radius=\"0.03\" length=\"0.05\"/></geometry>".into(),
+        ),
+        (
+            "extra",
+            "<geometry><box size=\"0.04 0.04 0.04\"/></geometry>".into(),
+        ),
+    ];
+    Fixture {
+        dir,
+        geometry,
+        must_contain,
+    }
+}
+
+impl Fixture {
+    fn write(&self, side_joint: &str) -> std::path::PathBuf {
+        let geometry: Vec<(&str, &str)> = self
+            .geometry
+            .iter()
+            .map(|(l, g)| (*l, g.as_str()))
+            .collect();
+        let path = self.dir.path().join("urdf/vendor.urdf");
+        std::fs::write(&path, description(&geometry, side_joint)).unwrap();
+        path
+    }
+
+    fn options(&self) -> ImportOptions {
+        ImportOptions {
+            package_paths: vec![PackagePath::Search(self.dir.path().join("src"))],
+            tool_link: Some("flange".into()),
+            ..ImportOptions::default()
+        }
+    }
+}
+
+#[test]
+fn every_kind_of_geometry_is_fitted_and_read_back_by_both_loaders() {
+    let fixture = fixture();
+    let path = fixture.write("fixed");
+    let imported = import_robot(&path, &fixture.options()).expect("imports");
+    assert_eq!(
+        (imported.base_link.as_str(), imported.tool_link.as_str()),
+        ("l0", "flange")
+    );
+    let links: Vec<&str> = imported.fits.iter().map(|f| f.link.as_str()).collect();
+    assert_eq!(links, ["l0", "l1", "l2", "l3", "l4", "l5", "l6", "l7"]);
+    for (link, point, slack) in &fixture.must_contain {
+        let fit = imported.fits.iter().find(|f| f.link == *link).unwrap();
+        let inside = fit
+            .capsules
+            .iter()
+            .any(|c| segment_distance(&c.start, &c.end, point, point) <= c.radius + slack);
+        assert!(inside, "{link}: {point} outside {:?}", fit.capsules);
+    }
+    for fit in &imported.fits {
+        let ratio = fit.capsule_volume_m3() / fit.source_volume_m3;
+        assert!(ratio > 0.99 && ratio < 4.0, "{}: ratio {ratio}", fit.link);
+    }
+    let l7 = imported.fits.iter().find(|f| f.link == "l7").unwrap();
+    assert_eq!(l7.elements.len(), 2, "the side link's box moved onto l7");
+    assert!(
+        !imported.urdf.contains("extra"),
+        "frames off the chain are dropped"
+    );
+
+    let robot = Robot::from_urdf_str(&imported.urdf, "l0", PEN_LINK).expect("the planners read it");
+    let flange = Robot::from_urdf_str(&imported.urdf, "l0", "flange").unwrap();
+    let checker =
+        ReferenceModel::from_urdf_str(&imported.urdf, "l0", PEN_LINK).expect("so does the checker");
+    // The description's own chain, without geometry and without the side link.
+    let bare: String = description(&[], "fixed")
+        .lines()
+        .filter(|line| !line.contains("to_extra"))
+        .map(|line| format!("{line}\n"))
+        .collect();
+    let source = Robot::from_urdf_str(&bare, "l0", "flange").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    for _ in 0..50 {
+        let q = JointVector::from_fn(|_, _| rng.random_range(-2.8..2.8));
+        let (tip, tool, original) = (robot.forward(&q), flange.forward(&q), source.forward(&q));
+        assert!(
+            (tool.tcp() - original.tcp()).norm() < 1e-12,
+            "the kinematics are kept"
+        );
+        let expected = tool.tcp() + tool.tool_axis() * 0.1;
+        assert!((tip.tcp() - expected).norm() < 1e-12);
+        let (ours, theirs) = (
+            robot.min_clearance(&robot.forward(&q)),
+            checker.min_clearance(&q),
+        );
+        let ours = ours.expect("pairs exist").clearance;
+        assert!((ours - theirs.0).abs() < 1e-9, "{ours} vs {theirs:?}");
+    }
+}
+
+#[test]
+fn what_cannot_be_imported_is_named() {
+    let fixture = fixture();
+    let path = fixture.write("prismatic");
+    let error = import_robot(&path, &fixture.options()).unwrap_err();
+    assert!(
+        matches!(&error, ImportError::Chain(m) if m.contains("'extra'") && m.contains("to_extra")),
+        "{error}"
+    );
+    let path = fixture.write("fixed");
+    let no_packages = ImportOptions {
+        package_paths: Vec::new(),
+        ..fixture.options()
+    };
+    let error = import_robot(&path, &no_packages).unwrap_err().to_string();
+    assert!(
+        error.contains("link 'l2': mesh 'package://vendor_description/meshes/l2.stl' not found"),
+        "{error}"
+    );
+    let named = ImportOptions {
+        package_paths: vec!["vendor_description=/nowhere".parse().unwrap()],
+        ..fixture.options()
+    };
+    let error = import_robot(&path, &named).unwrap_err().to_string();
+    assert!(error.contains("/nowhere/meshes/l2.stl"), "{error}");
+    let untold = ImportOptions {
+        tool_link: None,
+        ..fixture.options()
+    };
+    let error = import_robot(&path, &untold).unwrap_err().to_string();
+    assert!(
+        error.contains("leaf links [flange, extra]") && error.contains("--tool-link"),
+        "{error}"
+    );
+}
