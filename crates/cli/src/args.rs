@@ -26,7 +26,8 @@ pub enum Command {
     Check(CheckArgs),
     /// Import a vendor robot description: fit capsules to every link's collision geometry
     /// (boxes, cylinders, spheres, STL and OBJ meshes), attach the pen to the tool link, and
-    /// write a standard URDF the planners and the checker read (see docs/robot-import.md).
+    /// write a standard URDF the planners and the checker read, with an SRDF beside it listing
+    /// the link pairs not checked for self-collision (see docs/robot-import.md).
     ImportRobot(ImportArgs),
 }
 
@@ -56,6 +57,10 @@ pub struct ImportArgs {
     /// Pen radius (m).
     #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().radius_m)]
     pub pen_radius: f64,
+    /// An SRDF file (MoveIt's) whose `disable_collisions` pairs are not checked for
+    /// self-collision, besides adjacent links and links whose capsules overlap at mid-range.
+    #[arg(long, value_name = "SRDF")]
+    pub srdf: Option<PathBuf>,
     /// Most capsules fitted to one link (1 to 3): a loose single capsule is split along its
     /// axis when that saves a quarter of its volume.
     #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=3))]

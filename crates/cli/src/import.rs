@@ -2,8 +2,8 @@
 //! a capsule URDF with a pen, and a report of what was fitted.
 
 use anyhow::{Context, Result};
-use emg_io::{ImportOptions, ImportedRobot, PEN_LINK, Pen, import_robot};
-use emg_kinematics::Robot;
+use emg_io::{DisabledBecause, ImportOptions, ImportedRobot, PEN_LINK, Pen, import_robot};
+use emg_kinematics::{PairRule, Robot, srdf_beside};
 
 use crate::args::ImportArgs;
 use crate::output::write_text;
@@ -20,19 +20,31 @@ pub fn run_import(args: &ImportArgs) -> Result<()> {
             radius_m: args.pen_radius,
         },
         max_capsules_per_link: usize::from(args.max_capsules),
+        srdf: args.srdf.clone(),
     };
     let imported = import_robot(&args.file, &options)
         .with_context(|| format!("cannot import {}", args.file.display()))?;
     let base = imported.base_link.clone();
-    let robot = Robot::from_urdf_str(&imported.urdf, &base, PEN_LINK).with_context(|| {
-        format!("the imported chain from '{base}' to the pen cannot be planned with")
-    })?;
+    let rule = PairRule::AllExcept(
+        imported
+            .disabled
+            .iter()
+            .map(|(a, b, _)| (a.clone(), b.clone()))
+            .collect(),
+    );
+    let robot = Robot::from_urdf_str_with_rule(&imported.urdf, &base, PEN_LINK, rule)
+        .with_context(|| {
+            format!("the imported chain from '{base}' to the pen cannot be planned with")
+        })?;
+    let srdf = srdf_beside(&args.out);
     write_text(&args.out, &imported.urdf)?;
+    write_text(&srdf, &imported.srdf)?;
     println!("{}", report(&imported, &robot));
     println!(
-        "wrote {}; plan with: emg plan --robot {} --base-link {base} --tip-link {PEN_LINK} \
-         --controller classical --limits <joint_limits.yaml>",
+        "wrote {} and {}; plan with: emg plan --robot {} --base-link {base} --tip-link \
+         {PEN_LINK} --controller classical --limits <joint_limits.yaml>",
         args.out.display(),
+        srdf.display(),
         args.out.display()
     );
     Ok(())
@@ -55,24 +67,29 @@ fn report(imported: &ImportedRobot, robot: &Robot) -> String {
             fit.elements.join(", ")
         );
     }
+    let count = |why: DisabledBecause| imported.disabled.iter().filter(|d| d.2 == why).count();
+    let colliding: Vec<String> = imported
+        .disabled
+        .iter()
+        .filter(|d| d.2 == DisabledBecause::CollidingAtMidRange)
+        .map(|(a, b, _)| format!("{a}–{b}"))
+        .collect();
     text += &format!(
-        "the chain '{}' → '{}' has {} capsules and {} self-collision pairs (bodies at least 3 \
-         links apart)",
+        "self-collision rule: every two links that move relative to each other, except {} \
+         adjacent pairs, {} pairs whose capsules overlap at mid-range{} and {} pairs of the given \
+         SRDF: {} capsule pairs checked on the chain '{}' → '{}' ({} capsules)",
+        count(DisabledBecause::Adjacent),
+        count(DisabledBecause::CollidingAtMidRange),
+        if colliding.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", colliding.join(", "))
+        },
+        count(DisabledBecause::Given),
+        robot.collision_pairs().len(),
         robot.base_link(),
         robot.tip_link(),
         robot.capsules().len(),
-        robot.collision_pairs().len()
     );
-    let mid = robot.forward(&robot.mid_range());
-    if let Some(hit) = robot.first_collision(&mid, 0.0) {
-        let capsules = robot.capsules();
-        text += &format!(
-            "\nwarning: at mid-range the fitted capsules of '{}' and '{}' overlap by {:.1} mm: \
-             the fit is loose there, and every configuration near mid-range counts as a collision",
-            capsules[hit.pair.first].link,
-            capsules[hit.pair.second].link,
-            -hit.clearance * 1e3
-        );
-    }
     text
 }

@@ -2,7 +2,7 @@
 //! `rtb-data` package (PyPI; Peter Corke's Robotics Toolbox data), with binary STL collision
 //! meshes behind `package://` paths. Imported, it loads in the planners and in the independent
 //! checker and urdfdom's `check_urdf`, plans end to end with the classical controller, passes
-//! `emg check`, is drawn by the viewer, and the learned controllers refuse it naming the missing model and how to train one.
+//! `emg check`, is drawn by the viewer, comes with the SRDF of its self-collision rule, and the learned controllers refuse it naming the missing model and how to train one.
 //!
 //! The package is found at `$EMG_RTB_DATA` (the unpacked wheel's `rtbdata` directory; `.ci/run`
 //! downloads it). Without it the test prints a notice and passes, unless `EMG_REQUIRE_RTB_DATA=1`.
@@ -76,7 +76,17 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
         assert!(report.contains(link), "{report}");
     }
     assert!(report.contains("triangles"), "{report}");
-    assert!(!report.contains("warning"), "{report}");
+    // The self-collision rule is printed and written beside the URDF, where both loaders read it.
+    assert!(
+        report.contains("self-collision rule: every two links"),
+        "{report}"
+    );
+    let srdf = read(&robot.with_extension("srdf"));
+    assert!(
+        srdf.contains(r#"<disable_collisions link1="link_3" link2="link_4" reason="Adjacent"/>"#),
+        "{srdf}"
+    );
+    assert!(!srdf.contains(r#"link1="link_1" link2="link_3""#), "{srdf}");
     // The written file is standard: capsules as capped cylinders; only the visual meshes are
     // left.
     let urdf = read(&robot);

@@ -82,7 +82,8 @@ pub use joint_trajectory::{
 pub use mesh::{MeshError, mesh_volume, read_mesh};
 pub use paths::{PlanPaths, html_path};
 pub use robot_import::{
-    ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath, Pen, import_robot,
+    DisabledBecause, ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath,
+    Pen, import_robot,
 };
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};

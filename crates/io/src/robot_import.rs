@@ -9,7 +9,10 @@
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-use emg_kinematics::{Ball, Covered, FittedCapsule, Vec3, fit_capsules};
+use emg_kinematics::{
+    Ball, Covered, FittedCapsule, PairRule, Robot, Vec3, disabled_pairs, fit_capsules,
+    segment_distance,
+};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 
 use crate::mesh::{MeshError, mesh_volume, read_mesh};
@@ -82,6 +85,8 @@ pub struct ImportOptions {
     pub pen: Pen,
     /// Most capsules fitted to one link (1 to 3).
     pub max_capsules_per_link: usize,
+    /// An SRDF file whose `disable_collisions` pairs are not checked either.
+    pub srdf: Option<PathBuf>,
 }
 
 impl Default for ImportOptions {
@@ -92,6 +97,7 @@ impl Default for ImportOptions {
             base_link: None,
             pen: Pen::default(),
             max_capsules_per_link: 3,
+            srdf: None,
         }
     }
 }
@@ -116,11 +122,38 @@ impl LinkFit {
     }
 }
 
+/// Why two links are not checked against each other.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DisabledBecause {
+    /// A joint connects them.
+    Adjacent,
+    /// Their capsules overlap at the mid-range configuration.
+    CollidingAtMidRange,
+    /// The given SRDF file disables them.
+    Given,
+}
+
+impl DisabledBecause {
+    /// The SRDF `reason` attribute (MoveIt's words).
+    pub fn srdf_reason(self) -> &'static str {
+        match self {
+            Self::Adjacent => "Adjacent",
+            Self::CollidingAtMidRange => "Default",
+            Self::Given => "User",
+        }
+    }
+}
+
 /// A description with capsule collision geometry and a pen, ready to plan with.
 #[derive(Clone, Debug)]
 pub struct ImportedRobot {
     /// The standard URDF text.
     pub urdf: String,
+    /// The SRDF text listing the link pairs not checked for self-collision (written beside the
+    /// URDF, where the planners' and the checker's loaders find it).
+    pub srdf: String,
+    /// Those pairs, with why.
+    pub disabled: Vec<(String, String, DisabledBecause)>,
     /// The chain's base link.
     pub base_link: String,
     /// The link the pen was attached to.
@@ -256,12 +289,90 @@ pub fn import_robot(path: &Path, options: &ImportOptions) -> Result<ImportedRobo
         safety_controller: None,
     });
     let urdf = urdf_rs::write_to_string(&robot).map_err(|e| ImportError::Write(e.to_string()))?;
+    let mut disabled: Vec<(String, String, DisabledBecause)> = robot
+        .joints
+        .iter()
+        .map(|j| {
+            (
+                j.parent.link.clone(),
+                j.child.link.clone(),
+                DisabledBecause::Adjacent,
+            )
+        })
+        .collect();
+    if let Some(path) = &options.srdf {
+        let text = std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        let given = disabled_pairs(&text)
+            .map_err(|e| ImportError::Malformed(format!("{}: {e}", path.display())))?;
+        disabled.extend(
+            given
+                .into_iter()
+                .map(|(a, b)| (a, b, DisabledBecause::Given)),
+        );
+    }
+    let chain =
+        Robot::from_urdf_str_with_rule(&urdf, &base_link, PEN_LINK, PairRule::LinkSeparation)
+            .map_err(|e| {
+                ImportError::Chain(format!("the chain '{base_link}' → '{PEN_LINK}': {e}"))
+            })?;
+    for (a, b) in colliding_at_mid_range(&chain) {
+        let listed = disabled
+            .iter()
+            .any(|(x, y, _)| (*x == a && *y == b) || (*x == b && *y == a));
+        if !listed {
+            disabled.push((a, b, DisabledBecause::CollidingAtMidRange));
+        }
+    }
+    let mut srdf = format!("<?xml version=\"1.0\"?>\n<robot name=\"{}\">\n", robot.name);
+    for (a, b, why) in &disabled {
+        srdf += &format!(
+            "  <disable_collisions link1=\"{a}\" link2=\"{b}\" reason=\"{}\"/>\n",
+            why.srdf_reason()
+        );
+    }
+    srdf += "</robot>\n";
     Ok(ImportedRobot {
         urdf,
+        srdf,
+        disabled,
         base_link,
         tool_link,
         fits,
     })
+}
+
+/// The link pairs (distinct links, any two) whose capsules overlap at the mid-range
+/// configuration.
+fn colliding_at_mid_range(robot: &Robot) -> Vec<(String, String)> {
+    let kin = robot.forward(&robot.mid_range());
+    let placed: Vec<(&str, Vec3, Vec3, f64)> = robot
+        .capsules()
+        .iter()
+        .map(|c| {
+            (
+                c.link.as_str(),
+                kin.segment_point(c.segment, &c.start),
+                kin.segment_point(c.segment, &c.end),
+                c.radius,
+            )
+        })
+        .collect();
+    let mut pairs: Vec<(String, String)> = Vec::new();
+    for (i, a) in placed.iter().enumerate() {
+        for b in &placed[i + 1..] {
+            let overlap = segment_distance(&a.1, &a.2, &b.1, &b.2) < a.3 + b.3;
+            let known = pairs
+                .iter()
+                .any(|(x, y)| (x == a.0 && y == b.0) || (x == b.0 && y == a.0));
+            if a.0 != b.0 && overlap && !known {
+                pairs.push((a.0.to_string(), b.0.to_string()));
+            }
+        }
+    }
+    pairs
 }
 
 /// Which end of the chain a link is.

@@ -3,12 +3,14 @@
 //! link hanging off the chain by a fixed joint. The fitted capsules contain every element; the
 //! written URDF keeps the kinematics (the TCP is the tool link's origin moved along its z by the
 //! pen), and the planners' loader and the independent checker read the same capsules from it.
-//! Missing meshes, moving side links and ambiguous tool links are refused with their names.
+//! The self-collision rule (adjacent links, links overlapping at mid-range, a given SRDF's pairs)
+//! is written as an SRDF that both loaders follow when it lies beside the robot file. Missing
+//! meshes, moving side links and ambiguous tool links are refused with their names.
 
 use std::path::Path;
 
-use emg_io::{ImportError, ImportOptions, PEN_LINK, PackagePath, import_robot};
-use emg_kinematics::{JointVector, Robot, Vec3, segment_distance};
+use emg_io::{DisabledBecause, ImportError, ImportOptions, PEN_LINK, PackagePath, import_robot};
+use emg_kinematics::{JointVector, PairRule, Robot, Vec3, segment_distance, srdf_beside};
 use emg_verify::ReferenceModel;
 use rand::{RngExt, SeedableRng};
 
@@ -297,6 +299,83 @@ fn every_kind_of_geometry_is_fitted_and_read_back_by_both_loaders() {
         let ours = ours.expect("pairs exist").clearance;
         assert!((ours - theirs.0).abs() < 1e-9, "{ours} vs {theirs:?}");
     }
+}
+
+#[test]
+fn the_self_collision_rule_is_written_beside_and_both_loaders_follow_it() {
+    let fixture = fixture();
+    let path = fixture.write("fixed");
+    let srdf_in = fixture.dir.path().join("given.srdf");
+    std::fs::write(
+        &srdf_in,
+        r#"<robot name="vendor"><disable_collisions link1="l0" link2="l6" reason="Never"/></robot>"#,
+    )
+    .unwrap();
+    let options = ImportOptions {
+        srdf: Some(srdf_in),
+        ..fixture.options()
+    };
+    let imported = import_robot(&path, &options).unwrap();
+    let because = |a: &str, b: &str| {
+        imported
+            .disabled
+            .iter()
+            .find(|(x, y, _)| (x == a && y == b) || (x == b && y == a))
+            .map(|d| d.2)
+    };
+    assert_eq!(because("l2", "l3"), Some(DisabledBecause::Adjacent));
+    assert_eq!(because("l0", "l6"), Some(DisabledBecause::Given));
+    assert_eq!(because("l1", "l5"), None);
+    let out = fixture.dir.path().join("imported.urdf");
+    std::fs::write(&out, &imported.urdf).unwrap();
+    std::fs::write(srdf_beside(&out), &imported.srdf).unwrap();
+    let robot = Robot::from_urdf_file(&out, "l0", PEN_LINK).unwrap();
+    let PairRule::AllExcept(pairs) = robot.pair_rule() else {
+        panic!("the SRDF beside the file sets the rule");
+    };
+    assert_eq!(pairs.len(), imported.disabled.len());
+    let capsules = robot.capsules();
+    let expected = (0..capsules.len())
+        .flat_map(|i| (i + 1..capsules.len()).map(move |j| (i, j)))
+        .filter(|&(i, j)| {
+            let (a, b) = (&capsules[i], &capsules[j]);
+            a.segment != b.segment && because(&a.link, &b.link).is_none()
+        })
+        .count();
+    assert_eq!(robot.collision_pairs().len(), expected);
+    // Pairs two links apart are checked now, as the rule of the shipped robots would not.
+    let plain = Robot::from_urdf_str(&imported.urdf, "l0", PEN_LINK).unwrap();
+    assert!(robot.collision_pairs().len() > plain.collision_pairs().len());
+    let checker = ReferenceModel::from_urdf_file(&out, "l0", PEN_LINK).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+    let mut touching = 0;
+    for _ in 0..300 {
+        let q = JointVector::from_fn(|_, _| rng.random_range(-2.8..2.8));
+        let ours = robot.min_clearance(&robot.forward(&q)).unwrap().clearance;
+        let theirs = checker.min_clearance(&q).0;
+        // The checker also checks links that never move relative to each other; those keep
+        // the clearance they have at mid-range, which the rule leaves positive.
+        assert!(theirs <= ours + 1e-9, "{theirs} vs {ours}");
+        if ours < 0.0 {
+            assert!((ours - theirs).abs() < 1e-9, "{ours} vs {theirs}");
+        }
+        touching += usize::from(ours < 0.0);
+    }
+    assert!(touching > 10, "{touching} of 300 configurations collide");
+    // A malformed SRDF is named.
+    std::fs::write(
+        srdf_beside(&out),
+        "<robot><disable_collisions link1=\"l0\"/></robot>",
+    )
+    .unwrap();
+    let error = Robot::from_urdf_file(&out, "l0", PEN_LINK)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("imported.srdf") && error.contains("link2"),
+        "{error}"
+    );
+    assert!(ReferenceModel::from_urdf_file(&out, "l0", PEN_LINK).is_err());
 }
 
 #[test]

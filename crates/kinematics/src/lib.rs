@@ -12,7 +12,9 @@
 //! * [`damped_pseudo_inverse`]: `J⁺` with variable damping (Eq. 2 of the paper).
 //! * [`null_space_basis`] and [`task_aligned_basis`]: `N` and the Gram–Schmidt basis `B(q)`.
 //! * [`Robot::first_collision`] and [`Robot::min_clearance`]: capsule clearances between bodies at
-//!   least three links apart.
+//!   least three links apart, or between every two bodies but those an SRDF file beside the robot
+//!   file disables ([`PairRule`]).
+//! * [`fit_capsules`]: bounding capsules of meshes and other collision geometry.
 //! * [`Robot::first_contact`]: capsule clearances from the obstacles of a [`Scene`] and from a
 //!   task's work surface ([`Shape::work_surface`]).
 //! * [`project_to_pose`]: Newton projection onto an exact `(p0, n[, roll])` pose within limits.
@@ -39,6 +41,7 @@ mod projection;
 mod pseudo_inverse;
 mod robot;
 mod scene;
+mod srdf;
 
 pub use collision::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
 pub use fit::{Ball, Covered, FittedCapsule, fit_capsules};
@@ -51,6 +54,7 @@ pub use projection::{
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
 pub use scene::{ContactHit, Obstacle, ObstacleError, Scene, Shape, ToolContact};
+pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
 
 /// Number of actuated joints of every supported arm.
 pub const DOF: usize = 7;

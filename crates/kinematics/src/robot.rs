@@ -5,11 +5,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use crate::collision::{Capsule, CollisionPair, MAX_CAPSULES};
+use crate::srdf::PairRule;
 use crate::{DOF, JointVector, Vec3};
-
-/// Smallest chain-index separation of two bodies whose capsules are checked against each other
-/// (adjacent links always touch at their joint).
-const MIN_LINK_SEPARATION: usize = 3;
 
 /// Why a robot file could not be turned into a [`Robot`].
 #[derive(Debug, thiserror::Error)]
@@ -120,6 +117,14 @@ pub enum RobotError {
         /// Link carrying the cylinder.
         link: String,
     },
+    /// The SRDF file beside the robot file cannot be read.
+    #[error("SRDF file {path}: {problem}")]
+    Srdf {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        problem: String,
+    },
     /// A collision element uses geometry other than a capsule, a capped cylinder or a sphere.
     #[error(
         "link '{link}': collision geometry {kind} is not supported; use a cylinder with a \
@@ -203,6 +208,7 @@ pub struct Robot {
     /// Index of the first of the tool's capsules (they close the list).
     pub(crate) first_tool_capsule: usize,
     pub(crate) pairs: Vec<CollisionPair>,
+    pub(crate) pair_rule: PairRule,
     pub(crate) reach_centre: Vec3,
     pub(crate) reach_radius: f64,
 }
@@ -214,7 +220,8 @@ struct ChainLink<'a> {
 }
 
 impl Robot {
-    /// Reads the chain from `base_link` to `tip_link` of a URDF file.
+    /// Reads the chain from `base_link` to `tip_link` of a URDF file, with the pair rule of
+    /// [`PairRule::for_robot_file`] (an SRDF file beside it lists the pairs not checked).
     pub fn from_urdf_file(
         path: impl AsRef<Path>,
         base_link: &str,
@@ -225,17 +232,21 @@ impl Robot {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_urdf_str(&text, base_link, tip_link)
+        Self::from_urdf_str_with_rule(&text, base_link, tip_link, PairRule::for_robot_file(path)?)
     }
 
-    /// Reads a URDF file whose links form one chain: from its root link to its only leaf link.
+    /// Reads a URDF file whose links form one chain: from its root link to its only leaf link
+    /// (pair rule as [`Robot::from_urdf_file`]).
     pub fn from_chain_file(path: impl AsRef<Path>) -> Result<Self, RobotError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_chain_str(&text)
+        let urdf =
+            urdf_rs::read_from_string(&text).map_err(|e| RobotError::Malformed(e.to_string()))?;
+        let (base, tip) = chain_ends(&urdf)?;
+        Self::from_urdf_str_with_rule(&text, &base, &tip, PairRule::for_robot_file(path)?)
     }
 
     /// Reads URDF text whose links form one chain: from its root link to its only leaf link.
@@ -246,8 +257,20 @@ impl Robot {
         Self::from_urdf_str(text, &base, &tip)
     }
 
-    /// Reads the chain from `base_link` to `tip_link` of URDF text.
+    /// Reads the chain from `base_link` to `tip_link` of URDF text, checking bodies at least
+    /// three links apart for self-collision ([`PairRule::LinkSeparation`]).
     pub fn from_urdf_str(text: &str, base_link: &str, tip_link: &str) -> Result<Self, RobotError> {
+        Self::from_urdf_str_with_rule(text, base_link, tip_link, PairRule::LinkSeparation)
+    }
+
+    /// Reads the chain from `base_link` to `tip_link` of URDF text, checking the capsule pairs
+    /// `pair_rule` names.
+    pub fn from_urdf_str_with_rule(
+        text: &str,
+        base_link: &str,
+        tip_link: &str,
+        pair_rule: PairRule,
+    ) -> Result<Self, RobotError> {
         let urdf =
             urdf_rs::read_from_string(text).map_err(|e| RobotError::Malformed(e.to_string()))?;
         let path = chain_joints(&urdf, base_link, tip_link)?;
@@ -318,7 +341,7 @@ impl Robot {
             .iter()
             .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
             .collect();
-        let pairs = collision_pairs(&capsules);
+        let pairs = collision_pairs(&capsules, &pair_rule);
         let first_tool_capsule = first_tool_capsule(&capsules);
         let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
         let reach_centre = joints[0].translation;
@@ -346,6 +369,7 @@ impl Robot {
             bounding_radii,
             first_tool_capsule,
             pairs,
+            pair_rule,
             reach_centre,
             reach_radius,
         })
@@ -413,10 +437,15 @@ impl Robot {
         self.first_tool_capsule..self.capsules.len()
     }
 
-    /// The capsule pairs checked for self-collision: bodies at least three links apart that
-    /// move relative to each other.
+    /// The capsule pairs checked for self-collision: bodies that move relative to each other
+    /// and that [`Robot::pair_rule`] checks.
     pub fn collision_pairs(&self) -> &[CollisionPair] {
         &self.pairs
+    }
+
+    /// Which bodies are checked against each other for self-collision.
+    pub fn pair_rule(&self) -> &PairRule {
+        &self.pair_rule
     }
 
     /// Mid-range configuration `q_mid`, the default seed (the robot file carries no home pose).
@@ -710,12 +739,11 @@ fn collision_shape(
     })
 }
 
-fn collision_pairs(capsules: &[Capsule]) -> Vec<CollisionPair> {
+fn collision_pairs(capsules: &[Capsule], rule: &PairRule) -> Vec<CollisionPair> {
     let mut pairs = Vec::new();
     for (i, a) in capsules.iter().enumerate() {
         for (j, b) in capsules.iter().enumerate().skip(i + 1) {
-            if b.chain_index.abs_diff(a.chain_index) >= MIN_LINK_SEPARATION
-                && a.segment != b.segment
+            if a.segment != b.segment && rule.checks(&a.link, a.chain_index, &b.link, b.chain_index)
             {
                 pairs.push(CollisionPair {
                     first: i,

@@ -35,6 +35,9 @@ pub struct ReferenceModel {
     /// Chain index of the link whose capsules are the tool (the last link carrying capsules,
     /// when no revolute joint follows it), if any.
     tool_link: Option<usize>,
+    /// Link pairs not checked for self-collision, from an SRDF file beside the robot file;
+    /// `None`: links at least three apart are checked.
+    disabled: Option<Vec<(String, String)>>,
 }
 
 /// The name the work surface goes by in failures.
@@ -77,6 +80,14 @@ pub enum ModelError {
     /// The walk from the tip towards the base comes back to a link it has passed.
     #[error("the joints from the tip towards the base form a loop at link '{0}'")]
     Loop(String),
+    /// The SRDF file beside the robot file cannot be read.
+    #[error("SRDF file {path}: {problem}")]
+    Srdf {
+        /// The file.
+        path: String,
+        /// What is wrong with it.
+        problem: String,
+    },
     /// A number of the file the checker needs is not usable.
     #[error("{element}: {problem}")]
     Value {
@@ -218,6 +229,7 @@ impl ReferenceModel {
             joints,
             capsules,
             tool_link,
+            disabled: None,
         })
     }
 
@@ -231,7 +243,34 @@ impl ReferenceModel {
             path: path.display().to_string(),
             source,
         })?;
-        Self::from_urdf_str(&text, base, tip)
+        let mut model = Self::from_urdf_str(&text, base, tip)?;
+        let srdf = path.with_extension("srdf");
+        if srdf.is_file() {
+            let text = std::fs::read_to_string(&srdf).map_err(|source| ModelError::Io {
+                path: srdf.display().to_string(),
+                source,
+            })?;
+            model.disabled =
+                Some(
+                    disabled_collisions(&text).map_err(|problem| ModelError::Srdf {
+                        path: srdf.display().to_string(),
+                        problem,
+                    })?,
+                );
+        }
+        Ok(model)
+    }
+
+    /// Whether the capsules `a` and `b` are checked against each other: links at least three
+    /// apart, or, with an SRDF file, links it does not list (links that never move relative to
+    /// each other keep their clearance, so checking them costs nothing but time).
+    fn checked(&self, a: &ReferenceCapsule, b: &ReferenceCapsule) -> bool {
+        match &self.disabled {
+            None => a.chain_index.abs_diff(b.chain_index) >= 3,
+            Some(pairs) => !pairs
+                .iter()
+                .any(|(x, y)| (*x == a.link && *y == b.link) || (*x == b.link && *y == a.link)),
+        }
     }
 
     /// Link frames base to tip (one per link of the chain) for configuration `q`.
@@ -276,7 +315,8 @@ impl ReferenceModel {
             .collect()
     }
 
-    /// Smallest clearance (m) over capsule pairs at least three links apart, with their links.
+    /// Smallest clearance (m) over the checked capsule pairs (links at least three apart, or
+    /// those an SRDF file beside the robot file does not disable), with their links.
     pub fn min_clearance(&self, q: &Joints) -> (f64, String, String) {
         let frames = self.link_frames(q);
         let world = |c: &ReferenceCapsule, v: &Vector3<f64>| {
@@ -285,7 +325,7 @@ impl ReferenceModel {
         let mut best = (f64::INFINITY, String::new(), String::new());
         for (i, a) in self.capsules.iter().enumerate() {
             for b in &self.capsules[i + 1..] {
-                if a.chain_index.abs_diff(b.chain_index) < 3 {
+                if !self.checked(a, b) {
                     continue;
                 }
                 let gap = segments_gap(
@@ -443,6 +483,22 @@ fn finite(element: &str, groups: &[&[f64; 3]]) -> Result<(), ModelError> {
         element: element.to_string(),
         problem: format!("{groups:?} must be finite numbers"),
     })
+}
+
+/// The link pairs of the `disable_collisions` elements of an SRDF document.
+fn disabled_collisions(text: &str) -> Result<Vec<(String, String)>, String> {
+    let document = roxmltree::Document::parse(text).map_err(|e| e.to_string())?;
+    let mut pairs = Vec::new();
+    for node in document.descendants() {
+        if node.tag_name().name() != "disable_collisions" {
+            continue;
+        }
+        match (node.attribute("link1"), node.attribute("link2")) {
+            (Some(a), Some(b)) => pairs.push((a.to_string(), b.to_string())),
+            _ => return Err("a disable_collisions element lacks link1 or link2".into()),
+        }
+    }
+    Ok(pairs)
 }
 
 /// Distance (m) within which a sphere sits on a cylinder end as its cap.
