@@ -74,6 +74,12 @@ fn report(imported: &ImportedRobot, robot: &Robot) -> String {
         .filter(|d| d.2 == DisabledBecause::CollidingAtMidRange)
         .map(|(a, b, _)| format!("{a}–{b}"))
         .collect();
+    if !imported.held_joints.is_empty() {
+        text += &format!(
+            "joints off the chain held at 0 (their links' geometry merged): {}\n",
+            imported.held_joints.join(", ")
+        );
+    }
     text += &format!(
         "self-collision rule: every two links that move relative to each other, except {} \
          adjacent pairs, {} pairs whose capsules overlap at mid-range{} and {} pairs of the given \

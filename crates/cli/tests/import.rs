@@ -1,11 +1,17 @@
-//! `emg import-robot` on a description nobody here wrote: the KUKA LBR iiwa 14 R820 of the
-//! `rtb-data` package (PyPI; Peter Corke's Robotics Toolbox data), with binary STL collision
-//! meshes behind `package://` paths. Imported, it loads in the planners and in the independent
-//! checker and urdfdom's `check_urdf`, plans end to end with the classical controller, passes
-//! `emg check`, is drawn by the viewer, comes with the SRDF of its self-collision rule, and the learned controllers refuse it naming the missing model and how to train one.
+//! `emg import-robot` on descriptions nobody here wrote, from package registries:
+//! - the KUKA LBR iiwa 14 R820 of PyPI's `rtb-data` (Peter Corke's Robotics Toolbox data), binary
+//!   STL collision meshes behind `package://` paths;
+//! - the Franka Emika Panda of PyPI's `pybullet` (`pybullet_data`), OBJ collision meshes behind
+//!   `package://meshes/...` read beside the file as pybullet does, fingers on prismatic joints.
 //!
-//! The package is found at `$EMG_RTB_DATA` (the unpacked wheel's `rtbdata` directory; `.ci/run`
-//! downloads it). Without it the test prints a notice and passes, unless `EMG_REQUIRE_RTB_DATA=1`.
+//! Imported, each is read whole by urdfdom's `check_urdf`, comes with the SRDF of its
+//! self-collision rule, plans end to end with the classical controller, passes `emg check`, is
+//! drawn by the viewer, and the learned controllers refuse it naming the missing model and how to
+//! train one.
+//!
+//! The packages are found at `$EMG_RTB_DATA` (the unpacked wheel's `rtbdata` directory) and
+//! `$EMG_PYBULLET_DATA` (its `pybullet_data` directory); `.ci/run` downloads both. Without them a
+//! test prints a notice and passes, unless `EMG_REQUIRE_THIRD_PARTY_ROBOTS=1`.
 
 mod common;
 
@@ -13,68 +19,51 @@ use std::path::{Path, PathBuf};
 
 use common::{emg, read, read_json, temp_dir, text};
 
-/// The unpacked `rtbdata` directory, if available.
-fn rtb_data() -> Option<PathBuf> {
-    let dir = std::env::var_os("EMG_RTB_DATA").map(PathBuf::from);
-    match dir.filter(|d| d.join("xacro/kuka_description").is_dir()) {
+/// The unpacked package directory `$variable` names, if available (it must hold `inside`).
+fn package(variable: &str, inside: &str) -> Option<PathBuf> {
+    let dir = std::env::var_os(variable).map(PathBuf::from);
+    match dir.filter(|d| d.join(inside).exists()) {
         Some(dir) => Some(dir),
-        None if std::env::var_os("EMG_REQUIRE_RTB_DATA").is_some_and(|v| v == "1") => panic!(
-            "EMG_REQUIRE_RTB_DATA=1 but EMG_RTB_DATA does not name the unpacked rtb-data package \
-             (its rtbdata directory)"
-        ),
+        None if std::env::var("EMG_REQUIRE_THIRD_PARTY_ROBOTS").as_deref() == Ok("1") => {
+            panic!("EMG_REQUIRE_THIRD_PARTY_ROBOTS=1 but ${variable} does not hold {inside}")
+        }
         None => {
             eprintln!(
-                "notice: skipping the third-party import test: set EMG_RTB_DATA to the rtbdata \
-                 directory of the rtb-data wheel (pip download rtb-data)"
+                "notice: skipping a third-party import test: set {variable} to the unpacked \
+                 package (see .ci/run)"
             );
             None
         }
     }
 }
 
-/// MoveIt joint limits for the vendor file's joint names: the shipped iiwa's, renamed.
-fn limits_for_vendor_joints(dir: &Path) -> PathBuf {
-    let shipped = read(&common::data_dir().join("robots/iiwa14_pen.joint_limits.yaml"));
-    let renamed = (1..=7).fold(shipped, |text, k| {
-        text.replace(&format!("iiwa_joint_{k}:"), &format!("joint_a{k}:"))
+/// MoveIt joint limits for the vendor file's joint names: a shipped robot's, renamed.
+fn limits(dir: &Path, shipped: &str, rename: impl Fn(usize) -> (String, String)) -> PathBuf {
+    let text = read(&common::data_dir().join(format!("robots/{shipped}.joint_limits.yaml")));
+    let renamed = (1..=7).fold(text, |text, k| {
+        let (from, to) = rename(k);
+        text.replace(&format!("{from}:"), &format!("{to}:"))
     });
-    let path = dir.join("iiwa.joint_limits.yaml");
+    let path = dir.join("vendor.joint_limits.yaml");
     std::fs::write(&path, renamed).unwrap();
     path
 }
 
-#[test]
-fn a_vendor_description_with_meshes_plans_end_to_end() {
-    let Some(rtb) = rtb_data() else { return };
-    let tmp = temp_dir("import");
-    let dir = tmp.path();
-    let kuka = rtb.join("xacro/kuka_description/kuka_lbr_iiwa");
-    let vendor = kuka.join("urdf/lbr_iiwa_14_r820.urdf");
-    let robot = dir.join("iiwa.urdf");
-    let package = format!("kuka_lbr_iiwa_support={}", kuka.display());
-    let args = [
-        "import-robot",
-        vendor.to_str().unwrap(),
-        "--out",
-        robot.to_str().unwrap(),
-        "--tool-link",
-        "tool0",
-    ];
-    // Without the package path, the missing mesh is named with where it was looked for.
-    let output = emg(&args);
-    assert!(!output.status.success());
-    let error = text(&output.stderr);
-    assert!(
-        error.contains("link 'base_link': mesh 'package://kuka_lbr_iiwa_support/"),
-        "{error}"
-    );
-    assert!(error.contains("--package-path"), "{error}");
-    let output = emg(&[&args[..], &["--package-path", &package]].concat());
+/// One vendor description end to end: import with `import_args`, then plan, check and view.
+fn end_to_end(vendor: &Path, import_args: &[&str], base: &str, limits: &Path, dir: &Path) {
+    let robot = dir.join("robot.urdf");
+    let output = emg(&[
+        &[
+            "import-robot",
+            vendor.to_str().unwrap(),
+            "--out",
+            robot.to_str().unwrap(),
+        ],
+        import_args,
+    ]
+    .concat());
     let report = text(&output.stdout);
     assert!(output.status.success(), "{}", text(&output.stderr));
-    for link in ["base_link", "link_1", "link_7"] {
-        assert!(report.contains(link), "{report}");
-    }
     assert!(report.contains("triangles"), "{report}");
     // The self-collision rule is printed and written beside the URDF, where both loaders read it.
     assert!(
@@ -82,20 +71,23 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
         "{report}"
     );
     let srdf = read(&robot.with_extension("srdf"));
-    assert!(
-        srdf.contains(r#"<disable_collisions link1="link_3" link2="link_4" reason="Adjacent"/>"#),
-        "{srdf}"
-    );
-    assert!(!srdf.contains(r#"link1="link_1" link2="link_3""#), "{srdf}");
-    // The written file is standard: capsules as capped cylinders; only the visual meshes are
-    // left.
+    assert!(srdf.contains(r#"reason="Adjacent"/>"#), "{srdf}");
+    // The written file is standard: capsules as capped cylinders, no collision mesh left.
     let urdf = read(&robot);
     assert!(
-        !urdf.contains("/collision/") && !urdf.contains("<capsule"),
+        !urdf.contains("<capsule") && urdf.contains("pen_tip"),
         "{urdf}"
     );
-    assert!(urdf.contains("pen_tip"));
-
+    let description = urdf_rs::read_from_string(&urdf).unwrap();
+    for link in &description.links {
+        for collision in &link.collision {
+            assert!(
+                !matches!(collision.geometry, urdf_rs::Geometry::Mesh { .. }),
+                "{}",
+                link.name
+            );
+        }
+    }
     // urdfdom, the parser of ROS and MoveIt, reads it whole (when installed; CI installs it).
     let check_urdf =
         std::env::var_os("EMG_CHECK_URDF").map_or_else(|| "check_urdf".into(), PathBuf::from);
@@ -113,7 +105,6 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
             "EMG_REQUIRE_URDFDOM=1 but check_urdf was not found"
         ),
     }
-    let limits = limits_for_vendor_joints(dir);
     let stem = dir.join("line");
     let html = dir.join("line.html");
     let plan = [
@@ -121,7 +112,7 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
         "--robot",
         robot.to_str().unwrap(),
         "--base-link",
-        "base_link",
+        base,
         "--tip-link",
         "pen_tip",
         "--controller",
@@ -144,7 +135,7 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
     assert!(length > 0.05, "{}", text(&output.stdout));
     let page = read(&html);
     assert!(
-        page.contains(r#""link":"link_4""#),
+        page.contains(r#""link":"pen_tip""#),
         "the viewer draws the fitted capsules"
     );
     for file in ["line.json", "line.joint_trajectory.json"] {
@@ -154,7 +145,7 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
             "--robot",
             robot.to_str().unwrap(),
             "--base-link",
-            "base_link",
+            base,
             "--tip-link",
             "pen_tip",
         ]);
@@ -170,4 +161,61 @@ fn a_vendor_description_with_meshes_plans_end_to_end() {
     let error = text(&output.stderr);
     assert!(error.contains("no policy"), "{error}");
     assert!(error.contains("cargo xtask train-ppo --robot"), "{error}");
+}
+
+#[test]
+fn rtb_datas_iiwa_with_stl_meshes_plans_end_to_end() {
+    let Some(rtb) = package("EMG_RTB_DATA", "xacro/kuka_description") else {
+        return;
+    };
+    let tmp = temp_dir("import-iiwa");
+    let dir = tmp.path();
+    let kuka = rtb.join("xacro/kuka_description/kuka_lbr_iiwa");
+    let vendor = kuka.join("urdf/lbr_iiwa_14_r820.urdf");
+    // Without the package's directory, the missing mesh is named with where it was looked for.
+    let output = emg(&[
+        "import-robot",
+        vendor.to_str().unwrap(),
+        "--out",
+        dir.join("x.urdf").to_str().unwrap(),
+        "--tool-link",
+        "tool0",
+    ]);
+    assert!(!output.status.success());
+    let error = text(&output.stderr);
+    assert!(
+        error.contains("link 'base_link': mesh 'package://kuka_lbr_iiwa_support/"),
+        "{error}"
+    );
+    assert!(error.contains("--package-path"), "{error}");
+    let package = format!("kuka_lbr_iiwa_support={}", kuka.display());
+    let limits = limits(dir, "iiwa14_pen", |k| {
+        (format!("iiwa_joint_{k}"), format!("joint_a{k}"))
+    });
+    end_to_end(
+        &vendor,
+        &["--tool-link", "tool0", "--package-path", &package],
+        "base_link",
+        &limits,
+        dir,
+    );
+}
+
+#[test]
+fn pybullets_panda_with_obj_meshes_and_fingers_plans_end_to_end() {
+    let Some(data) = package("EMG_PYBULLET_DATA", "franka_panda/panda.urdf") else {
+        return;
+    };
+    let tmp = temp_dir("import-panda");
+    let dir = tmp.path();
+    let limits = limits(dir, "fr3_pen", |k| {
+        (format!("fr3_joint{k}"), format!("panda_joint{k}"))
+    });
+    end_to_end(
+        &data.join("franka_panda/panda.urdf"),
+        &["--tool-link", "panda_hand", "--pen-length", "0.2"],
+        "panda_link0",
+        &limits,
+        dir,
+    );
 }

@@ -1,6 +1,6 @@
 //! Vendor robot descriptions made usable: the chain from the base link to the tool link is kept
-//! (links hanging off it by fixed joints give it their collision geometry; frames without any
-//! are dropped), every link's collision geometry (boxes, cylinders, spheres, capsules and
+//! (links hanging off it give it their collision geometry, joints other than fixed ones held at
+//! position 0, e.g. a gripper's fingers; frames without any geometry are dropped), every link's collision geometry (boxes, cylinders, spheres, capsules and
 //! STL/OBJ meshes, wherever `package://` or a relative path puts them) is replaced by fitted
 //! bounding capsules, a pen is attached to the tool link, and the result is written as a
 //! standard URDF (each capsule a cylinder plus two sphere caps) that the planners and the
@@ -158,6 +158,8 @@ pub struct ImportedRobot {
     pub base_link: String,
     /// The link the pen was attached to.
     pub tool_link: String,
+    /// Moving joints off the chain whose links' geometry was merged with them held at 0.
+    pub held_joints: Vec<String>,
     /// What was fitted, link by link (links without collision geometry are left out).
     pub fits: Vec<LinkFit>,
 }
@@ -247,7 +249,7 @@ pub fn import_robot(path: &Path, options: &ImportOptions) -> Result<ImportedRobo
     }
     let tool_link = chain_end(&robot, options.tool_link.as_deref(), End::Leaf)?;
     let base_link = chain_end(&robot, options.base_link.as_deref(), End::Root)?;
-    keep_chain(&mut robot, &base_link, &tool_link)?;
+    let held_joints = keep_chain(&mut robot, &base_link, &tool_link)?;
     let mut fits = Vec::new();
     for link in &mut robot.links {
         if link.collision.is_empty() {
@@ -340,6 +342,7 @@ pub fn import_robot(path: &Path, options: &ImportOptions) -> Result<ImportedRobo
         disabled,
         base_link,
         tool_link,
+        held_joints,
         fits,
     })
 }
@@ -426,9 +429,13 @@ fn chain_end(robot: &urdf_rs::Robot, named: Option<&str>, end: End) -> Result<St
 }
 
 /// Keeps the links and joints from `base` to `tool`; the collision elements of a link hanging
-/// off that chain by fixed joints move to the chain link it hangs from. A link hanging off by a
-/// moving joint is refused when it has collision geometry (the planners move one serial chain).
-fn keep_chain(robot: &mut urdf_rs::Robot, base: &str, tool: &str) -> Result<(), ImportError> {
+/// off that chain move to the chain link it hangs from, with the joints on the way at position 0
+/// (the planners move one serial chain). Returns the moving joints so held.
+fn keep_chain(
+    robot: &mut urdf_rs::Robot,
+    base: &str,
+    tool: &str,
+) -> Result<Vec<String>, ImportError> {
     let parent_joint = |link: &str| robot.joints.iter().position(|j| j.child.link == link);
     let mut chain = vec![tool.to_string()];
     while chain.last().map(String::as_str) != Some(base) {
@@ -447,6 +454,7 @@ fn keep_chain(robot: &mut urdf_rs::Robot, base: &str, tool: &str) -> Result<(), 
     }
     let on_chain = |link: &str| chain.iter().any(|c| c == link);
     let mut moved: Vec<(String, urdf_rs::Collision)> = Vec::new();
+    let mut held = Vec::new();
     for link in robot.links.iter().filter(|l| !on_chain(&l.name)) {
         if link.collision.is_empty() {
             continue;
@@ -465,12 +473,8 @@ fn keep_chain(robot: &mut urdf_rs::Robot, base: &str, tool: &str) -> Result<(), 
                         link.name
                     ))
                 })?;
-            if joint.joint_type != urdf_rs::JointType::Fixed {
-                return Err(ImportError::Chain(format!(
-                    "link '{}' hangs off the chain by the moving joint '{}'; the planners move \
-                     one serial chain (remove its collision geometry, or fix the joint)",
-                    link.name, joint.name
-                )));
+            if joint.joint_type != urdf_rs::JointType::Fixed && !held.contains(&joint.name) {
+                held.push(joint.name.clone());
             }
             pose = isometry(&joint.origin) * pose;
             current = joint.parent.link.clone();
@@ -490,7 +494,7 @@ fn keep_chain(robot: &mut urdf_rs::Robot, base: &str, tool: &str) -> Result<(), 
     robot
         .joints
         .retain(|j| on_chain(&j.child.link) && on_chain(&j.parent.link));
-    Ok(())
+    Ok(held)
 }
 
 /// A URDF pose as a rigid transform (the origin's `xyz`, then its roll–pitch–yaw).
@@ -632,9 +636,9 @@ fn fit_link(
     })
 }
 
-/// The file a mesh `filename` names: `package://NAME/REST` through the package paths, `file://`
-/// and absolute paths as they are, others relative to the description's directory. `Err` lists
-/// the places looked in.
+/// The file a mesh `filename` names: `package://NAME/REST` through the package paths, else (as
+/// pybullet reads it) `NAME/REST` beside the description; `file://` and absolute paths as they
+/// are, others relative to the description's directory. `Err` lists the places looked in.
 fn resolve(filename: &str, base_dir: &Path, packages: &[PackagePath]) -> Result<PathBuf, String> {
     let mut tried = Vec::new();
     let found = |candidate: PathBuf, tried: &mut Vec<String>| {
@@ -661,8 +665,8 @@ fn resolve(filename: &str, base_dir: &Path, packages: &[PackagePath]) -> Result<
                 return Ok(file);
             }
         }
-        if packages.is_empty() {
-            tried.push("no --package-path given".into());
+        if let Some(file) = found(base_dir.join(rest), &mut tried) {
+            return Ok(file);
         }
         return Err(tried.join(", "));
     }
