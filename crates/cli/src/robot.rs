@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use emg_kinematics::Robot;
+use emg_kinematics::{Robot, RobotError};
 use emg_planner::{DataDir, SHIPPED_ROBOTS};
 use emg_verify::ReferenceModel;
 
@@ -40,7 +40,19 @@ pub fn load_robot(path: &Path, base: Option<&str>, tip: Option<&str>) -> Result<
         (None, None) => Robot::from_chain_file(path),
         _ => anyhow::bail!("name both --base-link and --tip-link, or neither"),
     };
-    robot.with_context(|| format!("cannot load robot {}", path.display()))
+    robot.map_err(|error| {
+        let hint = match error {
+            RobotError::UnsupportedGeometry { .. } | RobotError::UncappedCylinder { .. } => {
+                format!(
+                    " (a vendor description: fit capsules to it first with `emg import-robot {} \
+                 --out robot.urdf`, see docs/robot-import.md)",
+                    path.display()
+                )
+            }
+            _ => String::new(),
+        };
+        anyhow::Error::new(error).context(format!("cannot load robot {}{hint}", path.display()))
+    })
 }
 
 /// The independent checker's model of the same chain, read again from the file.

@@ -208,11 +208,28 @@ fn pybullets_panda_with_obj_meshes_and_fingers_plans_end_to_end() {
     };
     let tmp = temp_dir("import-panda");
     let dir = tmp.path();
+    let vendor = data.join("franka_panda/panda.urdf");
+    // Planning with the vendor file itself says how to import it.
+    let output = emg(&[
+        "plan",
+        "--robot",
+        vendor.to_str().unwrap(),
+        "--base-link",
+        "panda_link0",
+        "--tip-link",
+        "panda_hand",
+    ]);
+    assert!(!output.status.success());
+    let error = text(&output.stderr);
+    assert!(
+        error.contains("mesh is not supported") && error.contains("emg import-robot"),
+        "{error}"
+    );
     let limits = limits(dir, "fr3_pen", |k| {
         (format!("fr3_joint{k}"), format!("panda_joint{k}"))
     });
     end_to_end(
-        &data.join("franka_panda/panda.urdf"),
+        &vendor,
         &["--tool-link", "panda_hand", "--pen-length", "0.2"],
         "panda_link0",
         &limits,
