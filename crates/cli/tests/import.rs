@@ -1,6 +1,7 @@
 //! `emg import-robot` on descriptions nobody here wrote, from package registries:
 //! - the KUKA LBR iiwa 14 R820 of PyPI's `rtb-data` (Peter Corke's Robotics Toolbox data), binary
-//!   STL collision meshes behind `package://` paths;
+//!   STL collision meshes behind `package://` paths (and its COLLADA visual meshes read in their
+//!   place fit about the same capsules);
 //! - the Franka Emika Panda of PyPI's `pybullet` (`pybullet_data`), OBJ collision meshes behind
 //!   `package://meshes/...` read beside the file as pybullet does, fingers on prismatic joints.
 //!
@@ -199,6 +200,60 @@ fn rtb_datas_iiwa_with_stl_meshes_plans_end_to_end() {
         &limits,
         dir,
     );
+    // The package's COLLADA visual meshes, read as collision meshes, fit about the same
+    // capsules as its STL collision meshes: COLLADA is read in the right unit.
+    let dae = dir.join("dae.urdf");
+    let swapped = collada_collisions(&read(&vendor));
+    std::fs::write(&dae, swapped).unwrap();
+    let from_dae = dir.join("from_dae.urdf");
+    let output = emg(&[
+        "import-robot",
+        dae.to_str().unwrap(),
+        "--out",
+        from_dae.to_str().unwrap(),
+        "--tool-link",
+        "tool0",
+        "--package-path",
+        &package,
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    assert!(text(&output.stdout).contains("link_4.dae"));
+    let radii = |path: &Path| -> Vec<(String, f64)> {
+        let robot = urdf_rs::read_file(path).unwrap();
+        robot
+            .links
+            .iter()
+            .filter_map(|l| {
+                l.collision.iter().find_map(|c| match c.geometry {
+                    urdf_rs::Geometry::Sphere { radius } => Some((l.name.clone(), radius)),
+                    _ => None,
+                })
+            })
+            .collect()
+    };
+    let (stl, dae) = (radii(&dir.join("robot.urdf")), radii(&from_dae));
+    assert_eq!(stl.len(), dae.len());
+    for ((link, a), (_, b)) in stl.iter().zip(&dae) {
+        assert!(
+            (a - b).abs() < 0.1 * a,
+            "{link}: {a} m from STL, {b} m from COLLADA"
+        );
+    }
+}
+
+/// The description with its collision meshes swapped for the visual COLLADA ones.
+fn collada_collisions(text: &str) -> String {
+    text.lines()
+        .map(|line| {
+            if line.contains("/collision/") {
+                line.replace("/collision/", "/visual/")
+                    .replace(".stl", ".dae")
+            } else {
+                line.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 #[test]

@@ -1,5 +1,6 @@
-//! Collision meshes of robot descriptions as triangles: STL (binary or ASCII, `stl_io`) and
-//! Wavefront OBJ (`tobj`), told apart by the file extension.
+//! Collision meshes of robot descriptions as triangles: STL (binary or ASCII, `stl_io`),
+//! Wavefront OBJ (`tobj`) and COLLADA (`mesh-loader`, the file's unit applied), told apart by
+//! the file extension.
 
 use std::path::Path;
 
@@ -22,14 +23,14 @@ pub enum MeshError {
     Malformed {
         /// The file.
         path: String,
-        /// `STL` or `OBJ`.
+        /// `STL`, `OBJ` or `COLLADA`.
         kind: &'static str,
         /// The reader's message.
         message: String,
     },
     /// The extension names no supported format.
     #[error(
-        "mesh {path}: unsupported format (read: .stl, .obj; convert others, e.g. .dae, to one of them)"
+        "mesh {path}: unsupported format (read: .stl, .obj, .dae; convert others to one of them)"
     )]
     Unsupported {
         /// The file.
@@ -97,6 +98,37 @@ pub fn read_mesh(path: &Path) -> Result<Vec<[Vec3; 3]>, MeshError> {
                         return Err(MeshError::Malformed {
                             path: name.clone(),
                             kind: "OBJ",
+                            message: "a face names a vertex the file does not hold".into(),
+                        });
+                    };
+                    triangles.push([a, b, c]);
+                }
+            }
+            triangles
+        }
+        "dae" => {
+            let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+                path: name.clone(),
+                source,
+            })?;
+            let scene =
+                mesh_loader::collada::from_slice(&bytes).map_err(|e| MeshError::Malformed {
+                    path: name.clone(),
+                    kind: "COLLADA",
+                    message: e.to_string(),
+                })?;
+            let mut triangles = Vec::new();
+            for mesh in &scene.meshes {
+                let vertex = |i: u32| {
+                    mesh.vertices
+                        .get(i as usize)
+                        .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+                };
+                for face in &mesh.faces {
+                    let [Some(a), Some(b), Some(c)] = face.map(vertex) else {
+                        return Err(MeshError::Malformed {
+                            path: name.clone(),
+                            kind: "COLLADA",
                             message: "a face names a vertex the file does not hold".into(),
                         });
                     };
