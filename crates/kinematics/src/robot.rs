@@ -243,18 +243,20 @@ impl Robot {
             path: path.display().to_string(),
             source,
         })?;
-        let urdf =
-            urdf_rs::read_from_string(&text).map_err(|e| RobotError::Malformed(e.to_string()))?;
-        let (base, tip) = chain_ends(&urdf)?;
-        Self::from_urdf_str_with_rule(&text, &base, &tip, PairRule::for_robot_file(path)?)
+        Self::chain_with_rule(&text, PairRule::for_robot_file(path)?)
     }
 
     /// Reads URDF text whose links form one chain: from its root link to its only leaf link.
     pub fn from_chain_str(text: &str) -> Result<Self, RobotError> {
+        Self::chain_with_rule(text, PairRule::LinkSeparation)
+    }
+
+    /// The chain from the root link to the only leaf link of URDF text, with `pair_rule`.
+    fn chain_with_rule(text: &str, pair_rule: PairRule) -> Result<Self, RobotError> {
         let urdf =
             urdf_rs::read_from_string(text).map_err(|e| RobotError::Malformed(e.to_string()))?;
         let (base, tip) = chain_ends(&urdf)?;
-        Self::from_urdf_str(text, &base, &tip)
+        Self::from_urdf_str_with_rule(text, &base, &tip, pair_rule)
     }
 
     /// Reads the chain from `base_link` to `tip_link` of URDF text, checking bodies at least
