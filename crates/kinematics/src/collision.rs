@@ -2,9 +2,9 @@
 
 use arrayvec::ArrayVec;
 
-use crate::Vec3;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
+use crate::{DOF, Vec3};
 
 /// A capsule: the segment `start`–`end` (in its segment's frame) swept by `radius`.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,65 +48,183 @@ pub const MAX_CAPSULES: usize = 64;
 /// skipped only when its spheres are clearly apart.
 const SPHERE_SLACK_M: f64 = 1e-9;
 
-/// A capsule placed at one configuration: its axis end points in the base frame and twice the
-/// centre of its bounding sphere.
-#[derive(Clone, Copy, Debug)]
-struct PlacedCapsule {
-    start: Vec3,
-    end: Vec3,
-    doubled_centre: Vec3,
+/// The centres of every capsule's bounding sphere at one configuration (one transform each).
+type CapsuleCentres = ArrayVec<Vec3, MAX_CAPSULES>;
+
+/// The checked capsule pairs between two rigid segments.
+#[derive(Clone, Debug)]
+struct PairGroup {
+    /// The two segments.
+    segments: (usize, usize),
+    /// Indices into [`Robot::collision_pairs`], ascending.
+    pairs: Vec<usize>,
 }
 
-/// Every capsule of the robot placed at one configuration, each transformed once.
-type PlacedCapsules = ArrayVec<PlacedCapsule, MAX_CAPSULES>;
+/// The two-level bounding-sphere hierarchy of the self-collision test, fixed at load time: one
+/// sphere per rigid segment enclosing its capsules, then one per capsule. A capsule pair is
+/// measured only when both levels say it may be close, so a check places the segments'
+/// spheres (one transform each), tests the few segment pairs, and places only the capsules of
+/// the segment pairs that may touch.
+#[derive(Clone, Debug)]
+pub(crate) struct BroadPhase {
+    /// Centre of each capsule's bounding sphere (its axis midpoint), in its segment's frame.
+    capsule_centres: Vec<Vec3>,
+    /// Radius of each capsule's bounding sphere (half its axis length plus its radius).
+    capsule_radii: Vec<f64>,
+    /// Centre, in its segment's frame, of each segment's sphere (unused for segments without
+    /// capsules).
+    segment_centres: [Vec3; DOF + 1],
+    /// Radius of each segment's sphere (0 for segments without capsules).
+    segment_radii: [f64; DOF + 1],
+    /// The checked pairs grouped by segment pair.
+    groups: Vec<PairGroup>,
+}
 
-impl Robot {
-    /// Places every capsule at `kin` into `placed` (cleared first).
-    fn place_capsules(&self, kin: &Kinematics, placed: &mut PlacedCapsules) {
-        placed.clear();
-        for capsule in &self.capsules {
-            let start = kin.segment_point(capsule.segment, &capsule.start);
-            let end = kin.segment_point(capsule.segment, &capsule.end);
-            placed.push(PlacedCapsule {
-                start,
-                end,
-                doubled_centre: start + end,
-            });
+impl BroadPhase {
+    /// The hierarchy of `capsules` for the checked `pairs`.
+    pub(crate) fn new(capsules: &[Capsule], pairs: &[CollisionPair]) -> Self {
+        let capsule_centres = capsules.iter().map(|c| (c.start + c.end) * 0.5).collect();
+        let capsule_radii = capsules
+            .iter()
+            .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
+            .collect();
+        let mut segment_centres = [Vec3::zeros(); DOF + 1];
+        let mut segment_radii = [0.0; DOF + 1];
+        for segment in 0..=DOF {
+            let members = || capsules.iter().filter(move |c| c.segment == segment);
+            let Some(first) = members().next() else {
+                continue;
+            };
+            let (mut low, mut high) = (first.start, first.start);
+            for c in members() {
+                for point in [c.start, c.end] {
+                    low = low.inf(&point);
+                    high = high.sup(&point);
+                }
+            }
+            let centre = (low + high) * 0.5;
+            segment_centres[segment] = centre;
+            segment_radii[segment] = members()
+                .map(|c| (c.start - centre).norm().max((c.end - centre).norm()) + c.radius)
+                .fold(0.0, f64::max);
+        }
+        let mut groups: Vec<PairGroup> = Vec::new();
+        for (index, pair) in pairs.iter().enumerate() {
+            let segments = (capsules[pair.first].segment, capsules[pair.second].segment);
+            match groups.iter_mut().find(|group| group.segments == segments) {
+                Some(group) => group.pairs.push(index),
+                None => groups.push(PairGroup {
+                    segments,
+                    pairs: vec![index],
+                }),
+            }
+        }
+        Self {
+            capsule_centres,
+            capsule_radii,
+            segment_centres,
+            segment_radii,
+            groups,
         }
     }
 
-    /// Whether the bounding spheres of `pair` may be less than `threshold` apart (compared
-    /// squared: no square root). `false` proves the pair's clearance exceeds `threshold`.
-    #[inline]
-    fn spheres_within(&self, placed: &PlacedCapsules, pair: CollisionPair, threshold: f64) -> bool {
-        let reach = self.bounding_radii[pair.first] + self.bounding_radii[pair.second];
-        let limit = 2.0 * (reach + threshold + SPHERE_SLACK_M);
-        let gap = placed[pair.first].doubled_centre - placed[pair.second].doubled_centre;
-        !(limit > 0.0 && gap.norm_squared() > limit * limit)
-    }
-
-    /// Surface clearance of `pair` (m), negative when the capsules interpenetrate.
-    #[inline]
-    fn placed_clearance(&self, placed: &PlacedCapsules, pair: CollisionPair) -> f64 {
-        let (a, b) = (&placed[pair.first], &placed[pair.second]);
-        let radii = self.capsules[pair.first].radius + self.capsules[pair.second].radius;
-        segment_distance(&a.start, &a.end, &b.start, &b.end) - radii
-    }
-
-    /// The first checked capsule pair whose clearance is below `margin` (m), if any.
-    ///
-    /// Allocation-free: each capsule is placed once, and a bounding-sphere test skips the pairs
-    /// that are clearly apart before the segment distance.
-    pub fn first_collision(&self, kin: &Kinematics, margin: f64) -> Option<CollisionHit> {
-        let mut placed = PlacedCapsules::new();
-        self.place_capsules(kin, &mut placed);
-        self.pairs.iter().find_map(|&pair| {
-            if !self.spheres_within(&placed, pair, margin) {
-                return None;
+    /// The centre of each segment's sphere at `kin` (zero for segments without capsules).
+    fn segment_centres(&self, kin: &Kinematics) -> [Vec3; DOF + 1] {
+        std::array::from_fn(|s| {
+            if self.segment_radii[s] > 0.0 {
+                kin.segment_point(s, &self.segment_centres[s])
+            } else {
+                Vec3::zeros()
             }
-            let clearance = self.placed_clearance(&placed, pair);
-            (clearance < margin).then_some(CollisionHit { pair, clearance })
         })
+    }
+}
+
+/// Whether two spheres (centres `a`, `b`, radii summing to `reach`) may be less than
+/// `threshold` apart (compared squared: no square root). `false` proves that everything inside
+/// them is more than `threshold` apart.
+#[inline]
+fn spheres_within(a: &Vec3, b: &Vec3, reach: f64, threshold: f64) -> bool {
+    let limit = reach + threshold + SPHERE_SLACK_M;
+    !(limit > 0.0 && (a - b).norm_squared() > limit * limit)
+}
+
+impl Robot {
+    /// Places the centres of the capsules' bounding spheres at `kin` into `centres` (which
+    /// must be empty).
+    fn place_centres(&self, kin: &Kinematics, centres: &mut CapsuleCentres) {
+        for (capsule, local) in self.capsules.iter().zip(&self.broad_phase.capsule_centres) {
+            // Never full: a robot carries at most MAX_CAPSULES capsules.
+            let _ = centres.try_push(kin.segment_point(capsule.segment, local));
+        }
+    }
+
+    /// Whether the bounding spheres of `pair` may be less than `threshold` apart. `false`
+    /// proves the pair's clearance exceeds `threshold`.
+    #[inline]
+    fn capsule_spheres_within(
+        &self,
+        centres: &CapsuleCentres,
+        pair: CollisionPair,
+        threshold: f64,
+    ) -> bool {
+        let radii = &self.broad_phase.capsule_radii;
+        let reach = radii[pair.first] + radii[pair.second];
+        spheres_within(
+            &centres[pair.first],
+            &centres[pair.second],
+            reach,
+            threshold,
+        )
+    }
+
+    /// Surface clearance of `pair` at `kin` (m), negative when the capsules interpenetrate.
+    fn pair_clearance(&self, kin: &Kinematics, pair: CollisionPair) -> f64 {
+        let (a, b) = (&self.capsules[pair.first], &self.capsules[pair.second]);
+        let (a0, a1) = (
+            kin.segment_point(a.segment, &a.start),
+            kin.segment_point(a.segment, &a.end),
+        );
+        let (b0, b1) = (
+            kin.segment_point(b.segment, &b.start),
+            kin.segment_point(b.segment, &b.end),
+        );
+        segment_distance(&a0, &a1, &b0, &b1) - (a.radius + b.radius)
+    }
+
+    /// The first checked capsule pair (in [`Robot::collision_pairs`] order) whose clearance is
+    /// below `margin` (m), if any.
+    ///
+    /// Allocation-free: the [`BroadPhase`] hierarchy skips the segment pairs and then the
+    /// capsule pairs that are clearly apart before the exact distance.
+    pub fn first_collision(&self, kin: &Kinematics, margin: f64) -> Option<CollisionHit> {
+        let broad_phase = &self.broad_phase;
+        let segment_centres = broad_phase.segment_centres(kin);
+        let mut centres = CapsuleCentres::new();
+        self.place_centres(kin, &mut centres);
+        let mut first: Option<(usize, CollisionHit)> = None;
+        for group in &broad_phase.groups {
+            let (a, b) = group.segments;
+            let reach = broad_phase.segment_radii[a] + broad_phase.segment_radii[b];
+            if !spheres_within(&segment_centres[a], &segment_centres[b], reach, margin) {
+                continue;
+            }
+            for &index in &group.pairs {
+                if first.is_some_and(|(found, _)| found < index) {
+                    break;
+                }
+                let pair = self.pairs[index];
+                if !self.capsule_spheres_within(&centres, pair, margin) {
+                    continue;
+                }
+                let clearance = self.pair_clearance(kin, pair);
+                if clearance < margin {
+                    first = Some((index, CollisionHit { pair, clearance }));
+                    break;
+                }
+            }
+        }
+        first.map(|(_, hit)| hit)
     }
 
     /// Smallest clearance (m) over all checked pairs and the first pair that attains it.
@@ -114,15 +232,15 @@ impl Robot {
     /// Allocation-free; pairs whose bounding spheres are farther apart than the smallest
     /// clearance found so far are skipped.
     pub fn min_clearance(&self, kin: &Kinematics) -> Option<CollisionHit> {
-        let mut placed = PlacedCapsules::new();
-        self.place_capsules(kin, &mut placed);
+        let mut centres = CapsuleCentres::new();
+        self.place_centres(kin, &mut centres);
         let mut best: Option<CollisionHit> = None;
         for &pair in &self.pairs {
             let bound = best.map_or(f64::INFINITY, |hit| hit.clearance);
-            if bound.is_finite() && !self.spheres_within(&placed, pair, bound) {
+            if bound.is_finite() && !self.capsule_spheres_within(&centres, pair, bound) {
                 continue;
             }
-            let clearance = self.placed_clearance(&placed, pair);
+            let clearance = self.pair_clearance(kin, pair);
             if best.is_none_or(|hit| clearance.total_cmp(&hit.clearance).is_lt()) {
                 best = Some(CollisionHit { pair, clearance });
             }

@@ -4,7 +4,7 @@ use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaterni
 use std::collections::HashMap;
 use std::path::Path;
 
-use crate::collision::{Capsule, CollisionPair, MAX_CAPSULES};
+use crate::collision::{BroadPhase, Capsule, CollisionPair, MAX_CAPSULES};
 use crate::srdf::PairRule;
 use crate::{DOF, JointVector, Vec3};
 
@@ -203,8 +203,8 @@ pub struct Robot {
     pub(crate) tcp_offset: JointFrame,
     pub(crate) limits: JointLimits,
     pub(crate) capsules: Vec<Capsule>,
-    /// Radius of each capsule's bounding sphere (half its axis length plus its radius).
-    pub(crate) bounding_radii: Vec<f64>,
+    /// The bounding spheres of the self-collision test.
+    pub(crate) broad_phase: BroadPhase,
     /// Index of the first of the tool's capsules (they close the list).
     pub(crate) first_tool_capsule: usize,
     pub(crate) pairs: Vec<CollisionPair>,
@@ -339,11 +339,8 @@ impl Robot {
                 found: capsules.len(),
             });
         }
-        let bounding_radii = capsules
-            .iter()
-            .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
-            .collect();
         let pairs = collision_pairs(&capsules, &pair_rule);
+        let broad_phase = BroadPhase::new(&capsules, &pairs);
         let first_tool_capsule = first_tool_capsule(&capsules);
         let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
         let reach_centre = joints[0].translation;
@@ -368,7 +365,7 @@ impl Robot {
                 velocity: JointVector::from_column_slice(&velocity),
             },
             capsules,
-            bounding_radii,
+            broad_phase,
             first_tool_capsule,
             pairs,
             pair_rule,
