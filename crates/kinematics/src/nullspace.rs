@@ -96,7 +96,10 @@ pub fn task_aligned_basis(
 /// `det[J; Nᵀ] = det(R₃ₓ₃)·det(Q)` (each proper reflector contributes `det = −1`).
 ///
 /// Plain arrays, every sum accumulated in index order; the independent dot products of one
-/// reflector (one per column it is applied to) run side by side.
+/// reflector (one per column it is applied to) run side by side. Reflector `k` is zero above
+/// row `k`, so its sums and updates start at row `k`: the rows above would only add and
+/// subtract exact zeros (the null-space columns are exactly zero there until reflector `k`
+/// reaches them).
 fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) {
     // Column c of Jᵀ is row c of J.
     let mut columns: [[f64; DOF]; 3] =
@@ -106,13 +109,13 @@ fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) 
     for k in 0..3 {
         let mut v = [0.0; DOF];
         v[k..].copy_from_slice(&columns[k][k..]);
-        let norm = dot(&v, &v).sqrt();
+        let norm = dot_from(k, &v, &v).sqrt();
         let alpha = if v[k] > 0.0 { -norm } else { norm };
         v[k] -= alpha;
-        let length = dot(&v, &v).sqrt();
+        let length = dot_from(k, &v, &v).sqrt();
         if length > 0.0 {
-            v.iter_mut().for_each(|x| *x /= length);
-            reflect(&v, &mut columns[k..], k);
+            v[k..].iter_mut().for_each(|x| *x /= length);
+            reflect(k, &v, &mut columns[k..]);
             sign = -sign;
         }
         if alpha < 0.0 {
@@ -125,17 +128,18 @@ fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) 
         column[3 + c] = 1.0;
         column
     });
-    for v in reflectors.iter().rev() {
-        reflect(v, &mut null, 0);
+    for (k, v) in reflectors.iter().enumerate().rev() {
+        reflect(k, v, &mut null);
     }
     (NullSpaceBasis::from_fn(|r, c| null[c][r]), sign)
 }
 
-/// `x ← x − 2 v (v·x)` for every column `x` (rows from `first` on; `v` is zero above it).
-fn reflect(v: &[f64; DOF], columns: &mut [[f64; DOF]], first: usize) {
+/// `x ← x − 2 v (v·x)` for every column `x`, over the rows from `first` on (`v` is zero above
+/// it).
+fn reflect(first: usize, v: &[f64; DOF], columns: &mut [[f64; DOF]]) {
     let mut projections = [0.0; NULL_DIM];
     for (projection, column) in projections.iter_mut().zip(columns.iter()) {
-        *projection = dot(v, column);
+        *projection = dot_from(first, v, column);
     }
     for (projection, column) in projections.iter().zip(columns.iter_mut()) {
         for r in first..DOF {
@@ -144,11 +148,11 @@ fn reflect(v: &[f64; DOF], columns: &mut [[f64; DOF]], first: usize) {
     }
 }
 
-/// `a·b`, summed in index order from zero.
+/// `a·b` over the rows from `first` on, summed in index order from zero.
 #[inline]
-fn dot(a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
+fn dot_from(first: usize, a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
     let mut sum = 0.0;
-    for r in 0..DOF {
+    for r in first..DOF {
         sum += a[r] * b[r];
     }
     sum
