@@ -61,10 +61,10 @@ struct PairGroup {
 }
 
 /// The two-level bounding-sphere hierarchy of the self-collision test, fixed at load time: one
-/// sphere per rigid segment enclosing its capsules, then one per capsule. A capsule pair is
-/// measured only when both levels say it may be close, so a check places the segments'
-/// spheres (one transform each), tests the few segment pairs, and places only the capsules of
-/// the segment pairs that may touch.
+/// sphere per rigid segment enclosing its capsules, then one per capsule. A check places the
+/// centres of both kinds of sphere (one transform each), tests the few segment pairs, then the
+/// capsule pairs of the segment pairs that may touch, and transforms the axis end points only of
+/// the capsule pairs that pass both tests.
 #[derive(Clone, Debug)]
 pub(crate) struct BroadPhase {
     /// Centre of each capsule's bounding sphere (its axis midpoint), in its segment's frame.
@@ -128,15 +128,10 @@ impl BroadPhase {
         }
     }
 
-    /// The centre of each segment's sphere at `kin` (zero for segments without capsules).
+    /// The centre of each segment's sphere at `kin` (segments without capsules included: no
+    /// group refers to them).
     fn segment_centres(&self, kin: &Kinematics) -> [Vec3; DOF + 1] {
-        std::array::from_fn(|s| {
-            if self.segment_radii[s] > 0.0 {
-                kin.segment_point(s, &self.segment_centres[s])
-            } else {
-                Vec3::zeros()
-            }
-        })
+        std::array::from_fn(|s| kin.segment_point(s, &self.segment_centres[s]))
     }
 }
 

@@ -4,7 +4,7 @@
 //! segments); home is collision-free; a folded colliding configuration whose clearance agrees
 //! with an independent computation; and `first_collision`/`min_clearance` against an
 //! exhaustive independent check on random configurations (which exercises the bounding-sphere
-//! shortcut).
+//! shortcut), also on an arm whose only capsule on one body is a point (a sphere of radius 0).
 
 mod common;
 
@@ -362,4 +362,68 @@ fn first_collision_and_min_clearance_match_an_exhaustive_check() {
     );
     assert!(colliding > 0);
     assert!(worst < 1e-12);
+}
+
+#[test]
+fn a_body_whose_only_capsule_is_a_point_is_still_checked() {
+    // link6 carries only a point; only its pairs with the hand are checked, so a pair the
+    // broad phase wrongly skips cannot hide behind an earlier pair.
+    let text = common::robot_text();
+    let start = text.find("<link name=\"link6\">").expect("link6");
+    let end = start + text[start..].find("</link>").expect("end of link6");
+    let point = "<link name=\"link6\">\n    <collision>\n      <origin xyz=\"0 0 -0.03\"/>\n      \
+                 <geometry><sphere radius=\"0\"/></geometry>\n    </collision>\n  ";
+    let text = format!("{}{point}{}", &text[..start], &text[end..]);
+    let links: Vec<String> = robot().capsules().iter().map(|c| c.link.clone()).collect();
+    let mut disabled = Vec::new();
+    for (i, a) in links.iter().enumerate() {
+        for b in &links[i + 1..] {
+            if a != b && !(a == "link6" && b == "hand") {
+                disabled.push((a.clone(), b.clone()));
+            }
+        }
+    }
+    let rule = emg_kinematics::PairRule::AllExcept(disabled);
+    let robot = Robot::from_urdf_str_with_rule(&text, "link0", "pen_tip", rule)
+        .expect("edited robot loads");
+    let point = robot
+        .capsules()
+        .iter()
+        .position(|c| c.link == "link6")
+        .expect("link6 keeps its point");
+    assert_eq!(robot.capsules()[point].radius, 0.0);
+    let pairs = robot.collision_pairs();
+    assert_eq!(pairs.len(), 2, "the point against the hand's two capsules");
+    assert!(pairs.iter().all(|p| p.first == point));
+    let mut rng = rng(53);
+    let configurations: Vec<_> = (0..2000).map(|_| random_q(&mut rng, &robot)).collect();
+    let nearest = |q| {
+        let kin = robot.forward(q);
+        all_clearances(&robot, &kin)
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    };
+    // Joint 7 alone moves the hand about link6, so the clearance spans a narrow band: the
+    // margin lies between its two middle values, so that both verdicts occur and no
+    // clearance sits on it.
+    let mut clearances: Vec<f64> = configurations.iter().map(nearest).collect();
+    clearances.sort_by(f64::total_cmp);
+    let middle = clearances.len() / 2;
+    let margin = 0.5 * (clearances[middle - 1] + clearances[middle]);
+    let mut hits = 0;
+    for q in &configurations {
+        let kin = robot.forward(q);
+        let expected = all_clearances(&robot, &kin)
+            .iter()
+            .position(|&c| c < margin);
+        let hit = robot.first_collision(&kin, margin);
+        assert_eq!(
+            hit.map(|h| h.pair),
+            expected.map(|i| robot.collision_pairs()[i]),
+            "q {q:?}"
+        );
+        hits += usize::from(hit.is_some());
+    }
+    println!("the point came within {margin:.3} m of the hand in {hits} of 2000 configurations");
+    assert!(hits > 0 && hits < 2000, "the test must see both verdicts");
 }
