@@ -276,6 +276,44 @@ impl SearchRows {
             share_of_limit,
         })
     }
+
+    /// The budget and the statistics of task group `group` (`all` or a bucket), when present.
+    fn group(&self, group: &str) -> Option<(u64, &CellStats)> {
+        match self {
+            Self::Present {
+                budget_steps,
+                groups,
+                ..
+            } => groups.get(group).map(|stats| (*budget_steps, stats)),
+            Self::Missing(_) => None,
+        }
+    }
+
+    /// The sentence under a Table 1 that has Search rows: the search against Hybrid + DP, or why
+    /// there are no rows.
+    fn summary(&self) -> String {
+        match self {
+            Self::Present {
+                groups,
+                ratio_to_pipeline,
+                share_of_bound,
+                checker_failures,
+                share_of_limit,
+                ..
+            } => format!(
+                "Search vs Hybrid + DP: **×{ratio_to_pipeline:.3}** mean path length (goal ≥ ×1.35); \
+                 it reaches **{:.1} %** of ℓ_ref on average, {:.1} % of the reachability bound{}; \
+                 {checker_failures} checker failures.\n\n",
+                groups.get("all").map_or(f64::NAN, |s| s.ratio_percent.mean),
+                100.0 * share_of_bound,
+                share_of_limit.map_or(String::new(), |s| format!(
+                    " and {:.1} % of the best-known length ℓ* on the 1,000-task subset of `cargo xtask limit`",
+                    100.0 * s
+                )),
+            ),
+            Self::Missing(why) => format!("No search rows: {why}.\n\n"),
+        }
+    }
 }
 
 fn table1(set: &SetResult, paper: &PaperTables, search: &SearchRows) -> String {
@@ -299,13 +337,7 @@ fn table1(set: &SetResult, paper: &PaperTables, search: &SearchRows) -> String {
                 paper_four(&theirs[1], 1)
             );
         }
-        if let SearchRows::Present {
-            budget_steps,
-            groups,
-            ..
-        } = search
-            && let Some(stats) = groups.get(group)
-        {
+        if let Some((budget_steps, stats)) = search.group(group) {
             md += &format!(
                 "| {group} (ours n = {}, paper n = {}) | search ({budget_steps} steps) | {} | — | {} | — |\n",
                 stats.length_m.count,
@@ -326,27 +358,7 @@ fn table1(set: &SetResult, paper: &PaperTables, search: &SearchRows) -> String {
         100.0 * (dp_mean(set, ControllerKind::Hybrid) / classical - 1.0),
         100.0 * (dp_mean(set, ControllerKind::Rl) / classical - 1.0),
     );
-    md += &match search {
-        SearchRows::Present {
-            groups,
-            ratio_to_pipeline,
-            share_of_bound,
-            checker_failures,
-            share_of_limit,
-            ..
-        } => format!(
-            "Search vs Hybrid + DP: **×{ratio_to_pipeline:.3}** mean path length (goal ≥ ×1.35); \
-             it reaches **{:.1} %** of ℓ_ref on average, {:.1} % of the reachability bound{}; \
-             {checker_failures} checker failures.\n\n",
-            groups.get("all").map_or(f64::NAN, |s| s.ratio_percent.mean),
-            100.0 * share_of_bound,
-            share_of_limit.map_or(String::new(), |s| format!(
-                " and {:.1} % of the best-known length ℓ* on the 1,000-task subset of `cargo xtask limit`",
-                100.0 * s
-            )),
-        ),
-        SearchRows::Missing(why) => format!("No search rows: {why}.\n\n"),
-    };
+    md += &search.summary();
     md
 }
 
@@ -388,12 +400,15 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
             .with_context(|| format!("docs/results/{} lacks the unseen set", file.display()))?;
         md += &format!(
             "## Second arm: `{}`, Table 1\n\nThe whole pipeline on the second shipped arm (its own task sets, labels, \
-             diffusion seeder and policy; `docs/results/{}`), {} unseen tasks:\n\n\
+             diffusion seeder and policy; `docs/results/{}`), {} unseen tasks; the search rows are the \
+             search planner of `emg plan` at its default budget (`cargo xtask search-eval --robot {}`):\n\n\
              | tasks | π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|\n",
             robot.name,
             file.display(),
-            unseen.task_count
+            unseen.task_count,
+            robot.name
         );
+        let search = SearchRows::read(&results.join(robot.data_subdir()), unseen, &eval.buckets)?;
         for group in ["all", "easy", "medium", "difficult"] {
             for cell in unseen.cells(dp(), group) {
                 md += &format!(
@@ -404,6 +419,14 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
                     four(&cell.stats.ratio_percent, 1)
                 );
             }
+            if let Some((budget_steps, stats)) = search.group(group) {
+                md += &format!(
+                    "| {group} (n = {}) | search ({budget_steps} steps) | {} | {} |\n",
+                    stats.length_m.count,
+                    four(&stats.length_m, 3),
+                    four(&stats.ratio_percent, 1)
+                );
+            }
         }
         let classical = dp_mean(unseen, ControllerKind::Classical);
         md += &format!(
@@ -411,6 +434,7 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
             100.0 * (dp_mean(unseen, ControllerKind::Hybrid) / classical - 1.0),
             100.0 * (dp_mean(unseen, ControllerKind::Rl) / classical - 1.0),
         );
+        md += &search.summary();
     }
     Ok(md)
 }

@@ -1,6 +1,7 @@
-//! The published search results are what the planner gives now: on the first tasks of
-//! `docs/results/search.json`, the paper's pipeline and the search at every published budget
-//! plan the published path lengths. A change of the control step, the models, the seeding or the
+//! The published search results are what the planner gives now: on the first tasks of every
+//! shipped robot's `search.json` (`docs/results/` for the FR3, `docs/results/<robot>/` for the
+//! others), the paper's pipeline and the search at every published budget plan the published
+//! path lengths. A change of the control step, the models, the seeding or the
 //! search that changes any plan fails here, and the results have to be regenerated with
 //! `cargo xtask search-eval` (and `cargo xtask eval`, `cargo xtask limit`, which plan with the
 //! same code).
@@ -8,7 +9,8 @@
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
-    DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig, ShippedRobot,
+    DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SHIPPED_ROBOTS,
+    SearchConfig, ShippedRobot,
 };
 use serde_json::Value;
 
@@ -25,23 +27,34 @@ fn workspace() -> std::path::PathBuf {
 
 #[test]
 fn the_published_search_lengths_are_planned_again() {
-    let path = workspace().join("docs/results/search.json");
+    for shipped in SHIPPED_ROBOTS {
+        plan_the_published_lengths(shipped);
+    }
+}
+
+fn plan_the_published_lengths(shipped: ShippedRobot) {
+    let path = workspace()
+        .join("docs/results")
+        .join(shipped.data_subdir())
+        .join("search.json");
     let published: Value = serde_json::from_str(
         &std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())),
     )
     .expect("search.json parses");
     let data = DataDir::new(workspace().join("data"));
-    let fr3 = ShippedRobot::by_name("fr3").expect("the FR3 ships");
+    let robot = Robot::from_chain_file(shipped.path(&data)).expect("robot loads");
     assert_eq!(
-        published["robot"], "fr3_pen",
-        "search.json is the FR3's evaluation"
+        published["robot"].as_str(),
+        Some(robot.name()),
+        "{} is {}'s evaluation",
+        path.display(),
+        shipped.name
     );
-    let robot = Robot::from_chain_file(fr3.path(&data)).expect("robot loads");
     let task_file = workspace().join(published["tasks"].as_str().expect("tasks is a path"));
     let tasks = read_tasks(&task_file, &robot).expect("the published task set loads");
     let search: SearchConfig =
         serde_json::from_value(published["search"].clone()).expect("search settings");
-    let models = Models::shipped(&robot, &fr3.data_dir(&data)).expect("shipped models");
+    let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
     let planner = Planner::new(robot, models, PlannerConfig::default()).expect("valid config");
 
     let rows = published["rows"].as_array().expect("rows");
@@ -74,10 +87,12 @@ fn the_published_search_lengths_are_planned_again() {
                 .path_length_m;
             assert!(
                 (planned - length).abs() <= TOLERANCE_M,
-                "{} (budget {}), task {index}: planned {planned} m, published {length} m; \
-                 regenerate the results (cargo xtask search-eval)",
+                "{}: {} (budget {}), task {index}: planned {planned} m, published {length} m; \
+                 regenerate the results (cargo xtask search-eval --robot {})",
+                shipped.name,
                 row["planner"],
-                row["budget_steps"]
+                row["budget_steps"],
+                shipped.name
             );
         }
     }
