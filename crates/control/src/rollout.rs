@@ -1,6 +1,6 @@
 //! The one rollout loop shared by every controller (SPEC §3).
 
-use emg_kinematics::{JointVector, Kinematics, Robot};
+use emg_kinematics::{JointVector, Robot};
 use serde::{Deserialize, Serialize};
 
 use crate::config::RolloutConfig;
@@ -104,9 +104,10 @@ pub enum StepOutcome {
 /// A rollout in progress, advanced one control step at a time: the one implementation of the
 /// step (SPEC §3) that [`rollout`] and every learning environment share.
 ///
-/// Each step: build the [`StepContext`] at `q_t` ([`Episode::context`]), choose an action, and
-/// [`Episode::apply`] it: clip to `[−1, 1]⁴`, integrate `q̇ = J⁺ẋ + a_max B a` for `Δt`, and
-/// accept `q_{t+1}` only if it holds every constraint.
+/// Each step: read the [`StepContext`] at `q_t` ([`Episode::context`], computed once when the
+/// step was accepted), choose an action, and [`Episode::apply`] it: clip to `[−1, 1]⁴`,
+/// integrate `q̇ = J⁺ẋ + a_max B a` for `Δt`, and accept `q_{t+1}` only if it holds every
+/// constraint.
 ///
 /// Joint-velocity limits are honoured by time scaling: a step whose `q̇` would exceed
 /// `fraction · v_max,i` on some joint keeps its shape but lasts `Δt · max_i |q̇_i| / (fraction ·
@@ -114,13 +115,9 @@ pub enum StepOutcome {
 /// timestamps are the real ones. The geometric path is the same with limits on or off.
 #[derive(Clone, Debug)]
 pub struct Episode<'a> {
-    robot: &'a Robot,
-    task: &'a Task,
-    config: &'a RolloutConfig,
-    q: JointVector,
+    /// The state at the current configuration (its `q`, kinematics and previous action).
+    current: StepContext<'a>,
     time_s: f64,
-    kinematics: Kinematics,
-    previous_action: NullAction,
     steps: Vec<StepRecord>,
     termination: Option<Termination>,
 }
@@ -133,21 +130,28 @@ impl<'a> Episode<'a> {
         seed: &JointVector,
         config: &'a RolloutConfig,
     ) -> Self {
-        let kinematics = robot.forward(seed);
-        let mut episode = Self {
+        let current = StepContext::new(
             robot,
             task,
             config,
-            q: *seed,
+            0,
+            *seed,
+            robot.forward(seed),
+            NullAction::zeros(),
+        );
+        let mut episode = Self {
+            current,
             time_s: 0.0,
-            kinematics,
-            previous_action: NullAction::zeros(),
             steps: Vec::with_capacity((config.max_steps + 1).min(PREALLOCATED_STEPS)),
             termination: None,
         };
-        if let Some(violation) =
-            first_violation(robot, task, seed, &episode.kinematics, &config.constraints)
-        {
+        if let Some(violation) = first_violation(
+            robot,
+            task,
+            seed,
+            &episode.current.kinematics,
+            &config.constraints,
+        ) {
             episode.record(None);
             episode.termination = Some(Termination::InvalidStart { violation });
         } else if config.max_steps == 0 {
@@ -158,55 +162,47 @@ impl<'a> Episode<'a> {
     }
 
     /// The state a controller sees at the current step, or `None` once the episode is over.
-    pub fn context(&self) -> Option<StepContext<'a>> {
-        self.termination.is_none().then(|| {
-            StepContext::new(
-                self.robot,
-                self.task,
-                self.config,
-                self.steps.len(),
-                self.q,
-                self.kinematics.clone(),
-                self.previous_action,
-            )
-        })
+    pub fn context(&self) -> Option<&StepContext<'a>> {
+        self.termination.is_none().then_some(&self.current)
     }
 
-    /// Applies `action` (clipped to `[−1, 1]⁴`) chosen by `acting` at `context` (which must be
-    /// this episode's current [`Episode::context`]).
-    pub fn apply(
-        &mut self,
-        context: &StepContext<'_>,
-        action: &NullAction,
-        acting: ActingController,
-    ) -> StepOutcome {
+    /// Applies `action` (clipped to `[−1, 1]⁴`), chosen by `acting` at the current
+    /// [`Episode::context`].
+    pub fn apply(&mut self, action: &NullAction, acting: ActingController) -> StepOutcome {
         debug_assert!(self.termination.is_none(), "apply after the episode ended");
-        debug_assert_eq!(context.q, self.q, "the context of another step");
+        let StepContext {
+            robot,
+            task,
+            config,
+            ..
+        } = self.current;
         let action = action.map(|a| a.clamp(-1.0, 1.0));
-        let velocity = context.joint_velocity(&action);
-        let next = self.q + velocity * self.config.dt_s;
+        let velocity = self.current.joint_velocity(&action);
+        let next = self.current.q + velocity * config.dt_s;
         // The context already holds this configuration's tool angle and ρ.
-        self.push_record(Some(acting), context.tool_angle_deg, context.rho);
-        let next_kinematics = self.robot.forward(&next);
-        if let Some(violation) = first_violation(
-            self.robot,
-            self.task,
-            &next,
-            &next_kinematics,
-            &self.config.constraints,
-        ) {
+        self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
+        let next_kinematics = robot.forward(&next);
+        if let Some(violation) =
+            first_violation(robot, task, &next, &next_kinematics, &config.constraints)
+        {
             self.termination = Some(Termination::Violation {
                 violation,
                 rejected_q: next,
             });
             return StepOutcome::Terminated;
         }
-        let progress_m = (next_kinematics.tcp() - self.kinematics.tcp()).dot(&self.task.d);
+        let progress_m = (next_kinematics.tcp() - self.current.kinematics.tcp()).dot(&task.d);
         self.time_s += self.step_duration(&velocity);
-        self.q = next;
-        self.kinematics = next_kinematics;
-        self.previous_action = action;
-        if self.steps.len() == self.config.max_steps {
+        self.current = StepContext::new(
+            robot,
+            task,
+            config,
+            self.steps.len(),
+            next,
+            next_kinematics,
+            action,
+        );
+        if self.steps.len() == config.max_steps {
             self.record(None);
             self.termination = Some(Termination::StepCap);
             return StepOutcome::Truncated { progress_m };
@@ -238,7 +234,7 @@ impl<'a> Episode<'a> {
             .steps
             .last()
             .expect("a trajectory holds at least its seed");
-        let path_length_m = self.task.progress(&last.tcp);
+        let path_length_m = self.current.task.progress(&last.tcp);
         Trajectory {
             steps: self.steps,
             termination,
@@ -249,20 +245,22 @@ impl<'a> Episode<'a> {
     /// How long a step at joint velocity `velocity` lasts: `Δt`, stretched so that no joint
     /// exceeds its share of the velocity limit.
     fn step_duration(&self, velocity: &JointVector) -> f64 {
-        let Some(fraction) = self.config.constraints.velocity_limit_fraction else {
-            return self.config.dt_s;
+        let config = self.current.config;
+        let Some(fraction) = config.constraints.velocity_limit_fraction else {
+            return config.dt_s;
         };
-        let limits = &self.robot.limits().velocity;
+        let limits = &self.current.robot.limits().velocity;
         let stretch = (0..velocity.len())
             .map(|i| velocity[i].abs() / (fraction.get() * limits[i]))
             .fold(1.0, f64::max);
-        self.config.dt_s * stretch
+        config.dt_s * stretch
     }
 
     /// Records the current configuration, measuring its tool angle and `ρ`.
     fn record(&mut self, controller: Option<ActingController>) {
-        let angle = tool_angle_deg(&self.kinematics.tool_axis(), &self.task.n);
-        let rho = self.robot.limits().limit_proximity(&self.q);
+        let current = &self.current;
+        let angle = tool_angle_deg(&current.kinematics.tool_axis(), &current.task.n);
+        let rho = current.robot.limits().limit_proximity(&current.q);
         self.push_record(controller, angle, rho);
     }
 
@@ -270,8 +268,8 @@ impl<'a> Episode<'a> {
     fn push_record(&mut self, controller: Option<ActingController>, tool_angle_deg: f64, rho: f64) {
         self.steps.push(StepRecord {
             time_s: self.time_s,
-            q: self.q,
-            tcp: self.kinematics.tcp(),
+            q: self.current.q,
+            tcp: self.current.kinematics.tcp(),
             tool_angle_deg,
             rho,
             controller,
@@ -299,11 +297,11 @@ pub fn continue_rollout(
     controller: &mut dyn NullSpaceController,
 ) -> Trajectory {
     if let Some(first) = episode.context() {
-        controller.reset(&first);
+        controller.reset(first);
     }
     while let Some(context) = episode.context() {
-        let (action, acting) = controller.act(&context);
-        episode.apply(&context, &action, acting);
+        let (action, acting) = controller.act(context);
+        episode.apply(&action, acting);
     }
     episode.finish()
 }

@@ -52,6 +52,9 @@ pub struct StepContext<'a> {
 
 impl<'a> StepContext<'a> {
     /// Computes every quantity of the step at `q` from its forward kinematics (no allocation).
+    /// Always inlined: the context is then built where it is stored (an [`crate::Episode`]'s
+    /// current step) instead of being copied there.
+    #[inline(always)]
     pub fn new(
         robot: &'a Robot,
         task: &'a Task,

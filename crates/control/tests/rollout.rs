@@ -672,11 +672,11 @@ fn an_episode_copied_midway_goes_on_from_exactly_that_state() {
         // Drive a fresh episode for a few steps, copy it, and let another controller finish
         // the copy: the first steps are the whole rollout's, the rest the new controller's.
         let mut episode = emg_control::Episode::start(&robot, &task, &seed, &config);
-        controller.reset(&episode.context().expect("a valid start"));
+        controller.reset(episode.context().expect("a valid start"));
         for _ in 0..4 {
             let context = episode.context().expect("running");
-            let (action, acting) = controller.act(&context);
-            episode.apply(&context, &action, acting);
+            let (action, acting) = controller.act(context);
+            episode.apply(&action, acting);
         }
         let copy = episode.clone();
         let finished = emg_control::continue_rollout(episode, &mut controller);

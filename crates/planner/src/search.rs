@@ -327,10 +327,10 @@ impl<'a> Search<'a> {
             if at + 1 >= issued {
                 break;
             }
-            let Some(step) = episode.context() else {
+            if episode.is_finished() {
                 break;
-            };
-            episode.apply(&step, action, *acting);
+            }
+            episode.apply(action, *acting);
             self.spent += 1;
         }
         points.reverse();

@@ -147,7 +147,7 @@ impl Environment for ArmEnvironment<'_> {
             let episode = Episode::start(&pool.robot, task, &start, &pool.rollout);
             if let Some(context) = episode.context() {
                 self.path_length_m = task.progress(&context.kinematics.tcp());
-                self.context = Some(context);
+                self.context = Some(context.clone());
                 self.episode = Some(episode);
                 return;
             }
@@ -163,7 +163,7 @@ impl Environment for ArmEnvironment<'_> {
         let context = self.context.take().expect("step after reset");
         let episode = self.episode.as_mut().expect("step after reset");
         let action = NullAction::from_fn(|i, _| f64::from(action[i]));
-        let outcome = episode.apply(&context, &action, ActingController::Learned);
+        let outcome = episode.apply(&action, ActingController::Learned);
         let config = &self.pool.rollout;
         let reward =
             |progress_m: f64| (progress_m / (config.speed_m_per_s * config.dt_s)).clamp(0.0, 1.0);
@@ -173,7 +173,7 @@ impl Environment for ArmEnvironment<'_> {
                     .context()
                     .expect("a continued episode has a next step");
                 self.path_length_m = context.task.progress(&next.kinematics.tcp());
-                self.context = Some(next);
+                self.context = Some(next.clone());
                 Transition {
                     reward: reward(progress_m),
                     end: None,

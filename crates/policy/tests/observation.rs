@@ -14,17 +14,17 @@ fn observation_layout_element_by_element() {
     let mut episode = Episode::start(&robot, task, &seed, &config);
     let first = episode.context().expect("a valid seed");
     let mut at_reset = [f32::NAN; OBSERVATION_DIM];
-    observe(&first, &mut at_reset);
+    observe(first, &mut at_reset);
     assert!(
         at_reset[27..].iter().all(|&a| a == 0.0),
         "previous action is 0 at reset"
     );
 
     let action = NullAction::new(0.3, -0.7, 0.1, 0.9);
-    episode.apply(&first, &action, ActingController::Learned);
+    episode.apply(&action, ActingController::Learned);
     let context = episode.context().expect("one small step stays valid");
     let mut obs = [f32::NAN; OBSERVATION_DIM];
-    observe(&context, &mut obs);
+    observe(context, &mut obs);
 
     let limits = robot.limits();
     let q_bar = (context.q - limits.mid()).component_div(&limits.half_range());
