@@ -10,13 +10,13 @@ use emg_control::{Task, rollout};
 use emg_eval::{BucketConfig, CellStats, EvalRecord, SetResult, bucket_members, cell_stats, four};
 use emg_hybrid::count_switches;
 use emg_io::read_tasks;
-use emg_planner::{ControllerKind, Executor, SHIPPED_ROBOTS, SeedSource};
+use emg_planner::{ControllerKind, Executor, SHIPPED_ROBOTS, SeedSource, ShippedRobot};
 use plotters::prelude::*;
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
 
 use crate::ablate_control::{SwitchingAblation, WeightsAblation};
-use crate::search_eval;
+use crate::search_eval::{self, BUDGET_FIGURE};
 use crate::{protocol, workspace};
 
 /// Options of `report`.
@@ -123,7 +123,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          Do not edit by hand. Ours: FR3 with pen, 10,000 evaluation tasks never seen in training; every \
          trajectory behind every table passed the independent constraint checker.\n\n",
     );
-    let search = SearchRows::read(&args.results, unseen, &eval.buckets)?;
+    let search = SearchRows::read(
+        &args.results,
+        &args.figures,
+        SHIPPED_ROBOTS[0],
+        unseen,
+        &eval.buckets,
+    )?;
     md += &table1(unseen, &paper, &search);
     md += &table2(unseen, &paper, &search);
     md += &figures(args, unseen)?;
@@ -152,7 +158,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     md += &velocity_limits(&args.results)?;
     md += &crate::surface_report::section(&args.results);
-    md += &other_arms(&args.results)?;
+    md += &other_arms(&args.results, &args.figures)?;
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     Ok(())
@@ -201,6 +207,8 @@ enum SearchRows {
         checker_failures: usize,
         /// Task mean of length / ℓ* over the limit subset (`limit.json`), when present.
         share_of_limit: Option<f64>,
+        /// Link (relative to `docs/`) to the mean length against budget figure, when written.
+        budget_figure: Option<PathBuf>,
     },
     /// Why there are no Search rows.
     Missing(String),
@@ -220,27 +228,42 @@ struct LimitRow {
 }
 
 impl SearchRows {
-    /// Reads `search.json` (and `limit.json`) from `results`.
-    fn read(results: &Path, set: &SetResult, buckets: &BucketConfig) -> anyhow::Result<Self> {
+    /// Reads `robot`'s `search.json` (and `limit.json`) from its directory under `results`, and
+    /// looks for its budget figure under `figures` (`docs/figures`).
+    fn read(
+        results: &Path,
+        figures: &Path,
+        robot: ShippedRobot,
+        set: &SetResult,
+        buckets: &BucketConfig,
+    ) -> anyhow::Result<Self> {
+        let results = results.join(robot.data_subdir());
+        // The `cargo xtask search-eval` arguments that select `robot` (none for the default).
+        let robot_flag = if robot == SHIPPED_ROBOTS[0] {
+            String::new()
+        } else {
+            format!(" --robot {}", robot.name)
+        };
         let path = results.join("search.json");
         if !path.exists() {
-            return Ok(Self::Missing(
-                "no `search.json`: run `cargo xtask search-eval --tasks 10000`".into(),
-            ));
+            return Ok(Self::Missing(format!(
+                "no `search.json`: run `cargo xtask search-eval{robot_flag} --tasks {}`",
+                set.task_count
+            )));
         }
         let record: search_eval::Record = read(&path)?;
         if record.tasks != set.tasks || record.task_count != set.task_count {
             return Ok(Self::Missing(format!(
                 "`search.json` covers the first {} tasks of `{}`, not the {} of `{}`: run `cargo \
-                 xtask search-eval --tasks {}`",
+                 xtask search-eval{robot_flag} --tasks {}`",
                 record.task_count, record.tasks, set.task_count, set.tasks, set.task_count
             )));
         }
         let Some(row) = record.default_budget_row() else {
-            return Ok(Self::Missing(
-                "`search.json` lacks the default budget: run `cargo xtask search-eval` with it"
-                    .into(),
-            ));
+            return Ok(Self::Missing(format!(
+                "`search.json` lacks the default budget: run `cargo xtask search-eval{robot_flag}` \
+                 with it"
+            )));
         };
         let references = &set.references_m;
         let all: Vec<usize> = (0..references.len()).collect();
@@ -266,6 +289,11 @@ impl SearchRows {
         } else {
             None
         };
+        let figure = Path::new(robot.data_subdir()).join(BUDGET_FIGURE);
+        let budget_figure = figures
+            .join(&figure)
+            .exists()
+            .then(|| Path::new("figures").join(figure));
         Ok(Self::Present {
             budget_steps: row.budget_steps.unwrap_or_default(),
             groups,
@@ -274,6 +302,7 @@ impl SearchRows {
             share_of_bound: row.share_of_bound,
             checker_failures: row.checker_failures,
             share_of_limit,
+            budget_figure,
         })
     }
 
@@ -299,16 +328,23 @@ impl SearchRows {
                 share_of_bound,
                 checker_failures,
                 share_of_limit,
+                budget_figure,
                 ..
             } => format!(
                 "Search vs Hybrid + DP: **×{ratio_to_pipeline:.3}** mean path length (goal ≥ ×1.35); \
                  it reaches **{:.1} %** of ℓ_ref on average, {:.1} % of the reachability bound{}; \
-                 {checker_failures} checker failures.\n\n",
+                 {checker_failures} checker failures.\n\n{}",
                 groups.get("all").map_or(f64::NAN, |s| s.ratio_percent.mean),
                 100.0 * share_of_bound,
                 share_of_limit.map_or(String::new(), |s| format!(
                     " and {:.1} % of the best-known length ℓ* on the 1,000-task subset of `cargo xtask limit`",
                     100.0 * s
+                )),
+                budget_figure.as_ref().map_or(String::new(), |link| format!(
+                    "![search budget]({})\n\n*Mean path length of the search planner against its step \
+                     budget, beside Hybrid + DP and the mean reachability bound (`cargo xtask \
+                     search-eval`).*\n\n",
+                    link.display()
                 )),
             ),
             Self::Missing(why) => format!("No search rows: {why}.\n\n"),
@@ -389,9 +425,9 @@ fn velocity_limits(results: &Path) -> anyhow::Result<String> {
 }
 
 /// Table 1 of every shipped robot other than the FR3, from its own `eval.json`.
-fn other_arms(results: &Path) -> anyhow::Result<String> {
+fn other_arms(results: &Path, figures: &Path) -> anyhow::Result<String> {
     let mut md = String::new();
-    for robot in &SHIPPED_ROBOTS[1..] {
+    for &robot in &SHIPPED_ROBOTS[1..] {
         let file = Path::new(robot.data_subdir()).join("eval.json");
         let eval: EvalRecord = read(&results.join(&file))
             .with_context(|| format!("run `cargo xtask eval --robot {}` first", robot.name))?;
@@ -408,7 +444,7 @@ fn other_arms(results: &Path) -> anyhow::Result<String> {
             unseen.task_count,
             robot.name
         );
-        let search = SearchRows::read(&results.join(robot.data_subdir()), unseen, &eval.buckets)?;
+        let search = SearchRows::read(results, figures, robot, unseen, &eval.buckets)?;
         for group in ["all", "easy", "medium", "difficult"] {
             for cell in unseen.cells(dp(), group) {
                 md += &format!(

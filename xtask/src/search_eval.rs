@@ -15,6 +15,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
+/// File name of the mean length against budget figure in a robot's figure directory.
+pub const BUDGET_FIGURE: &str = "search-budget.svg";
+
 /// Options of `search-eval`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -42,7 +45,7 @@ pub struct Args {
     #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Output figure.
-    #[arg(long, default_value_os_t = workspace::figure("search-budget.svg"))]
+    #[arg(long, default_value_os_t = workspace::figure(BUDGET_FIGURE))]
     figure: PathBuf,
 }
 
