@@ -309,8 +309,11 @@ fn linear_accumulate(
 const ROW_BLOCK: usize = 4;
 /// Outputs per register block of [`linear_accumulate`].
 const LANE_BLOCK: usize = 16;
+/// Outputs per block of the outputs a [`LANE_BLOCK`] leaves over (a head's few outputs).
+const NARROW_BLOCK: usize = 4;
 
-/// `out += input · W + b` for rows `first … first + R`.
+/// `out += input · W + b` for rows `first … first + R`: blocks of [`LANE_BLOCK`] outputs, then
+/// of [`NARROW_BLOCK`], then single outputs.
 #[inline(always)]
 fn linear_rows<const R: usize>(
     values: &[f32],
@@ -319,43 +322,47 @@ fn linear_rows<const R: usize>(
     first: usize,
     out: &mut [f32],
 ) {
+    let column = linear_blocks::<R, LANE_BLOCK>(values, view, input, first, 0, out);
+    let column = linear_blocks::<R, NARROW_BLOCK>(values, view, input, first, column, out);
+    linear_blocks::<R, 1>(values, view, input, first, column, out);
+}
+
+/// Outputs `column…` of [`linear_rows`] in blocks of `L` while a whole block fits; returns the
+/// first output left.
+#[inline(always)]
+fn linear_blocks<const R: usize, const L: usize>(
+    values: &[f32],
+    view: LinearView,
+    input: &[f32],
+    first: usize,
+    mut column: usize,
+    out: &mut [f32],
+) -> usize {
     let (n_in, n_out) = (view.inputs, view.outputs);
     let weight = &values[view.weight..view.weight + n_in * n_out];
     let bias = &values[view.bias..view.bias + n_out];
     let x: [&[f32]; R] =
         std::array::from_fn(|r| &input[(first + r) * n_in..(first + r + 1) * n_in]);
-    let mut column = 0;
-    while column + LANE_BLOCK <= n_out {
-        let mut acc = [[0.0f32; LANE_BLOCK]; R];
+    while column + L <= n_out {
+        let mut acc = [[0.0f32; L]; R];
         for (i, w_row) in weight.chunks_exact(n_out).enumerate() {
-            let w: &[f32; LANE_BLOCK] = w_row[column..column + LANE_BLOCK]
-                .try_into()
-                .expect("block");
+            let w: &[f32; L] = w_row[column..column + L].try_into().expect("block");
             for r in 0..R {
                 let a = x[r][i];
-                for l in 0..LANE_BLOCK {
+                for l in 0..L {
                     acc[r][l] += a * w[l];
                 }
             }
         }
         for (r, acc_row) in acc.iter().enumerate() {
-            let y =
-                &mut out[(first + r) * n_out + column..(first + r) * n_out + column + LANE_BLOCK];
+            let y = &mut out[(first + r) * n_out + column..(first + r) * n_out + column + L];
             for ((yl, al), bl) in y.iter_mut().zip(acc_row).zip(&bias[column..]) {
                 *yl += al + bl;
             }
         }
-        column += LANE_BLOCK;
+        column += L;
     }
-    for j in column..n_out {
-        for r in 0..R {
-            let mut sum = 0.0f32;
-            for (i, &a) in x[r].iter().enumerate() {
-                sum += a * weight[i * n_out + j];
-            }
-            out[(first + r) * n_out + j] += sum + bias[j];
-        }
-    }
+    column
 }
 
 /// LayerNorm of each `view.dim`-long row.
@@ -405,6 +412,43 @@ fn fast_exp(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_block_shape_sums_like_the_plain_loop() {
+        let value = |i: usize| ((i as f32 * 0.618).sin() * 1.7).fract();
+        let inputs = 23;
+        // Row and output counts that use each block shape alone and together.
+        for rows in [1, 3, 4, 5, 9] {
+            for outputs in [1, 3, 4, 7, 16, 21, 37] {
+                let view = LinearView {
+                    weight: 5,
+                    bias: 5 + inputs * outputs,
+                    inputs,
+                    outputs,
+                };
+                let values: Vec<f32> = (0..view.bias + outputs).map(value).collect();
+                let input: Vec<f32> = (0..rows * inputs).map(|i| value(i + 911)).collect();
+                let start: Vec<f32> = (0..rows * outputs).map(|i| value(i + 313)).collect();
+                let mut blocked = start.clone();
+                linear_accumulate(&values, view, &input, rows, &mut blocked);
+                for r in 0..rows {
+                    for j in 0..outputs {
+                        let mut sum = 0.0f32;
+                        for i in 0..inputs {
+                            sum += input[r * inputs + i] * values[view.weight + i * outputs + j];
+                        }
+                        let want = start[r * outputs + j] + (sum + values[view.bias + j]);
+                        let got = blocked[r * outputs + j];
+                        assert_eq!(
+                            got.to_bits(),
+                            want.to_bits(),
+                            "{rows}×{outputs}: ({r}, {j})"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn fast_exp_matches_the_library_exponential() {
