@@ -166,6 +166,11 @@ impl<'a> Episode<'a> {
         self.termination.is_none().then_some(&self.current)
     }
 
+    /// The state at the last accepted configuration, also once the episode is over.
+    pub fn state(&self) -> &StepContext<'a> {
+        &self.current
+    }
+
     /// Applies `action` (clipped to `[−1, 1]⁴`), chosen by `acting` at the current
     /// [`Episode::context`].
     pub fn apply(&mut self, action: &NullAction, acting: ActingController) -> StepOutcome {

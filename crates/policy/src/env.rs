@@ -2,9 +2,7 @@
 //! `a ∈ (−1, 1)⁴` in `B(q)` scaled by `a_max` (Eq. 7), reward `clip(Δp·d / (v·Δt), 0, 1)`,
 //! termination at the first broken constraint, truncation at the step cap.
 
-use emg_control::{
-    ActingController, Episode, NullAction, RolloutConfig, StepContext, StepOutcome, Task,
-};
+use emg_control::{ActingController, Episode, NullAction, RolloutConfig, StepOutcome, Task};
 use emg_kinematics::{JointVector, Robot};
 use emg_seeding::LabelSet;
 use rand::RngExt;
@@ -110,8 +108,6 @@ impl TrainingPool {
             .map(|_| ArmEnvironment {
                 pool: self,
                 episode: None,
-                context: None,
-                path_length_m: 0.0,
             })
             .collect()
     }
@@ -129,12 +125,20 @@ impl TrainingPool {
     }
 }
 
-/// One arm environment: an [`Episode`] on a task of the pool, driven by actions in `B(q)`.
+/// One arm environment: an [`Episode`] on a task of the pool, driven by actions in `B(q)`;
+/// after the episode's end it is observed at its last accepted step (a truncation's value
+/// bootstrap) until the next reset.
 pub struct ArmEnvironment<'a> {
     pool: &'a TrainingPool,
     episode: Option<Episode<'a>>,
-    context: Option<StepContext<'a>>,
-    path_length_m: f64,
+}
+
+impl ArmEnvironment<'_> {
+    fn episode(&self) -> &Episode<'_> {
+        self.episode
+            .as_ref()
+            .expect("an environment is reset before use")
+    }
 }
 
 impl Environment for ArmEnvironment<'_> {
@@ -143,11 +147,8 @@ impl Environment for ArmEnvironment<'_> {
         for _ in 0..RESET_ATTEMPTS {
             let index = rng.random_range(0..pool.tasks.len());
             let start = pool.start(index, rng);
-            let task = &pool.tasks[index];
-            let episode = Episode::start(&pool.robot, task, &start, &pool.rollout);
-            if let Some(context) = episode.context() {
-                self.path_length_m = task.progress(&context.kinematics.tcp());
-                self.context = Some(context.clone());
+            let episode = Episode::start(&pool.robot, &pool.tasks[index], &start, &pool.rollout);
+            if !episode.is_finished() {
                 self.episode = Some(episode);
                 return;
             }
@@ -156,51 +157,24 @@ impl Environment for ArmEnvironment<'_> {
     }
 
     fn observe(&self, out: &mut [f32; OBSERVATION_DIM]) {
-        observe(self.context.as_ref().expect("observe after reset"), out);
+        observe(self.episode().state(), out);
     }
 
     fn step(&mut self, action: &[f32; ACTION_DIM]) -> Transition {
-        let context = self.context.take().expect("step after reset");
         let episode = self.episode.as_mut().expect("step after reset");
         let action = NullAction::from_fn(|i, _| f64::from(action[i]));
-        let outcome = episode.apply(&action, ActingController::Learned);
         let config = &self.pool.rollout;
         let reward =
             |progress_m: f64| (progress_m / (config.speed_m_per_s * config.dt_s)).clamp(0.0, 1.0);
-        match outcome {
-            StepOutcome::Continued { progress_m } => {
-                let next = episode
-                    .context()
-                    .expect("a continued episode has a next step");
-                self.path_length_m = context.task.progress(&next.kinematics.tcp());
-                self.context = Some(next.clone());
-                Transition {
-                    reward: reward(progress_m),
-                    end: None,
-                }
-            }
-            StepOutcome::Truncated { progress_m } => {
-                let trajectory = self.episode.take().expect("running").finish();
-                let last = trajectory
-                    .steps
-                    .last()
-                    .expect("a trajectory holds its seed");
-                self.path_length_m = trajectory.path_length_m;
-                let pool = self.pool;
-                self.context = Some(StepContext::new(
-                    &pool.robot,
-                    context.task,
-                    &pool.rollout,
-                    trajectory.steps.len() - 1,
-                    last.q,
-                    pool.robot.forward(&last.q),
-                    action.map(|a| a.clamp(-1.0, 1.0)),
-                ));
-                Transition {
-                    reward: reward(progress_m),
-                    end: Some(EpisodeEnd::Truncated),
-                }
-            }
+        match episode.apply(&action, ActingController::Learned) {
+            StepOutcome::Continued { progress_m } => Transition {
+                reward: reward(progress_m),
+                end: None,
+            },
+            StepOutcome::Truncated { progress_m } => Transition {
+                reward: reward(progress_m),
+                end: Some(EpisodeEnd::Truncated),
+            },
             StepOutcome::Terminated => Transition {
                 reward: 0.0,
                 end: Some(EpisodeEnd::Terminated),
@@ -209,6 +183,7 @@ impl Environment for ArmEnvironment<'_> {
     }
 
     fn score(&self) -> f64 {
-        self.path_length_m
+        let state = self.episode().state();
+        state.task.progress(&state.kinematics.tcp())
     }
 }
