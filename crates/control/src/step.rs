@@ -52,8 +52,8 @@ pub struct StepContext<'a> {
 
 impl<'a> StepContext<'a> {
     /// Computes every quantity of the step at `q` from its forward kinematics (no allocation).
-    /// Always inlined: the context is then built where it is stored (an [`crate::Episode`]'s
-    /// current step) instead of being copied there.
+    /// Always inlined: inside [`crate::Episode`]'s step it then copies less of the context on
+    /// its way into the episode (measured: 1.9 % fewer instructions per step).
     #[inline(always)]
     pub fn new(
         robot: &'a Robot,
