@@ -126,6 +126,19 @@ pub fn first_violation(
     kin: &Kinematics,
     cfg: &ConstraintConfig,
 ) -> Option<Violation> {
+    admit(robot, task, q, kin, cfg).err()
+}
+
+/// The tool angle of `q` (degrees) when `q` holds every constraint, else the first constraint
+/// it breaks (in the order of [`first_violation`]). The angle is the cone check's own
+/// measurement, so an accepted step needs no second one.
+pub(crate) fn admit(
+    robot: &Robot,
+    task: &Task,
+    q: &JointVector,
+    kin: &Kinematics,
+    cfg: &ConstraintConfig,
+) -> Result<f64, Violation> {
     let limits = robot.limits();
     if let Some(i) = limits.first_violation(q, 0.0) {
         let limit = if q[i] < limits.lower[i] {
@@ -133,7 +146,7 @@ pub fn first_violation(
         } else {
             limits.upper[i]
         };
-        return Some(Violation::JointLimit {
+        return Err(Violation::JointLimit {
             joint: i + 1,
             value_rad: q[i],
             limit_rad: limit,
@@ -142,15 +155,18 @@ pub fn first_violation(
     let distance = task.lateral_error(&kin.tcp()).norm();
     // NaN counts as a violation.
     if distance.is_nan() || distance > cfg.line_tolerance_m {
-        return Some(Violation::LineTolerance {
+        return Err(Violation::LineTolerance {
             distance_m: distance,
         });
     }
     let angle = tool_angle_deg(&kin.tool_axis(), &task.n);
     if angle.is_nan() || angle > cfg.theta_max_deg {
-        return Some(Violation::ToolCone { angle_deg: angle });
+        return Err(Violation::ToolCone { angle_deg: angle });
     }
-    first_contact(robot, task, kin, cfg)
+    match first_contact(robot, task, kin, cfg) {
+        Some(violation) => Err(violation),
+        None => Ok(angle),
+    }
 }
 
 /// The first contact of the arm at `kin`: a capsule pair closer than the collision margin, a

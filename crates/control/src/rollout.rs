@@ -4,9 +4,9 @@ use emg_kinematics::{JointVector, Robot};
 use serde::{Deserialize, Serialize};
 
 use crate::config::RolloutConfig;
-use crate::constraints::{Violation, first_violation, tool_angle_deg};
+use crate::constraints::{Violation, admit, first_violation, tool_angle_deg};
 use crate::controller::{ActingController, NullSpaceController};
-use crate::step::{NullAction, StepContext};
+use crate::step::{Measured, NullAction, StepContext};
 use crate::task::Task;
 
 /// Steps a rollout reserves room for up front (the default step cap and its seed fit); longer
@@ -187,24 +187,27 @@ impl<'a> Episode<'a> {
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
         let next_kinematics = robot.forward(&next);
-        if let Some(violation) =
-            first_violation(robot, task, &next, &next_kinematics, &config.constraints)
+        let tool_angle_deg = match admit(robot, task, &next, &next_kinematics, &config.constraints)
         {
-            self.termination = Some(Termination::Violation {
-                violation,
-                rejected_q: next,
-            });
-            return StepOutcome::Terminated;
-        }
+            Ok(tool_angle_deg) => tool_angle_deg,
+            Err(violation) => {
+                self.termination = Some(Termination::Violation {
+                    violation,
+                    rejected_q: next,
+                });
+                return StepOutcome::Terminated;
+            }
+        };
         let progress_m = (next_kinematics.tcp() - self.current.kinematics.tcp()).dot(&task.d);
         self.time_s += self.step_duration(&velocity);
-        self.current = StepContext::new(
-            robot,
-            task,
-            config,
+        self.current = StepContext::measured(
+            (robot, task, config),
             self.steps.len(),
-            next,
-            next_kinematics,
+            Measured {
+                q: next,
+                kinematics: next_kinematics,
+                tool_angle_deg,
+            },
             action,
         );
         if self.steps.len() == config.max_steps {

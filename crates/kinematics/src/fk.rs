@@ -76,6 +76,11 @@ impl Kinematics {
         &self.jacobian
     }
 
+    /// `JJᵀ` (3×3), computed on each call.
+    pub fn jacobian_gram(&self) -> Matrix3<f64> {
+        self.jacobian * self.jacobian.transpose()
+    }
+
     /// Unit rotation axis `ω_i` of joint `i` (0-based) in the base frame.
     pub fn joint_axis(&self, i: usize) -> Vec3 {
         self.rotations[i + 1].column(2).into_owned()

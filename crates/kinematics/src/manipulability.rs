@@ -11,14 +11,22 @@ use crate::{DOF, JointVector, Vec3};
 /// With `A = JJᵀ + λ_μ²I`, `w = A⁻¹d`, `s = dᵀw`:
 /// `∂w_d/∂q_i = s^(−3/2) · wᵀ H_i (Jᵀw)` where `H_i = ∂J/∂q_i` has columns
 /// `∂J_k/∂q_i = ω_min(i,k) × J_max(i,k)` (revolute joints).
+/// `gram` is `JJᵀ` of `kin`'s Jacobian ([`Kinematics::jacobian_gram`], or
+/// [`crate::DampedPseudoInverse::gram`] where the step has built the pseudo-inverse already).
 /// Returns `(w_d, ∇w_d)`; allocation-free.
 pub fn directional_manipulability(
     kin: &Kinematics,
+    gram: &Matrix3<f64>,
     d: &Vec3,
     lambda_mu: f64,
 ) -> (f64, JointVector) {
+    debug_assert_eq!(
+        *gram,
+        kin.jacobian_gram(),
+        "gram is JJᵀ of this configuration"
+    );
     let jacobian = kin.jacobian();
-    let a = jacobian * jacobian.transpose() + Matrix3::identity() * (lambda_mu * lambda_mu);
+    let a = gram + Matrix3::identity() * (lambda_mu * lambda_mu);
     let w = a.try_inverse().unwrap_or_else(Matrix3::zeros) * d;
     let s = d.dot(&w);
     if s <= 0.0 {

@@ -36,11 +36,17 @@ pub struct DampedPseudoInverse {
     pub matrix: SMatrix<f64, DOF, 3>,
     /// Damping `λ` that was applied.
     pub lambda: f64,
-    /// `JJᵀ`, kept for [`DampedPseudoInverse::sigma_min`].
+    /// `JJᵀ`, kept for [`DampedPseudoInverse::sigma_min`] and [`DampedPseudoInverse::gram`].
     gram: Matrix3<f64>,
 }
 
 impl DampedPseudoInverse {
+    /// `JJᵀ` of the Jacobian it was built from (for [`crate::directional_manipulability`],
+    /// so that a step computes the product once).
+    pub fn gram(&self) -> &Matrix3<f64> {
+        &self.gram
+    }
+
     /// Smallest singular value `σ_min` of `J` (closed-form eigenvalue of `JJᵀ`).
     pub fn sigma_min(&self) -> f64 {
         smallest_symmetric_eigenvalue(&self.gram).max(0.0).sqrt()

@@ -72,7 +72,9 @@ fn directional_manipulability_gradient_matches_finite_differences() {
     for _ in 0..CONFIGS {
         let q = random_q(&mut rng, &robot);
         let d = random_unit(&mut rng);
-        let (value, gradient) = directional_manipulability(&robot.forward(&q), &d, LAMBDA_MU);
+        let kin = robot.forward(&q);
+        let (value, gradient) =
+            directional_manipulability(&kin, &kin.jacobian_gram(), &d, LAMBDA_MU);
         let reference = directional_manipulability_value(&robot, &q, &d);
         worst_value = worst_value.max((value - reference).abs() / reference.max(1.0));
         let numeric = JointVector::from_fn(|i, _| {
@@ -103,7 +105,7 @@ fn directional_manipulability_value_is_the_directional_singular_value_without_da
         let u = svd.u.expect("u requested");
         for k in 0..3 {
             let d: Vec3 = u.column(k).into_owned();
-            let (value, _) = directional_manipulability(&kin, &d, 0.0);
+            let (value, _) = directional_manipulability(&kin, &kin.jacobian_gram(), &d, 0.0);
             let sigma = svd.singular_values[k];
             assert!(
                 (value - sigma).abs() < 1e-9 * sigma.max(1.0),

@@ -20,7 +20,7 @@ type Identity4 = SMatrix<f64, 4, 4>;
 /// The three SPEC §4 gradients at q for task direction d and plane normal n.
 fn gradients(robot: &Robot, q: &JointVector, d: &Vec3, n: &Vec3) -> [JointVector; 3] {
     let kin = robot.forward(q);
-    let (_, grad_wd) = directional_manipulability(&kin, d, 1e-3);
+    let (_, grad_wd) = directional_manipulability(&kin, &kin.jacobian_gram(), d, 1e-3);
     let grad_align = tool_alignment_gradient(&kin, n);
     let limits = robot.limits();
     let grad_centre = -(2.0 / 7.0) * limits.normalise(q).component_div(&limits.half_range());

@@ -60,7 +60,13 @@ impl HeuristicObjective {
     ) -> (f64, JointVector) {
         match self {
             Self::Manipulability => {
-                directional_manipulability(&robot.forward(q), &task.d, cfg.manipulability_damping)
+                let kin = robot.forward(q);
+                directional_manipulability(
+                    &kin,
+                    &kin.jacobian_gram(),
+                    &task.d,
+                    cfg.manipulability_damping,
+                )
             }
             Self::JointCentring => {
                 let limits = robot.limits();
