@@ -2,6 +2,7 @@
 
 use arrayvec::ArrayVec;
 
+use crate::clearance_floor::{ClearanceFloor, clearance_floor};
 use crate::fk::Kinematics;
 use crate::robot::Robot;
 use crate::{DOF, Vec3};
@@ -41,12 +42,15 @@ pub struct CollisionHit {
     pub clearance: f64,
 }
 
+#[cfg(test)]
+mod tests;
+
 /// Most capsules a robot may carry: the placed capsules of one check live on the stack.
 pub const MAX_CAPSULES: usize = 64;
 
-/// Slack (m) kept by the bounding-sphere tests, far above their rounding error: a pair is
-/// skipped only when its spheres are clearly apart.
-const SPHERE_SLACK_M: f64 = 1e-9;
+/// Slack (m) kept by the bounding-sphere tests and the clearance floors, far above their rounding
+/// error: a pair is skipped only when it is clearly apart.
+const SKIP_SLACK_M: f64 = 1e-9;
 
 /// The centres of every capsule's bounding sphere at one configuration (one transform each).
 type CapsuleCentres = ArrayVec<Vec3, MAX_CAPSULES>;
@@ -58,13 +62,19 @@ struct PairGroup {
     segments: (usize, usize),
     /// Indices into [`Robot::collision_pairs`], ascending.
     pairs: Vec<usize>,
+    /// The certified floor of the pairs' clearance over every configuration
+    /// ([`clearance_floor`]); `−∞` until the robot is loaded, and for segments too many joints
+    /// apart.
+    floor: ClearanceFloor,
 }
 
-/// The two-level bounding-sphere hierarchy of the self-collision test, fixed at load time: one
-/// sphere per rigid segment enclosing its capsules, then one per capsule. A check places the
-/// centres of both kinds of sphere (one transform each), tests the few segment pairs, then the
-/// capsule pairs of the segment pairs that may touch, and transforms the axis end points only of
-/// the capsule pairs that pass both tests.
+/// The broad phase of the self-collision test, fixed at load time: a certified clearance floor
+/// per segment pair (segments one or two joints apart whose capsules never come close), one
+/// bounding sphere per rigid segment enclosing its capsules, then one per capsule. A check skips
+/// the segment pairs whose floor clears the margin, places the segment spheres (one transform
+/// each) and tests the remaining segment pairs, then the capsule spheres of the segment pairs
+/// that may touch, and transforms the axis end points only of the capsule pairs that pass every
+/// test.
 #[derive(Clone, Debug)]
 pub(crate) struct BroadPhase {
     /// Centre of each capsule's bounding sphere (its axis midpoint), in its segment's frame.
@@ -116,6 +126,7 @@ impl BroadPhase {
                 None => groups.push(PairGroup {
                     segments,
                     pairs: vec![index],
+                    floor: ClearanceFloor::UNSEARCHED,
                 }),
             }
         }
@@ -140,41 +151,75 @@ impl BroadPhase {
 /// them is more than `threshold` apart.
 #[inline]
 fn spheres_within(a: &Vec3, b: &Vec3, reach: f64, threshold: f64) -> bool {
-    let limit = reach + threshold + SPHERE_SLACK_M;
+    let limit = reach + threshold + SKIP_SLACK_M;
     !(limit > 0.0 && (a - b).norm_squared() > limit * limit)
 }
 
 impl Robot {
+    /// This robot with the clearance floor of each of its segment pairs searched
+    /// ([`clearance_floor`]); the last step of loading a robot.
+    pub(crate) fn with_clearance_floors(mut self) -> Self {
+        let floors: Vec<ClearanceFloor> = self
+            .broad_phase
+            .groups
+            .iter()
+            .map(|group| {
+                let pairs: Vec<CollisionPair> =
+                    group.pairs.iter().map(|&index| self.pairs[index]).collect();
+                clearance_floor(&self, group.segments, &pairs)
+            })
+            .collect();
+        for (group, floor) in self.broad_phase.groups.iter_mut().zip(floors) {
+            group.floor = floor;
+        }
+        self
+    }
+
+    /// Whether `group`'s clearance floor proves its pairs farther apart than `margin` at `kin`:
+    /// the floor clears the margin and the joints between its segments are within their
+    /// limits, where the floor holds.
+    #[inline]
+    fn floor_clears(&self, group: &PairGroup, kin: &Kinematics, margin: f64) -> bool {
+        let (a, b) = group.segments;
+        let q = kin.configuration();
+        group.floor.floor > margin + SKIP_SLACK_M
+            && (a..b).all(|j| self.limits.lower[j] <= q[j] && q[j] <= self.limits.upper[j])
+    }
+
     /// Places the centres of the capsules' bounding spheres at `kin` into `centres` (which
     /// must be empty).
     fn place_centres(&self, kin: &Kinematics, centres: &mut CapsuleCentres) {
-        for (capsule, local) in self.capsules.iter().zip(&self.broad_phase.capsule_centres) {
+        for capsule in 0..self.capsules.len() {
             // Never full: a robot carries at most MAX_CAPSULES capsules.
-            let _ = centres.try_push(kin.segment_point(capsule.segment, local));
+            let _ = centres.try_push(self.capsule_centre(kin, capsule));
         }
     }
 
-    /// Whether the bounding spheres of `pair` may be less than `threshold` apart. `false`
-    /// proves the pair's clearance exceeds `threshold`.
+    /// The centre of `capsule`'s bounding sphere at `kin`.
+    #[inline]
+    fn capsule_centre(&self, kin: &Kinematics, capsule: usize) -> Vec3 {
+        kin.segment_point(
+            self.capsules[capsule].segment,
+            &self.broad_phase.capsule_centres[capsule],
+        )
+    }
+
+    /// Whether the bounding spheres of `pair` (centred at `centres`) may be less than
+    /// `threshold` apart. `false` proves the pair's clearance exceeds `threshold`.
     #[inline]
     fn capsule_spheres_within(
         &self,
-        centres: &CapsuleCentres,
+        (first, second): (&Vec3, &Vec3),
         pair: CollisionPair,
         threshold: f64,
     ) -> bool {
         let radii = &self.broad_phase.capsule_radii;
         let reach = radii[pair.first] + radii[pair.second];
-        spheres_within(
-            &centres[pair.first],
-            &centres[pair.second],
-            reach,
-            threshold,
-        )
+        spheres_within(first, second, reach, threshold)
     }
 
     /// Surface clearance of `pair` at `kin` (m), negative when the capsules interpenetrate.
-    fn pair_clearance(&self, kin: &Kinematics, pair: CollisionPair) -> f64 {
+    pub(crate) fn pair_clearance(&self, kin: &Kinematics, pair: CollisionPair) -> f64 {
         let (a, b) = (&self.capsules[pair.first], &self.capsules[pair.second]);
         let (a0, a1) = (
             kin.segment_point(a.segment, &a.start),
@@ -190,15 +235,17 @@ impl Robot {
     /// The first checked capsule pair (in [`Robot::collision_pairs`] order) whose clearance is
     /// below `margin` (m), if any.
     ///
-    /// Allocation-free: the [`BroadPhase`] hierarchy skips the segment pairs and then the
-    /// capsule pairs that are clearly apart before the exact distance.
+    /// Allocation-free: the [`BroadPhase`] skips the segment pairs whose clearance floor clears
+    /// `margin`, then the segment pairs and the capsule pairs whose bounding spheres are clearly
+    /// apart, before the exact distance.
     pub fn first_collision(&self, kin: &Kinematics, margin: f64) -> Option<CollisionHit> {
         let broad_phase = &self.broad_phase;
         let segment_centres = broad_phase.segment_centres(kin);
-        let mut centres = CapsuleCentres::new();
-        self.place_centres(kin, &mut centres);
         let mut first: Option<(usize, CollisionHit)> = None;
         for group in &broad_phase.groups {
+            if self.floor_clears(group, kin, margin) {
+                continue;
+            }
             let (a, b) = group.segments;
             let reach = broad_phase.segment_radii[a] + broad_phase.segment_radii[b];
             if !spheres_within(&segment_centres[a], &segment_centres[b], reach, margin) {
@@ -209,7 +256,11 @@ impl Robot {
                     break;
                 }
                 let pair = self.pairs[index];
-                if !self.capsule_spheres_within(&centres, pair, margin) {
+                let centres = (
+                    self.capsule_centre(kin, pair.first),
+                    self.capsule_centre(kin, pair.second),
+                );
+                if !self.capsule_spheres_within((&centres.0, &centres.1), pair, margin) {
                     continue;
                 }
                 let clearance = self.pair_clearance(kin, pair);
@@ -232,7 +283,8 @@ impl Robot {
         let mut best: Option<CollisionHit> = None;
         for &pair in &self.pairs {
             let bound = best.map_or(f64::INFINITY, |hit| hit.clearance);
-            if bound.is_finite() && !self.capsule_spheres_within(&centres, pair, bound) {
+            let pair_centres = (&centres[pair.first], &centres[pair.second]);
+            if bound.is_finite() && !self.capsule_spheres_within(pair_centres, pair, bound) {
                 continue;
             }
             let clearance = self.pair_clearance(kin, pair);

@@ -14,6 +14,7 @@ pub type PositionJacobian = SMatrix<f64, 3, DOF>;
 /// frame of joint `s`, turned by `q_s` about its local +z.
 #[derive(Clone, Debug)]
 pub struct Kinematics {
+    configuration: JointVector,
     rotations: [Matrix3<f64>; DOF + 1],
     positions: [Vec3; DOF + 1],
     tcp: Vec3,
@@ -46,6 +47,7 @@ impl Robot {
             jacobian.set_column(i, &axis.cross(&(tcp - positions[i + 1])));
         }
         Kinematics {
+            configuration: *q,
             rotations,
             positions,
             tcp,
@@ -56,6 +58,11 @@ impl Robot {
 }
 
 impl Kinematics {
+    /// The configuration `q` these kinematics are of.
+    pub fn configuration(&self) -> &JointVector {
+        &self.configuration
+    }
+
     /// TCP (pen tip) position `p(q)`, metres.
     pub fn tcp(&self) -> Vec3 {
         self.tcp

@@ -32,6 +32,7 @@
 //! # Ok::<(), emg_kinematics::RobotError>(())
 //! ```
 
+mod clearance_floor;
 mod collision;
 mod fit;
 mod fk;

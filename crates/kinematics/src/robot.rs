@@ -371,7 +371,8 @@ impl Robot {
             pair_rule,
             reach_centre,
             reach_radius,
-        })
+        }
+        .with_clearance_floors())
     }
 
     /// SHA-256 (hex) of the chain as the planners see it: every joint frame (rotation and

@@ -4,7 +4,8 @@
 //! segments); home is collision-free; a folded colliding configuration whose clearance agrees
 //! with an independent computation; and `first_collision`/`min_clearance` against an
 //! exhaustive independent check on random configurations (which exercises the bounding-sphere
-//! shortcut), also on an arm whose only capsule on one body is a point (a sphere of radius 0).
+//! shortcut and the clearance floors), also beyond the joint limits, where the floors do not
+//! hold, and on an arm whose only capsule on one body is a point (a sphere of radius 0).
 
 mod common;
 
@@ -362,6 +363,37 @@ fn first_collision_and_min_clearance_match_an_exhaustive_check() {
     );
     assert!(colliding > 0);
     assert!(worst < 1e-12);
+}
+
+#[test]
+fn pairs_certified_clear_within_the_limits_are_still_checked_beyond_them() {
+    // The hand's clearance floor against link5 holds within the limits of joints 6 and 7;
+    // with joint 6 below its lower limit the two can touch, and the check must find it.
+    let robot = robot();
+    let mut rng = rng(54);
+    let lower = robot.limits().lower[5];
+    let mut hand_on_link5 = 0;
+    for _ in 0..2000 {
+        let mut q = random_q(&mut rng, &robot);
+        q[5] = rng.random_range(lower - 3.0..lower);
+        q[6] = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        let kin = robot.forward(&q);
+        let expected = all_clearances(&robot, &kin)
+            .iter()
+            .position(|&c| c < 0.0)
+            .map(|i| robot.collision_pairs()[i]);
+        let hit = robot.first_collision(&kin, 0.0).map(|h| h.pair);
+        assert_eq!(hit, expected, "q {q:?}");
+        let capsules = robot.capsules();
+        hand_on_link5 += usize::from(hit.is_some_and(|pair| {
+            (capsules[pair.first].segment, capsules[pair.second].segment) == (5, 7)
+        }));
+    }
+    println!("link5 touched the hand or the pen in {hand_on_link5} of 2000 configurations");
+    assert!(
+        hand_on_link5 > 0,
+        "the test must reach the pairs the floor skips"
+    );
 }
 
 #[test]
