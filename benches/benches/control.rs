@@ -25,8 +25,7 @@ fn benches(c: &mut Criterion) {
     c.bench_function("classical_control_step", |b| {
         b.iter(|| {
             let kinematics = robot.forward(black_box(&q));
-            let step =
-                StepContext::new(robot, task, &config, 0, q, kinematics, NullAction::zeros());
+            let step = StepContext::new(robot, task, &config, 0, kinematics, NullAction::zeros());
             let (action, _) = controller.act(&step);
             q + step.joint_velocity(&action) * config.dt_s
         })
@@ -34,7 +33,7 @@ fn benches(c: &mut Criterion) {
 
     let kinematics = robot.forward(&q);
     c.bench_function("constraint_check", |b| {
-        b.iter(|| first_violation(robot, task, black_box(&q), &kinematics, &config.constraints))
+        b.iter(|| first_violation(robot, task, black_box(&kinematics), &config.constraints))
     });
 
     c.bench_function("classical_rollout", |b| {

@@ -72,7 +72,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             continue;
         };
         let kinematics = robot.forward(&q);
-        if first_violation(&robot, task, &q, &kinematics, &rollout_config.constraints).is_some() {
+        if first_violation(&robot, task, &kinematics, &rollout_config.constraints).is_some() {
             continue;
         }
         let mut points = vec![Vec3::zeros()];

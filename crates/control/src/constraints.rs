@@ -1,6 +1,6 @@
 //! The constraints every step must hold, and which one a configuration breaks.
 
-use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3};
+use emg_kinematics::{Kinematics, Robot, Shape, ToolContact, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::config::ConstraintConfig;
@@ -117,28 +117,28 @@ pub fn tool_angle_deg(z: &Vec3, n: &Vec3) -> f64 {
     z.cross(n).norm().atan2(z.dot(n)).to_degrees()
 }
 
-/// The first constraint `q` breaks, checked in the order joint limits, line, cone, collision
+/// The first constraint that the configuration of `kin` (its forward kinematics,
+/// [`Robot::forward`]) breaks, checked in the order joint limits, line, cone, collision
 /// (self-collision, then the work surface, then the scene's obstacles).
 pub fn first_violation(
     robot: &Robot,
     task: &Task,
-    q: &JointVector,
     kin: &Kinematics,
     cfg: &ConstraintConfig,
 ) -> Option<Violation> {
-    admit(robot, task, q, kin, cfg).err()
+    admit(robot, task, kin, cfg).err()
 }
 
-/// The tool angle of `q` (degrees) when `q` holds every constraint, else the first constraint
-/// it breaks (in the order of [`first_violation`]). The angle is the cone check's own
-/// measurement, so an accepted step needs no second one.
+/// The tool angle (degrees) of the configuration `q` of `kin` when `q` holds every constraint,
+/// else the first constraint it breaks (in the order of [`first_violation`]). The angle is the
+/// cone check's own measurement, so an accepted step needs no second one.
 pub(crate) fn admit(
     robot: &Robot,
     task: &Task,
-    q: &JointVector,
     kin: &Kinematics,
     cfg: &ConstraintConfig,
 ) -> Result<f64, Violation> {
+    let q = kin.configuration();
     let limits = robot.limits();
     if let Some(i) = limits.first_violation(q, 0.0) {
         let limit = if q[i] < limits.lower[i] {

@@ -135,7 +135,6 @@ impl<'a> Episode<'a> {
             task,
             config,
             0,
-            *seed,
             robot.forward(seed),
             NullAction::zeros(),
         );
@@ -148,7 +147,6 @@ impl<'a> Episode<'a> {
         if let Some(violation) = first_violation(
             robot,
             task,
-            seed,
             &episode.current.kinematics,
             &config.constraints,
         ) {
@@ -187,8 +185,7 @@ impl<'a> Episode<'a> {
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
         let next_kinematics = robot.forward(&next);
-        let tool_angle_deg = match admit(robot, task, &next, &next_kinematics, &config.constraints)
-        {
+        let tool_angle_deg = match admit(robot, task, &next_kinematics, &config.constraints) {
             Ok(tool_angle_deg) => tool_angle_deg,
             Err(violation) => {
                 self.termination = Some(Termination::Violation {
@@ -204,7 +201,6 @@ impl<'a> Episode<'a> {
             (robot, task, config),
             self.steps.len(),
             Measured {
-                q: next,
                 kinematics: next_kinematics,
                 tool_angle_deg,
             },

@@ -10,11 +10,10 @@ use crate::config::RolloutConfig;
 use crate::constraints::tool_angle_deg;
 use crate::task::Task;
 
-/// A configuration with the quantities measured of it before its step context is built.
+/// A configuration's forward kinematics with the quantities measured of it before its step
+/// context is built.
 pub(crate) struct Measured {
-    /// The configuration `q`.
-    pub(crate) q: JointVector,
-    /// Its forward kinematics.
+    /// The forward kinematics of the configuration `q`.
     pub(crate) kinematics: Kinematics,
     /// Its tool angle (degrees), [`tool_angle_deg`].
     pub(crate) tool_angle_deg: f64,
@@ -61,13 +60,13 @@ pub struct StepContext<'a> {
 }
 
 impl<'a> StepContext<'a> {
-    /// Computes every quantity of the step at `q` from its forward kinematics (no allocation).
+    /// Computes every quantity of the step at the configuration of `kinematics` (its forward
+    /// kinematics, [`Robot::forward`]) (no allocation).
     pub fn new(
         robot: &'a Robot,
         task: &'a Task,
         config: &'a RolloutConfig,
         step: usize,
-        q: JointVector,
         kinematics: Kinematics,
         previous_action: NullAction,
     ) -> Self {
@@ -76,7 +75,6 @@ impl<'a> StepContext<'a> {
             (robot, task, config),
             step,
             Measured {
-                q,
                 kinematics,
                 tool_angle_deg,
             },
@@ -93,12 +91,12 @@ impl<'a> StepContext<'a> {
         (robot, task, config): (&'a Robot, &'a Task, &'a RolloutConfig),
         step: usize,
         Measured {
-            q,
             kinematics,
             tool_angle_deg,
         }: Measured,
         previous_action: NullAction,
     ) -> Self {
+        let q = *kinematics.configuration();
         let limits = robot.limits();
         let q_normalised = limits.normalise(&q);
         let rho = q_normalised.amax();

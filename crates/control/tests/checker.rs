@@ -337,8 +337,7 @@ fn checker_rejects_malformed_trajectories_without_panicking() {
     let mut nan = *rejected_q;
     nan[2] = f64::NAN;
     let robot = robot();
-    let found =
-        emg_control::first_violation(&robot, &task, &nan, &robot.forward(&nan), &constraints);
+    let found = emg_control::first_violation(&robot, &task, &robot.forward(&nan), &constraints);
     let Some(violation @ Violation::JointLimit { joint: 3, .. }) = found else {
         panic!("{found:?}")
     };

@@ -60,21 +60,13 @@ fn classical_control_step_and_constraint_check_do_not_allocate() {
         let before = allocations();
         for step in 0..20 {
             let kinematics = robot.forward(&q);
-            let context = StepContext::new(
-                &robot,
-                task,
-                &config,
-                step,
-                q,
-                kinematics,
-                NullAction::zeros(),
-            );
+            let context =
+                StepContext::new(&robot, task, &config, step, kinematics, NullAction::zeros());
             let (action, _) = controller.act(&context);
             let next = q + context.joint_velocity(&action) * config.dt_s;
             let next_kinematics = robot.forward(&next);
             steps += 1;
-            if first_violation(&robot, task, &next, &next_kinematics, &config.constraints).is_some()
-            {
+            if first_violation(&robot, task, &next_kinematics, &config.constraints).is_some() {
                 break;
             }
             q = next;

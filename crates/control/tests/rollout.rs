@@ -41,7 +41,7 @@ fn assert_invariants(robot: &Robot, task: &Task, trajectory: &Trajectory, config
     assert!(!steps.is_empty());
     for (k, step) in steps.iter().enumerate() {
         let kin = robot.forward(&step.q);
-        if let Some(v) = first_violation(robot, task, &step.q, &kin, &config.constraints) {
+        if let Some(v) = first_violation(robot, task, &kin, &config.constraints) {
             panic!("step {k} of {} breaks {v}", steps.len());
         }
         if k == 0 {
@@ -86,7 +86,7 @@ fn assert_invariants(robot: &Robot, task: &Task, trajectory: &Trajectory, config
             rejected_q,
         } => {
             let kin = robot.forward(rejected_q);
-            let found = first_violation(robot, task, rejected_q, &kin, &config.constraints);
+            let found = first_violation(robot, task, &kin, &config.constraints);
             assert_eq!(
                 found.as_ref(),
                 Some(violation),
@@ -144,7 +144,7 @@ fn assert_replay(robot: &Robot, task: &Task, trajectory: &Trajectory, config: &R
         if trajectory.steps[k].controller.is_none() {
             break;
         }
-        let context = StepContext::new(robot, task, config, k, q, robot.forward(&q), previous);
+        let context = StepContext::new(robot, task, config, k, robot.forward(&q), previous);
         let xi = controller.secondary_command(&context);
         let action = context.action_from_secondary(&xi);
         let next = q + context.joint_velocity(&action) * config.dt_s;
@@ -189,7 +189,6 @@ fn progress_per_step_is_about_v_dt() {
                 &task,
                 &config,
                 0,
-                pair[0].q,
                 robot.forward(&pair[0].q),
                 NullAction::zeros(),
             );
@@ -407,7 +406,6 @@ fn actions_are_clipped_and_the_interface_is_honoured() {
             &task,
             &config,
             k,
-            q,
             robot.forward(&q),
             NullAction::zeros(),
         );
@@ -433,7 +431,6 @@ fn contexts<'a>(
                 task,
                 config,
                 k,
-                step.q,
                 robot.forward(&step.q),
                 NullAction::zeros(),
             ));
@@ -574,7 +571,6 @@ fn step_context_gradients_match_finite_differences() {
                 task,
                 &config,
                 0,
-                q,
                 robot.forward(&q),
                 NullAction::zeros(),
             )

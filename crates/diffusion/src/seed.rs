@@ -208,7 +208,7 @@ impl DpSeeder {
                     continue;
                 };
                 let kinematics = robot.forward(&q);
-                if first_violation(robot, task, &q, &kinematics, constraints).is_none() {
+                if first_violation(robot, task, &kinematics, constraints).is_none() {
                     return Ok(DpSeed {
                         q,
                         origin: SeedOrigin::Diffusion,

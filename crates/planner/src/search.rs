@@ -419,7 +419,7 @@ fn candidates(context: &SearchContext<'_>, task: &Task, pipeline: &JointVector) 
     let mut found: Vec<Candidate> = Vec::new();
     let mut offer = |q: JointVector, source: &'static str| {
         let kinematics = robot.forward(&q);
-        let valid = first_violation(robot, task, &q, &kinematics, constraints).is_none();
+        let valid = first_violation(robot, task, &kinematics, constraints).is_none();
         let distinct = (pipeline - q).amax() >= distinct_rad
             && found.iter().all(|c| (c.q - q).amax() >= distinct_rad);
         if valid && distinct {

@@ -30,10 +30,7 @@ fn labels_reach_the_exact_pose_and_hold_every_constraint() {
                 axis_error < 1e-6 && kin.tool_axis().dot(&task.n) > 0.0,
                 "task {i}: axis ≠ n"
             );
-            assert!(
-                first_violation(&robot, task, &label.q, &kin, &config.rollout.constraints)
-                    .is_none()
-            );
+            assert!(first_violation(&robot, task, &kin, &config.rollout.constraints).is_none());
             assert!(label.length_m >= config.min_length_m);
             let tolerance = config
                 .stability

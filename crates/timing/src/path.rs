@@ -59,7 +59,7 @@ impl SmoothPath {
     ) -> Self {
         assert!(!waypoints.is_empty(), "a path needs a waypoint");
         let valid = |q: &JointVector| {
-            first_violation(robot, task, q, &robot.forward(q), constraints).is_none()
+            first_violation(robot, task, &robot.forward(q), constraints).is_none()
         };
         let mut params = Vec::with_capacity(waypoints.len());
         let mut previous = robot.forward(&waypoints[0]).tcp();
@@ -167,7 +167,7 @@ fn first_failing_segment(
         });
         even.chain(spline.turning_points(k)).find_map(|s| {
             let q = spline.eval(s).q;
-            first_violation(robot, task, &q, &robot.forward(&q), constraints).map(|v| (k, v))
+            first_violation(robot, task, &robot.forward(&q), constraints).map(|v| (k, v))
         })
     })
 }
