@@ -6,7 +6,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use emg_benches::Fixture;
+use emg_benches::{Fixture, LongRollout};
 use emg_control::{
     ClassicalController, NullAction, NullSpaceController, RolloutConfig, StepContext,
     first_violation, rollout,
@@ -43,22 +43,11 @@ fn benches(c: &mut Criterion) {
         })
     });
 
-    // The first-100 task whose classical rollout from its seed takes the most steps, so that
-    // the per-rollout set-up is a small share of the time per step.
-    let (long_task, long_seed, steps) = fixture
-        .tasks
-        .iter()
-        .filter_map(|task| {
-            let seed = task.q0_seed?;
-            let mut controller = ClassicalController::default();
-            let steps = rollout(robot, task, &seed, &mut controller, &config)
-                .steps
-                .len()
-                - 1;
-            Some((task, seed, steps))
-        })
-        .max_by_key(|&(_, _, steps)| steps)
-        .expect("evaluation tasks keep their seed");
+    let LongRollout {
+        task: long_task,
+        seed: long_seed,
+        steps,
+    } = fixture.long_rollout();
     c.bench_function("full_step", |b| {
         b.iter_custom(|iterations| {
             let mut elapsed = Duration::ZERO;

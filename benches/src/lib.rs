@@ -5,9 +5,9 @@
 //! assert!(!fixture.tasks.is_empty());
 //! ```
 
-use emg_control::Task;
+use emg_control::{ClassicalController, RolloutConfig, Task, rollout};
 use emg_io::read_tasks;
-use emg_kinematics::Robot;
+use emg_kinematics::{JointVector, Robot};
 
 /// The shipped robot and the first tasks of the shipped evaluation set.
 pub struct Fixture {
@@ -29,10 +29,42 @@ impl Fixture {
         Self { robot, tasks }
     }
 
+    /// The task whose classical rollout from its seed (default [`RolloutConfig`]) takes the
+    /// most steps: the rollout of the `full_step` benchmark and of the instruction count of
+    /// `cargo xtask bench-report`, long so that the per-rollout set-up is a small share of a
+    /// step's cost.
+    pub fn long_rollout(&self) -> LongRollout<'_> {
+        let config = RolloutConfig::default();
+        self.tasks
+            .iter()
+            .filter_map(|task| {
+                let seed = task.q0_seed?;
+                let mut controller = ClassicalController::default();
+                let steps = rollout(&self.robot, task, &seed, &mut controller, &config)
+                    .steps
+                    .len()
+                    - 1;
+                Some(LongRollout { task, seed, steps })
+            })
+            .max_by_key(|long| long.steps)
+            .expect("evaluation tasks keep their seed")
+    }
+
     /// The workspace's shipped data directory.
     pub fn data_dir() -> std::path::PathBuf {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data")
     }
+}
+
+/// The rollout of [`Fixture::long_rollout`].
+#[derive(Clone, Copy, Debug)]
+pub struct LongRollout<'a> {
+    /// Its task.
+    pub task: &'a Task,
+    /// The task's seed, where the rollout starts.
+    pub seed: JointVector,
+    /// Steps it accepts after the seed.
+    pub steps: usize,
 }
 
 /// The shipped FR3 robot file.
