@@ -60,8 +60,8 @@ pub struct StepContext<'a> {
 }
 
 impl<'a> StepContext<'a> {
-    /// Computes every quantity of the step at the configuration of `kinematics` (its forward
-    /// kinematics, [`Robot::forward`]) (no allocation).
+    /// Computes every quantity of the step at the configuration whose forward kinematics
+    /// ([`Robot::forward`]) `kinematics` is (no allocation).
     pub fn new(
         robot: &'a Robot,
         task: &'a Task,

@@ -62,9 +62,9 @@ struct PairGroup {
     segments: (usize, usize),
     /// Indices into [`Robot::collision_pairs`], ascending.
     pairs: Vec<usize>,
-    /// The certified floor of the pairs' clearance over every configuration
-    /// ([`clearance_floor`]); `−∞` until the robot is loaded, and for segments too many joints
-    /// apart.
+    /// The certified floor of the pairs' clearance wherever the joints between the two segments
+    /// are within their limits ([`clearance_floor`]); `−∞` until the robot is loaded, and for
+    /// segments too many joints apart.
     floor: ClearanceFloor,
 }
 
