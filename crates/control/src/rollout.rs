@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::RolloutConfig;
 use crate::constraints::{Violation, admit, first_violation, tool_angle_deg};
 use crate::controller::{ActingController, NullSpaceController};
-use crate::step::{Measured, NullAction, StepContext};
+use crate::step::{NullAction, StepContext};
 use crate::task::Task;
 
 /// Steps a rollout reserves room for up front (the default step cap and its seed fit); longer
@@ -184,10 +184,16 @@ impl<'a> Episode<'a> {
         let next = self.current.q + velocity * config.dt_s;
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
-        let next_kinematics = robot.forward(&next);
-        let tool_angle_deg = match admit(robot, task, &next_kinematics, &config.constraints) {
+        // The next configuration's kinematics are written in place; the rest of the context
+        // follows them once the step is accepted.
+        let previous_tcp = self.current.kinematics.tcp();
+        robot.forward_into(&next, &mut self.current.kinematics);
+        let tool_angle_deg = match admit(robot, task, &self.current.kinematics, &config.constraints)
+        {
             Ok(tool_angle_deg) => tool_angle_deg,
             Err(violation) => {
+                // The state stays at the last accepted configuration, kinematics included.
+                robot.forward_into(&self.current.q, &mut self.current.kinematics);
                 self.termination = Some(Termination::Violation {
                     violation,
                     rejected_q: next,
@@ -195,17 +201,10 @@ impl<'a> Episode<'a> {
                 return StepOutcome::Terminated;
             }
         };
-        let progress_m = (next_kinematics.tcp() - self.current.kinematics.tcp()).dot(&task.d);
+        let progress_m = (self.current.kinematics.tcp() - previous_tcp).dot(&task.d);
         self.time_s += self.step_duration(&velocity);
-        self.current = StepContext::measured(
-            (robot, task, config),
-            self.steps.len(),
-            Measured {
-                kinematics: next_kinematics,
-                tool_angle_deg,
-            },
-            action,
-        );
+        self.current
+            .advance(self.steps.len(), tool_angle_deg, action);
         if self.steps.len() == config.max_steps {
             self.record(None);
             self.termination = Some(Termination::StepCap);

@@ -10,15 +10,6 @@ use crate::config::RolloutConfig;
 use crate::constraints::tool_angle_deg;
 use crate::task::Task;
 
-/// A configuration's forward kinematics with the quantities measured of it before its step
-/// context is built.
-pub(crate) struct Measured {
-    /// The forward kinematics of the configuration `q`.
-    pub(crate) kinematics: Kinematics,
-    /// Its tool angle (degrees), [`tool_angle_deg`].
-    pub(crate) tool_angle_deg: f64,
-}
-
 /// A null-space action `a ∈ [−1, 1]⁴`: coordinates in the basis `B(q)` (Sec. 4.2).
 pub type NullAction = SVector<f64, 4>;
 
@@ -71,55 +62,17 @@ impl<'a> StepContext<'a> {
         previous_action: NullAction,
     ) -> Self {
         let tool_angle_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n);
-        Self::measured(
-            (robot, task, config),
-            step,
-            Measured {
-                kinematics,
-                tool_angle_deg,
-            },
-            previous_action,
-        )
-    }
-
-    /// [`StepContext::new`] at a configuration whose tool angle is measured already (by the
-    /// constraint check that accepted it). Always inlined: inside [`crate::Episode`]'s step the
-    /// context is then built with fewer copies on its way into the episode (measured: 3 %
-    /// fewer instructions per step).
-    #[inline(always)]
-    pub(crate) fn measured(
-        (robot, task, config): (&'a Robot, &'a Task, &'a RolloutConfig),
-        step: usize,
-        Measured {
-            kinematics,
-            tool_angle_deg,
-        }: Measured,
-        previous_action: NullAction,
-    ) -> Self {
-        let q = *kinematics.configuration();
-        let limits = robot.limits();
-        let q_normalised = limits.normalise(&q);
-        let rho = q_normalised.amax();
-        let jacobian = kinematics.jacobian();
-        let pseudo_inverse = damped_pseudo_inverse(jacobian, &config.damping);
-        let (manipulability, manipulability_gradient) = directional_manipulability(
-            &kinematics,
-            pseudo_inverse.gram(),
-            &task.d,
-            config.manipulability_damping,
-        );
-        let alignment_gradient = tool_alignment_gradient(&kinematics, &task.n);
-        let centring_gradient =
-            -q_normalised.component_div(&limits.half_range()) * (2.0 / q.len() as f64);
-        let basis = task_aligned_basis(
-            jacobian,
-            [
-                &manipulability_gradient,
-                &alignment_gradient,
-                &centring_gradient,
-            ],
-            &config.basis,
-        );
+        let Derived {
+            q,
+            q_normalised,
+            rho,
+            manipulability,
+            manipulability_gradient,
+            alignment_gradient,
+            centring_gradient,
+            pseudo_inverse,
+            basis,
+        } = Derived::of(robot, task, config, &kinematics);
         Self {
             robot,
             task,
@@ -140,6 +93,33 @@ impl<'a> StepContext<'a> {
         }
     }
 
+    /// Moves the context to step `step`, whose configuration's forward kinematics have been
+    /// written over `self.kinematics` ([`Robot::forward_into`]) and whose tool angle the
+    /// constraint check that accepted it measured: every other quantity is computed again in
+    /// place, so a rollout's step copies no context. Always inlined into [`crate::Episode`]'s
+    /// step.
+    #[inline(always)]
+    pub(crate) fn advance(
+        &mut self,
+        step: usize,
+        tool_angle_deg: f64,
+        previous_action: NullAction,
+    ) {
+        let derived = Derived::of(self.robot, self.task, self.config, &self.kinematics);
+        self.step = step;
+        self.q = derived.q;
+        self.q_normalised = derived.q_normalised;
+        self.rho = derived.rho;
+        self.tool_angle_deg = tool_angle_deg;
+        self.manipulability = derived.manipulability;
+        self.manipulability_gradient = derived.manipulability_gradient;
+        self.alignment_gradient = derived.alignment_gradient;
+        self.centring_gradient = derived.centring_gradient;
+        self.pseudo_inverse = derived.pseudo_inverse;
+        self.basis = derived.basis;
+        self.previous_action = previous_action;
+    }
+
     /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3).
     pub fn task_velocity(&self) -> Vec3 {
         let lateral = self.task.lateral_error(&self.kinematics.tcp());
@@ -157,5 +137,62 @@ impl<'a> StepContext<'a> {
     pub fn action_from_secondary(&self, xi: &JointVector) -> NullAction {
         (self.basis.columns.transpose() * xi / self.config.null_speed_max_rad_per_s)
             .map(|a| a.clamp(-1.0, 1.0))
+    }
+}
+
+/// The quantities of a [`StepContext`] that follow from its configuration's forward kinematics
+/// alone (Eqs. 2–4): the one definition that [`StepContext::new`] and [`StepContext::advance`]
+/// share.
+struct Derived {
+    q: JointVector,
+    q_normalised: JointVector,
+    rho: f64,
+    manipulability: f64,
+    manipulability_gradient: JointVector,
+    alignment_gradient: JointVector,
+    centring_gradient: JointVector,
+    pseudo_inverse: DampedPseudoInverse,
+    basis: TaskBasis,
+}
+
+impl Derived {
+    /// Computes them at the configuration of `kinematics` (no allocation).
+    #[inline(always)]
+    fn of(robot: &Robot, task: &Task, config: &RolloutConfig, kinematics: &Kinematics) -> Self {
+        let q = *kinematics.configuration();
+        let limits = robot.limits();
+        let q_normalised = limits.normalise(&q);
+        let rho = q_normalised.amax();
+        let jacobian = kinematics.jacobian();
+        let pseudo_inverse = damped_pseudo_inverse(jacobian, &config.damping);
+        let (manipulability, manipulability_gradient) = directional_manipulability(
+            kinematics,
+            pseudo_inverse.gram(),
+            &task.d,
+            config.manipulability_damping,
+        );
+        let alignment_gradient = tool_alignment_gradient(kinematics, &task.n);
+        let centring_gradient =
+            -q_normalised.component_div(&limits.half_range()) * (2.0 / q.len() as f64);
+        let basis = task_aligned_basis(
+            jacobian,
+            [
+                &manipulability_gradient,
+                &alignment_gradient,
+                &centring_gradient,
+            ],
+            &config.basis,
+        );
+        Self {
+            q,
+            q_normalised,
+            rho,
+            manipulability,
+            manipulability_gradient,
+            alignment_gradient,
+            centring_gradient,
+            pseudo_inverse,
+            basis,
+        }
     }
 }

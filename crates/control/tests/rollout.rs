@@ -7,7 +7,8 @@
 //!   every recorded configuration exactly; out-of-range actions are clipped; `reset`/`act` see
 //!   the right step index and previous action.
 //! - The step cap and an invalid start end the rollout as documented.
-//! - An episode copied midway and continued goes on from exactly the copied state.
+//! - An episode copied midway and continued goes on from exactly the copied state; an episode
+//!   that rejected a step keeps exactly the state of its last accepted step.
 //! - In a `StepContext`: the classical action is `clip(Bᵀξ/a_max)` with `ξ` of Eq. 3; `J·B ≈ 0`
 //!   and `BᵀB = I`, so the null-space term leaves the TCP velocity unchanged; `J q̇ = ẋ` when
 //!   undamped; the gradients match finite differences; the cone gate is 0 below `θmax − 8°`,
@@ -687,4 +688,68 @@ fn an_episode_copied_midway_goes_on_from_exactly_that_state() {
             "the copy goes on with the controller that took it over"
         );
     }
+}
+
+#[test]
+fn a_rejected_step_leaves_the_state_of_the_last_accepted_one() {
+    let robot = robot();
+    let config = RolloutConfig::default();
+    let mut rejected = 0;
+    for (_, task) in tasks(&robot, 6) {
+        let seed = task.q0_seed.expect("sampled tasks keep their seed");
+        let mut controller = ClassicalController::new(ClassicalGains::default());
+        let mut episode = emg_control::Episode::start(&robot, &task, &seed, &config);
+        controller.reset(episode.context().expect("a valid start"));
+        while let Some(context) = episode.context() {
+            let (action, acting) = controller.act(context);
+            episode.apply(&action, acting);
+        }
+        let state = episode.state();
+        let trajectory = episode.clone().finish();
+        if !matches!(trajectory.termination, Termination::Violation { .. }) {
+            continue;
+        }
+        rejected += 1;
+        let last = trajectory
+            .steps
+            .last()
+            .expect("a trajectory holds its seed");
+        assert_eq!(state.q, last.q, "the state is the last accepted step's");
+        let fresh = StepContext::new(
+            &robot,
+            &task,
+            &config,
+            state.step,
+            robot.forward(&state.q),
+            state.previous_action,
+        );
+        // Debug prints every quantity of the step, each f64 in its shortest exact form.
+        assert_eq!(
+            format!(
+                "{:?}",
+                (&state.kinematics, &state.pseudo_inverse, &state.basis)
+            ),
+            format!(
+                "{:?}",
+                (&fresh.kinematics, &fresh.pseudo_inverse, &fresh.basis)
+            )
+        );
+        assert_eq!(
+            (state.rho, state.tool_angle_deg, state.manipulability),
+            (fresh.rho, fresh.tool_angle_deg, fresh.manipulability)
+        );
+        assert_eq!(
+            [
+                state.manipulability_gradient,
+                state.alignment_gradient,
+                state.centring_gradient
+            ],
+            [
+                fresh.manipulability_gradient,
+                fresh.alignment_gradient,
+                fresh.centring_gradient
+            ]
+        );
+    }
+    assert!(rejected > 0, "some rollout ends by rejecting a step");
 }

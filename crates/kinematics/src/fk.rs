@@ -25,8 +25,30 @@ pub struct Kinematics {
 impl Robot {
     /// Forward kinematics of configuration `q` (no allocation).
     pub fn forward(&self, q: &JointVector) -> Kinematics {
-        let mut rotations = [Matrix3::identity(); DOF + 1];
-        let mut positions = [Vec3::zeros(); DOF + 1];
+        let mut kinematics = Kinematics {
+            configuration: *q,
+            rotations: [Matrix3::identity(); DOF + 1],
+            positions: [Vec3::zeros(); DOF + 1],
+            tcp: Vec3::zeros(),
+            tcp_rotation: Matrix3::identity(),
+            jacobian: PositionJacobian::zeros(),
+        };
+        self.forward_into(q, &mut kinematics);
+        kinematics
+    }
+
+    /// [`Robot::forward`] of `q` written over `kinematics` (a `Kinematics` of this robot), so a
+    /// caller that keeps its kinematics in place (the rollout's step) copies none of it.
+    pub fn forward_into(&self, q: &JointVector, kinematics: &mut Kinematics) {
+        let Kinematics {
+            configuration,
+            rotations,
+            positions,
+            tcp,
+            tcp_rotation,
+            jacobian,
+        } = kinematics;
+        *configuration = *q;
         for (i, joint) in self.joints.iter().enumerate() {
             let (parent_rotation, parent_position) = (rotations[i], positions[i]);
             let fixed: Matrix3<f64> = parent_rotation * joint.rotation;
@@ -39,20 +61,11 @@ impl Robot {
             positions[i + 1] = parent_position + parent_rotation * joint.translation;
         }
         let last = rotations[DOF];
-        let tcp = positions[DOF] + last * self.tcp_offset.translation;
-        let tcp_rotation = last * self.tcp_offset.rotation;
-        let mut jacobian = PositionJacobian::zeros();
+        *tcp = positions[DOF] + last * self.tcp_offset.translation;
+        *tcp_rotation = last * self.tcp_offset.rotation;
         for i in 0..DOF {
             let axis = rotations[i + 1].column(2).into_owned();
-            jacobian.set_column(i, &axis.cross(&(tcp - positions[i + 1])));
-        }
-        Kinematics {
-            configuration: *q,
-            rotations,
-            positions,
-            tcp,
-            tcp_rotation,
-            jacobian,
+            jacobian.set_column(i, &axis.cross(&(*tcp - positions[i + 1])));
         }
     }
 }

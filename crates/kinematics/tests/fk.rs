@@ -1,7 +1,8 @@
 //! Forward kinematics of the shipped FR3-with-pen robot: the SPEC §1 known answers (q = 0 and
 //! home), and agreement with an independent modified (Craig) DH computation, written here from
 //! the SPEC's DH table, on 1,000 random configurations (TCP position, full TCP orientation and
-//! every joint axis line).
+//! every joint axis line); `forward_into` over another configuration's kinematics gives exactly
+//! what `forward` gives.
 
 mod common;
 
@@ -139,6 +140,22 @@ fn matches_independent_modified_dh_on_random_configurations() {
         worst_axis < 1e-9,
         "joint axis lines differ from DH by {worst_axis:e}"
     );
+}
+
+#[test]
+fn forward_into_over_other_kinematics_is_exactly_forward() {
+    let robot = robot();
+    let mut rng = rng(0x1e7f_0dd5);
+    let mut kinematics = robot.forward(&random_q(&mut rng, &robot));
+    for _ in 0..200 {
+        let q = random_q(&mut rng, &robot);
+        robot.forward_into(&q, &mut kinematics);
+        // Debug prints every field, each f64 in its shortest exact form.
+        assert_eq!(
+            format!("{kinematics:?}"),
+            format!("{:?}", robot.forward(&q))
+        );
+    }
 }
 
 #[test]
