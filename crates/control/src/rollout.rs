@@ -184,10 +184,12 @@ impl<'a> Episode<'a> {
         let next = self.current.q + velocity * config.dt_s;
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
-        // The next configuration's kinematics are written in place; the rest of the context
-        // follows them once the step is accepted.
+        // The next configuration's kinematics are written in place; the rest of the context is
+        // derived from them before the check (which it overlaps, see `StepContext::derive`)
+        // and taken on once the step is accepted.
         let previous_tcp = self.current.kinematics.tcp();
         robot.forward_into(&next, &mut self.current.kinematics);
+        let derived = self.current.derive();
         let tool_angle_deg = match admit(robot, task, &self.current.kinematics, &config.constraints)
         {
             Ok(tool_angle_deg) => tool_angle_deg,
@@ -204,7 +206,7 @@ impl<'a> Episode<'a> {
         let progress_m = (self.current.kinematics.tcp() - previous_tcp).dot(&task.d);
         self.time_s += self.step_duration(&velocity);
         self.current
-            .advance(self.steps.len(), tool_angle_deg, action);
+            .advance(self.steps.len(), tool_angle_deg, action, derived);
         if self.steps.len() == config.max_steps {
             self.record(None);
             self.termination = Some(Termination::StepCap);

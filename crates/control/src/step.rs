@@ -93,19 +93,19 @@ impl<'a> StepContext<'a> {
         }
     }
 
-    /// Moves the context to step `step`, whose configuration's forward kinematics have been
-    /// written over `self.kinematics` ([`Robot::forward_into`]) and whose tool angle the
-    /// constraint check that accepted it measured: every other quantity is computed again in
-    /// place, so a rollout's step copies no context. Always inlined into [`crate::Episode`]'s
-    /// step.
+    /// Moves the context to step `step`: its configuration's forward kinematics have been
+    /// written over `self.kinematics` ([`Robot::forward_into`]), `derived` is what
+    /// [`StepContext::derive`] computed from them, and the constraint check that accepted the
+    /// configuration measured `tool_angle_deg`. A rollout's step copies no context. Always
+    /// inlined into [`crate::Episode`]'s step.
     #[inline(always)]
     pub(crate) fn advance(
         &mut self,
         step: usize,
         tool_angle_deg: f64,
         previous_action: NullAction,
+        derived: Derived,
     ) {
-        let derived = Derived::of(self.robot, self.task, self.config, &self.kinematics);
         self.step = step;
         self.q = derived.q;
         self.q_normalised = derived.q_normalised;
@@ -118,6 +118,15 @@ impl<'a> StepContext<'a> {
         self.pseudo_inverse = derived.pseudo_inverse;
         self.basis = derived.basis;
         self.previous_action = previous_action;
+    }
+
+    /// The quantities that follow from `self.kinematics` alone, for [`StepContext::advance`].
+    /// The step computes them before its constraint check, which needs none of them, so that
+    /// the check's work overlaps the tail of their chain of dependent square roots and
+    /// divisions (the null-space basis); on a rejected step they are dropped.
+    #[inline(always)]
+    pub(crate) fn derive(&self) -> Derived {
+        Derived::of(self.robot, self.task, self.config, &self.kinematics)
     }
 
     /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3).
@@ -141,9 +150,9 @@ impl<'a> StepContext<'a> {
 }
 
 /// The quantities of a [`StepContext`] that follow from its configuration's forward kinematics
-/// alone (Eqs. 2–4): the one definition that [`StepContext::new`] and [`StepContext::advance`]
+/// alone (Eqs. 2–4): the one definition that [`StepContext::new`] and [`StepContext::derive`]
 /// share.
-struct Derived {
+pub(crate) struct Derived {
     q: JointVector,
     q_normalised: JointVector,
     rho: f64,

@@ -49,10 +49,12 @@ impl Robot {
             jacobian,
         } = kinematics;
         *configuration = *q;
-        for (i, joint) in self.joints.iter().enumerate() {
+        // Every sine and cosine first: a library call clobbers every floating-point register,
+        // so calls inside the loop would spill the chain of rotations around each of them.
+        let turns: [(f64, f64); DOF] = std::array::from_fn(|i| q[i].sin_cos());
+        for (i, (joint, &(sin, cos))) in self.joints.iter().zip(&turns).enumerate() {
             let (parent_rotation, parent_position) = (rotations[i], positions[i]);
             let fixed: Matrix3<f64> = parent_rotation * joint.rotation;
-            let (sin, cos) = q[i].sin_cos();
             let (c0, c1) = (fixed.column(0), fixed.column(1));
             let mut rotation = fixed;
             rotation.set_column(0, &(c0 * cos + c1 * sin));
