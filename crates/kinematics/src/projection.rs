@@ -112,7 +112,9 @@ pub fn project_to_pose(
     let (lower, upper) = (limits.lower + margin, limits.upper - margin);
     let clamp = |q: JointVector| q.zip_zip_map(&lower, &upper, |v, lo, hi| v.clamp(lo, hi));
     let mut q = clamp(*start);
-    let (mut rows, mut error) = pose_residual(&robot.forward(&q), target);
+    // One buffer for every trial's kinematics, written in place.
+    let mut kinematics = robot.forward(&q);
+    let (mut rows, mut error) = pose_residual(&kinematics, target);
     let mut damping = cfg.damping;
     for iteration in 0..=cfg.max_iterations {
         let (position_error, orientation_error) = split_norms(&error);
@@ -149,7 +151,8 @@ pub fn project_to_pose(
             step *= cfg.max_step_rad / largest;
         }
         let trial = clamp(q + step);
-        let (trial_rows, trial_error) = pose_residual(&robot.forward(&trial), target);
+        robot.forward_into(&trial, &mut kinematics);
+        let (trial_rows, trial_error) = pose_residual(&kinematics, target);
         if trial_error.norm_squared() < error.norm_squared() {
             (q, rows, error) = (trial, trial_rows, trial_error);
             damping = (damping / cfg.damping_factor).max(cfg.min_damping);

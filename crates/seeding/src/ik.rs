@@ -77,8 +77,12 @@ pub fn solve_cone_ik(
     };
     let cone = cfg.cone_deg.to_radians();
     let mut q = *start;
-    for _ in 0..=cfg.max_iterations {
-        let kin = robot.forward(&q);
+    // One buffer for every iteration's kinematics, written in place.
+    let mut kin = robot.forward(&q);
+    for iteration in 0..=cfg.max_iterations {
+        if iteration > 0 {
+            robot.forward_into(&q, &mut kin);
+        }
         let (rows, mut error) = pose_residual(&kin, &target);
         let axis = kin.tool_axis();
         let angle = axis.cross(n).norm().atan2(axis.dot(n));
