@@ -1,6 +1,7 @@
 //! Planning time on one core: the paper's pipeline (DP seed, one hybrid rollout) and the search
 //! planner at its default step budget, each planning the first 20 evaluation tasks per
-//! iteration (tasks differ a lot in length; a fixed set keeps the median comparable).
+//! iteration (tasks differ a lot in length; a fixed set keeps the median comparable), and the
+//! reachability bound that `emg plan` prints beside each plan, for the same tasks.
 
 use std::hint::black_box;
 
@@ -48,6 +49,14 @@ fn benches(c: &mut Criterion) {
             })
         });
     }
+    group.bench_function("reach_bound_20_tasks", |b| {
+        b.iter(|| {
+            tasks
+                .iter()
+                .map(|task| planner.reach(black_box(task), &[]).reachable_m)
+                .sum::<f64>()
+        })
+    });
     group.finish();
 }
 
