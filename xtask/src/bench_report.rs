@@ -222,8 +222,11 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
     serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }
 
+/// The table of medians; every benchmark runs on one core except those named `…_all_cores`.
 fn table(rows: &[Row]) -> String {
-    let mut table = String::from("| benchmark | median | per second (one core) |\n|---|---|---|\n");
+    let mut table = String::from(
+        "| benchmark | median | per second (one core, or all for `…_all_cores`) |\n|---|---|---|\n",
+    );
     for row in rows {
         table += &format!(
             "| {} | {} | {:.3e} |\n",

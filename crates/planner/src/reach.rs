@@ -17,6 +17,7 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use emg_seeding::{IkConfig, solve_cone_ik};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Settings of the reachability scan ([`reach`]).
@@ -180,17 +181,21 @@ impl Scan<'_> {
             }
         }
         if found.is_empty() {
+            // Every restart's start is drawn first, in order, then they are tried in parallel
+            // and the first one in that order that succeeds is kept: the result of trying them
+            // one by one, whatever the thread count (the stream is read on only after all of
+            // them failed, and then all of them were drawn either way). The restarts of a point
+            // that has no valid configuration, the last of every scan, are most of its work.
             let limits = robot.limits();
-            for _ in 0..config.restarts {
-                let start = JointVector::from_fn(|i, _| {
-                    let u: f64 = rng.random();
-                    limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
-                });
-                if let Some(q) = valid(&start) {
-                    found.push(q);
-                    break;
-                }
-            }
+            let starts: Vec<JointVector> = (0..config.restarts)
+                .map(|_| {
+                    JointVector::from_fn(|i, _| {
+                        let u: f64 = rng.random();
+                        limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
+                    })
+                })
+                .collect();
+            found.extend(starts.par_iter().find_map_first(valid));
         }
         found
     }

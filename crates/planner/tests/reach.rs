@@ -1,7 +1,8 @@
 //! The reachability bound: every witness it gives is checked by the independent checker (TCP on
 //! the line within the tolerance at its grid point, tool axis inside the cone, joints inside the
 //! limits, no self-collision); no plan goes further than the bound (it is a necessary
-//! condition); a start out of the arm's reach has none.
+//! condition); a start out of the arm's reach has none; the bound does not depend on the number
+//! of threads that try a point's restarts.
 
 use emg_control::Task;
 use emg_io::read_tasks;
@@ -120,4 +121,30 @@ fn a_start_out_of_reach_has_no_bound() {
     .expect("a valid task");
     let reach = planner.reach(&task, &[]);
     assert!(!reach.reachable_p0 && reach.reachable_m == 0.0 && reach.witnesses.is_empty());
+}
+
+#[test]
+fn the_bound_does_not_depend_on_the_thread_count() {
+    let planner = planner();
+    let tasks = read_tasks(
+        &fr3().data_dir(&data()).join("tasks/eval-v1.tasks"),
+        planner.robot(),
+    )
+    .expect("shipped tasks");
+    let scan = |threads: usize| -> Vec<Reach> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+            .install(|| {
+                tasks[..4]
+                    .iter()
+                    .map(|task| planner.reach(task, &[]))
+                    .collect()
+            })
+    };
+    let one = scan(1);
+    // A scan tries its last point, where every restart fails, in parallel.
+    assert!(one.iter().all(|reach| reach.reachable_p0));
+    assert_eq!(one, scan(3));
 }
