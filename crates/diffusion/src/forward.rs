@@ -406,8 +406,14 @@ fn fast_exp(x: f32) -> f32 {
         + r * (1.0
             + r * (0.5
                 + r * (1.0 / 6.0 + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (1.0 / 720.0))))));
-    p * f32::from_bits(((n as i32 + 127) as u32) << 23)
+    // 2ⁿ from its exponent bits: n + 127 + 2²³ is exact and its low mantissa bits are n + 127
+    // (n is an integer in [−126, 127]); shifting by 23 drops the rest. Float arithmetic, unlike
+    // a saturating float-to-int cast, vectorises.
+    p * f32::from_bits((n + EXPONENT_BITS).to_bits() << 23)
 }
+
+/// `127 + 2²³`: the exponent bias, plus the power of two whose float has unit spacing.
+const EXPONENT_BITS: f32 = 8_388_735.0;
 
 #[cfg(test)]
 mod tests {
@@ -447,6 +453,14 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn the_exponent_bits_are_every_power_of_two_fast_exp_takes() {
+        for n in -126..=127 {
+            let power = f32::from_bits((n as f32 + EXPONENT_BITS).to_bits() << 23);
+            assert_eq!(power, 2f32.powi(n), "2^{n}");
         }
     }
 
