@@ -12,7 +12,7 @@ fn benches(c: &mut Criterion) {
     let weights = PolicyWeights::read(&path).expect("shipped weights load (cargo xtask train-ppo)");
     let policy = PlainPolicy::new(&weights);
     let mut scratch = policy.scratch();
-    let observation: [f32; OBSERVATION_DIM] = std::array::from_fn(|i| (i as f32 * 0.37).sin());
+    let observation: [f32; OBSERVATION_DIM] = std::array::from_fn(|i| libm::sinf(i as f32 * 0.37));
     c.bench_function("policy_action_batch1", |b| {
         b.iter(|| {
             policy

@@ -270,14 +270,17 @@ fn write_loss_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()> {
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(55)
-        .build_cartesian_2d(0.0..max_step, (low * 0.9).log10()..(high * 1.1).log10())?;
+        .build_cartesian_2d(
+            0.0..max_step,
+            libm::log10(low * 0.9)..libm::log10(high * 1.1),
+        )?;
     chart
         .configure_mesh()
         .x_desc("optimiser step")
         .y_desc("log10 loss")
         .draw()?;
     chart.draw_series(LineSeries::new(
-        log.iter().map(|r| (r.step as f64, r.loss.log10())),
+        log.iter().map(|r| (r.step as f64, libm::log10(r.loss))),
         &BLUE,
     ))?;
     root.present()?;

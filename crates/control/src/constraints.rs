@@ -114,7 +114,7 @@ impl std::fmt::Display for Violation {
 
 /// Angle between the tool axis `z` and the normal `n` (degrees).
 pub fn tool_angle_deg(z: &Vec3, n: &Vec3) -> f64 {
-    z.cross(n).norm().atan2(z.dot(n)).to_degrees()
+    libm::atan2(z.cross(n).norm(), z.dot(n)).to_degrees()
 }
 
 /// The first constraint that the configuration of `kin` (its forward kinematics,

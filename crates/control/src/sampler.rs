@@ -1,6 +1,6 @@
 //! The task population of SPEC §2: tasks generated from random collision-free configurations.
 
-use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3};
+use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3, rotation_about};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -134,8 +134,7 @@ pub fn candidate(robot: &Robot, config: &SamplerConfig, index: u64) -> Option<Ta
     let z = kinematics.tool_axis();
     let tilt = rng.random_range(0.0..=config.max_tilt_deg).to_radians();
     let tilt_axis = perpendicular_direction(&z, rng.random_range(0.0..std::f64::consts::TAU));
-    let n =
-        nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(tilt_axis), tilt) * z;
+    let n = rotation_about(&tilt_axis, tilt) * z;
     let d = perpendicular_direction(&n, rng.random_range(0.0..std::f64::consts::TAU));
     let task = Task::new(robot, kinematics.tcp(), d, n, Some(q)).ok()?;
     match config.surface_clearance_m {
@@ -162,5 +161,6 @@ fn perpendicular_direction(axis: &Vec3, phi: f64) -> Vec3 {
     };
     let e1 = axis.cross(&helper).normalize();
     let e2 = axis.cross(&e1);
-    e1 * phi.cos() + e2 * phi.sin()
+    let (sin, cos) = libm::sincos(phi);
+    e1 * cos + e2 * sin
 }

@@ -463,10 +463,7 @@ fn checker_rejects_a_tilted_normal() {
     let robot = robot();
     // Tilt n by 40° about d: every recorded tool axis is then far outside the 30° cone,
     // and the recorded angles disagree with the new normal.
-    let rotation = nalgebra::Rotation3::from_axis_angle(
-        &nalgebra::Unit::new_normalize(task.d),
-        40f64.to_radians(),
-    );
+    let rotation = emg_kinematics::rotation_about(&task.d.normalize(), 40f64.to_radians());
     let tilted = Task::new(&robot, task.p0, task.d, rotation * task.n, None).expect("valid task");
     let failure = checker()
         .check(&tilted, &trajectory, &ConstraintConfig::default())

@@ -17,7 +17,6 @@ use emg_control::{
 };
 use emg_kinematics::{Obstacle, Scene, Shape, Vec3};
 use emg_verify::{Bounds, FailedCheck, Line};
-use nalgebra::Rotation3;
 use rand::RngExt;
 
 use common::{checker, classical, random_q, rng, robot, tasks};
@@ -37,7 +36,7 @@ fn random_obstacle(rng: &mut rand_chacha::ChaCha8Rng, kind: usize) -> Obstacle {
     let shape = match kind {
         0 => Shape::Cuboid {
             centre,
-            rotation: Rotation3::from_euler_angles(
+            rotation: emg_kinematics::rotation_from_rpy(
                 rng.random_range(-3.0..3.0),
                 rng.random_range(-1.5..1.5),
                 rng.random_range(-3.0..3.0),

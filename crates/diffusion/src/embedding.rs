@@ -6,10 +6,10 @@ pub fn sinusoidal_embedding(t: usize, out: &mut [f32]) {
     let half = out.len() / 2;
     let (sines, cosines) = out.split_at_mut(half);
     for (i, (s, c)) in sines.iter_mut().zip(cosines.iter_mut()).enumerate() {
-        let frequency = (-(10_000f64.ln()) * i as f64 / half as f64).exp();
-        let angle = t as f64 * frequency;
-        *s = angle.sin() as f32;
-        *c = angle.cos() as f32;
+        let frequency = libm::exp(-libm::log(10_000.0) * i as f64 / half as f64);
+        let (sin, cos) = libm::sincos(t as f64 * frequency);
+        *s = sin as f32;
+        *c = cos as f32;
     }
 }
 
@@ -23,6 +23,6 @@ mod tests {
         sinusoidal_embedding(0, &mut out);
         assert_eq!(out, [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0]);
         sinusoidal_embedding(3, &mut out);
-        assert!((out[0] - 3f32.sin()).abs() < 1e-6 && (out[4] - 3f32.cos()).abs() < 1e-6);
+        assert!((out[0] - libm::sinf(3.0)).abs() < 1e-6 && (out[4] - libm::cosf(3.0)).abs() < 1e-6);
     }
 }

@@ -1,5 +1,7 @@
 //! The cosine noise schedule `ᾱ_t` and the DDIM time grid.
 
+use std::f64::consts::FRAC_PI_2;
+
 /// Offset `s` of the cosine schedule (Nichol & Dhariwal; SPEC §6).
 const COSINE_OFFSET: f64 = 0.008;
 
@@ -18,9 +20,8 @@ impl CosineSchedule {
     /// The schedule of length `timesteps` (T).
     pub fn new(timesteps: usize) -> Self {
         let f = |tau: f64| {
-            ((tau + COSINE_OFFSET) / (1.0 + COSINE_OFFSET) * std::f64::consts::FRAC_PI_2)
-                .cos()
-                .powi(2)
+            let cos = libm::cos((tau + COSINE_OFFSET) / (1.0 + COSINE_OFFSET) * FRAC_PI_2);
+            cos * cos
         };
         let t_count = timesteps as f64;
         let mut product = 1.0;

@@ -5,9 +5,9 @@ use std::time::{Duration, Instant};
 
 use emg_control::{ConstraintConfig, Task, first_violation};
 use emg_kinematics::{DOF, JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
+use emg_learning::StandardNormal;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 use crate::config::SampleConfig;

@@ -10,10 +10,10 @@ use burn::grad_clipping::GradientClippingConfig;
 use burn::module::Module;
 use burn::optim::{AdamWConfig, GradientsParams};
 use burn::tensor::{Device, Tensor, TensorData};
+use emg_learning::StandardNormal;
 use emg_learning::checkpoint::{self, CheckpointError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{Backend, DiffusionConfig, TrainConfig};

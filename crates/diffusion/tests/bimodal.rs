@@ -4,9 +4,9 @@
 use emg_diffusion::{
     Backend, DdimSampler, DiffusionConfig, SampleConfig, TrainConfig, Trainer, TrainingSet,
 };
+use emg_learning::StandardNormal;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 
 /// The condition is `[s, 0.5]` (the network's LayerNorm needs two components to carry `s`).
 /// Condition s = +1: modes (0.5, 0.5) and (−0.5, −0.5); condition −1: (0.5, −0.5) and (−0.5, 0.5).

@@ -16,7 +16,8 @@ fn robot() -> Robot {
 fn tasks(robot: &Robot) -> Vec<Task> {
     (0..4)
         .map(|k| {
-            let q = robot.mid_range() + JointVector::from_fn(|i, _| 0.15 * ((i + k) as f64).sin());
+            let q =
+                robot.mid_range() + JointVector::from_fn(|i, _| 0.15 * libm::sin((i + k) as f64));
             let kin = robot.forward(&q);
             let n = kin.tool_axis();
             let d = (Vec3::y() - n * n.dot(&Vec3::y())).normalize();

@@ -51,8 +51,8 @@ fn plain_matches_burn(backend: Backend) {
     let device = backend.device();
     let model = weights.to_model(&device);
     let rows = 5;
-    let samples: Vec<f32> = (0..rows * 3).map(|i| (i as f32 * 0.37).sin()).collect();
-    let conditions: Vec<f32> = (0..rows * 4).map(|i| (i as f32 * 0.91).cos()).collect();
+    let samples: Vec<f32> = (0..rows * 3).map(|i| libm::sinf(i as f32 * 0.37)).collect();
+    let conditions: Vec<f32> = (0..rows * 4).map(|i| libm::cosf(i as f32 * 0.91)).collect();
     let dropped = [0.0f32, 1.0, 0.0, 1.0, 0.0];
     let t = 31;
     let mut times = vec![0.0f32; rows * 8];

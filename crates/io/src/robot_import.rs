@@ -11,9 +11,9 @@ use std::str::FromStr;
 
 use emg_kinematics::{
     Ball, Covered, FittedCapsule, PairRule, Robot, Vec3, disabled_pairs, fit_capsules,
-    segment_distance,
+    rotation_from_rpy, rotation_onto, rpy_of, segment_distance,
 };
-use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
 use crate::mesh::{MeshError, mesh_volume, read_mesh};
 
@@ -503,14 +503,14 @@ fn isometry(pose: &urdf_rs::Pose) -> Isometry3<f64> {
     let [roll, pitch, yaw] = pose.rpy.0;
     Isometry3::from_parts(
         Translation3::new(x, y, z),
-        UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+        UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(roll, pitch, yaw)),
     )
 }
 
 /// A rigid transform as a URDF pose.
 fn urdf_pose(pose: &Isometry3<f64>) -> urdf_rs::Pose {
     let t = pose.translation.vector;
-    let (roll, pitch, yaw) = pose.rotation.euler_angles();
+    let (roll, pitch, yaw) = rpy_of(&pose.rotation.to_rotation_matrix());
     urdf_rs::Pose {
         xyz: urdf_rs::Vec3([t.x, t.y, t.z]),
         rpy: urdf_rs::Vec3([roll, pitch, yaw]),
@@ -737,10 +737,11 @@ fn box_triangles(half: &Vec3) -> Vec<[Vec3; 3]> {
 /// Triangles of a prism circumscribing the cylinder of `radius` and `length` along z, centred
 /// at the origin (its side faces touch the cylinder, so it contains it).
 fn prism_triangles(radius: f64, length: f64) -> Vec<[Vec3; 3]> {
-    let circumradius = radius / (std::f64::consts::PI / PRISM_SIDES as f64).cos();
+    let circumradius = radius / libm::cos(std::f64::consts::PI / PRISM_SIDES as f64);
     let corner = |k: usize, z: f64| {
         let angle = std::f64::consts::TAU * k as f64 / PRISM_SIDES as f64;
-        Vec3::new(circumradius * angle.cos(), circumradius * angle.sin(), z)
+        let (sin, cos) = libm::sincos(angle);
+        Vec3::new(circumradius * cos, circumradius * sin, z)
     };
     let (bottom, top) = (-0.5 * length, 0.5 * length);
     (0..PRISM_SIDES)
@@ -782,9 +783,8 @@ fn capsule_elements(capsule: &FittedCapsule) -> Vec<urdf_rs::Collision> {
     if length < 1e-9 {
         return vec![sphere(0.5 * (capsule.start + capsule.end))];
     }
-    let turn = Rotation3::rotation_between(&Vec3::z(), &axis)
-        .unwrap_or_else(|| Rotation3::from_axis_angle(&Vec3::x_axis(), std::f64::consts::PI));
-    let (roll, pitch, yaw) = turn.euler_angles();
+    let turn = rotation_onto(&Vec3::z(), &(axis / length));
+    let (roll, pitch, yaw) = rpy_of(&turn);
     // The caps sit where the loaders put the cylinder's ends: the centre ± half the length
     // along the turned z axis.
     let centre = 0.5 * (capsule.start + capsule.end);

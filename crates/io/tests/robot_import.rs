@@ -11,7 +11,9 @@
 use std::path::Path;
 
 use emg_io::{DisabledBecause, ImportOptions, PEN_LINK, PackagePath, import_robot};
-use emg_kinematics::{JointVector, PairRule, Robot, Vec3, segment_distance, srdf_beside};
+use emg_kinematics::{
+    JointVector, PairRule, Robot, Vec3, rotation_from_rpy, segment_distance, srdf_beside,
+};
 use emg_verify::ReferenceModel;
 use rand::{RngExt, SeedableRng};
 
@@ -157,14 +159,15 @@ fn fixture() -> Fixture {
     for k in 0..16 {
         let a = std::f64::consts::TAU * k as f64 / 16.0;
         for z in [-0.06, 0.06] {
-            must_contain.push(("l1", Vec3::new(0.04 * a.cos(), 0.04 * a.sin(), z), 1e-9));
+            let (sin, cos) = libm::sincos(a);
+            must_contain.push(("l1", Vec3::new(0.04 * cos, 0.04 * sin, z), 1e-9));
         }
     }
     must_contain.push(("l4", Vec3::new(0.0, 0.0, 0.11), 1e-9));
     must_contain.push(("l4", Vec3::new(0.0, 0.05, 0.06), 1e-9));
     let side = nalgebra::Isometry3::from_parts(
         nalgebra::Translation3::new(0.05, 0.0, 0.02),
-        nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.3, 0.0),
+        nalgebra::UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(0.0, 0.3, 0.0)),
     );
     for i in 0..8 {
         let s = |bit: usize| if i & (1 << bit) != 0 { 0.02 } else { -0.02 };

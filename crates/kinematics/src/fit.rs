@@ -152,7 +152,7 @@ fn fit_capsule(covered: &Covered) -> Option<FittedCapsule> {
         (0.5 * (lo_u + hi_u), 0.5 * (lo_v + hi_v))
     };
     for step in 0..200 {
-        let reach = |&(x, y, r): &(f64, f64, f64)| (x - cu).hypot(y - cv) + r;
+        let reach = |&(x, y, r): &(f64, f64, f64)| libm::hypot(x - cu, y - cv) + r;
         let far = footprint
             .iter()
             .max_by(|a, b| reach(a).total_cmp(&reach(b)))
@@ -166,7 +166,7 @@ fn fit_capsule(covered: &Covered) -> Option<FittedCapsule> {
         .iter()
         .map(|b| {
             let (x, y) = (b.centre.dot(&u) - cu, b.centre.dot(&v) - cv);
-            (b.centre.dot(&axis), x.hypot(y), b.radius)
+            (b.centre.dot(&axis), libm::hypot(x, y), b.radius)
         })
         .collect();
     let smallest = placed

@@ -51,7 +51,7 @@ impl Robot {
         *configuration = *q;
         // Every sine and cosine first: a library call clobbers every floating-point register,
         // so calls inside the loop would spill the chain of rotations around each of them.
-        let turns: [(f64, f64); DOF] = std::array::from_fn(|i| q[i].sin_cos());
+        let turns: [(f64, f64); DOF] = std::array::from_fn(|i| libm::sincos(q[i]));
         for (i, (joint, &(sin, cos))) in self.joints.iter().zip(&turns).enumerate() {
             let (parent_rotation, parent_position) = (rotations[i], positions[i]);
             let fixed: Matrix3<f64> = parent_rotation * joint.rotation;

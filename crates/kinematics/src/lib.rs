@@ -41,6 +41,7 @@ mod nullspace;
 mod projection;
 mod pseudo_inverse;
 mod robot;
+mod rotation;
 mod scene;
 mod srdf;
 
@@ -54,6 +55,7 @@ pub use projection::{
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
+pub use rotation::{rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
 pub use scene::{ContactHit, Obstacle, ObstacleError, Scene, Shape, ToolContact};
 pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
 

@@ -32,7 +32,7 @@ pub fn directional_manipulability(
     if s <= 0.0 {
         return (0.0, JointVector::zeros());
     }
-    let value = s.powf(-0.5);
+    let value = 1.0 / s.sqrt();
     let u = jacobian.transpose() * w;
     let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
     let columns: [Vec3; DOF] = std::array::from_fn(|k| jacobian.column(k).into_owned());

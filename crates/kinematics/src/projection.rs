@@ -245,7 +245,7 @@ pub fn pose_residual(
             );
             let cross = z.cross(&target.tool_axis);
             let sin = cross.norm();
-            let angle = sin.atan2(z.dot(&target.tool_axis));
+            let angle = libm::atan2(sin, z.dot(&target.tool_axis));
             let rotation_axis = if sin > 1e-12 { cross / sin } else { u };
             let phi = rotation_axis * angle;
             error[3] = u.dot(&phi);
@@ -273,7 +273,7 @@ fn rotation_vector(r: &Matrix3<f64>) -> Vec3 {
     ) * 0.5;
     let sin = skew.norm();
     let cos = (r.trace() - 1.0) * 0.5;
-    let angle = sin.atan2(cos);
+    let angle = libm::atan2(sin, cos);
     if cos > 0.0 || sin > 1e-6 {
         return if sin > 0.0 {
             skew * (angle / sin)

@@ -107,6 +107,6 @@ pub(crate) fn smallest_symmetric_eigenvalue(m: &Matrix3<f64>) -> f64 {
     let p = (p2 / 6.0).sqrt();
     let b = (m - Matrix3::identity() * trace_third) / p;
     let r = (b.determinant() * 0.5).clamp(-1.0, 1.0);
-    let phi = r.acos() / 3.0;
-    trace_third + 2.0 * p * (phi + 2.0 * std::f64::consts::FRAC_PI_3).cos()
+    let phi = libm::acos(r) / 3.0;
+    trace_third + 2.0 * p * libm::cos(phi + 2.0 * std::f64::consts::FRAC_PI_3)
 }

@@ -1,10 +1,11 @@
 //! The robot model: a serial chain of seven revolute joints read from a URDF file.
 
-use nalgebra::{Isometry3, Matrix3, Point3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::path::Path;
 
 use crate::collision::{BroadPhase, Capsule, CollisionPair, MAX_CAPSULES};
+use crate::rotation::{rotation_from_rpy, rotation_onto};
 use crate::srdf::PairRule;
 use crate::{DOF, JointVector, Vec3};
 
@@ -562,7 +563,7 @@ fn pose_to_isometry(pose: &urdf_rs::Pose) -> Result<Isometry3<f64>, String> {
     }
     Ok(Isometry3::from_parts(
         Translation3::new(x, y, z),
-        UnitQuaternion::from_euler_angles(roll, pitch, yaw),
+        UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(roll, pitch, yaw)),
     ))
 }
 
@@ -577,8 +578,7 @@ fn axis_alignment(joint: &urdf_rs::Joint) -> Result<Isometry3<f64>, RobotError> 
             problem: format!("{:?} is not a usable direction", joint.axis.xyz.0),
         });
     }
-    let rotation = Rotation3::rotation_between(&Vector3::z(), &(axis / norm))
-        .unwrap_or_else(|| Rotation3::from_axis_angle(&Vector3::x_axis(), std::f64::consts::PI));
+    let rotation = rotation_onto(&Vector3::z(), &(axis / norm));
     Ok(Isometry3::from_parts(
         Translation3::identity(),
         UnitQuaternion::from_rotation_matrix(&rotation),

@@ -8,6 +8,7 @@ use crate::Vec3;
 use crate::collision::segment_distance;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
+use crate::rotation::{rotation_from_rpy, rpy_of};
 
 /// A solid the arm keeps clear of, in the base frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -379,7 +380,7 @@ impl ObstacleFile {
             let [roll, pitch, yaw] = finite("box.rpy", cuboid.rpy)?.into();
             Shape::Cuboid {
                 centre: finite("box.centre", cuboid.centre)?,
-                rotation: Rotation3::from_euler_angles(roll, pitch, yaw),
+                rotation: rotation_from_rpy(roll, pitch, yaw),
                 half_extents: edges * 0.5,
             }
         } else if let Some(sphere) = file.sphere {
@@ -427,7 +428,7 @@ impl From<Obstacle> for ObstacleFile {
                 rotation,
                 half_extents,
             } => {
-                let (roll, pitch, yaw) = rotation.euler_angles();
+                let (roll, pitch, yaw) = rpy_of(rotation);
                 file.cuboid = Some(BoxFile {
                     centre: array(centre),
                     size: array(&(half_extents * 2.0)),

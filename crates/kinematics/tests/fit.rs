@@ -6,7 +6,9 @@
 mod common;
 
 use common::{random_point, random_unit, rng};
-use emg_kinematics::{Ball, Covered, FittedCapsule, Vec3, fit_capsules, segment_distance};
+use emg_kinematics::{
+    Ball, Covered, FittedCapsule, Vec3, fit_capsules, rotation_about, segment_distance,
+};
 use rand::RngExt;
 
 /// Whether `p` lies in one of `capsules` (to rounding).
@@ -21,7 +23,8 @@ fn covered_by(capsules: &[FittedCapsule], p: &Vec3, radius: f64) -> bool {
 fn prism(sides: usize, radius: f64, length: f64) -> Covered {
     let corner = |k: usize, z: f64| {
         let angle = std::f64::consts::TAU * k as f64 / sides as f64;
-        Vec3::new(radius * angle.cos(), radius * angle.sin(), z)
+        let (sin, cos) = libm::sincos(angle);
+        Vec3::new(radius * cos, radius * sin, z)
     };
     let mut triangles = Vec::new();
     for k in 0..sides {
@@ -91,7 +94,7 @@ fn a_cylinder_gets_a_capsule_of_its_radius_along_its_axis() {
     let (radius, length) = (0.05, 0.3);
     // Circumscribed: the prism contains the cylinder.
     let sides = 32;
-    let circumradius = radius / (std::f64::consts::PI / sides as f64).cos();
+    let circumradius = radius / libm::cos(std::f64::consts::PI / sides as f64);
     let capsules = fit_capsules(&prism(sides, circumradius, length), 3).unwrap();
     assert_eq!(capsules.len(), 1, "{capsules:?}");
     let capsule = capsules[0];
@@ -116,7 +119,7 @@ fn a_cylinder_gets_a_capsule_of_its_radius_along_its_axis() {
 fn an_l_shape_is_split_in_two() {
     let mut bars = prism(4, 0.03, 0.4);
     // A second bar along x from the top of the first.
-    let turn = nalgebra::Rotation3::from_axis_angle(&Vec3::y_axis(), std::f64::consts::FRAC_PI_2);
+    let turn = rotation_about(&Vec3::y(), std::f64::consts::FRAC_PI_2);
     bars.triangles.extend(
         prism(4, 0.03, 0.4)
             .triangles

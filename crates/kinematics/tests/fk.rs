@@ -20,14 +20,14 @@ const FLANGE_D: f64 = 0.107;
 const PEN_FROM_FLANGE: f64 = 0.2034;
 
 fn rot_x(a: f64) -> Matrix4<f64> {
-    let (s, c) = a.sin_cos();
+    let (s, c) = libm::sincos(a);
     Matrix4::new(
         1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0,
     )
 }
 
 fn rot_z(a: f64) -> Matrix4<f64> {
-    let (s, c) = a.sin_cos();
+    let (s, c) = libm::sincos(a);
     Matrix4::new(
         c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
     )

@@ -61,7 +61,7 @@ fn directional_manipulability_value(
     let j = kin.jacobian();
     let a = j * j.transpose() + Matrix3::identity() * (LAMBDA_MU * LAMBDA_MU);
     let s = d.dot(&(a.try_inverse().expect("damped JJᵀ is invertible") * d));
-    s.powf(-0.5)
+    1.0 / s.sqrt()
 }
 
 #[test]

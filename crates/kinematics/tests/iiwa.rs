@@ -69,7 +69,8 @@ fn bending_one_y_joint_swings_the_rest_of_the_arm_towards_x() {
         config[joint] = FRAC_PI_2;
         assert_pose(&robot, config, Vec3::new(arm, 0.0, pivot_z), Vec3::x());
         config[joint] = -0.5;
-        let swung = Vec3::new((-0.5f64).sin(), 0.0, (-0.5f64).cos());
+        let (sin, cos) = libm::sincos(-0.5);
+        let swung = Vec3::new(sin, 0.0, cos);
         assert_pose(
             &robot,
             config,

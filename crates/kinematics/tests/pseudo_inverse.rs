@@ -5,7 +5,9 @@
 mod common;
 
 use common::{random_q, rng, robot};
-use emg_kinematics::{DampingConfig, JointVector, PositionJacobian, Robot, damped_pseudo_inverse};
+use emg_kinematics::{
+    DampingConfig, JointVector, PositionJacobian, Robot, damped_pseudo_inverse, rotation_from_rpy,
+};
 use nalgebra::{Matrix3, SMatrix};
 
 fn svd_sigma_min(j: &PositionJacobian) -> f64 {
@@ -146,7 +148,7 @@ fn damping_follows_the_schedule_near_singularities() {
 #[test]
 fn exact_singularity_gets_full_damping() {
     // A rank-deficient Jacobian (two rows equal): σ_min = 0, so λ = λ_max and J⁺ stays finite.
-    let mut j = PositionJacobian::from_fn(|r, c| ((r * 7 + c) as f64 * 0.37).sin());
+    let mut j = PositionJacobian::from_fn(|r, c| libm::sin((r * 7 + c) as f64 * 0.37));
     let row = j.row(0).into_owned();
     j.set_row(1, &row);
     let pinv = damped_pseudo_inverse(&j, &DampingConfig::default());
@@ -197,7 +199,7 @@ fn damping_decision_at_the_threshold_follows_the_eigenvalue() {
     // Jacobians with singular values (1, 0.5, σ) for σ swept across σ_0 = 0.05, in a rotated
     // frame: the well-conditioned shortcut must give the λ the eigenvalue gives.
     let cfg = DampingConfig::default();
-    let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+    let rotation = rotation_from_rpy(0.3, -0.7, 1.1).into_inner();
     let mut damped = 0;
     for k in -200..=200 {
         let sigma = cfg.sigma_threshold * (1.0 + f64::from(k) * 1e-8);

@@ -7,7 +7,9 @@
 mod common;
 
 use common::{home, random_point, random_q, random_unit, rng, robot};
-use emg_kinematics::{Obstacle, Scene, Shape, ToolContact, Vec3};
+use emg_kinematics::{
+    Obstacle, Scene, Shape, ToolContact, Vec3, rotation_about, rotation_from_rpy,
+};
 use nalgebra::Rotation3;
 use rand::RngExt;
 
@@ -54,7 +56,7 @@ fn random_shape(rng: &mut rand_chacha::ChaCha8Rng, kind: usize) -> Shape {
         },
         1 => Shape::Cuboid {
             centre: random_point(rng, 0.2),
-            rotation: Rotation3::from_scaled_axis(random_unit(rng) * rng.random_range(0.0..3.0)),
+            rotation: rotation_about(&random_unit(rng), rng.random_range(0.0..3.0)),
             half_extents: Vec3::new(
                 rng.random_range(0.0..0.3),
                 rng.random_range(0.01..0.3),
@@ -255,7 +257,7 @@ fn scene_files_read_back_and_write_back() {
         panic!("a box");
     };
     assert_eq!(*half_extents, Vec3::new(0.1, 0.05, 0.1));
-    assert!((rotation.angle() - 0.3).abs() < 1e-15);
+    assert_eq!(*rotation, rotation_from_rpy(0.0, 0.0, 0.3));
     assert_eq!(scene.obstacles[1].clearance_m, 0.01);
     assert_eq!(scene.obstacles[2].clearance_m, 0.0);
     let again: Scene = serde_json::from_str(&serde_json::to_string(&scene).unwrap()).unwrap();

@@ -7,6 +7,8 @@
 //!   weights files are written with `emg_io::write_atomically`);
 //! - [`RobotStamp`]: the robot a weights file was trained for (name and chain fingerprint), and
 //!   [`check_stamp`], which refuses a file trained for another arm;
+//! - [`StandardNormal`]: normal samples with the same bits on every machine (the noise of both
+//!   models' training and of the seeder's sampling);
 //! - [`checkpoint`]: checkpoint directories (a model, its optimizer and the JSON run state)
 //!   written into a staging sibling and swapped in whole.
 //!
@@ -22,8 +24,10 @@
 mod backend;
 pub mod checkpoint;
 pub mod container;
+mod normal;
 mod stamp;
 
 pub use backend::Backend;
 pub use container::ContainerError;
+pub use normal::StandardNormal;
 pub use stamp::{RobotStamp, StampError, check_stamp};

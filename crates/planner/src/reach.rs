@@ -208,7 +208,8 @@ fn offset_directions(n: &Vec3, d: &Vec3, count: usize) -> Vec<Vec3> {
     (0..count)
         .map(|i| {
             let angle = std::f64::consts::TAU * i as f64 / count as f64;
-            n * angle.cos() + side * angle.sin()
+            let (sin, cos) = libm::sincos(angle);
+            n * cos + side * sin
         })
         .collect()
 }

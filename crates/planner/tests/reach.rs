@@ -54,7 +54,7 @@ fn check_witnesses(planner: &Planner, checker: &ReferenceModel, task: &Task, rea
             across <= constraints.line_tolerance_m,
             "witness {k}: {across} m off the line"
         );
-        let angle = axis.dot(&task.n).clamp(-1.0, 1.0).acos().to_degrees();
+        let angle = libm::acos(axis.dot(&task.n).clamp(-1.0, 1.0)).to_degrees();
         assert!(
             angle <= constraints.theta_max_deg + 1e-9,
             "witness {k}: tool {angle}° from n"

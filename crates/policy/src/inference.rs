@@ -74,7 +74,7 @@ pub struct ActorOutput {
 impl ActorOutput {
     /// The deterministic action `tanh(μ)` used at evaluation (SPEC §5).
     pub fn deterministic_action(&self) -> [f32; ACTION_DIM] {
-        self.mean.map(f32::tanh)
+        self.mean.map(libm::tanhf)
     }
 }
 
@@ -228,7 +228,7 @@ mod tests {
 
     /// A layer with deterministic pseudo-random weights and biases.
     fn layer(input: usize, output: usize, salt: f32) -> Layer {
-        let value = |i: usize| ((i as f32 * 0.618 + salt).sin() * 1.7).fract();
+        let value = |i: usize| (libm::sinf(i as f32 * 0.618 + salt) * 1.7).fract();
         Layer {
             input,
             output,
@@ -242,7 +242,7 @@ mod tests {
         // Output counts that use each block width alone and together.
         for output in [1, 3, 4, 5, 31, 32, 33, 36, 37, 128, 133] {
             let layer = layer(29, output, output as f32);
-            let x: Vec<f32> = (0..29).map(|i| (i as f32 * 0.37).cos()).collect();
+            let x: Vec<f32> = (0..29).map(|i| libm::cosf(i as f32 * 0.37)).collect();
             let mut blocked = vec![f32::NAN; output];
             layer.forward(&x, &mut blocked);
             for (j, got) in blocked.iter().enumerate() {
@@ -268,7 +268,7 @@ mod tests {
         };
         for k in 0..50 {
             let observation: [f32; OBSERVATION_DIM] =
-                std::array::from_fn(|i| ((i * 31 + k) as f32 * 0.77).sin());
+                std::array::from_fn(|i| libm::sinf((i * 31 + k) as f32 * 0.77));
             let portable = trunk_portable(&layers, &observation, &mut scratch).to_vec();
             // SAFETY: the CPU reports AVX2 (checked above).
             let vector = unsafe { trunk_avx2(&layers, &observation, &mut scratch) };

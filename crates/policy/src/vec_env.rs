@@ -3,9 +3,9 @@
 //! depend on the number of threads, and each in-flight episode is recorded as (reset seed,
 //! actions) so a checkpoint can rebuild it exactly by replay.
 
+use emg_learning::StandardNormal;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rand_distr::StandardNormal;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -265,9 +265,9 @@ impl<E: Environment> VecEnv<E> {
                         let mut log_prob = 0.0;
                         for k in 0..ACTION_DIM {
                             let noise: f32 = rng.sample(StandardNormal);
-                            let u = output.mean[k] + output.log_std[k].exp() * noise;
+                            let u = output.mean[k] + libm::expf(output.log_std[k]) * noise;
                             samples[t * ACTION_DIM + k] = u;
-                            action[k] = u.tanh();
+                            action[k] = libm::tanhf(u);
                             log_prob += -0.5 * noise * noise - output.log_std[k] - HALF_LN_TWO_PI;
                         }
                         log_probs[t] = log_prob;

@@ -209,7 +209,8 @@ pub fn sample_branches(
         let [first, second] = tangent_directions(robot, root, target, cfg);
         for ray in 0..cfg.rays {
             let angle = std::f64::consts::TAU * ray as f64 / cfg.rays as f64;
-            let direction = first * angle.cos() + second * angle.sin();
+            let (sin, cos) = libm::sincos(angle);
+            let direction = first * cos + second * sin;
             let path = walk(robot, root, target, &direction, cfg, projection);
             configurations.extend(
                 path.points

@@ -85,7 +85,7 @@ pub fn solve_cone_ik(
         }
         let (rows, mut error) = pose_residual(&kin, &target);
         let axis = kin.tool_axis();
-        let angle = axis.cross(n).norm().atan2(axis.dot(n));
+        let angle = libm::atan2(axis.cross(n).norm(), axis.dot(n));
         let excess = (angle - cone).max(0.0);
         let orientation_scale = if angle > 0.0 { excess / angle } else { 0.0 };
         for k in 3..6 {

@@ -2,8 +2,7 @@
 //! small task perturbations → the top `K'` (Sec. 4.1, SPEC §7).
 
 use emg_control::{ClassicalController, Task, rollout};
-use emg_kinematics::{JointVector, PoseTarget, Robot, Vec3, project_to_pose};
-use nalgebra::{Rotation3, Unit};
+use emg_kinematics::{JointVector, PoseTarget, Robot, Vec3, project_to_pose, rotation_about};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -128,8 +127,7 @@ fn perturbed_tasks(
             let shift = random_unit(rng) * cfg.position_m;
             let axis = random_unit(rng);
             let axis = (axis - task.n * axis.dot(&task.n)).normalize();
-            let turn =
-                Rotation3::from_axis_angle(&Unit::new_unchecked(axis), cfg.angle_deg.to_radians());
+            let turn = rotation_about(&axis, cfg.angle_deg.to_radians());
             Task::new(robot, task.p0 + shift, turn * task.d, turn * task.n, None).ok()
         })
         .collect()

@@ -159,11 +159,13 @@ mod tests {
     use super::*;
 
     fn wave(s: f64) -> JointVector {
-        JointVector::from_fn(|i, _| (s * (1.0 + i as f64)).sin())
+        JointVector::from_fn(|i, _| libm::sin(s * (1.0 + i as f64)))
     }
 
     fn spline(n: usize) -> JointSpline {
-        let knots: Vec<f64> = (0..=n).map(|k| (k as f64 / n as f64).powf(1.3)).collect();
+        let knots: Vec<f64> = (0..=n)
+            .map(|k| libm::pow(k as f64 / n as f64, 1.3))
+            .collect();
         let values = knots.iter().map(|&s| wave(s)).collect();
         JointSpline::natural(knots, values)
     }

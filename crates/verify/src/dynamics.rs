@@ -260,7 +260,7 @@ mod tests {
         let (mut time_s, mut q, mut qd, mut qdd) = (vec![], vec![], vec![], vec![]);
         for k in 0..=n {
             let t = k as f64 * h;
-            let (s, co) = (omega * t).sin_cos();
+            let (s, co) = libm::sincos(omega * t);
             let value = c * (1.0 - co).powi(2);
             let velocity = 2.0 * c * (1.0 - co) * omega * s;
             let acceleration = 2.0 * c * omega * omega * (s * s + (1.0 - co) * co);
@@ -272,7 +272,7 @@ mod tests {
         // The continuous peaks of |q̇|, |q̈| and |q⃛| = 2cω³ |sin(ωt) (4 cos(ωt) − 1)|.
         let mut peaks = [0.0_f64; 3];
         for k in 0..=1_000_000 {
-            let (s, co) = (omega * k as f64 * 1e-6).sin_cos();
+            let (s, co) = libm::sincos(omega * k as f64 * 1e-6);
             peaks[0] = peaks[0].max((2.0 * c * (1.0 - co) * omega * s).abs());
             peaks[1] = peaks[1].max((2.0 * c * omega * omega * (s * s + (1.0 - co) * co)).abs());
             peaks[2] = peaks[2].max((2.0 * c * omega.powi(3) * s * (4.0 * co - 1.0)).abs());

@@ -2,7 +2,7 @@
 //! homogeneous transforms (URDF joint origin × rotation about the file's joint axis), its own
 //! collision-pair rule and its own segment-distance routine.
 
-use nalgebra::{Matrix4, Rotation3, Unit, Vector3, Vector4};
+use nalgebra::{Matrix3, Matrix4, Rotation3, Unit, Vector3, Vector4};
 
 use crate::record::{Bounds, JOINTS, Joints, Line, Solid};
 
@@ -132,7 +132,7 @@ impl ReferenceModel {
             )?;
             let [x, y, z] = joint.origin.xyz.0;
             let [r, p, yaw] = joint.origin.rpy.0;
-            let mut origin = Rotation3::from_euler_angles(r, p, yaw).to_homogeneous();
+            let mut origin = rpy_rotation(r, p, yaw).to_homogeneous();
             origin[(0, 3)] = x;
             origin[(1, 3)] = y;
             origin[(2, 3)] = z;
@@ -196,7 +196,7 @@ impl ReferenceModel {
                 }
                 let [x, y, z] = collision.origin.xyz.0;
                 let [r, p, yaw] = collision.origin.rpy.0;
-                let rotation = Rotation3::from_euler_angles(r, p, yaw);
+                let rotation = rpy_rotation(r, p, yaw);
                 let centre = Vector3::new(x, y, z);
                 let axis = rotation * Vector3::z() * half;
                 let capsule = ReferenceCapsule {
@@ -280,7 +280,7 @@ impl ReferenceModel {
         for joint in &self.joints {
             let mut transform = frames.last().expect("base frame") * joint.origin;
             if let Some(axis) = &joint.axis {
-                transform *= Rotation3::from_axis_angle(axis, q[revolute]).to_homogeneous();
+                transform *= axis_rotation(axis, q[revolute]).to_homogeneous();
                 revolute += 1;
             }
             frames.push(transform);
@@ -436,7 +436,21 @@ fn axis_depth(solid: &Solid, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 /// Angle between unit vectors (degrees) as `atan2(|a × b|, a·b)`: `acos(a·b)` loses half the
 /// digits near 0°, where one rounding of the dot product already reads as ~1e-6°.
 pub(crate) fn angle_deg(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b)).to_degrees()
+    libm::atan2(a.cross(b).norm(), a.dot(b)).to_degrees()
+}
+
+/// URDF's `rpy` rotation `R_z(yaw) R_y(pitch) R_x(roll)`, its sines and cosines from the `libm`
+/// crate (the same bits on every machine, unlike the C library's).
+fn rpy_rotation(roll: f64, pitch: f64, yaw: f64) -> Rotation3<f64> {
+    let about = |axis: Vector3<f64>, angle| axis_rotation(&Unit::new_unchecked(axis), angle);
+    about(Vector3::z(), yaw) * about(Vector3::y(), pitch) * about(Vector3::x(), roll)
+}
+
+/// The rotation by `angle` about the unit `axis`: `I + sin θ [a]× + (1 − cos θ) [a]×²`.
+fn axis_rotation(axis: &Unit<Vector3<f64>>, angle: f64) -> Rotation3<f64> {
+    let (sin, cos) = libm::sincos(angle);
+    let skew = axis.cross_matrix();
+    Rotation3::from_matrix_unchecked(Matrix3::identity() + skew * sin + skew * skew * (1.0 - cos))
 }
 
 /// `value <= bound`; false when either is NaN, so that every check fails closed.

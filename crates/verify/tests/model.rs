@@ -106,7 +106,7 @@ fn a_capped_cylinder_is_the_capsule_it_stands_for_and_an_uncapped_one_is_refused
     let capsule = ReferenceModel::from_urdf_str(&as_capsule, "link0", "pen_tip").unwrap();
     for k in 0..200 {
         let t = f64::from(k) * 0.05;
-        let q = Joints::from_fn(|i, _| (t * (1.0 + i as f64)).sin() * 1.5);
+        let q = Joints::from_fn(|i, _| libm::sin(t * (1.0 + i as f64)) * 1.5);
         assert_eq!(shipped.min_clearance(&q), capsule.min_clearance(&q));
     }
     let uncapped = shipped_text.replace(

@@ -49,7 +49,8 @@ pub fn random_unit(rng: &mut ChaCha8Rng) -> Vec3 {
     let z: f64 = rng.random_range(-1.0..1.0);
     let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
     let r = (1.0 - z * z).sqrt();
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin, cos) = libm::sincos(phi);
+    Vec3::new(r * cos, r * sin, z)
 }
 
 /// A point drawn uniformly in the cube `[-half, half]³`.
@@ -76,7 +77,7 @@ pub fn central_difference<const R: usize>(
 
 /// Angle (rad) between two vectors, accurate for tiny angles.
 pub fn angle_between(a: &Vec3, b: &Vec3) -> f64 {
-    a.cross(b).norm().atan2(a.dot(b))
+    libm::atan2(a.cross(b).norm(), a.dot(b))
 }
 
 /// The workspace's shipped data directory.
