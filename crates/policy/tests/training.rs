@@ -63,7 +63,7 @@ fn a_short_run_raises_the_mean_return_above_the_untrained_policy() {
     let network = NetworkConfig {
         hidden: vec![32, 32],
     };
-    let mut trainer = Trainer::new(network, small_ppo(12), Backend::Flex).unwrap();
+    let mut trainer = Trainer::new(network, small_ppo(40), Backend::Flex).unwrap();
     let untrained = mean_return(&robot, &tasks, &trainer.weights());
     let mut envs = trainer.start_envs(pool.environments(16)).unwrap();
     while !trainer.is_done() {
