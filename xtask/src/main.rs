@@ -21,6 +21,7 @@ mod limit;
 mod make_tasks;
 mod progress;
 mod protocol;
+mod regenerate;
 mod report;
 mod search_eval;
 mod stamp_weights;
@@ -74,6 +75,9 @@ enum Command {
     /// Every task planned as `emg plan` plans it, timed rest to rest within the joint limits,
     /// written and checked as `emg check` checks it (docs/results/timing.*).
     Timing(timing::Args),
+    /// Every shipped task set, label file, model and result, each pipeline in dependency order
+    /// (resumable: finished stages are journaled in target/regenerate/; --list, --from STAGE).
+    Regenerate(regenerate::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -93,5 +97,6 @@ fn main() -> anyhow::Result<()> {
         Command::SearchEval(args) => search_eval::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Timing(args) => timing::run(&args),
+        Command::Regenerate(args) => regenerate::run(&args),
     }
 }
