@@ -11,7 +11,8 @@ use anyhow::Context;
 use emg_eval::{Summary, four};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, limits_file_beside,
+    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind,
+    limits_file_beside,
 };
 use emg_timing::Scaling;
 use plotters::prelude::*;
@@ -126,7 +127,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         &config.rollout.constraints,
     )
     .with_context(|| format!("the joint limits {}", limits_file.display()))?;
-    let request = PlanRequest::default();
+    // `emg plan`'s defaults: the search planner, the hybrid controller, DP seeds.
+    let request = PlanRequest {
+        planner: PlannerKind::Search,
+        ..PlanRequest::default()
+    };
     let robot_name = args.robot.display().to_string();
     let bar = progress::bar(tasks.len() as u64, "timing");
     let outcomes: Vec<Outcome> = pool.install(|| {
