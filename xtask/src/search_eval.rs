@@ -1,13 +1,14 @@
 //! `cargo xtask search-eval`: the search planner against the paper's pipeline (Hybrid + DP) on
 //! the first tasks of the evaluation set, at several step budgets, beside each task's
-//! reachability bound (`docs/results/search.{json,md}`, `docs/figures/search-budget.svg`).
+//! reachability bound (`docs/results/search.{json,md}`, `docs/figures/search-budget.svg`):
+//! shares of the bound length-weighted per bucket of the bound, and the time every plan took.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
 use emg_control::CheckRollout;
-use emg_eval::{Summary, four};
+use emg_eval::{BoundShare, Summary, bound_shares, four};
 use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
@@ -26,7 +27,7 @@ pub struct Args {
     #[arg(long, default_value_t = 10_000)]
     tasks: usize,
     /// Step budgets of the search, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 10_000, 20_000, 50_000])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 10_000, 50_000])]
     budgets: Vec<u64>,
     /// Worker threads (0 = one per core); the results do not depend on it.
     #[arg(long, default_value_t = 0)]
@@ -62,10 +63,17 @@ pub struct Row {
     pub ratio_to_pipeline: f64,
     /// Mean over tasks of length / reachability bound (tasks with a bound above 0).
     pub share_of_bound: f64,
+    /// `Σ length / Σ bound` per bucket of the bound, then over all tasks, with the tasks below
+    /// half their bound.
+    pub bound_shares: Vec<BoundShare>,
     /// Steps actually taken by the returned plans, mean.
     pub plan_steps: f64,
     /// Wall time × threads per task on this machine (ms): the CPU time a task takes.
     pub cpu_ms_per_task: f64,
+    /// Time each plan took on its thread (ms; search and bound together), over the tasks.
+    pub plan_ms: Summary,
+    /// Median and 99th percentile of the plan times (ms).
+    pub plan_ms_median_p99: [f64; 2],
     /// Plans the independent checker rejected.
     pub checker_failures: usize,
     /// Path length of every task (m), in task order (the report's Search rows per bucket).
@@ -87,8 +95,12 @@ pub struct Record {
     pub threads: usize,
     /// Search settings (`budget_steps` per row).
     pub search: SearchConfig,
-    /// Reachability bounds of the tasks.
+    /// Reachability bounds of the tasks: the scan's, raised to the longest plan of any row.
     pub reachability_bound_m: Summary,
+    /// Tasks where some plan went beyond the scan's own bound.
+    pub scan_missed: usize,
+    /// The bound of every task (m), in task order.
+    pub bounds_m: Vec<f64>,
     /// The pipeline, then the search at each budget.
     pub rows: Vec<Row>,
 }
@@ -113,22 +125,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let search: SearchConfig =
         workspace::read_config(args.search_config.as_deref(), "search config")?;
 
-    println!("reachability bound of {} tasks", tasks.len());
-    let bar = progress::bar(tasks.len() as u64, "reach");
-    let bounds: Vec<f64> = pool.install(|| {
-        use rayon::prelude::*;
-        tasks
-            .par_iter()
-            .map(|task| {
-                let reach = planner.reach(task, &[]);
-                bar.inc(1);
-                reach.reachable_m
-            })
-            .collect()
-    });
-    bar.finish();
-
     let mut rows = Vec::new();
+    // The scan's bound of every task: the search scans it (from the pipeline's seed, at every
+    // budget alike) and hands it back with its plan.
+    let mut scanned: Option<Vec<f64>> = None;
     let mut pipeline_mean: Option<f64> = None;
     let settings = std::iter::once(None).chain(args.budgets.iter().copied().map(Some));
     for budget in settings.progress_with(progress::bar(1 + args.budgets.len() as u64, "budgets")) {
@@ -148,12 +148,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         };
         let planner = planner.with_config(config)?;
         let started = Instant::now();
-        let plans = pool.install(|| planner.plan_many(&tasks, &request));
+        let plans: Vec<_> = pool.install(|| {
+            use rayon::prelude::*;
+            tasks
+                .par_iter()
+                .map(|task| {
+                    let started = Instant::now();
+                    let plan = planner.plan(task, &request);
+                    (plan, started.elapsed().as_secs_f64() * 1e3)
+                })
+                .collect()
+        });
         let cpu_ms = started.elapsed().as_secs_f64() * 1e3 * threads as f64;
         let mut lengths = Vec::with_capacity(tasks.len());
+        let mut plan_ms = Vec::with_capacity(tasks.len());
+        let mut scans = Vec::with_capacity(tasks.len());
         let mut steps = 0usize;
         let mut failures = 0;
-        for (task, plan) in tasks.iter().zip(plans) {
+        for (task, (plan, ms)) in tasks.iter().zip(plans) {
             let plan = plan.with_context(|| format!("planning {task:?}"))?;
             if checker
                 .check(
@@ -167,6 +179,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
             steps += plan.trajectory.steps.len() - 1;
             lengths.push(plan.trajectory.path_length_m);
+            plan_ms.push(ms);
+            scans.extend(plan.reach.map(|reach| reach.scanned_m));
+        }
+        if scans.len() == tasks.len() {
+            scanned.get_or_insert(scans);
         }
         let summary = Summary::of(&lengths).context("no tasks")?;
         let pipeline_mean = *pipeline_mean.get_or_insert(summary.mean);
@@ -180,12 +197,36 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             budget_steps: budget,
             ratio_to_pipeline: summary.mean / pipeline_mean,
             path_length_m: summary,
-            share_of_bound: mean_ratio(&lengths, &bounds),
+            share_of_bound: 0.0,
+            bound_shares: Vec::new(),
             plan_steps: steps as f64 / tasks.len() as f64,
             cpu_ms_per_task: cpu_ms / tasks.len() as f64,
+            plan_ms: Summary::of(&plan_ms).context("no tasks")?,
+            plan_ms_median_p99: [percentile(&plan_ms, 0.5), percentile(&plan_ms, 0.99)],
             checker_failures: failures,
             lengths_m: lengths,
         });
+    }
+    let scanned = match scanned {
+        Some(scanned) => scanned,
+        None => pool.install(|| {
+            use rayon::prelude::*;
+            tasks
+                .par_iter()
+                .map(|task| planner.reach(task, &[]).scanned_m)
+                .collect()
+        }),
+    };
+    // Every plan witnesses its length: the bound never reads below a plan.
+    let bounds: Vec<f64> = scanned
+        .iter()
+        .enumerate()
+        .map(|(i, &scan)| rows.iter().map(|r| r.lengths_m[i]).fold(scan, f64::max))
+        .collect();
+    let scan_missed = bounds.iter().zip(&scanned).filter(|(b, s)| b > s).count();
+    for row in &mut rows {
+        row.share_of_bound = mean_ratio(&row.lengths_m, &bounds);
+        row.bound_shares = bound_shares(&row.lengths_m, &bounds, &bounds);
     }
 
     let record = Record {
@@ -196,12 +237,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         threads,
         search,
         reachability_bound_m: Summary::of(&bounds).context("no tasks")?,
+        scan_missed,
+        bounds_m: bounds,
         rows,
     };
     workspace::write_results(&args.out_dir, "search", &record, &markdown(&record))?;
     draw(&record, &args.figure)?;
     println!("wrote {}", args.figure.display());
     Ok(())
+}
+
+/// The `fraction` quantile of `values` (nearest rank).
+fn percentile(values: &[f64], fraction: f64) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let rank = (fraction * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
 }
 
 /// Mean of `values[i] / of[i]` over the tasks where `of[i]` is positive.
@@ -219,14 +270,20 @@ fn markdown(record: &Record) -> String {
     let mut md = format!(
         "# Search planner vs the paper's pipeline\n\nWritten by `cargo xtask search-eval`. Do not \
          edit by hand. Robot `{}`, the first {} tasks of `{}`. The pipeline is Hybrid + DP (one \
-         seed, one rollout); the search rolls that plan out first, then ranks candidate starts \
-         (q0_seed, q_mu, q_jl, {} diffusion samples, cone IK from {} restarts) by classical \
-         rollouts, re-rolls the best {} with the hybrid controller, then repairs the longest \
-         rollouts of the best {} starts where they failed (each null-space basis direction held \
-         for {} steps from 1 to 32 steps before the end, then the hybrid or the classical \
-         controller), until its budget of control steps is spent. Every plan is re-checked by the independent checker. Reachability bound \
-         (m, mean / std / min / max): {}. Times are CPU time per task on {} ({} threads) and \
-         depend on the machine; the lengths do not.\n\n\
+         seed, one rollout). The search first scans the task's reachability bound, rolls the \
+         pipeline's plan out, then ranks candidate starts (q0_seed, q_mu, q_jl, {} diffusion \
+         samples, cone IK from {} restarts) by classical rollouts and re-rolls the best {} with \
+         the hybrid controller; then it searches backwards (the reversed task from the scan's \
+         configuration at the far end of the bound, classical rollouts from its candidate \
+         starts) and follows every reversed motion that gets past `p0` forwards; then it \
+         repairs the longest rollouts of the best {} starts where they failed (each null-space \
+         basis direction held for {} steps from 1 to 32 steps before the end, then the hybrid \
+         or the classical controller). It stops when its budget of control steps is spent or a \
+         plan comes within {} m of the bound. Every plan is re-checked by the independent \
+         checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
+         plan beyond the scan's bound on {} tasks); it ignores continuity, so it may be loose. \
+         Bound (m, mean / std / min / max): {}. Times are on {} ({} threads) and depend on the \
+         machine; the lengths do not.\n\n\
          | planner | budget (steps) | path length (m, mean / std / min / max) | mean / pipeline \
          mean | length / bound (task mean) | steps per plan | CPU ms per task | checker failures |\n\
          |---|---|---|---|---|---|---|---|\n",
@@ -238,6 +295,8 @@ fn markdown(record: &Record) -> String {
         record.search.finalists,
         record.search.repaired_starts,
         record.search.detour_steps,
+        record.search.stop_within_m,
+        record.scan_missed,
         four(&record.reachability_bound_m, 3),
         record.machine,
         record.threads,
@@ -246,7 +305,7 @@ fn markdown(record: &Record) -> String {
         md += &format!(
             "| {} | {} | {} | {:.3} | {:.3} | {:.1} | {:.1} | {} |\n",
             row.planner,
-            row.budget_steps.map_or("—".into(), |b| b.to_string()),
+            budget_name(row),
             four(&row.path_length_m, 4),
             row.ratio_to_pipeline,
             row.share_of_bound,
@@ -255,37 +314,75 @@ fn markdown(record: &Record) -> String {
             row.checker_failures,
         );
     }
+    md += "\n## Share of the bound by bucket of the bound\n\nΣ length / Σ bound over the \
+           tasks whose bound lies in the bucket (the task mean of length / bound in brackets), and \
+           the tasks that end below half their bound.\n\n| planner | budget (steps) |";
+    let Some(first) = record.rows.first() else {
+        return md;
+    };
+    for bucket in &first.bound_shares {
+        md += &format!(" {} ({} tasks) |", bucket.bucket, bucket.tasks);
+    }
+    md += " tasks below 0.5 × bound |\n|---|---|";
+    md += &"---|".repeat(first.bound_shares.len() + 1);
+    md += "\n";
+    for row in &record.rows {
+        md += &format!("| {} | {} |", row.planner, budget_name(row));
+        for bucket in &row.bound_shares {
+            md += &format!(" {:.3} ({:.3}) |", bucket.share, bucket.task_mean_share);
+        }
+        let below = row.bound_shares.last().map_or(0, |all| all.below_half.len());
+        md += &format!(" {below} |\n");
+    }
+    md += "\n## Time per plan\n\nThe time each plan took on its thread (the search with its \
+           bound scan; ms).\n\n| planner | budget (steps) | mean | median | 99th percentile | \
+           slowest |\n|---|---|---|---|---|---|\n";
+    for row in &record.rows {
+        md += &format!(
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} |\n",
+            row.planner,
+            budget_name(row),
+            row.plan_ms.mean,
+            row.plan_ms_median_p99[0],
+            row.plan_ms_median_p99[1],
+            row.plan_ms.max,
+        );
+    }
     md
 }
 
-/// Mean path length against the search budget, with the pipeline and the mean bound as lines.
+/// The budget of a row for tables: its steps, or a dash for the pipeline.
+fn budget_name(row: &Row) -> String {
+    row.budget_steps.map_or("—".into(), |b| b.to_string())
+}
+
+/// Σ length / Σ bound against the search budget, one line per bucket of the bound and one for
+/// all tasks, with the pipeline's share of all tasks as a horizontal line.
 fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let searched: Vec<(f64, f64)> = record
+    let searched: Vec<&Row> = record
         .rows
         .iter()
-        .filter_map(|r| r.budget_steps.map(|b| (b as f64, r.path_length_m.mean)))
+        .filter(|r| r.budget_steps.is_some())
         .collect();
+    let budget = |r: &Row| r.budget_steps.unwrap_or(0) as f64;
+    let (x_min, x_max) = searched.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+        (lo.min(budget(r)), hi.max(budget(r)))
+    });
     let pipeline = record
         .rows
         .iter()
         .find(|r| r.budget_steps.is_none())
-        .map_or(0.0, |r| r.path_length_m.mean);
-    let bound = record.reachability_bound_m.mean;
-    let (x_min, x_max) = searched
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), (x, _)| {
-            (lo.min(*x), hi.max(*x))
-        });
-    let y_max = bound.max(pipeline) * 1.1;
+        .and_then(|r| r.bound_shares.last())
+        .map_or(0.0, |all| all.share);
     let root = SVGBackend::new(path, (720, 420)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!(
-                "{}: mean path length against the search budget",
+                "{}: Σ length / Σ bound against the search budget",
                 record.robot
             ),
             ("sans-serif", 18),
@@ -293,34 +390,41 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(56)
-        .build_cartesian_2d((x_min * 0.8..x_max * 1.25).log_scale(), 0.0..y_max)?;
+        .build_cartesian_2d((x_min * 0.8..x_max * 1.25).log_scale(), 0.0..1.05)?;
     chart
         .configure_mesh()
         .light_line_style(WHITE)
         .x_label_formatter(&|x| format!("{x:.0}"))
         .x_desc("budget (control steps per task, log scale)")
-        .y_desc("mean path length (m)")
+        .y_desc("Σ length / Σ bound")
         .draw()?;
     let span = [x_min * 0.8, x_max * 1.25];
-    chart
-        .draw_series(LineSeries::new(
-            span.map(|x| (x, bound)),
-            BLACK.stroke_width(1),
-        ))?
-        .label(format!("reachability bound {bound:.3} m"))
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
     chart
         .draw_series(LineSeries::new(
             span.map(|x| (x, pipeline)),
             RED.stroke_width(2),
         ))?
-        .label(format!("Hybrid + DP pipeline {pipeline:.3} m"))
+        .label(format!("Hybrid + DP pipeline, all tasks {pipeline:.3}"))
         .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], RED));
-    chart
-        .draw_series(LineSeries::new(searched.clone(), BLUE.stroke_width(2)))?
-        .label("search")
-        .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLUE));
-    chart.draw_series(searched.iter().map(|p| Circle::new(*p, 4, BLUE.filled())))?;
+    let buckets = searched.first().map_or(0, |r| r.bound_shares.len());
+    for bucket in 0..buckets {
+        let colour = Palette99::pick(bucket).to_rgba();
+        let colour = if bucket + 1 == buckets {
+            BLACK.to_rgba()
+        } else {
+            colour
+        };
+        let points: Vec<(f64, f64)> = searched
+            .iter()
+            .map(|r| (budget(r), r.bound_shares[bucket].share))
+            .collect();
+        let first = &searched[0].bound_shares[bucket];
+        chart
+            .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
+            .label(format!("search, bound {} ({} tasks)", first.bucket, first.tasks))
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
+        chart.draw_series(points.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
+    }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))

@@ -265,7 +265,7 @@ fn write_plan(
     index: Option<usize>,
 ) -> Result<String> {
     let trajectory = &plan.trajectory;
-    let reach = (args.reach == OnOff::On).then(|| planner.reach(task, &[plan.seed.q]));
+    let reach = (args.reach == OnOff::On).then(|| planner.reach_of(task, plan));
     let paths = PlanPaths::new(&args.out, index);
     let robot = args.robot.display().to_string();
     let files = PlanFiles::new(
@@ -301,9 +301,13 @@ fn write_plan(
         Some(reach) => format!(" of at most {:.2} m reachable", reach.reachable_m),
         None => String::new(),
     };
+    let short = match reach.as_ref().and_then(|r| r.shortfall(trajectory)) {
+        Some(note) => format!("\n  note: {note}"),
+        None => String::new(),
+    };
     let hint = fixed_contact_hint(planner.robot(), trajectory);
     Ok(format!(
-        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{hint}\n  \
+        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{hint}{short}\n  \
          seed: {}{projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
          requested speed {:.0} % of the time, {} points at {} Hz{cut}\n  \

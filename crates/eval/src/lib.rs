@@ -10,13 +10,16 @@
 //! * [`run_set`], [`merge_sets`], [`summarize`], [`markdown`]: Tables 1–2 of one task set, whole
 //!   or from shards merged bit for bit; [`EvalRecord`] is the typed result file.
 //! * [`BucketConfig`], [`cell_stats`]: the difficulty buckets and per-cell statistics.
+//! * [`bound_shares`]: length-weighted shares of a reference by bucket of the reachability bound.
 
 mod batch;
+mod bound_share;
 mod buckets;
 mod progress;
 mod protocol;
 mod setup;
 
+pub use bound_share::{BOUND_BUCKET_EDGES_M, BoundShare, bound_bucket, bound_shares};
 pub use batch::{Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram};
 pub use buckets::{
     BucketConfig, CellStats, Difficulty, MIN_REFERENCE_M, bucket_members, cell_stats,

@@ -43,6 +43,9 @@ pub struct TrajectoryFile<'a> {
     /// The task's reachability bound (m), when it was computed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reachable_m: Option<f64>,
+    /// Why the plan ends well below the bound, when it does (below 0.9 × `reachable_m`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub below_bound: Option<String>,
 }
 
 impl TrajectoryFile<'_> {

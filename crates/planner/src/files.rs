@@ -10,6 +10,7 @@ use emg_io::{
 use emg_timing::TimingError;
 
 use crate::planner::{Plan, PlanRequest, Planner};
+use crate::reach::shortfall;
 use crate::timing::MotionTiming;
 
 /// How a plan was asked for, as its files record it.
@@ -82,6 +83,9 @@ impl PlanFiles {
             termination: &trajectory.termination,
             path_length_m: trajectory.path_length_m,
             reachable_m: record.reachable_m,
+            below_bound: record
+                .reachable_m
+                .and_then(|bound| shortfall(trajectory, bound)),
         };
         let constraints = &config.rollout.constraints;
         let motion = record.timing.time(robot, task, constraints, trajectory)?;

@@ -34,6 +34,7 @@ mod search;
 mod seed;
 mod shipped;
 mod timing;
+mod track;
 
 pub use config::{ConfigError, PlannerConfig};
 pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
@@ -45,8 +46,10 @@ pub use models::{
 };
 pub use parse::ParseError;
 pub use planner::{Plan, PlanError, PlanRequest, Planner, PlannerKind};
-pub use reach::{MAX_REACH_RESTARTS, Reach, ReachConfig, reach};
-pub use search::{MAX_SEARCH_BUDGET_STEPS, SearchConfig};
+pub use reach::{
+    MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE, reach, shortfall, witness_chains,
+};
+pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig};
 pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 pub use timing::{DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside};

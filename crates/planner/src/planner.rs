@@ -85,6 +85,9 @@ pub struct Plan {
     pub seed: Seed,
     /// The rollout from that seed; every step holds every constraint.
     pub trajectory: Trajectory,
+    /// The task's reachability bound, witnessed by the plan, when the planner computed it (the
+    /// search does, to guide and end its search); else [`Planner::reach_of`] computes it.
+    pub reach: Option<Reach>,
 }
 
 /// Why a task could not be planned.
@@ -150,12 +153,20 @@ impl Planner {
             let context = SearchContext {
                 robot: &self.robot,
                 rollout: &self.config.rollout,
+                reach: &self.config.reach,
                 executor: &executor,
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
             };
-            let (seed, trajectory) = search(&context, task, seed, request.controller, controller)?;
-            return Ok(Plan { seed, trajectory });
+            let mut reach = self.reach(task, &[seed.q]);
+            let (seed, trajectory) =
+                search(&context, task, seed, request.controller, controller, &reach)?;
+            reach.witness(&trajectory);
+            return Ok(Plan {
+                seed,
+                trajectory,
+                reach: Some(reach),
+            });
         }
         let trajectory = rollout(
             &self.robot,
@@ -164,7 +175,21 @@ impl Planner {
             &mut controller,
             &self.config.rollout,
         );
-        Ok(Plan { seed, trajectory })
+        Ok(Plan {
+            seed,
+            trajectory,
+            reach: None,
+        })
+    }
+
+    /// The reachability bound of `task` witnessed by `plan`: the plan's own when it holds one,
+    /// else [`Planner::reach`] from the plan's seed, raised to the plan's length.
+    pub fn reach_of(&self, task: &Task, plan: &Plan) -> Reach {
+        plan.reach.clone().unwrap_or_else(|| {
+            let mut reach = self.reach(task, &[plan.seed.q]);
+            reach.witness(&plan.trajectory);
+            reach
+        })
     }
 
     /// The seed `request` names for `task` ([`prepare_seed`]).

@@ -12,8 +12,10 @@
 //! good as its IK sampling (warm starts from the previous point's solutions, then seeded random
 //! restarts): a point the sampling misses ends the scan early.
 
-use emg_control::{ConstraintConfig, OutOfRange, Task, first_contact};
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_control::{
+    ConstraintConfig, OutOfRange, Task, Trajectory, first_contact, first_violation,
+};
+use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, Vec3, project_to_pose};
 use emg_seeding::{IkConfig, solve_cone_ik};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -76,15 +78,38 @@ impl ReachConfig {
 /// The reachability bound of one task.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Reach {
-    /// Largest `s` such that every grid point of `[0, s]` has a valid configuration (m); 0 when
-    /// not even `p0` has one (then [`Reach::reachable_p0`] is false).
+    /// The bound (m): the larger of [`Reach::scanned_m`] and the length of every plan it has
+    /// witnessed ([`Reach::witness`]), since every configuration a plan visits is a valid one.
     pub reachable_m: f64,
+    /// Largest `s` such that the scan found a valid configuration at every grid point of
+    /// `[0, s]` (m); 0 when not even `p0` has one (then [`Reach::reachable_p0`] is false).
+    pub scanned_m: f64,
     /// Whether `p0` itself has a valid configuration.
     pub reachable_p0: bool,
     /// The grid spacing (m).
     pub grid_m: f64,
-    /// The evidence: one valid configuration per grid point from `p0` to the bound, in order.
+    /// The evidence of the scan: one valid configuration per grid point from `p0` to
+    /// [`Reach::scanned_m`], in order.
     pub witnesses: Vec<JointVector>,
+}
+
+impl Reach {
+    /// Raises the bound to the length of `trajectory`, a motion every configuration of which
+    /// holds every constraint: the points it reached are reachable, whatever the scan missed.
+    pub fn witness(&mut self, trajectory: &Trajectory) {
+        self.reachable_m = self.reachable_m.max(trajectory.path_length_m);
+    }
+
+    /// Why `trajectory` ends well short of the bound, when it ends below
+    /// [`SHORTFALL_SHARE`] of it: how far it got, what ended it, and that the bound may be loose.
+    pub fn shortfall(&self, trajectory: &Trajectory) -> Option<String> {
+        shortfall(trajectory, self.reachable_m)
+    }
+
+    /// Whether a witnessed plan went beyond the scan's own bound.
+    pub fn scan_missed(&self) -> bool {
+        self.reachable_m > self.scanned_m
+    }
 }
 
 /// The reachability bound of `task` under `constraints` (module documentation); `hints` are
@@ -97,19 +122,7 @@ pub fn reach(
     config: &ReachConfig,
     hints: &[JointVector],
 ) -> Reach {
-    let scan = Scan {
-        robot,
-        task,
-        constraints,
-        config,
-        ik: IkConfig {
-            cone_deg: constraints.theta_max_deg,
-            // Strictly inside the limits, which the rollout's check treats as closed.
-            joint_margin_rad: 1e-6,
-            max_iterations: 100,
-            ..IkConfig::default()
-        },
-    };
+    let scan = Scan::new(robot, task, constraints, config);
     let (centre, radius) = robot.reach_sphere();
     let offsets = offset_directions(&task.n, &task.d, config.offsets);
     let mut carried: Vec<JointVector> = hints.to_vec();
@@ -136,12 +149,31 @@ pub fn reach(
         witnesses.push(found[0]);
         carried = found;
     }
+    let scanned_m = witnesses.len().saturating_sub(1) as f64 * config.grid_m;
     Reach {
-        reachable_m: witnesses.len().saturating_sub(1) as f64 * config.grid_m,
+        reachable_m: scanned_m,
+        scanned_m,
         reachable_p0: !witnesses.is_empty(),
         grid_m: config.grid_m,
         witnesses,
     }
+}
+
+/// Share of the reachability bound below which a plan's output says that it ends short.
+pub const SHORTFALL_SHARE: f64 = 0.9;
+
+/// Why `trajectory` ends well short of the bound `reachable_m`, when it ends below
+/// [`SHORTFALL_SHARE`] of it.
+pub fn shortfall(trajectory: &Trajectory, reachable_m: f64) -> Option<String> {
+    let length = trajectory.path_length_m;
+    (length < SHORTFALL_SHARE * reachable_m).then(|| {
+        format!(
+            "the plan ends at {length:.2} m, below {SHORTFALL_SHARE} × the bound of \
+             {reachable_m:.2} m, because {}; the bound only says that every point up to it has \
+             a valid configuration, not that they join into one motion, so it may be loose",
+            trajectory.termination
+        )
+    })
 }
 
 /// One task's scan: what every grid point is searched with.
@@ -153,7 +185,103 @@ struct Scan<'a> {
     ik: IkConfig,
 }
 
+impl<'a> Scan<'a> {
+    fn new(
+        robot: &'a Robot,
+        task: &'a Task,
+        constraints: &'a ConstraintConfig,
+        config: &'a ReachConfig,
+    ) -> Self {
+        Self {
+            robot,
+            task,
+            constraints,
+            config,
+            ik: IkConfig {
+                cone_deg: constraints.theta_max_deg,
+                // Strictly inside the limits, which the rollout's check treats as closed.
+                joint_margin_rad: 1e-6,
+                max_iterations: 100,
+                ..IkConfig::default()
+            },
+        }
+    }
+}
+
+/// The chains of the scan's witnesses joined back to `p0`: the witnesses split where two
+/// neighbours differ by more than `max_jump_rad` (largest joint change: another self-motion
+/// branch); each piece after the first is extended backwards from its first configuration, at
+/// each grid point before it in turn, by the valid configuration on the pose nearest the one
+/// after it (the Newton projection from it, else the cone IK from it), while the change stays
+/// within `max_jump_rad`. The pieces that reach `p0` this way, with the first piece, are the
+/// chains: each holds one configuration per grid point from `p0`, the farthest-reaching first.
+pub fn witness_chains(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    config: &ReachConfig,
+    reach: &Reach,
+    max_jump_rad: f64,
+) -> Vec<Vec<JointVector>> {
+    if reach.witnesses.is_empty() {
+        return Vec::new();
+    }
+    let scan = Scan::new(robot, task, constraints, config);
+    let witnesses = &reach.witnesses;
+    let mut starts = vec![0];
+    starts.extend(
+        (1..witnesses.len()).filter(|&k| (witnesses[k] - witnesses[k - 1]).amax() > max_jump_rad),
+    );
+    let mut chains = Vec::new();
+    for (piece, &start) in starts.iter().enumerate() {
+        let end = starts.get(piece + 1).copied().unwrap_or(witnesses.len());
+        let mut chain = vec![witnesses[start]];
+        for k in (0..start).rev() {
+            let point = task.p0 + task.d * (k as f64 * reach.grid_m);
+            let after = chain[chain.len() - 1];
+            match scan
+                .nearest_on_pose(&point, &after)
+                .or_else(|| scan.continuation(&point, &after))
+            {
+                Some(q) if (q - after).amax() <= max_jump_rad => chain.push(q),
+                _ => break,
+            }
+        }
+        if chain.len() == start + 1 {
+            chain.reverse();
+            chain.extend_from_slice(&witnesses[start + 1..end]);
+            chains.push(chain);
+        }
+    }
+    chains.sort_by_key(|chain| std::cmp::Reverse(chain.len()));
+    chains
+}
+
 impl Scan<'_> {
+    /// The valid configuration at `target` with the tool axis along `n` nearest `start` (the
+    /// Newton projection from it), if any.
+    fn nearest_on_pose(&self, target: &Vec3, start: &JointVector) -> Option<JointVector> {
+        let robot = self.robot;
+        let pose = PoseTarget {
+            position: *target,
+            tool_axis: self.task.n,
+            roll_axis: None,
+        };
+        let r = project_to_pose(robot, start, &pose, &ProjectionConfig::default());
+        let (q, _) = r.ok()?;
+        let kinematics = robot.forward(&q);
+        first_violation(robot, self.task, &kinematics, self.constraints)
+            .is_none()
+            .then_some(q)
+    }
+
+    /// The valid configuration at `target` the cone IK reaches from `start`, if any.
+    fn continuation(&self, target: &Vec3, start: &JointVector) -> Option<JointVector> {
+        let robot = self.robot;
+        solve_cone_ik(robot, start, target, &self.task.n, &self.ik)
+            .filter(|q| first_contact(robot, self.task, &robot.forward(q), self.constraints).is_none())
+    }
+
     /// Valid configurations at `target`: the continuations of the `carried` warm starts
     /// (distinct, at most `config.branches`), or, when none continues, the first one random
     /// restarts find.
@@ -164,11 +292,7 @@ impl Scan<'_> {
         rng: &mut ChaCha8Rng,
     ) -> Vec<JointVector> {
         let (robot, ik, config) = (self.robot, &self.ik, self.config);
-        let valid = |start: &JointVector| {
-            solve_cone_ik(robot, start, target, &self.task.n, ik).filter(|q| {
-                first_contact(robot, self.task, &robot.forward(q), self.constraints).is_none()
-            })
-        };
+        let valid = |start: &JointVector| self.continuation(target, start);
         let mut found: Vec<JointVector> = Vec::new();
         for start in carried {
             if found.len() == config.branches {

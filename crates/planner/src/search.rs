@@ -39,7 +39,9 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
+use crate::reach::{Reach, ReachConfig, witness_chains};
 use crate::seed::Seed;
+use crate::track::{Reference, progress_per_step, tracking_action};
 
 /// Settings of the search planner.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,6 +62,15 @@ pub struct SearchConfig {
     pub detour_steps: usize,
     /// Starts whose longest rollouts the repair stage works on, best first.
     pub repaired_starts: usize,
+    /// The search ends as soon as a rollout comes this close (m) to the first grid point the
+    /// reachability scan found no configuration at (0: once a rollout reaches it, which proves
+    /// the scan short there and leaves nothing it can tell).
+    pub stop_within_m: f64,
+    /// Largest joint change (rad) between the scan's configurations at neighbouring grid
+    /// points that still counts as one self-motion branch, in its chains.
+    pub chain_jump_rad: f64,
+    /// The scan's chains (farthest-reaching first) the long-horizon stage follows.
+    pub chains: usize,
     /// Seed of the IK restarts.
     pub seed: u64,
 }
@@ -74,6 +85,9 @@ impl Default for SearchConfig {
             distinct_rad: 0.05,
             detour_steps: 10,
             repaired_starts: 8,
+            stop_within_m: 0.0,
+            chain_jump_rad: 0.25,
+            chains: 4,
             seed: 20_261_123,
         }
     }
@@ -113,7 +127,14 @@ impl SearchConfig {
         )?;
         OutOfRange::require("search.distinct_rad", self.distinct_rad, "[0, ∞)", |d| {
             d >= 0.0
-        })
+        })?;
+        OutOfRange::require("search.stop_within_m", self.stop_within_m, "[0, 1]", |d| {
+            (0.0..=1.0).contains(&d)
+        })?;
+        OutOfRange::require("search.chain_jump_rad", self.chain_jump_rad, "(0, 6.3]", |r| {
+            r > 0.0 && r <= 6.3
+        })?;
+        OutOfRange::require("search.chains", count(self.chains), "[0, 64]", |n| n <= 64.0)
     }
 }
 
@@ -128,6 +149,7 @@ struct Candidate {
 pub(crate) struct SearchContext<'a> {
     pub robot: &'a Robot,
     pub rollout: &'a RolloutConfig,
+    pub reach: &'a ReachConfig,
     pub executor: &'a ExecutorConfig,
     pub seeder: Option<&'a DpSeeder>,
     pub config: &'a SearchConfig,
@@ -143,26 +165,46 @@ struct Detour {
     steps: usize,
 }
 
-/// The controller of one search rollout from the step it takes over: it holds `detour` for
-/// its steps, then hands over to `tail`; it records every action it issues.
-struct Branch<'a> {
-    detour: Option<Detour>,
+/// What a search rollout does before its tail controller takes over.
+#[derive(Clone, Copy)]
+enum Lead<'r> {
+    /// A detour, held for its steps.
+    Detour(Detour),
+    /// Follows a reference motion while it reaches one step further along the line.
+    Track(&'r Reference),
+}
+
+/// The controller of one search rollout from the step it takes over: it follows `lead`, then
+/// hands over to `tail` for good; it records every action it issues.
+struct Branch<'a, 'r> {
+    lead: Option<Lead<'r>>,
     tail: &'a mut Executor,
     issued: Vec<Issued>,
 }
 
-impl NullSpaceController for Branch<'_> {
+impl NullSpaceController for Branch<'_, '_> {
     fn reset(&mut self, first: &StepContext<'_>) {
         self.issued.clear();
         self.tail.reset(first);
     }
 
     fn act(&mut self, step: &StepContext<'_>) -> Issued {
-        let chosen = match self.detour {
-            Some(detour) if self.issued.len() < detour.steps => {
-                (detour.action, ActingController::Search)
+        let led = match self.lead {
+            Some(Lead::Detour(detour)) if self.issued.len() < detour.steps => Some(detour.action),
+            Some(Lead::Track(reference)) => {
+                let next_m = step.task.progress(&step.kinematics.tcp()) + progress_per_step(step);
+                reference
+                    .at(next_m)
+                    .map(|target| tracking_action(step, &target))
             }
-            _ => self.tail.act(step),
+            _ => None,
+        };
+        let chosen = match led {
+            Some(action) => (action, ActingController::Search),
+            None => {
+                self.lead = None;
+                self.tail.act(step)
+            }
         };
         self.issued.push(chosen);
         chosen
@@ -182,13 +224,39 @@ struct Best {
 struct Search<'a> {
     context: &'a SearchContext<'a>,
     task: &'a Task,
+    /// Control steps the search may evaluate in all.
+    budget: u64,
+    /// The search ends as soon as a rollout gets this far (m): nothing is left to find.
+    enough_m: f64,
     spent: u64,
     leaders: Vec<Best>,
 }
 
+impl<'a> Search<'a> {
+    /// A search of `task` with nothing spent and no leader yet.
+    fn new(context: &'a SearchContext<'a>, task: &'a Task, budget: u64, enough_m: f64) -> Self {
+        Self {
+            context,
+            task,
+            budget,
+            enough_m,
+            spent: 0,
+            leaders: Vec::new(),
+        }
+    }
+}
+
 impl Search<'_> {
-    fn budget_left(&self) -> bool {
-        self.spent < self.context.config.budget_steps
+    /// Whether the search is over: its budget spent, or its longest rollout long enough.
+    fn done(&self) -> bool {
+        self.spent >= self.budget || self.longest_m() >= self.enough_m
+    }
+
+    /// The length of the longest rollout so far (m; −∞ before the first).
+    fn longest_m(&self) -> f64 {
+        self.leaders
+            .first()
+            .map_or(f64::NEG_INFINITY, |b| b.trajectory.path_length_m)
     }
 
     /// Rolls out from `seed` with `tail`, charges its steps to the budget, and keeps it if it
@@ -199,33 +267,45 @@ impl Search<'_> {
         self.try_branch(seed, episode, &[], None, tail)
     }
 
-    /// Takes over `episode` (from `seed`, after the actions `prefix`) with `detour` then `tail`,
-    /// charges the steps it evaluates to the budget, and keeps the rollout if it is among the
-    /// longest so far.
+    /// [`Search::branch`], kept if it is among the longest so far; returns its length.
     fn try_branch(
         &mut self,
         seed: &Seed,
         episode: Episode<'_>,
         prefix: &[Issued],
-        detour: Option<Detour>,
+        lead: Option<Lead<'_>>,
         tail: &mut Executor,
     ) -> f64 {
+        let rollout = self.branch(seed, episode, prefix, lead, tail);
+        let length = rollout.trajectory.path_length_m;
+        self.offer(rollout);
+        length
+    }
+
+    /// Takes over `episode` (from `seed`, after the actions `prefix`) with `lead` then `tail`
+    /// and charges the steps it evaluates to the budget.
+    fn branch(
+        &mut self,
+        seed: &Seed,
+        episode: Episode<'_>,
+        prefix: &[Issued],
+        lead: Option<Lead<'_>>,
+        tail: &mut Executor,
+    ) -> Best {
         let mut branch = Branch {
-            detour,
+            lead,
             tail,
             issued: Vec::new(),
         };
         let trajectory = continue_rollout(episode, &mut branch);
         self.spent += steps_evaluated(&trajectory).saturating_sub(prefix.len() as u64);
-        let length = trajectory.path_length_m;
         let mut issued = prefix.to_vec();
         issued.extend(branch.issued);
-        self.offer(Best {
+        Best {
             seed: seed.clone(),
             trajectory,
             issued,
-        });
-        length
+        }
     }
 
     /// Keeps `rollout` among the leaders if it is the longest from its start so far and
@@ -284,7 +364,7 @@ impl Search<'_> {
             for (at, episode) in self.branch_points(&base) {
                 for action in &directions {
                     for tail in tails.iter_mut() {
-                        if !self.budget_left() {
+                        if self.done() {
                             return false;
                         }
                         let detour = Detour {
@@ -292,7 +372,8 @@ impl Search<'_> {
                             steps: self.context.config.detour_steps,
                         };
                         let prefix = &base.issued[..at];
-                        self.try_branch(&base.seed, episode.clone(), prefix, Some(detour), tail);
+                        let lead = Some(Lead::Detour(detour));
+                        self.try_branch(&base.seed, episode.clone(), prefix, lead, tail);
                     }
                 }
             }
@@ -343,33 +424,38 @@ const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
 
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
 /// rolled out by `finalist`, the executor of `controller`) is always evaluated first, so the
-/// search never returns less; then the other candidates are ranked by classical rollouts, the
-/// best [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollouts of the
-/// best starts repaired by detours near their ends, while budget is left.
+/// search never returns less; then the scan's chains of configurations (`reach`) are followed
+/// from `p0`, the other candidates are ranked by classical rollouts, the best
+/// [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollouts of the best
+/// starts repaired by detours near their ends, while budget is left and no rollout has come
+/// within [`SearchConfig::stop_within_m`] of the first grid point the scan missed.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
     seed: Seed,
     controller: ControllerKind,
     finalist: Executor,
+    reach: &Reach,
 ) -> Result<(Seed, Trajectory), ExecutorError> {
     let classical = Executor::new(ControllerKind::Classical, None, context.executor)?;
     let mut tails = vec![finalist];
     if controller != ControllerKind::Classical {
         tails.push(classical);
     }
-    let candidates = candidates(context, task, &seed.q);
-    let mut search = Search {
-        context,
-        task,
-        spent: 0,
-        leaders: Vec::new(),
-    };
+    let config = context.config;
+    let enough_m = reach.scanned_m + reach.grid_m - config.stop_within_m;
+    let mut search = Search::new(context, task, config.budget_steps, enough_m);
     search.try_start(&seed, &mut tails[0]);
+    search.track_chains(reach, &mut tails);
+    let candidates = if search.done() {
+        Vec::new()
+    } else {
+        candidates(context, task, &[seed.q])
+    };
     let mut ranked: Vec<(usize, f64)> = Vec::new();
     let classical_tail = tails.len() - 1;
     for (index, candidate) in candidates.iter().enumerate() {
-        if !search.budget_left() {
+        if search.done() {
             break;
         }
         let length = search.try_start(&candidate.seed(), &mut tails[classical_tail]);
@@ -378,8 +464,8 @@ pub(crate) fn search(
     if controller != ControllerKind::Classical {
         // Longest first; equal lengths keep the candidates' order.
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
-        for &(index, _) in ranked.iter().take(context.config.finalists) {
-            if !search.budget_left() {
+        for &(index, _) in ranked.iter().take(config.finalists) {
+            if search.done() {
                 break;
             }
             search.try_start(&candidates[index].seed(), &mut tails[0]);
@@ -388,6 +474,72 @@ pub(crate) fn search(
     search.repair(&mut tails);
     let best = search.leaders.swap_remove(0);
     Ok((best.seed, best.trajectory))
+}
+
+impl Search<'_> {
+    /// The long-horizon stage (`crate::track`): each of the scan's chains of configurations
+    /// from `p0` ([`witness_chains`], farthest-reaching first, at most
+    /// [`SearchConfig::chains`]) is followed from its configuration at `p0` by each tail in
+    /// turn, the tail taking over where the chain ends.
+    fn track_chains(&mut self, reach: &Reach, tails: &mut [Executor]) {
+        let context = self.context;
+        if self.done() {
+            return;
+        }
+        let chains = witness_chains(
+            context.robot,
+            self.task,
+            &context.rollout.constraints,
+            context.reach,
+            reach,
+            context.config.chain_jump_rad,
+        );
+        for chain in chains.iter().take(context.config.chains) {
+            if let Some(reference) = Reference::along_grid(chain, reach.grid_m) {
+                self.track(&reference, tails);
+            }
+        }
+    }
+
+    /// Follows `reference` from its configuration at `p0`, with each tail taking over where it
+    /// ends.
+    fn track(&mut self, reference: &Reference, tails: &mut [Executor]) {
+        let context = self.context;
+        let Some(q) = reference.at(0.0) else {
+            return;
+        };
+        let kinematics = context.robot.forward(&q);
+        if first_violation(context.robot, self.task, &kinematics, &context.rollout.constraints)
+            .is_some()
+        {
+            return;
+        }
+        let seed = Seed {
+            q,
+            source: CHAIN_SOURCE,
+            projection_iterations: None,
+        };
+        for tail in tails.iter_mut() {
+            if self.done() {
+                return;
+            }
+            let episode = Episode::start(context.robot, self.task, &q, context.rollout);
+            self.try_branch(&seed, episode, &[], Some(Lead::Track(reference)), tail);
+        }
+    }
+}
+
+/// The source name of a start the long-horizon stage found: the first configuration of a chain
+/// of the reachability scan.
+pub const CHAIN_SOURCE: &str = "scan-chain";
+
+/// The task's start pose: the TCP on `p0`, the tool axis along `n`.
+fn start_pose(task: &Task) -> PoseTarget {
+    PoseTarget {
+        position: task.p0,
+        tool_axis: task.n,
+        roll_axis: None,
+    }
 }
 
 impl Candidate {
@@ -410,9 +562,9 @@ fn steps_evaluated(trajectory: &Trajectory) -> u64 {
         ))
 }
 
-/// The distinct valid starts on the start pose other than `pipeline` (the seed already
-/// rolled out), in the fixed order of the module documentation.
-fn candidates(context: &SearchContext<'_>, task: &Task, pipeline: &JointVector) -> Vec<Candidate> {
+/// The distinct valid starts on the start pose other than `tried` (the seeds already rolled
+/// out), in the fixed order of the module documentation.
+fn candidates(context: &SearchContext<'_>, task: &Task, tried: &[JointVector]) -> Vec<Candidate> {
     let robot = context.robot;
     let constraints = &context.rollout.constraints;
     let distinct_rad = context.config.distinct_rad;
@@ -420,18 +572,14 @@ fn candidates(context: &SearchContext<'_>, task: &Task, pipeline: &JointVector) 
     let mut offer = |q: JointVector, source: &'static str| {
         let kinematics = robot.forward(&q);
         let valid = first_violation(robot, task, &kinematics, constraints).is_none();
-        let distinct = (pipeline - q).amax() >= distinct_rad
+        let distinct = tried.iter().all(|t| (t - q).amax() >= distinct_rad)
             && found.iter().all(|c| (c.q - q).amax() >= distinct_rad);
         if valid && distinct {
             found.push(Candidate { q, source });
         }
     };
     let projection = ProjectionConfig::default();
-    let target = PoseTarget {
-        position: task.p0,
-        tool_axis: task.n,
-        roll_axis: None,
-    };
+    let target = start_pose(task);
     if let Some(q0) = task.q0_seed {
         offer(q0, "generating");
         for (objective, source) in [

@@ -442,6 +442,7 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
         termination: &trajectory.termination,
         path_length_m: trajectory.path_length_m,
         reachable_m: Some(0.5),
+        below_bound: None,
     };
     // A low rate keeps the timed file small enough to mutate many times.
     let timing = MotionTiming::new(

@@ -126,7 +126,7 @@ impl Planner {
         let plan = self.inner.plan(task, &request.request)?;
         let reachable_m = request
             .reach
-            .then(|| self.inner.reach(task, &[plan.seed.q]).reachable_m);
+            .then(|| self.inner.reach_of(task, &plan).reachable_m);
         Ok((plan, reachable_m))
     }
 
