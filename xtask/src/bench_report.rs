@@ -98,17 +98,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     );
     let report_path = root.join("docs/results/benchmarks.md");
     emg_io::write_atomically(&report_path, report)?;
-    let readme_path = root.join("README.md");
-    let readme = std::fs::read_to_string(&readme_path)?;
-    let (Some(start), Some(end)) = (readme.find(README_START), readme.find(README_END)) else {
-        bail!("README.md lacks the {README_START} … {README_END} markers");
-    };
-    let updated = format!(
-        "{}{README_START}\n{table}{}",
-        &readme[..start],
-        &readme[end..]
-    );
-    emg_io::write_atomically(&readme_path, updated)?;
+    workspace::replace_readme_section(README_START, README_END, &table)?;
     println!("wrote {} and the README table", report_path.display());
     Ok(())
 }

@@ -6,14 +6,15 @@
 //! Resumable and shardable: each finished task is written atomically as its own file in the
 //! journal directory (`target/limit/` by default) and a run skips the tasks already there;
 //! `--shard i/n` takes the tasks whose index is `i` mod `n`. `--merge` reads every task's file
-//! and writes `docs/results/limit.{json,md}`: per bucket of ℓ*, ℓ*, the bound, and each
-//! planner's share of ℓ*.
+//! and writes `docs/results/limit.{json,md}`: per bucket of the bound, length-weighted shares
+//! (ℓ* and each planner of the bound, each planner of ℓ*) and the tasks below half their bound;
+//! per bucket of ℓ*, the task means the report reads.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use emg_control::CheckRollout;
-use emg_eval::{BucketConfig, Difficulty, Summary, four};
+use emg_eval::{BoundShare, BucketConfig, Difficulty, Summary, bound_shares, four};
 
 use emg_planner::{PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
 use emg_seeding::Shard;
@@ -51,8 +52,8 @@ pub struct Args {
     out_dir: PathBuf,
 }
 
-/// The search settings of the limit: far more starts, finalists, repairs and steps than the
-/// planner's default.
+/// The search settings of the limit: far more starts, finalists, repairs, chains and steps
+/// than the planner's default.
 fn limit_search() -> SearchConfig {
     SearchConfig {
         budget_steps: 200_000,
@@ -60,6 +61,7 @@ fn limit_search() -> SearchConfig {
         ik_restarts: 512,
         finalists: 16,
         repaired_starts: 16,
+        chains: 16,
         ..SearchConfig::default()
     }
 }
@@ -83,7 +85,7 @@ struct TaskLimit {
     limit_seed: String,
     /// The limit's joint configurations, one per step (rad).
     limit_q: Vec<[f64; 7]>,
-    /// The reachability bound (m).
+    /// The reachability bound (m): the scan's, raised to ℓ* where the limit went beyond it.
     bound_m: f64,
     /// Hybrid + DP, the paper's pipeline (m).
     pipeline_m: f64,
@@ -172,7 +174,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 limit_m: limit.trajectory.path_length_m,
                 limit_seed: limit.seed.source.to_string(),
                 limit_q: limit.trajectory.steps.iter().map(|s| s.q.into()).collect(),
-                bound_m: planner.reach(task, &[limit.seed.q]).reachable_m,
+                bound_m: planner.reach_of(task, &limit).reachable_m,
                 pipeline_m,
                 search_m,
             };
@@ -212,10 +214,25 @@ struct Bucket {
     search_share_of_limit: f64,
 }
 
+/// Length-weighted shares over one bucket of the bound.
+#[derive(Serialize)]
+struct BoundBucket {
+    /// ℓ* of the bound.
+    limit: BoundShare,
+    /// The default search of the bound.
+    search: BoundShare,
+    /// Hybrid + DP of the bound.
+    pipeline: BoundShare,
+    /// The default search of ℓ*.
+    search_of_limit: BoundShare,
+}
+
 #[derive(Serialize)]
 struct Record {
     robot: String,
     identity: Identity,
+    /// Per bucket of the bound, then all tasks.
+    by_bound: Vec<BoundBucket>,
     buckets_by_limit: BucketConfig,
     rows: Vec<Bucket>,
 }
@@ -263,9 +280,27 @@ fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
             search_share_of_limit: share(&|r| (r.search_m, r.limit_m)),
         });
     }
+    let column = |f: fn(&TaskLimit) -> f64| records.iter().map(f).collect::<Vec<f64>>();
+    let (limits, bounds) = (column(|r| r.limit_m), column(|r| r.bound_m));
+    let (searched, pipeline) = (column(|r| r.search_m), column(|r| r.pipeline_m));
+    let by_bound = bound_shares(&limits, &bounds, &bounds)
+        .into_iter()
+        .zip(bound_shares(&searched, &bounds, &bounds))
+        .zip(bound_shares(&pipeline, &bounds, &bounds))
+        .zip(bound_shares(&searched, &limits, &bounds))
+        .map(
+            |(((limit, search), pipeline), search_of_limit)| BoundBucket {
+                limit,
+                search,
+                pipeline,
+                search_of_limit,
+            },
+        )
+        .collect();
     let record = Record {
         robot: workspace::relative(&args.robot),
         identity: identity.clone(),
+        by_bound,
         buckets_by_limit: buckets,
         rows,
     };
@@ -278,12 +313,15 @@ fn markdown(record: &Record) -> String {
         "# Best-known lengths (ℓ*) and the reachability bound\n\nWritten by `cargo xtask limit` and \
          `cargo xtask limit --merge`. Do not edit by hand. Robot `{}`, the first {} tasks of `{}`. \
          ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
-         {} restarts, {} finalists, the best {} starts repaired), every trajectory re-checked by \
-         the independent checker; the bound is the reachability scan (a necessary condition, so an \
-         upper bound as good as its IK sampling). Buckets by ℓ* (Easy ≥ {} m, Difficult < {} m). \
-         Shares are task means of the ratio.\n\n\
-         | bucket | tasks | ℓ* (m, mean / std / min / max) | bound (m) | ℓ* / bound | Hybrid + DP / ℓ* | \
-         search (default budget {}) / ℓ* |\n|---|---|---|---|---|---|---|\n",
+         {} restarts, {} finalists, the best {} starts repaired, up to {} of the scan's chains \
+         followed from `p0`), every trajectory re-checked by the independent checker; the bound is \
+         the reachability scan (a necessary condition, so an upper bound as good as its IK \
+         sampling), raised to ℓ* where a plan went beyond it.\n\n\
+         ## By bucket of the bound\n\nΣ length / Σ reference over the tasks whose bound lies in \
+         the bucket (the task mean of the ratio in brackets); below ½: the tasks that end below \
+         half of the reference.\n\n\
+         | bound | tasks | ℓ* / bound | search / bound | Hybrid + DP / bound | search / ℓ* | \
+         search below ½ bound | ℓ* below ½ bound |\n|---|---|---|---|---|---|---|---|\n",
         record.robot,
         record.identity.task_count,
         record.identity.tasks,
@@ -292,6 +330,38 @@ fn markdown(record: &Record) -> String {
         limit.ik_restarts,
         limit.finalists,
         limit.repaired_starts,
+        limit.chains,
+    );
+    let share = |s: &BoundShare| format!("{:.3} ({:.3})", s.share, s.task_mean_share);
+    for row in &record.by_bound {
+        md += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            row.limit.bucket,
+            row.limit.tasks,
+            share(&row.limit),
+            share(&row.search),
+            share(&row.pipeline),
+            share(&row.search_of_limit),
+            row.search.below_half.len(),
+            row.limit.below_half.len(),
+        );
+    }
+    let short: Vec<String> = record
+        .by_bound
+        .last()
+        .map(|all| all.limit.below_half.iter().map(|i| i.to_string()).collect())
+        .unwrap_or_default();
+    if !short.is_empty() {
+        md += &format!(
+            "\nTasks whose ℓ* ends below half their bound (by index): {}.\n",
+            short.join(", ")
+        );
+    }
+    md += &format!(
+        "\n## By bucket of ℓ*\n\nBuckets by ℓ* (Easy ≥ {} m, Difficult < {} m); shares are task \
+         means of the ratio.\n\n\
+         | bucket | tasks | ℓ* (m, mean / std / min / max) | bound (m) | ℓ* / bound | Hybrid + DP / ℓ* | \
+         search (default budget {}) / ℓ* |\n|---|---|---|---|---|---|---|\n",
         record.buckets_by_limit.easy_min_m,
         record.buckets_by_limit.difficult_below_m,
         record.identity.search.budget_steps,

@@ -159,8 +159,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     md += &velocity_limits(&args.results)?;
     md += &crate::surface_report::section(&args.results);
     md += &other_arms(&args.results, &args.figures)?;
+    let shares = search_eval::shares_table(&args.results)?;
+    md += &format!(
+        "## Long lines: the share of the bound\n\nΣ path length / Σ reachability bound over the \
+         unseen tasks whose bound lies in each bucket (`cargo xtask search-eval`; \
+         `docs/results/search.md` per budget):\n\n{shares}\n"
+    );
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
+    if args.results == workspace::root().join("docs/results") {
+        workspace::replace_readme_section(
+            search_eval::README_START,
+            search_eval::README_END,
+            &shares,
+        )?;
+        println!("wrote the README's table of search shares");
+    }
     Ok(())
 }
 
@@ -341,9 +355,9 @@ impl SearchRows {
                     100.0 * s
                 )),
                 budget_figure.as_ref().map_or(String::new(), |link| format!(
-                    "![search budget]({})\n\n*Mean path length of the search planner against its step \
-                     budget, beside Hybrid + DP and the mean reachability bound (`cargo xtask \
-                     search-eval`).*\n\n",
+                    "![search budget]({})\n\n*Σ length / Σ reachability bound of the search \
+                     planner against its step budget, per bucket of the bound and over all tasks, \
+                     beside Hybrid + DP (`cargo xtask search-eval`).*\n\n",
                     link.display()
                 )),
             ),

@@ -9,7 +9,7 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{BoundShare, Summary, bound_shares, four};
-use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SearchConfig};
+use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SHIPPED_ROBOTS, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -27,7 +27,7 @@ pub struct Args {
     #[arg(long, default_value_t = 10_000)]
     tasks: usize,
     /// Step budgets of the search, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 10_000, 50_000])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 10_000, 20_000, 50_000])]
     budgets: Vec<u64>,
     /// Worker threads (0 = one per core); the results do not depend on it.
     #[arg(long, default_value_t = 0)]
@@ -247,6 +247,55 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Markers of the README's table of search shares by bucket of the bound
+/// ([`shares_table`], written by `cargo xtask report`).
+pub const README_START: &str = "<!-- search-shares:start -->";
+/// The end marker of that table.
+pub const README_END: &str = "<!-- search-shares:end -->";
+
+/// For every shipped arm with a `search.json` under `results` (the FR3's top-level, the
+/// others' in their sub-directories), the pipeline and the search at the default budget:
+/// `Σ length / Σ bound` per bucket of the bound, the tasks below half their bound and the mean
+/// time per plan.
+pub fn shares_table(results: &Path) -> anyhow::Result<String> {
+    let mut md = String::from(
+        "| arm | planner | < 0.5 m | 0.5 – 1 m | ≥ 1 m | all | below ½ bound | mean ms per plan |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for shipped in SHIPPED_ROBOTS {
+        let path = results.join(shipped.data_subdir()).join("search.json");
+        if !path.exists() {
+            continue;
+        }
+        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
+            .with_context(|| format!("reading {}", path.display()))?;
+        let pipeline = record.rows.iter().find(|r| r.budget_steps.is_none());
+        for row in pipeline.into_iter().chain(record.default_budget_row()) {
+            md += &format!("| {} | {} |", shipped.name, row_name(row));
+            for bucket in &row.bound_shares {
+                md += &format!(" {:.3} |", bucket.share);
+            }
+            let below = row
+                .bound_shares
+                .last()
+                .map_or(0, |all| all.below_half.len());
+            md += &format!(
+                " {below} of {} | {:.1} |\n",
+                record.task_count, row.plan_ms.mean
+            );
+        }
+    }
+    Ok(md)
+}
+
+/// A row's planner for tables: the pipeline, or the search with its budget.
+fn row_name(row: &Row) -> String {
+    match row.budget_steps {
+        None => "Hybrid + DP (the paper's pipeline)".into(),
+        Some(budget) => format!("search ({budget} steps)"),
+    }
+}
+
 /// The `fraction` quantile of `values` (nearest rank).
 fn percentile(values: &[f64], fraction: f64) -> f64 {
     let mut sorted = values.to_vec();
@@ -331,7 +380,10 @@ fn markdown(record: &Record) -> String {
         for bucket in &row.bound_shares {
             md += &format!(" {:.3} ({:.3}) |", bucket.share, bucket.task_mean_share);
         }
-        let below = row.bound_shares.last().map_or(0, |all| all.below_half.len());
+        let below = row
+            .bound_shares
+            .last()
+            .map_or(0, |all| all.below_half.len());
         md += &format!(" {below} |\n");
     }
     md += "\n## Time per plan\n\nThe time each plan took on its thread (the search with its \
@@ -368,9 +420,11 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
         .filter(|r| r.budget_steps.is_some())
         .collect();
     let budget = |r: &Row| r.budget_steps.unwrap_or(0) as f64;
-    let (x_min, x_max) = searched.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
-        (lo.min(budget(r)), hi.max(budget(r)))
-    });
+    let (x_min, x_max) = searched
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+            (lo.min(budget(r)), hi.max(budget(r)))
+        });
     let pipeline = record
         .rows
         .iter()
@@ -421,7 +475,10 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
         let first = &searched[0].bound_shares[bucket];
         chart
             .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(format!("search, bound {} ({} tasks)", first.bucket, first.tasks))
+            .label(format!(
+                "search, bound {} ({} tasks)",
+                first.bucket, first.tasks
+            ))
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
         chart.draw_series(points.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
     }

@@ -234,6 +234,19 @@ pub fn machine() -> String {
     )
 }
 
+/// Replaces the text between the `start` and `end` marker lines of the workspace's README.md
+/// with `text` (atomically); an error when a marker is missing.
+pub fn replace_readme_section(start: &str, end: &str, text: &str) -> anyhow::Result<()> {
+    let path = root().join("README.md");
+    let readme = std::fs::read_to_string(&path)?;
+    let (Some(from), Some(to)) = (readme.find(start), readme.find(end)) else {
+        anyhow::bail!("README.md lacks the {start} … {end} markers");
+    };
+    let updated = format!("{}{start}\n{text}{}", &readme[..from], &readme[to..]);
+    emg_io::write_atomically(&path, updated)?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

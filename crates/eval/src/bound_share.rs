@@ -96,7 +96,10 @@ mod tests {
         let shares = bound_shares(&lengths, &references, &bounds);
         let names: Vec<&str> = shares.iter().map(|s| s.bucket.as_str()).collect();
         assert_eq!(names, ["< 0.5 m", "0.5 – 1 m", "≥ 1 m", "all"]);
-        assert_eq!((shares[0].tasks, shares[1].tasks, shares[2].tasks), (1, 0, 1));
+        assert_eq!(
+            (shares[0].tasks, shares[1].tasks, shares[2].tasks),
+            (1, 0, 1)
+        );
         assert!((shares[0].share - 1.0).abs() < 1e-12);
         assert_eq!(shares[1].share, 0.0);
         assert!((shares[2].share - 0.2).abs() < 1e-12);

@@ -19,8 +19,8 @@ mod progress;
 mod protocol;
 mod setup;
 
-pub use bound_share::{BOUND_BUCKET_EDGES_M, BoundShare, bound_bucket, bound_shares};
 pub use batch::{Summary, joint_limit_histogram, rollout_all, rollout_from, termination_histogram};
+pub use bound_share::{BOUND_BUCKET_EDGES_M, BoundShare, bound_bucket, bound_shares};
 pub use buckets::{
     BucketConfig, CellStats, Difficulty, MIN_REFERENCE_M, bucket_members, cell_stats,
 };

@@ -10,11 +10,14 @@
 //! point, but configurations found independently need not join into one continuous motion. So
 //! no planner goes further than the true bound, and this estimate of it is an upper bound only as
 //! good as its IK sampling (warm starts from the previous point's solutions, then seeded random
-//! restarts): a point the sampling misses ends the scan early.
+//! restarts): a point the sampling misses ends the scan early. Every configuration a plan
+//! visits is valid too, so a plan witnesses its own length ([`Reach::witness`]): the bound a
+//! plan reports never reads below the plan.
+//!
+//! The scan's configurations also guide the search: joined into chains on one self-motion
+//! branch ([`witness_chains`]), they show a motion along the line that the search follows.
 
-use emg_control::{
-    ConstraintConfig, OutOfRange, Task, Trajectory, first_contact, first_violation,
-};
+use emg_control::{ConstraintConfig, OutOfRange, Task, Trajectory, first_contact, first_violation};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, Vec3, project_to_pose};
 use emg_seeding::{IkConfig, solve_cone_ik};
 use rand::{RngExt, SeedableRng};
@@ -278,8 +281,9 @@ impl Scan<'_> {
     /// The valid configuration at `target` the cone IK reaches from `start`, if any.
     fn continuation(&self, target: &Vec3, start: &JointVector) -> Option<JointVector> {
         let robot = self.robot;
-        solve_cone_ik(robot, start, target, &self.task.n, &self.ik)
-            .filter(|q| first_contact(robot, self.task, &robot.forward(q), self.constraints).is_none())
+        solve_cone_ik(robot, start, target, &self.task.n, &self.ik).filter(|q| {
+            first_contact(robot, self.task, &robot.forward(q), self.constraints).is_none()
+        })
     }
 
     /// Valid configurations at `target`: the continuations of the `carried` warm starts

@@ -1,19 +1,26 @@
-//! The search planner: many starts instead of one, ranked by rollouts.
+//! The search planner: many starts instead of one, ranked by rollouts, guided by the
+//! reachability bound.
 //!
 //! The task is known before the motion starts, and which self-motion branch the arm starts on
-//! decides most of how far it gets. So instead of the paper's first valid seed, the search
-//! first rolls out the pipeline's own plan (its seed and controller, so the search never does
-//! worse), then gathers candidate starts on the start pose from every source at hand, in a
-//! fixed order: the task's generating configuration `q0_seed` and its two heuristic ascents
-//! (`q_mu`, `q_jl`), a batch of diffusion samples (all of them, not the first valid one), and
-//! cone-IK solutions from seeded random restarts spread over the branches. Each valid start is
-//! ranked by a rollout of the classical controller (cheap, no network); the best
-//! [`SearchConfig::finalists`] are rolled out again with the requested controller. Then the
-//! longest rollouts of the best [`SearchConfig::repaired_starts`] starts are repaired in turn
-//! where they failed: from 1, 2, 4, … 32 steps before the end, each null-space basis direction
-//! (±`e_i` of `B(q)`) is held for a few steps and the requested and the classical controller
-//! take over again; a round that goes further starts the next round from the new rollout. The
-//! longest rollout of all is the plan.
+//! decides most of how far it gets. The planner scans the task's reachability bound first
+//! (`crate::reach`) and hands it to the search. The search first rolls out the pipeline's own
+//! plan (its seed and controller, so the search never does worse); then, the long-horizon
+//! stage, it follows the scan's chains of configurations from `p0` (`witness_chains`: one
+//! valid configuration per grid point on one self-motion branch, so the branch that survives
+//! far along the line is known before the motion starts) with each controller taking over
+//! where a chain ends (`crate::track`); then it gathers candidate starts on the start pose from
+//! every source at hand, in a fixed order: the task's generating configuration `q0_seed` and
+//! its two heuristic ascents (`q_mu`, `q_jl`), a batch of diffusion samples (all of them, not
+//! the first valid one), and cone-IK solutions from seeded random restarts spread over the
+//! branches. Each valid start is ranked by a rollout of the classical controller (cheap, no
+//! network); the best [`SearchConfig::finalists`] are rolled out again with the requested
+//! controller. Then the longest rollouts of the best [`SearchConfig::repaired_starts`] starts
+//! are repaired in turn where they failed: from 1, 2, 4, … 32 steps before the end, each
+//! null-space basis direction (±`e_i` of `B(q)`) is held for a few steps and the requested and
+//! the classical controller take over again; a round that goes further starts the next round
+//! from the new rollout. The longest rollout of all is the plan. The search ends early once a
+//! rollout reaches the first grid point the scan found no configuration at: nothing is left
+//! that the bound can tell.
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
@@ -22,8 +29,8 @@
 //! `ActingController::Search`.
 //!
 //! The budget counts control steps (every step evaluated, accepted or rejected, replays
-//! included), never wall time, so a plan is a pure function of the task and the configuration,
-//! whatever the machine or the thread count.
+//! included; the scan's IK is not counted), never wall time, so a plan is a pure function of
+//! the task and the configuration, whatever the machine or the thread count.
 
 use emg_control::{
     ActingController, Episode, NullAction, NullSpaceController, OutOfRange, RolloutConfig,
@@ -131,10 +138,15 @@ impl SearchConfig {
         OutOfRange::require("search.stop_within_m", self.stop_within_m, "[0, 1]", |d| {
             (0.0..=1.0).contains(&d)
         })?;
-        OutOfRange::require("search.chain_jump_rad", self.chain_jump_rad, "(0, 6.3]", |r| {
-            r > 0.0 && r <= 6.3
-        })?;
-        OutOfRange::require("search.chains", count(self.chains), "[0, 64]", |n| n <= 64.0)
+        OutOfRange::require(
+            "search.chain_jump_rad",
+            self.chain_jump_rad,
+            "(0, 6.3]",
+            |r| r > 0.0 && r <= 6.3,
+        )?;
+        OutOfRange::require("search.chains", count(self.chains), "[0, 64]", |n| {
+            n <= 64.0
+        })
     }
 }
 
@@ -509,8 +521,13 @@ impl Search<'_> {
             return;
         };
         let kinematics = context.robot.forward(&q);
-        if first_violation(context.robot, self.task, &kinematics, &context.rollout.constraints)
-            .is_some()
+        if first_violation(
+            context.robot,
+            self.task,
+            &kinematics,
+            &context.rollout.constraints,
+        )
+        .is_some()
         {
             return;
         }

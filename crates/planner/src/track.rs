@@ -57,3 +57,57 @@ pub(crate) fn tracking_action(step: &StepContext<'_>, target: &JointVector) -> N
 pub(crate) fn progress_per_step(step: &StepContext<'_>) -> f64 {
     step.config.speed_m_per_s * step.config.dt_s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use emg_control::RolloutConfig;
+    use emg_kinematics::Robot;
+
+    fn fr3() -> Robot {
+        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+        Robot::from_chain_file(data.join("robots/fr3_pen.urdf")).expect("the FR3 loads")
+    }
+
+    #[test]
+    fn a_reference_interpolates_between_its_grid_points_and_nowhere_else() {
+        let (a, b) = (JointVector::zeros(), JointVector::repeat(1.0));
+        let reference = Reference::along_grid(&[a, b, a], 0.01).expect("three points");
+        assert_eq!(reference.at(0.0), Some(a));
+        let between = reference.at(0.0025).expect("inside");
+        assert!((between - JointVector::repeat(0.25)).amax() < 1e-12);
+        assert!((reference.at(0.015).expect("inside") - JointVector::repeat(0.5)).amax() < 1e-12);
+        assert_eq!(reference.at(0.02), Some(a));
+        assert_eq!(reference.at(-1e-9), None);
+        assert_eq!(reference.at(0.0201), None);
+        assert!(Reference::along_grid(&[a], 0.01).is_none());
+    }
+
+    #[test]
+    fn the_tracking_action_recovers_the_action_that_reaches_the_target() {
+        let robot = fr3();
+        let task = crate::demo_task(&robot).expect("the demo task");
+        let config = RolloutConfig::default();
+        let q = task.q0_seed.expect("the demo task has its configuration");
+        let step = StepContext::new(
+            &robot,
+            &task,
+            &config,
+            0,
+            robot.forward(&q),
+            NullAction::zeros(),
+        );
+        assert_eq!(progress_per_step(&step), 0.2 * 0.05);
+        // The configuration one step of `action` reaches, as the rollout integrates it (Eq. 2).
+        let action = NullAction::new(0.3, -0.7, 0.1, 0.9);
+        let target = q + step.joint_velocity(&action) * config.dt_s;
+        let tracked = tracking_action(&step, &target);
+        assert!(
+            (tracked - action).amax() < 1e-9,
+            "{tracked} against {action}"
+        );
+        // A target out of reach in one step saturates the action.
+        let far = q + step.basis.columns.column(0) * 10.0;
+        assert_eq!(tracking_action(&step, &far)[0], 1.0);
+    }
+}

@@ -9,7 +9,7 @@ use emg_io::read_tasks;
 use emg_kinematics::{Robot, Vec3};
 use emg_planner::{
     ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, Reach, SeedSource,
-    ShippedRobot,
+    ShippedRobot, witness_chains,
 };
 use emg_verify::ReferenceModel;
 
@@ -38,7 +38,7 @@ fn check_witnesses(planner: &Planner, checker: &ReferenceModel, task: &Task, rea
     let limits = checker.limits();
     assert_eq!(
         reach.witnesses.len() as f64,
-        (reach.reachable_m / reach.grid_m).round() + f64::from(u8::from(reach.reachable_p0)),
+        (reach.scanned_m / reach.grid_m).round() + f64::from(u8::from(reach.reachable_p0)),
         "one witness per grid point"
     );
     for (k, q) in reach.witnesses.iter().enumerate() {
@@ -104,6 +104,61 @@ fn no_plan_goes_beyond_the_bound_and_every_witness_holds() {
     // The bound is informative: on some tasks the arm could be placed well past where the
     // classical controller stops.
     assert!(beyond_plan > 0, "the bound never exceeds the plan");
+}
+
+#[test]
+fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
+    let planner = planner();
+    let robot = planner.robot();
+    let checker = checker(robot);
+    let tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
+        .expect("shipped tasks");
+    let request = PlanRequest {
+        planner: emg_planner::PlannerKind::Search,
+        controller: ControllerKind::Classical,
+        ..PlanRequest::default()
+    };
+    let constraints = &planner.config().rollout.constraints;
+    for task in &tasks[..6] {
+        let plan = planner.plan(task, &request).expect("searches");
+        let reach = plan.reach.clone().expect("the search scans the bound");
+        assert_eq!(
+            planner.reach_of(task, &plan),
+            reach,
+            "the plan's own bound is reused"
+        );
+        let length = plan.trajectory.path_length_m;
+        assert!(
+            reach.reachable_m >= length,
+            "bound {reach:?} below the plan {length} m"
+        );
+        assert!(reach.reachable_m >= reach.scanned_m);
+        // Every chain the search may follow is a chain of valid configurations from `p0`, one
+        // per grid point, on one self-motion branch.
+        let jump = planner.config().search.chain_jump_rad;
+        let chains = witness_chains(
+            robot,
+            task,
+            constraints,
+            &planner.config().reach,
+            &reach,
+            jump,
+        );
+        assert!(!chains.is_empty(), "the scan's first chain starts at p0");
+        for chain in &chains {
+            let grid: Vec<_> = chain.to_vec();
+            let as_scan = Reach {
+                reachable_m: (grid.len() - 1) as f64 * reach.grid_m,
+                scanned_m: (grid.len() - 1) as f64 * reach.grid_m,
+                witnesses: grid,
+                ..reach.clone()
+            };
+            check_witnesses(&planner, &checker, task, &as_scan);
+            for pair in chain.windows(2) {
+                assert!((pair[1] - pair[0]).amax() <= jump, "a chain jumps branches");
+            }
+        }
+    }
 }
 
 #[test]

@@ -8,7 +8,8 @@ use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
-    DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig, ShippedRobot,
+    CHAIN_SOURCE, DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig,
+    ShippedRobot,
 };
 use emg_verify::ReferenceModel;
 
@@ -99,14 +100,39 @@ fn search_never_returns_less_and_often_more() {
 }
 
 #[test]
+fn long_lines_are_planned_along_the_scans_chains() {
+    // The first tasks of the evaluation set whose bound is at least 1 m.
+    let planner = planner(small_search());
+    let robot = planner.robot();
+    let checker =
+        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+            .expect("checker");
+    let constraints = &planner.config().rollout.constraints;
+    let mut followed = 0;
+    for task in tasks(robot, 40) {
+        if planner.reach(&task, &[]).scanned_m < 1.0 {
+            continue;
+        }
+        let searched = planner.plan(&task, &search_request()).expect("searches");
+        checker
+            .check(&task, &searched.trajectory, constraints)
+            .expect("every searched plan holds every constraint");
+        followed += usize::from(searched.seed.source == CHAIN_SOURCE);
+    }
+    assert!(followed > 0, "no long line was planned along a chain");
+}
+
+#[test]
 fn a_spent_budget_gives_the_pipeline_plan() {
     let mut config = small_search();
     config.search.budget_steps = 1;
     let planner = planner(config);
     for task in tasks(planner.robot(), 4) {
+        let searched = planner.plan(&task, &search_request()).expect("searches");
+        let pipeline = planner.plan(&task, &PlanRequest::default()).expect("plans");
         assert_eq!(
-            planner.plan(&task, &search_request()).expect("searches"),
-            planner.plan(&task, &PlanRequest::default()).expect("plans"),
+            (searched.seed, searched.trajectory),
+            (pipeline.seed, pipeline.trajectory)
         );
     }
 }
