@@ -54,7 +54,7 @@ pub struct Args {
 
 /// The search settings of the limit: far more starts, finalists, repairs, chains and steps
 /// than the planner's default.
-fn limit_search() -> SearchConfig {
+pub fn limit_search() -> SearchConfig {
     SearchConfig {
         budget_steps: 200_000,
         dp_samples: 128,

@@ -10,7 +10,9 @@ use emg_control::{Task, rollout};
 use emg_eval::{BucketConfig, CellStats, EvalRecord, SetResult, bucket_members, cell_stats, four};
 use emg_hybrid::count_switches;
 use emg_io::read_tasks;
-use emg_planner::{ControllerKind, Executor, SHIPPED_ROBOTS, SeedSource, ShippedRobot};
+use emg_planner::{
+    ControllerKind, Executor, SHIPPED_ROBOTS, SearchConfig, SeedSource, ShippedRobot,
+};
 use plotters::prelude::*;
 use serde::Deserialize;
 use serde::de::DeserializeOwned;
@@ -228,10 +230,26 @@ enum SearchRows {
     Missing(String),
 }
 
-/// The "All" row of `limit.json` (`cargo xtask limit --merge`).
+/// The "All" row of `limit.json` (`cargo xtask limit --merge`), and the settings it was made
+/// with.
 #[derive(Deserialize)]
 struct LimitFile {
+    identity: LimitIdentity,
     rows: Vec<LimitRow>,
+}
+
+/// The search settings a `limit.json` was made with.
+#[derive(Deserialize)]
+struct LimitIdentity {
+    limit: SearchConfig,
+    search: SearchConfig,
+}
+
+impl LimitIdentity {
+    /// Whether the limit's searches are today's: its own settings and the default search's.
+    fn is_current(&self) -> bool {
+        self.limit == crate::limit::limit_search() && self.search == SearchConfig::default()
+    }
 }
 
 /// One bucket of `limit.json`.
@@ -295,10 +313,11 @@ impl SearchRows {
         let limit_path = results.join("limit.json");
         let share_of_limit = if limit_path.exists() {
             let limit: LimitFile = read(&limit_path)?;
+            // A limit made with other search settings says nothing of today's search.
             limit
                 .rows
                 .iter()
-                .find(|r| r.bucket == "All")
+                .find(|r| r.bucket == "All" && limit.identity.is_current())
                 .map(|r| r.search_share_of_limit)
         } else {
             None

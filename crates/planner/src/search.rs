@@ -279,7 +279,9 @@ impl Search<'_> {
         self.try_branch(seed, episode, &[], None, tail)
     }
 
-    /// [`Search::branch`], kept if it is among the longest so far; returns its length.
+    /// Takes over `episode` (from `seed`, after the actions `prefix`) with `lead` then `tail`,
+    /// charges the steps it evaluates to the budget, and keeps the rollout if it is among the
+    /// longest so far; returns its length.
     fn try_branch(
         &mut self,
         seed: &Seed,
@@ -288,22 +290,6 @@ impl Search<'_> {
         lead: Option<Lead<'_>>,
         tail: &mut Executor,
     ) -> f64 {
-        let rollout = self.branch(seed, episode, prefix, lead, tail);
-        let length = rollout.trajectory.path_length_m;
-        self.offer(rollout);
-        length
-    }
-
-    /// Takes over `episode` (from `seed`, after the actions `prefix`) with `lead` then `tail`
-    /// and charges the steps it evaluates to the budget.
-    fn branch(
-        &mut self,
-        seed: &Seed,
-        episode: Episode<'_>,
-        prefix: &[Issued],
-        lead: Option<Lead<'_>>,
-        tail: &mut Executor,
-    ) -> Best {
         let mut branch = Branch {
             lead,
             tail,
@@ -311,13 +297,15 @@ impl Search<'_> {
         };
         let trajectory = continue_rollout(episode, &mut branch);
         self.spent += steps_evaluated(&trajectory).saturating_sub(prefix.len() as u64);
+        let length = trajectory.path_length_m;
         let mut issued = prefix.to_vec();
         issued.extend(branch.issued);
-        Best {
+        self.offer(Best {
             seed: seed.clone(),
             trajectory,
             issued,
-        }
+        });
+        length
     }
 
     /// Keeps `rollout` among the leaders if it is the longest from its start so far and
