@@ -31,7 +31,7 @@ fn benches(c: &mut Criterion) {
     ] {
         let request = PlanRequest {
             planner: planner_kind,
-            ..PlanRequest::default()
+            ..PlanRequest::pipeline()
         };
         group.bench_function(name, |b| {
             b.iter(|| {

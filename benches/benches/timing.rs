@@ -25,7 +25,7 @@ fn benches(c: &mut Criterion) {
         .iter()
         .map(|task| {
             planner
-                .plan(task, &PlanRequest::default())
+                .plan(task, &PlanRequest::pipeline())
                 .expect("evaluation tasks plan")
         })
         .collect();

@@ -98,7 +98,8 @@ pub struct Args {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 enum Surface {
-    /// The arm keeps off the work surface.
+    /// The arm keeps off the work surface's whole half-space (the strictest surface: the
+    /// sampled tasks of `--surface-clearance` keep it clear at their start).
     On,
     /// The paper's protocol: the surface is ignored.
     Off,
@@ -107,7 +108,10 @@ enum Surface {
 impl Surface {
     /// Sets the constraint in `constraints`.
     fn apply(self, constraints: &mut emg_control::ConstraintConfig) {
-        constraints.work_surface = self == Self::On;
+        constraints.work_surface = match self {
+            Self::On => emg_kinematics::WorkSurface::HalfSpace,
+            Self::Off => emg_kinematics::WorkSurface::Off,
+        };
     }
 }
 

@@ -132,7 +132,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let bar = progress::bar(pending.len() as u64, "limit");
     let search = PlanRequest {
         planner: PlannerKind::Search,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     workspace::thread_pool(args.threads)?.install(|| {
         pending.par_iter().try_for_each(|&index| {
@@ -142,7 +142,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .plan(task, request)
                     .with_context(|| format!("task {index}"))
             };
-            let pipeline = plan(&planner, &PlanRequest::default())?;
+            let pipeline = plan(&planner, &PlanRequest::pipeline())?;
             let searched = plan(&planner, &search)?;
             let large = plan(&limit_planner, &search)?;
             let (pipeline_m, search_m) = (

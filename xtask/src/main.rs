@@ -13,6 +13,7 @@ mod ablate;
 mod ablate_control;
 mod backend_choice;
 mod bench_report;
+mod cartesian_eval;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
@@ -69,6 +70,9 @@ enum Command {
     StampWeights(stamp_weights::Args),
     /// The search planner against the pipeline at several step budgets (docs/results/search.*).
     SearchEval(search_eval::Args),
+    /// The baseline of motion-planning frameworks, a MoveIt-style Cartesian path, on the tasks
+    /// of search-eval beside their bounds (docs/results/cartesian.*).
+    CartesianEval(cartesian_eval::Args),
     /// Best-known lengths (a large search) and reachability bounds of an evaluation subset
     /// (resumable, --shard i/n, --merge → docs/results/limit.*).
     Limit(limit::Args),
@@ -95,6 +99,7 @@ fn main() -> anyhow::Result<()> {
         Command::FigureBranches(args) => figure_branches::run(&args),
         Command::StampWeights(args) => stamp_weights::run(&args),
         Command::SearchEval(args) => search_eval::run(&args),
+        Command::CartesianEval(args) => cartesian_eval::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Timing(args) => timing::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),

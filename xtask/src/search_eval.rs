@@ -137,12 +137,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             ..PlannerConfig::default()
         };
         let request = match budget {
-            None => PlanRequest::default(),
+            None => PlanRequest::pipeline(),
             Some(steps) => {
                 config.search.budget_steps = steps;
                 PlanRequest {
                     planner: PlannerKind::Search,
-                    ..PlanRequest::default()
+                    ..PlanRequest::pipeline()
                 }
             }
         };
@@ -269,6 +269,24 @@ pub fn shares_table(results: &Path) -> anyhow::Result<String> {
         }
         let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
             .with_context(|| format!("reading {}", path.display()))?;
+        let cartesian = path.with_file_name("cartesian.json");
+        if cartesian.exists() {
+            let baseline: crate::cartesian_eval::Record =
+                serde_json::from_str(&std::fs::read_to_string(&cartesian)?)
+                    .with_context(|| format!("reading {}", cartesian.display()))?;
+            md += &format!("| {} | MoveIt-style Cartesian path |", shipped.name);
+            for bucket in &baseline.bound_shares {
+                md += &format!(" {:.3} |", bucket.share);
+            }
+            let below = baseline
+                .bound_shares
+                .last()
+                .map_or(0, |all| all.below_half.len());
+            md += &format!(
+                " {below} of {} | {:.1} |\n",
+                baseline.task_count, baseline.mean_ms
+            );
+        }
         let pipeline = record.rows.iter().find(|r| r.budget_steps.is_none());
         for row in pipeline.into_iter().chain(record.default_budget_row()) {
             md += &format!("| {} | {} |", shipped.name, row_name(row));

@@ -130,7 +130,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // `emg plan`'s defaults: the search planner, the hybrid controller, DP seeds.
     let request = PlanRequest {
         planner: PlannerKind::Search,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let robot_name = args.robot.display().to_string();
     let bar = progress::bar(tasks.len() as u64, "timing");

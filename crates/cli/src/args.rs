@@ -4,6 +4,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand};
+use emg_kinematics::WorkSurface;
 use emg_planner::{ControllerKind, PlannerKind, SeedSource};
 
 /// Extreme straight-line motion on a 7-DoF arm holding a pen.
@@ -17,6 +18,10 @@ pub struct Cli {
 
 /// The subcommands.
 #[derive(Debug, Subcommand)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "parsed once per run: boxing saves nothing worth the indirection"
+)]
 pub enum Command {
     /// Plan straight-line motions: seed, roll out a controller, write the trajectories.
     Plan(PlanArgs),
@@ -78,11 +83,11 @@ pub struct CheckArgs {
     #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot)]
     pub robot: Option<PathBuf>,
     /// Base link of the kinematic chain (default: the file's root link).
-    #[arg(long, requires = "tip_link")]
+    #[arg(long)]
     pub base_link: Option<String>,
     /// Tip link of the chain, the TCP whose z-axis is the tool axis (default: the file's only
     /// leaf link).
-    #[arg(long, requires = "base_link")]
+    #[arg(long)]
     pub tip_link: Option<String>,
     /// Take the task (and, without --config, the constraints) from this emg-trajectory/1 or
     /// emg-joint-trajectory/2 file instead of FILE (a CSV carries none).
@@ -147,11 +152,11 @@ pub struct PlanArgs {
           default_value = "fr3")]
     pub robot: PathBuf,
     /// Base link of the kinematic chain (default: the file's root link).
-    #[arg(long, requires = "tip_link")]
+    #[arg(long)]
     pub base_link: Option<String>,
     /// Tip link of the chain, the TCP whose z-axis is the tool axis (default: the file's only
     /// leaf link).
-    #[arg(long, requires = "base_link")]
+    #[arg(long)]
     pub tip_link: Option<String>,
     /// A task given on the command line.
     #[command(flatten)]
@@ -168,7 +173,10 @@ pub struct PlanArgs {
     /// Diffusion-seeder weights for `--seed dp` (default: those shipped for a shipped robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub weights: Option<PathBuf>,
-    /// JSON file with optional `rollout` and `gains` objects (unset fields keep their defaults).
+    /// Planner configuration (JSON): any of `rollout` (with `constraints`), `gains`, `switch`,
+    /// `measure`, `reach` and `search` (e.g. `{"search": {"budget_steps": 50000}}`); unset
+    /// fields keep their defaults (the work plate on). The schema is emg_planner's
+    /// PlannerConfig, documented in docs/ARCHITECTURE.md.
     #[arg(long, value_name = "JSON")]
     pub config: Option<PathBuf>,
     /// Output path stem: writes STEM.json and STEM.csv (the planned path) and
@@ -187,18 +195,22 @@ pub struct PlanArgs {
     #[arg(long, value_name = "NAME", value_parser = PlannerKind::from_str, default_value = "search")]
     pub planner: PlannerKind,
     /// Null-space controller: `classical` (Eq. 3), `rl` (the PPO policy, Sec. 4.2) or `hybrid`
-    /// (learned inside, classical near the joint limits, Sec. 4.3).
-    #[arg(long, value_name = "NAME", value_parser = ControllerKind::from_str, default_value = "hybrid")]
-    pub controller: ControllerKind,
+    /// (learned inside, classical near the joint limits, Sec. 4.3). Default: `hybrid` when a
+    /// policy is trained for the robot (--policy or the shipped one), else `classical`.
+    #[arg(long, value_name = "NAME", value_parser = ControllerKind::from_str)]
+    pub controller: Option<ControllerKind>,
     /// Policy weights of `--controller rl` and `hybrid` (default: those shipped for a shipped
     /// robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub policy: Option<PathBuf>,
-    /// Keep the arm, all but the pen, off the task's work surface: the plane through p0 with
-    /// normal n, the material on the far side (where the pen points). `off` plans as the
-    /// paper's protocol does. Replaces the --config file's `rollout.constraints.work_surface`.
-    #[arg(long, value_name = "on|off", default_value = "on")]
-    pub surface: OnOff,
+    /// The part the line is drawn on, which the arm, all but the pen, keeps off: `plate` (a
+    /// plate under the line, its top face in the plane through p0 with normal n: 0.2 m wide,
+    /// from 0.05 m behind p0 to 2 m beyond, 0.05 m thick; the config's
+    /// `rollout.constraints.work_surface` sets other sizes), `half-space` (everything beyond
+    /// that plane) or `off` (the paper's protocol). Default: the --config file's
+    /// `work_surface` when it sets one, else `plate`.
+    #[arg(long, value_name = "plate|half-space|off", value_parser = WorkSurface::from_str)]
+    pub surface: Option<WorkSurface>,
     /// Scene file (JSON) of obstacles the whole arm, pen included, keeps clear of: half-spaces,
     /// boxes, spheres and capsules in the base frame, each with its clearance (see
     /// docs/scene.md). Replaces the --config file's `rollout.constraints.scene`.
@@ -211,7 +223,8 @@ pub struct PlanArgs {
     pub reach: OnOff,
     /// Joint limits the joint trajectory is timed for (MoveIt joint_limits.yaml with velocity,
     /// acceleration and jerk limits). Default: <robot file stem>.joint_limits.yaml beside the
-    /// robot file.
+    /// robot file, else the robot file's velocity limits with assumed acceleration and jerk
+    /// limits (5 rad/s², 300 rad/s³; said in the output).
     #[arg(long, value_name = "YAML")]
     pub limits: Option<PathBuf>,
     /// Scaling of the joint limits.
@@ -241,13 +254,6 @@ impl PlanArgs {
         self.weights.clone().or_else(|| {
             crate::robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE)
         })
-    }
-
-    /// The joint limits file: `--limits`, else the one beside the robot file.
-    pub fn limits_path(&self) -> PathBuf {
-        self.limits
-            .clone()
-            .unwrap_or_else(|| emg_planner::limits_file_beside(&self.robot))
     }
 
     /// The policy weights: `--policy`, else those shipped for the robot (if any).

@@ -21,7 +21,11 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
     let contents = TrajectoryContents::read(file)?;
     let carried = contents.carried();
-    let task_from = match args.task_from.as_deref() {
+    // A CSV carries no task: by default it is taken from the JSON written beside it.
+    let beside = (carried.is_none() && args.line.p0.is_none() && args.task_from.is_none())
+        .then(|| file.with_extension("json"))
+        .filter(|path| path.is_file());
+    let task_from = match args.task_from.as_deref().or(beside.as_deref()) {
         Some(path) => Some((path, read_task_from(path)?)),
         None => None,
     };
@@ -56,9 +60,10 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
             "the file".to_string(),
         ),
         _ => bail!(
-            "{} is a CSV file, which carries no task: give --task-from <emg-trajectory JSON> or \
-             --p0 x,y,z --d x,y,z --n x,y,z",
-            file.display()
+            "{} is a CSV file, which carries no task, and no {} lies beside it: give \
+             --task-from <emg-trajectory JSON> or --p0 x,y,z --d x,y,z --n x,y,z",
+            file.display(),
+            file.with_extension("json").display()
         ),
     };
     let (constraints, constraints_origin) = match (&args.config, &carried, &task_from) {

@@ -37,17 +37,36 @@ pub fn run_import(args: &ImportArgs) -> Result<()> {
             format!("the imported chain from '{base}' to the pen cannot be planned with")
         })?;
     let srdf = srdf_beside(&args.out);
+    let limits = emg_planner::limits_file_beside(&args.out);
     write_text(&args.out, &imported.urdf)?;
     write_text(&srdf, &imported.srdf)?;
+    write_text(&limits, &joint_limits_yaml(&args.file, &robot))?;
     println!("{}", report(&imported, &robot));
     println!(
-        "wrote {} and {}; plan with: emg plan --robot {} --base-link {base} --tip-link \
-         {PEN_LINK} --controller classical --limits <joint_limits.yaml>",
+        "wrote {}, {} and {} (velocities from the vendor file, acceleration and jerk limits \
+         assumed: replace them with the vendor's values); plan with: emg plan --robot {}",
         args.out.display(),
         srdf.display(),
+        limits.display(),
         args.out.display()
     );
     Ok(())
+}
+
+/// The MoveIt joint_limits.yaml of an imported robot: the vendor file's velocity limits, and
+/// acceleration and jerk limits marked as assumed (a URDF holds none).
+fn joint_limits_yaml(vendor: &std::path::Path, robot: &Robot) -> String {
+    let header = format!(
+        "Joint limits written by `emg import-robot` from {}, in MoveIt's joint_limits.yaml \
+         layout.\nmax_velocity: the vendor file's <limit velocity> of each joint.\n\
+         max_acceleration {} rad/s² and max_jerk {} rad/s³: ASSUMED, conservative values \
+         (docs/robot-import.md), since a URDF holds no acceleration or jerk limits; replace them \
+         with the vendor's published values.",
+        vendor.display(),
+        emg_timing::ASSUMED_ACCELERATION_RAD_S2,
+        emg_timing::ASSUMED_JERK_RAD_S3
+    );
+    emg_timing::DynamicLimits::assumed(robot).to_yaml(robot, &header)
 }
 
 /// The fit report: per link, what it held, the capsules and their volume against it.

@@ -72,8 +72,8 @@ use clap::Parser;
 use emg_control::{Task, Trajectory};
 use emg_io::{PlanPaths, html_path};
 use emg_planner::{
-    Models, MotionTiming, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest, Planner,
-    PlannerConfig, SeedSource,
+    ControllerKind, Models, MotionTiming, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest,
+    Planner, PlannerConfig, SeedSource,
 };
 
 use crate::args::{Cli, Command, OnOff, PlanArgs};
@@ -110,16 +110,19 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     )?;
     let mut config = match &args.config {
         Some(path) => PlannerConfig::read(path)?,
-        None => PlannerConfig::default(),
+        None => PlannerConfig::cell(),
     };
-    config.rollout.constraints.work_surface = args.surface == OnOff::On;
+    if let Some(surface) = args.surface {
+        config.rollout.constraints.work_surface = surface;
+    }
     if let Some(path) = &args.scene {
         config.rollout.constraints.scene = emg_io::read_scene(path)?;
     }
+    let controller = controller(args);
     let models = Models::load(
         &robot,
         diffusion_weights(args)?.as_deref(),
-        policy_weights(args)?.as_deref(),
+        policy_weights(args, controller)?.as_deref(),
     )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
     let timing = motion_timing(args, &robot, &config)?;
@@ -127,17 +130,40 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     let request = PlanRequest {
         planner: args.planner,
         seed: args.seed.clone(),
-        controller: args.controller,
+        controller,
     };
+    if args.controller.is_none() && controller == ControllerKind::Classical {
+        println!(
+            "controller: classical (no policy is trained for robot {0}; `cargo xtask train-ppo \
+             --robot {0}` trains one, --policy loads one)",
+            args.robot.display()
+        );
+    }
+    if timing.assumed() {
+        println!(
+            "joint limits: no {} beside the robot file, so the motion is timed with the robot \
+             file's velocities and assumed acceleration and jerk limits ({} rad/s², {} rad/s³); \
+             `emg import-robot` writes one, --limits reads another",
+            emg_planner::limits_file_beside(&args.robot)
+                .file_name()
+                .unwrap_or_default()
+                .to_string_lossy(),
+            emg_timing::ASSUMED_ACCELERATION_RAD_S2,
+            emg_timing::ASSUMED_JERK_RAD_S3
+        );
+    }
     let many = tasks.len() > 1;
-    let mut failures = 0;
+    let mut failures: Vec<(usize, String)> = Vec::new();
+    let mut refused: Vec<(usize, String)> = Vec::new();
     for (index, task) in tasks.iter().enumerate() {
         if let Some(stop) = interrupt.received() {
-            let written = index - failures;
+            let written = index - failures.len() - refused.len();
             return Err(anyhow::Error::new(stop).context(format!(
-                "{written} of {} tasks planned and written whole, {failures} failed; the rest \
-                 were not started",
-                tasks.len()
+                "{written} of {} tasks planned and written whole, {} refused, {} failed; the \
+                 rest were not started",
+                tasks.len(),
+                refused.len(),
+                failures.len()
             )));
         }
         let label = if many {
@@ -145,27 +171,82 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         } else {
             String::new()
         };
-        let planned = planner
-            .plan(task, &request)
-            .map_err(|error| plan_error(error, &request))
-            .and_then(|plan| {
-                let record = Record {
-                    request: &request,
-                    timing: &timing,
-                };
-                write_plan(&planner, args, &record, task, &plan, many.then_some(index))
-            });
-        match planned {
-            Ok(report) => println!("{label}{report}"),
-            Err(error) if many => {
-                failures += 1;
+        let plan = match planner.plan(task, &request) {
+            Ok(plan) => plan,
+            Err(error) => {
+                let error = plan_error(error, &request);
                 eprintln!("{label}error: {error:#}");
+                failures.push((index, format!("{error:#}")));
+                continue;
             }
-            Err(error) => return Err(error),
+        };
+        if let Some(reason) = refusal(planner.robot(), &plan.trajectory) {
+            eprintln!("{label}refused, nothing written: {reason}");
+            refused.push((index, reason));
+            continue;
+        }
+        let record = Record {
+            request: &request,
+            timing: &timing,
+        };
+        match write_plan(&planner, args, &record, task, &plan, many.then_some(index)) {
+            Ok(report) => println!("{label}{report}"),
+            Err(error) => {
+                eprintln!("{label}error: {error:#}");
+                failures.push((index, format!("{error:#}")));
+            }
         }
     }
-    anyhow::ensure!(failures == 0, "{failures} of {} tasks failed", tasks.len());
-    Ok(())
+    if !many {
+        return match (refused.pop(), failures.pop()) {
+            (Some(_), _) => Err(anyhow::anyhow!("the task was refused at its start")),
+            (_, Some((_, error))) => Err(anyhow::anyhow!(error)),
+            (None, None) => Ok(()),
+        };
+    }
+    if refused.is_empty() && failures.is_empty() {
+        return Ok(());
+    }
+    let mut summary = format!(
+        "{} of {} tasks planned; {} refused at their start, {} failed:",
+        tasks.len() - refused.len() - failures.len(),
+        tasks.len(),
+        refused.len(),
+        failures.len()
+    );
+    for (index, reason) in refused.iter().chain(&failures) {
+        summary.push_str(&format!("\n  task {index}: {reason}"));
+    }
+    Err(anyhow::anyhow!(summary))
+}
+
+/// The controller: `--controller`, else hybrid when a policy is trained for the robot (given
+/// with --policy or shipped), else classical.
+fn controller(args: &PlanArgs) -> ControllerKind {
+    args.controller.unwrap_or_else(|| {
+        if args.policy_path().is_some_and(|path| path.exists()) {
+            ControllerKind::Hybrid
+        } else {
+            ControllerKind::Classical
+        }
+    })
+}
+
+/// Why a plan has no motion to execute, when its start was refused: the constraint the start
+/// breaks and what to try.
+fn refusal(robot: &emg_kinematics::Robot, trajectory: &Trajectory) -> Option<String> {
+    let emg_control::Termination::InvalidStart { violation } = &trajectory.termination else {
+        return None;
+    };
+    let hint = fixed_contact_hint(robot, trajectory);
+    let advice = if hint.is_empty() {
+        "; try another --seed, a task nearer the arm's mid-range, or --planner search"
+    } else {
+        ""
+    };
+    Some(format!(
+        "the start configuration breaks a constraint: {violation}{hint}{advice}"
+    ))
 }
 
 /// How the joint trajectories are timed: the limits file (`--limits`, else the one beside the
@@ -175,20 +256,11 @@ fn motion_timing(
     robot: &emg_kinematics::Robot,
     config: &PlannerConfig,
 ) -> Result<MotionTiming> {
-    let limits = args.limits_path();
-    if args.limits.is_none() && !limits.exists() {
-        anyhow::bail!(
-            "no joint limits for robot {}: {} does not exist; write one in MoveIt's \
-             joint_limits.yaml layout (velocity, acceleration and jerk limits per joint) or give \
-             --limits FILE",
-            args.robot.display(),
-            limits.display()
-        );
-    }
     let tool_speed = args.tool_speed.unwrap_or(config.rollout.speed_m_per_s);
-    MotionTiming::new(
+    MotionTiming::for_robot_file(
         robot,
-        &limits,
+        &args.robot,
+        args.limits.as_deref(),
         args.scaling.scaling()?,
         tool_speed,
         args.rate_hz,
@@ -239,8 +311,11 @@ fn diffusion_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
 
 /// The policy weights of `--controller rl` and `hybrid`: `--policy`, else the robot's shipped
 /// ones.
-fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
-    if !args.controller.needs_policy() {
+fn policy_weights(
+    args: &PlanArgs,
+    controller: ControllerKind,
+) -> Result<Option<std::path::PathBuf>> {
+    if !controller.needs_policy() {
         return Ok(None);
     }
     match args.policy_path() {
@@ -249,7 +324,7 @@ fn policy_weights(args: &PlanArgs) -> Result<Option<std::path::PathBuf>> {
             "--controller {}: no policy is shipped for robot {1}; pass --policy, train one with \
              `cargo xtask make-tasks --robot {1}` and `cargo xtask train-ppo --robot {1}`, or use \
              --controller classical",
-            args.controller,
+            controller,
             args.robot.display()
         ),
     }
@@ -288,7 +363,13 @@ fn write_plan(
         _ => String::new(),
     };
     let viewer = match &args.html {
-        Some(html) => write_viewer(planner, args, task, trajectory, &html_path(html, index))?,
+        Some(html) => write_viewer(
+            planner,
+            record.request.controller,
+            task,
+            trajectory,
+            &html_path(html, index),
+        )?,
         None => String::new(),
     };
     let steps = trajectory.steps.len() - 1;
@@ -305,16 +386,16 @@ fn write_plan(
         Some(note) => format!("\n  note: {note}"),
         None => String::new(),
     };
-    let hint = fixed_contact_hint(planner.robot(), trajectory);
     Ok(format!(
-        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{hint}{short}\n  \
-         seed: {}{projected}\n  \
+        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
+         seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
          requested speed {:.0} % of the time, {} points at {} Hz{cut}\n  \
          wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,
+        emg_planner::seed_source_meaning(plan.seed.source),
         timed.duration_s,
         timed.time_optimal_s,
         timed.tool_speed_share * 100.0,
@@ -344,12 +425,13 @@ fn fixed_contact_hint(robot: &emg_kinematics::Robot, trajectory: &Trajectory) ->
         return String::new();
     }
     let option = if obstacle == emg_control::WORK_SURFACE {
-        ", or plan with --surface off"
+        ", give the part's size (rollout.constraints.work_surface in --config), or plan with \
+         --surface off"
     } else {
         ""
     };
     format!(
-        "\n  the {obstacle} cuts {link}, which never moves: no configuration clears it; move the \
+        "; the {obstacle} cuts {link}, which never moves: no configuration clears it; move the \
          part or the base{option}"
     )
 }
@@ -357,7 +439,7 @@ fn fixed_contact_hint(robot: &emg_kinematics::Robot, trajectory: &Trajectory) ->
 /// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.
 fn write_viewer(
     planner: &Planner,
-    args: &PlanArgs,
+    controller: ControllerKind,
     task: &Task,
     trajectory: &Trajectory,
     path: &Path,
@@ -366,7 +448,7 @@ fn write_viewer(
         .file_stem()
         .unwrap_or(path.as_os_str())
         .to_string_lossy();
-    let title = format!("{name}: {} controller", args.controller);
+    let title = format!("{name}: {} controller", controller);
     let page = emg_viewer::render_html(&emg_viewer::ViewerInput {
         robot: planner.robot(),
         task,

@@ -20,26 +20,26 @@ pub fn default_robot() -> PathBuf {
 }
 
 /// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`) gives its file, anything else is a
-/// path to a robot file.
+/// path to an existing robot file.
 pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
-    if value.is_empty() {
-        let names: Vec<_> = SHIPPED_ROBOTS.iter().map(|r| r.name).collect();
+    let names: Vec<_> = SHIPPED_ROBOTS.iter().map(|r| r.name).collect();
+    let path = data_dir().robot_file(value);
+    if value.is_empty() || !path.exists() {
         return Err(format!(
-            "give a robot file or one of the shipped robots: {}",
+            "no shipped robot is named '{value}' and no file {} exists: give one of the shipped \
+             robots ({}) or a robot file (URDF; a vendor description with meshes is imported \
+             first with `emg import-robot`)",
+            path.display(),
             names.join(", ")
         ));
     }
-    Ok(data_dir().robot_file(value))
+    Ok(path)
 }
 
-/// Loads the robot file: the chain between `base` and `tip` when both are named, else from the
-/// file's root link to its only leaf link.
+/// Loads the robot file: the chain from `base` (default: the file's only root link) to `tip`
+/// (default: its only leaf link).
 pub fn load_robot(path: &Path, base: Option<&str>, tip: Option<&str>) -> Result<Robot> {
-    let robot = match (base, tip) {
-        (Some(base), Some(tip)) => Robot::from_urdf_file(path, base, tip),
-        (None, None) => Robot::from_chain_file(path),
-        _ => anyhow::bail!("name both --base-link and --tip-link, or neither"),
-    };
+    let robot = Robot::from_file_between(path, base, tip);
     robot.map_err(|error| {
         let hint = match error {
             RobotError::UnsupportedGeometry { .. } | RobotError::UncappedCylinder { .. } => {
@@ -80,9 +80,12 @@ mod tests {
             let model = shipped_model(&path, "ppo-v1.weights").unwrap();
             assert!(model.starts_with(robot.data_dir(&data_dir())));
         }
-        assert_eq!(
-            parse_robot("my/arm.urdf").unwrap(),
-            PathBuf::from("my/arm.urdf")
+        let file = SHIPPED_ROBOTS[1].path(&data_dir());
+        assert_eq!(parse_robot(file.to_str().unwrap()).unwrap(), file);
+        let error = parse_robot("ur5").unwrap_err();
+        assert!(
+            error.contains("fr3, iiwa14") && error.contains("'ur5'"),
+            "{error}"
         );
         assert_eq!(
             shipped_model(Path::new("my/arm.urdf"), "ppo-v1.weights"),
@@ -99,7 +102,10 @@ mod tests {
             (found.base_link(), found.tip_link()),
             ("iiwa_link_0", "pen_tip")
         );
-        let error = load_robot(&path, Some("iiwa_link_0"), None).unwrap_err();
-        assert!(error.to_string().contains("--tip-link"), "{error}");
+        let tip_only = load_robot(&path, None, Some("iiwa_link_7")).unwrap();
+        assert_eq!(
+            (tip_only.base_link(), tip_only.tip_link()),
+            ("iiwa_link_0", "iiwa_link_7")
+        );
     }
 }

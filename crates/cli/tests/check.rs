@@ -121,8 +121,15 @@ fn every_file_of_a_plan_passes_and_tampering_is_caught() {
     let output = emg(&["replay", joint.to_str().unwrap()]);
     assert!(output.status.success(), "{}", text(&output.stderr));
 
-    // The CSV carries no task: it comes from --task-from or --p0/--d/--n.
-    let err = check_err(&[csv.to_str().unwrap()]);
+    // The CSV carries no task: it comes from the JSON beside it, --task-from or --p0/--d/--n.
+    let out = check_ok(&[csv.to_str().unwrap()]);
+    assert!(
+        out.contains(&format!("task from --task-from {}", json.display())),
+        "{out}"
+    );
+    let alone = csv.with_file_name("alone.csv");
+    std::fs::copy(&csv, &alone).unwrap();
+    let err = check_err(&[alone.to_str().unwrap()]);
     assert!(
         err.contains("carries no task") && err.contains("--task-from"),
         "{err}"

@@ -6,9 +6,10 @@
 //!   `package://meshes/...` read beside the file as pybullet does, fingers on prismatic joints.
 //!
 //! Imported, each is read whole by urdfdom's `check_urdf`, comes with the SRDF of its
-//! self-collision rule, plans end to end with the classical controller, passes `emg check`, is
-//! drawn by the viewer, and the learned controllers refuse it naming the missing model and how to
-//! train one.
+//! self-collision rule and a joint_limits.yaml, plans more than 10 cm with the default command
+//! (`emg plan --robot imported.urdf --out x`, no other flag, no hand-written file), every written
+//! file passes `emg check`, it is drawn by the viewer, and the learned controllers refuse it
+//! naming the missing model and how to train one.
 //!
 //! The packages are found at `$EMG_RTB_DATA` (the unpacked wheel's `rtbdata` directory) and
 //! `$EMG_PYBULLET_DATA` (its `pybullet_data` directory); `.ci/run` downloads both. Without them a
@@ -38,20 +39,9 @@ fn package(variable: &str, inside: &str) -> Option<PathBuf> {
     }
 }
 
-/// MoveIt joint limits for the vendor file's joint names: a shipped robot's, renamed.
-fn limits(dir: &Path, shipped: &str, rename: impl Fn(usize) -> (String, String)) -> PathBuf {
-    let text = read(&common::data_dir().join(format!("robots/{shipped}.joint_limits.yaml")));
-    let renamed = (1..=7).fold(text, |text, k| {
-        let (from, to) = rename(k);
-        text.replace(&format!("{from}:"), &format!("{to}:"))
-    });
-    let path = dir.join("vendor.joint_limits.yaml");
-    std::fs::write(&path, renamed).unwrap();
-    path
-}
-
-/// One vendor description end to end: import with `import_args`, then plan, check and view.
-fn end_to_end(vendor: &Path, import_args: &[&str], base: &str, limits: &Path, dir: &Path) {
+/// One vendor description end to end: import with `import_args`, then plan with the default
+/// command, check every written file, and view.
+fn end_to_end(vendor: &Path, import_args: &[&str], base: &str, dir: &Path) {
     let robot = dir.join("robot.urdf");
     let output = emg(&[
         &[
@@ -106,52 +96,58 @@ fn end_to_end(vendor: &Path, import_args: &[&str], base: &str, limits: &Path, di
             "EMG_REQUIRE_URDFDOM=1 but check_urdf was not found"
         ),
     }
-    let stem = dir.join("line");
-    let html = dir.join("line.html");
-    let plan = [
+    // The limits file written beside it: the vendor's velocities, assumed acceleration and jerk.
+    let limits = read(&dir.join("robot.joint_limits.yaml"));
+    assert!(
+        limits.contains("ASSUMED") && limits.contains("max_jerk: 300.0"),
+        "{limits}"
+    );
+    // The default command plans it, with no other flag and no hand-written file: the classical
+    // controller (no policy is trained for it) said in one line, more than 10 cm of line.
+    let stem = dir.join("x");
+    let plain = [
         "plan",
         "--robot",
         robot.to_str().unwrap(),
-        "--base-link",
-        base,
-        "--tip-link",
-        "pen_tip",
-        "--controller",
-        "classical",
-        "--planner",
-        "controller",
-        "--surface",
-        "off",
-        "--limits",
-        limits.to_str().unwrap(),
-        "--html",
-        html.to_str().unwrap(),
         "--out",
         stem.to_str().unwrap(),
     ];
+    let output = emg(&plain);
+    let stdout = text(&output.stdout);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    assert!(stdout.contains("controller: classical"), "{stdout}");
+    assert!(!stdout.contains("assumed acceleration"), "{stdout}");
+    let record = read_json(&dir.join("x.json"));
+    let length = record["path_length_m"].as_f64().unwrap();
+    assert!(length > 0.1, "{stdout}");
+    // Every written file passes the checker, told nothing but the file (the CSV takes its task
+    // from the JSON beside it).
+    for file in ["x.json", "x.csv", "x.joint_trajectory.json"] {
+        let output = emg(&["check", dir.join(file).to_str().unwrap()]);
+        assert!(output.status.success(), "{file}: {}", text(&output.stderr));
+    }
+    // The viewer draws the fitted capsules.
+    let html = dir.join("line.html");
+    let plan = [
+        &plain[..],
+        &[
+            "--base-link",
+            base,
+            "--tip-link",
+            "pen_tip",
+            "--controller",
+            "classical",
+        ],
+        &["--html", html.to_str().unwrap()],
+    ]
+    .concat();
     let output = emg(&plan);
     assert!(output.status.success(), "{}", text(&output.stderr));
-    let record = read_json(&dir.join("line.json"));
-    let length = record["path_length_m"].as_f64().unwrap();
-    assert!(length > 0.05, "{}", text(&output.stdout));
     let page = read(&html);
     assert!(
         page.contains(r#""link":"pen_tip""#),
         "the viewer draws the fitted capsules"
     );
-    for file in ["line.json", "line.joint_trajectory.json"] {
-        let output = emg(&[
-            "check",
-            dir.join(file).to_str().unwrap(),
-            "--robot",
-            robot.to_str().unwrap(),
-            "--base-link",
-            base,
-            "--tip-link",
-            "pen_tip",
-        ]);
-        assert!(output.status.success(), "{file}: {}", text(&output.stderr));
-    }
     // The learned controllers need models trained for this arm.
     let hybrid: Vec<&str> = plan
         .iter()
@@ -190,14 +186,10 @@ fn rtb_datas_iiwa_with_stl_meshes_plans_end_to_end() {
     );
     assert!(error.contains("--package-path"), "{error}");
     let package = format!("kuka_lbr_iiwa_support={}", kuka.display());
-    let limits = limits(dir, "iiwa14_pen", |k| {
-        (format!("iiwa_joint_{k}"), format!("joint_a{k}"))
-    });
     end_to_end(
         &vendor,
         &["--tool-link", "tool0", "--package-path", &package],
         "base_link",
-        &limits,
         dir,
     );
     // The package's COLLADA visual meshes, read as collision meshes, fit about the same
@@ -280,14 +272,10 @@ fn pybullets_panda_with_obj_meshes_and_fingers_plans_end_to_end() {
         error.contains("mesh is not supported") && error.contains("emg import-robot"),
         "{error}"
     );
-    let limits = limits(dir, "fr3_pen", |k| {
-        (format!("fr3_joint{k}"), format!("panda_joint{k}"))
-    });
     end_to_end(
         &vendor,
         &["--tool-link", "panda_hand", "--pen-length", "0.2"],
         "panda_link0",
-        &limits,
         dir,
     );
 }

@@ -126,14 +126,29 @@ fn a_work_surface_cutting_the_base_is_named_and_the_scene_is_recorded() {
         "--reach",
         "off",
     ];
-    // Drawing downwards 35 cm above the base: the surface (on by default) cuts the base.
-    let stem = dir.join("cut");
+    // Drawing downwards 35 cm above the base: the default plate under the line clears the
+    // base and the line plans; the whole half-space cuts the base, and the task is refused
+    // with nothing written and a nonzero exit status.
+    let stem = dir.join("plate");
     let out = plan_ok(&[&line[..], &["--out", stem.to_str().unwrap()]].concat());
-    assert!(out.contains("link0 touched the work surface"), "{out}");
-    assert!(out.contains("which never moves"), "{out}");
-    assert!(out.contains("--surface off"), "{out}");
-    let doc = read_json(&dir.join("cut.json"));
-    assert_eq!(doc["config"]["constraints"]["work_surface"], true);
+    assert!(out.contains("path length"), "{out}");
+    let doc = read_json(&dir.join("plate.json"));
+    let plate = &doc["config"]["constraints"]["work_surface"]["plate"];
+    assert_eq!(plate["half_width_m"], 0.1, "{doc}");
+    assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{doc}");
+    let stem = dir.join("cut");
+    let error = plan_err(
+        &[
+            &line[..],
+            &["--surface", "half-space", "--out", stem.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(error.contains("refused, nothing written"), "{error}");
+    assert!(error.contains("link0 touched the work surface"), "{error}");
+    assert!(error.contains("which never moves"), "{error}");
+    assert!(error.contains("--surface off"), "{error}");
+    assert!(!dir.join("cut.json").exists() && !dir.join("cut.csv").exists());
     // A scene file is recorded in the constraints, and its obstacles end the motion.
     let scene = dir.join("scene.json");
     std::fs::write(
@@ -452,29 +467,25 @@ fn robot_by_name_and_by_file() {
 
     let copy = dir.join("my_arm.urdf");
     std::fs::copy(&robot_path, &copy).unwrap();
-    let message = plan_err(&[
+    // A robot file with no models and no limits file beside it plans with the default command:
+    // the classical controller and assumed limits, each said in one line.
+    let plain = [
         "--robot",
         copy.to_str().unwrap(),
-        "--out",
-        stem.to_str().unwrap(),
-    ]);
-    assert!(message.contains("--policy"), "{message}");
-    // Joint limits a URDF cannot hold: none beside the copy, so the error says what to give.
-    let classical = [
-        "--robot",
-        copy.to_str().unwrap(),
-        "--controller",
-        "classical",
         "--out",
         stem.to_str().unwrap(),
     ];
-    let message = plan_err(&classical);
+    let out = plan_ok(&plain);
+    assert!(out.contains("controller: classical (no policy"), "{out}");
     assert!(
-        message.contains("no joint limits")
-            && message.contains("my_arm.joint_limits.yaml")
-            && message.contains("--limits"),
-        "{message}"
+        out.contains("joint limits: no my_arm.joint_limits.yaml") && out.contains("assumed"),
+        "{out}"
     );
+    let joint = read_json(&dir.join("iiwa.joint_trajectory.json"));
+    assert_eq!(joint["limits"]["joint_limits_file"], "assumed", "{joint}");
+    let message = plan_err(&[&plain[..], &["--controller", "hybrid"]].concat());
+    assert!(message.contains("--policy"), "{message}");
+    let classical = [&plain[..], &["--controller", "classical"]].concat();
     let limits = robot_path.with_file_name("iiwa14_pen.joint_limits.yaml");
     let limited = [&classical[..], &["--limits", limits.to_str().unwrap()]].concat();
     plan_ok(&limited);

@@ -1,6 +1,6 @@
 //! Every constant of the rollout and the classical controller, with SPEC defaults (serde).
 
-use emg_kinematics::{BasisConfig, DampingConfig, Scene};
+use emg_kinematics::{BasisConfig, DampingConfig, Scene, WorkSurface};
 use serde::{Deserialize, Serialize};
 
 /// The constraints a rollout must hold at every step (SPEC §2).
@@ -17,11 +17,12 @@ pub struct ConstraintConfig {
     /// `null`) leaves joint speeds unbounded, as the paper's runs do. Steps that would be faster
     /// are slowed down in time, not changed in shape (see [`crate::Episode`]).
     pub velocity_limit_fraction: Option<VelocityLimitFraction>,
-    /// Keep every capsule of the arm but the tool's off the task's work surface (SPEC §9: the
-    /// plane through `p0` with normal `n`, material on `(x − p0)·n > 0`). Off by default, as in
-    /// the paper's protocol; `emg plan` turns it on.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub work_surface: bool,
+    /// The task's work surface, which every capsule of the arm but the tool's keeps off (SPEC
+    /// §9: material on `(x − p0)·n > 0`): a finite plate under the line or the whole
+    /// half-space. Off by default, as in the paper's protocol; `emg plan` and Python plan with
+    /// the default plate.
+    #[serde(skip_serializing_if = "WorkSurface::is_off")]
+    pub work_surface: WorkSurface,
     /// Obstacles of the cell; every capsule of the arm, the tool's included, keeps each one's
     /// clearance.
     #[serde(skip_serializing_if = "Scene::is_empty")]
@@ -35,7 +36,7 @@ impl Default for ConstraintConfig {
             theta_max_deg: 30.0,
             collision_margin_m: 0.0,
             velocity_limit_fraction: Some(VelocityLimitFraction::FULL),
-            work_surface: false,
+            work_surface: WorkSurface::Off,
             scene: Scene::default(),
         }
     }

@@ -1,6 +1,6 @@
 //! The constraints every step must hold, and which one a configuration breaks.
 
-use emg_kinematics::{Kinematics, Robot, Shape, ToolContact, Vec3};
+use emg_kinematics::{Kinematics, Robot, ToolContact, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::config::ConstraintConfig;
@@ -191,11 +191,10 @@ pub fn first_contact(
         obstacle: obstacle.to_string(),
         clearance_m: hit.clearance,
     };
-    if cfg.work_surface {
-        let surface = Shape::work_surface(&task.p0, &task.n);
-        if let Some(hit) = robot.first_contact(kin, &surface, 0.0, ToolContact::Allowed) {
-            return Some(scene_contact(WORK_SURFACE, hit));
-        }
+    if let Some(surface) = cfg.work_surface.shape(&task.p0, &task.d, &task.n)
+        && let Some(hit) = robot.first_contact(kin, &surface, 0.0, ToolContact::Allowed)
+    {
+        return Some(scene_contact(WORK_SURFACE, hit));
     }
     cfg.scene.obstacles.iter().find_map(|obstacle| {
         robot

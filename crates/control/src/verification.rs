@@ -2,10 +2,10 @@
 //! recorded trajectory as the checker's plain data. Nothing here checks anything; the checker
 //! recomputes every quantity from the robot file.
 
-use emg_kinematics::Shape;
+use emg_kinematics::{Shape, WorkSurface};
 use emg_verify::{
     Blame, Bounds, CheckFailure, Ending, Line, Obstacle, RecordedStep, Recording, ReferenceModel,
-    Solid,
+    Solid, Surface,
 };
 
 use crate::config::ConstraintConfig;
@@ -30,7 +30,16 @@ impl From<&ConstraintConfig> for Bounds {
             theta_max_deg: constraints.theta_max_deg,
             collision_margin_m: constraints.collision_margin_m,
             velocity_limit_fraction: constraints.velocity_limit_fraction.map(|f| f.get()),
-            work_surface: constraints.work_surface,
+            work_surface: match constraints.work_surface {
+                WorkSurface::Off => None,
+                WorkSurface::HalfSpace => Some(Surface::HalfSpace),
+                WorkSurface::Plate(plate) => Some(Surface::Plate {
+                    half_width_m: plate.half_width_m,
+                    behind_m: plate.behind_m,
+                    ahead_m: plate.ahead_m,
+                    thickness_m: plate.thickness_m,
+                }),
+            },
             obstacles: constraints
                 .scene
                 .obstacles

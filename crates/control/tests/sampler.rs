@@ -236,7 +236,7 @@ fn the_realistic_population_is_the_paper_population_where_the_surface_clears_the
     let config = RolloutConfig {
         max_steps: 1,
         constraints: ConstraintConfig {
-            work_surface: true,
+            work_surface: emg_kinematics::WorkSurface::HalfSpace,
             ..ConstraintConfig::default()
         },
         ..RolloutConfig::default()

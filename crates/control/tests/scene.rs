@@ -7,6 +7,8 @@
 //! - rollouts planned with the surface off that cross it fail the checker told of the surface,
 //!   at the first step that crosses it; an obstacle placed on a rollout's path ends the rollout
 //!   before it;
+//! - an elbow dipping into the work plate is caught by the library and the checker; moved
+//!   beside the line, the plate no longer touches it while the half-space still does;
 //! - a constraint file with the surface and a scene reads; without them it writes as before.
 
 mod common;
@@ -15,16 +17,25 @@ use emg_control::{
     CheckRollout, ConstraintConfig, RolloutConfig, Termination, Violation, WORK_SURFACE,
     first_contact,
 };
-use emg_kinematics::{Obstacle, Scene, Shape, Vec3};
+use emg_kinematics::{Obstacle, Plate, Scene, Shape, Vec3, WorkSurface};
 use emg_verify::{Bounds, FailedCheck, Line};
 use rand::RngExt;
 
 use common::{checker, classical, random_q, rng, robot, tasks};
 
-fn with_surface() -> RolloutConfig {
+fn with_surface(surface: WorkSurface) -> RolloutConfig {
     let mut config = RolloutConfig::default();
-    config.constraints.work_surface = true;
+    config.constraints.work_surface = surface;
     config
+}
+
+/// The three work surfaces, in turn.
+fn surface(case: usize) -> WorkSurface {
+    [
+        WorkSurface::Off,
+        WorkSurface::HalfSpace,
+        WorkSurface::plate(),
+    ][case % 3]
 }
 
 fn random_obstacle(rng: &mut rand_chacha::ChaCha8Rng, kind: usize) -> Obstacle {
@@ -78,7 +89,7 @@ fn library_and_checker_agree_on_scene_contact() {
     for case in 0..2_000 {
         let task = &tasks[case % tasks.len()].1;
         let mut constraints = ConstraintConfig {
-            work_surface: case % 3 == 0,
+            work_surface: surface(case / 3),
             ..ConstraintConfig::default()
         };
         constraints.scene.obstacles = (0..case % 3)
@@ -127,63 +138,122 @@ fn library_and_checker_agree_on_scene_contact() {
 fn rollouts_hold_the_work_surface_and_the_checker_confirms_it() {
     let robot = robot();
     let checker = checker();
-    let config = with_surface();
-    let (mut invalid_starts, mut surface_ends, mut others) = (0, 0, 0);
-    for (index, task) in tasks(&robot, 400) {
-        let trajectory = classical(&robot, &task, &config);
-        checker
-            .check(&task, &trajectory, &config.constraints)
-            .unwrap_or_else(|e| panic!("task {index}: {e}"));
-        match &trajectory.termination {
-            Termination::InvalidStart {
-                violation: Violation::SceneContact { obstacle, .. },
-            } => {
-                assert_eq!(obstacle, WORK_SURFACE);
-                invalid_starts += 1;
+    for surface in [WorkSurface::HalfSpace, WorkSurface::plate()] {
+        let config = with_surface(surface);
+        let (mut invalid_starts, mut surface_ends, mut others) = (0, 0, 0);
+        for (index, task) in tasks(&robot, 400) {
+            let trajectory = classical(&robot, &task, &config);
+            checker
+                .check(&task, &trajectory, &config.constraints)
+                .unwrap_or_else(|e| panic!("{surface}, task {index}: {e}"));
+            match &trajectory.termination {
+                Termination::InvalidStart {
+                    violation: Violation::SceneContact { obstacle, .. },
+                } => {
+                    assert_eq!(obstacle, WORK_SURFACE);
+                    invalid_starts += 1;
+                }
+                Termination::Violation {
+                    violation: Violation::SceneContact { obstacle, link, .. },
+                    ..
+                } => {
+                    assert_eq!(obstacle, WORK_SURFACE);
+                    assert_ne!(link, "pen_tip", "the pen may touch the surface");
+                    surface_ends += 1;
+                }
+                _ => others += 1,
             }
-            Termination::Violation {
-                violation: Violation::SceneContact { obstacle, link, .. },
-                ..
-            } => {
-                assert_eq!(obstacle, WORK_SURFACE);
-                assert_ne!(link, "pen_tip", "the pen may touch the surface");
-                surface_ends += 1;
-            }
-            _ => others += 1,
         }
+        assert!(
+            invalid_starts > 0 && surface_ends > 0 && others > 0,
+            "{surface}: {invalid_starts} invalid starts, {surface_ends} ended on the surface, \
+             {others} others"
+        );
     }
-    assert!(
-        invalid_starts > 0 && surface_ends > 0 && others > 0,
-        "{invalid_starts} invalid starts, {surface_ends} ended on the surface, {others} others"
-    );
 }
 
 #[test]
 fn the_checker_catches_a_rollout_through_the_work_surface() {
     let robot = robot();
     let free = RolloutConfig::default();
-    let surface = with_surface();
-    let mut caught = 0;
-    for (index, task) in tasks(&robot, 60) {
-        let crossing = classical(&robot, &task, &free);
-        let Some(first) = crossing.steps.iter().position(|step| {
-            let kin = robot.forward(&step.q);
-            first_contact(&robot, &task, &kin, &surface.constraints).is_some()
-        }) else {
-            continue;
-        };
-        let failure = checker()
-            .check(&task, &crossing, &surface.constraints)
-            .expect_err("crossing the surface fails");
-        assert_eq!(failure.check, FailedCheck::SceneContact, "task {index}");
-        assert_eq!(failure.step, first, "task {index}: {failure}");
-        assert!(failure.to_string().contains(WORK_SURFACE), "{failure}");
-        caught += 1;
+    for (surface, least) in [(WorkSurface::HalfSpace, 6), (WorkSurface::plate(), 1)] {
+        let surface_config = with_surface(surface);
+        let mut caught = 0;
+        for (index, task) in tasks(&robot, 120) {
+            let crossing = classical(&robot, &task, &free);
+            let Some(first) = crossing.steps.iter().position(|step| {
+                let kin = robot.forward(&step.q);
+                first_contact(&robot, &task, &kin, &surface_config.constraints).is_some()
+            }) else {
+                continue;
+            };
+            let failure = checker()
+                .check(&task, &crossing, &surface_config.constraints)
+                .expect_err("crossing the surface fails");
+            assert_eq!(failure.check, FailedCheck::SceneContact, "task {index}");
+            assert_eq!(failure.step, first, "task {index}: {failure}");
+            assert!(failure.to_string().contains(WORK_SURFACE), "{failure}");
+            caught += 1;
+        }
+        assert!(
+            caught >= least,
+            "{surface}: only {caught} of 120 rollouts cross their surface"
+        );
     }
-    assert!(
-        caught > 5,
-        "only {caught} of 60 rollouts cross their surface"
-    );
+}
+
+#[test]
+fn an_elbow_dipping_into_the_plate_is_caught_and_a_plate_beside_it_is_not() {
+    let robot = robot();
+    let checker = checker();
+    let (_, sampled) = tasks(&robot, 1).remove(0);
+    let q = sampled.q0_seed.expect("a sampled task has its seed");
+    let kin = robot.forward(&q);
+    // The fourth link's capsules: the elbow.
+    let elbow = robot
+        .capsules()
+        .iter()
+        .find(|c| c.link == "link4")
+        .expect("the FR3 has a link4 capsule");
+    let elbow_point = kin.segment_point(elbow.segment, &elbow.start);
+    let n = Vec3::new(0.0, 0.0, -1.0);
+    let d = Vec3::new(1.0, 0.0, 0.0);
+    let across = n.cross(&d);
+    // A line whose plate's top face lies 1 cm below the elbow's axis point, 0.5 m before it.
+    let dipping = |offset_across: f64| {
+        let p0 = elbow_point - n * (0.01 + elbow.radius) - d * 0.5 + across * offset_across;
+        emg_control::Task::new(&robot, p0, d, n, None).unwrap()
+    };
+    let plate = ConstraintConfig {
+        work_surface: WorkSurface::plate(),
+        ..ConstraintConfig::default()
+    };
+    let half_space = ConstraintConfig {
+        work_surface: WorkSurface::HalfSpace,
+        ..ConstraintConfig::default()
+    };
+    for (task, constraints, touches) in [
+        (dipping(0.0), &plate, true),
+        (dipping(0.0), &half_space, true),
+        (dipping(Plate::default().half_width_m + 0.2), &plate, false),
+        (
+            dipping(Plate::default().half_width_m + 0.2),
+            &half_space,
+            true,
+        ),
+    ] {
+        let library = first_contact(&robot, &task, &kin, constraints);
+        let (margin, link, _) = checker
+            .scene_margin(&q, &(&task).into(), &(constraints).into())
+            .expect("a surface to keep off");
+        assert_eq!(
+            matches!(library, Some(Violation::SceneContact { .. })),
+            touches,
+            "{}: {library:?}",
+            constraints.work_surface
+        );
+        assert_eq!(margin < 0.0, touches, "{link}: {margin}");
+    }
 }
 
 #[test]
@@ -243,7 +313,32 @@ fn constraint_files_carry_the_surface_and_the_scene() {
     let text = r#"{"work_surface": true, "scene": {"obstacles": [
         {"name": "table", "half_space": {"point": [0, 0, -0.01], "normal": [0, 0, 1]}}]}}"#;
     let constraints: ConstraintConfig = serde_json::from_str(text).unwrap();
-    assert!(constraints.work_surface);
+    assert_eq!(constraints.work_surface, WorkSurface::HalfSpace);
+    let plate: ConstraintConfig =
+        serde_json::from_str(r#"{"work_surface": {"plate": {"ahead_m": 1.0}}}"#).unwrap();
+    assert_eq!(
+        plate.work_surface,
+        WorkSurface::Plate(Plate {
+            ahead_m: 1.0,
+            ..Plate::default()
+        })
+    );
+    for (text, surface) in [
+        (r#"{"work_surface": "plate"}"#, WorkSurface::plate()),
+        (r#"{"work_surface": "off"}"#, WorkSurface::Off),
+        (r#"{"work_surface": false}"#, WorkSurface::Off),
+    ] {
+        let read: ConstraintConfig = serde_json::from_str(text).unwrap();
+        assert_eq!(read.work_surface, surface, "{text}");
+        let again: ConstraintConfig =
+            serde_json::from_str(&serde_json::to_string(&read).unwrap()).unwrap();
+        assert_eq!(again, read);
+    }
+    let error = serde_json::from_str::<ConstraintConfig>(
+        r#"{"work_surface": {"plate": {"thickness_m": -1}}}"#,
+    )
+    .unwrap_err();
+    assert!(error.to_string().contains("plate.thickness_m"), "{error}");
     assert_eq!(constraints.scene.obstacles[0].name, "table");
     let again: ConstraintConfig =
         serde_json::from_str(&serde_json::to_string(&constraints).unwrap()).unwrap();

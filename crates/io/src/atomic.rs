@@ -11,7 +11,9 @@ const PARTIAL_SUFFIX: &str = ".partial";
 /// (synced, then renamed into place), creating missing parent directories, so an interrupted
 /// write never leaves a half-written file at `path`, and several processes writing the same
 /// file at once (job-array elements on shared storage) each rename a whole file of their own.
-/// A crash between the write and the rename leaves only the `.partial` file.
+/// A crash between the write and the rename leaves only the `.partial` file. The file gets the
+/// permissions any new file gets (read-write for all, less the process's umask: 0644 under
+/// the usual umask 022), not a temporary file's 0600.
 pub fn write_atomically(path: impl AsRef<Path>, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
     let path = path.as_ref();
     let parent = match path.parent().filter(|p| !p.as_os_str().is_empty()) {
@@ -31,10 +33,15 @@ pub fn write_atomically(path: impl AsRef<Path>, bytes: impl AsRef<[u8]>) -> std:
         })?
         .to_os_string();
     prefix.push(".");
-    let mut staging = tempfile::Builder::new()
-        .prefix(&prefix)
-        .suffix(PARTIAL_SUFFIX)
-        .tempfile_in(parent)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(PARTIAL_SUFFIX);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // The kernel clears the umask's bits of the mode a file is created with.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut staging = builder.tempfile_in(parent)?;
     staging.write_all(bytes.as_ref())?;
     staging.as_file().sync_all()?;
     staging.persist(path).map_err(|e| e.error)?;
@@ -140,6 +147,18 @@ mod tests {
         let error = open_journal(&journal, "{\"set\": 2}\n").unwrap_err();
         assert!(matches!(error, JournalError::Mismatch { .. }), "{error}");
         assert!(error.to_string().contains("remove"), "{error}");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn written_files_get_the_permissions_of_new_files() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let (plain, atomic) = (dir.path().join("plain"), dir.path().join("atomic"));
+        std::fs::write(&plain, b"x").unwrap();
+        write_atomically(&atomic, b"x").unwrap();
+        let mode = |path: &Path| std::fs::metadata(path).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&atomic), mode(&plain));
     }
 
     #[test]

@@ -16,7 +16,7 @@
 //!   file disables ([`PairRule`]).
 //! * [`fit_capsules`]: bounding capsules of meshes and other collision geometry.
 //! * [`Robot::first_contact`]: capsule clearances from the obstacles of a [`Scene`] and from a
-//!   task's work surface ([`Shape::work_surface`]).
+//!   task's work surface ([`WorkSurface`]: a finite [`Plate`] or a half-space).
 //! * [`project_to_pose`]: Newton projection onto an exact `(p0, n[, roll])` pose within limits.
 //!
 //! ```
@@ -56,7 +56,9 @@ pub use projection::{
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
 pub use rotation::{rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
-pub use scene::{ContactHit, Obstacle, ObstacleError, Scene, Shape, ToolContact};
+pub use scene::{
+    ContactHit, Obstacle, ObstacleError, Plate, Scene, Shape, ToolContact, WorkSurface,
+};
 pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
 
 /// Number of actuated joints of every supported arm.

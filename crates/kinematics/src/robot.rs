@@ -239,12 +239,25 @@ impl Robot {
     /// Reads a URDF file whose links form one chain: from its root link to its only leaf link
     /// (pair rule as [`Robot::from_urdf_file`]).
     pub fn from_chain_file(path: impl AsRef<Path>) -> Result<Self, RobotError> {
+        Self::from_file_between(path, None, None)
+    }
+
+    /// Reads the chain of a URDF file from `base_link` (default: the file's only root link) to
+    /// `tip_link` (default: its only leaf link), pair rule as [`Robot::from_urdf_file`].
+    pub fn from_file_between(
+        path: impl AsRef<Path>,
+        base_link: Option<&str>,
+        tip_link: Option<&str>,
+    ) -> Result<Self, RobotError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
             path: path.display().to_string(),
             source,
         })?;
-        Self::chain_with_rule(&text, PairRule::for_robot_file(path)?)
+        let urdf =
+            urdf_rs::read_from_string(&text).map_err(|e| RobotError::Malformed(e.to_string()))?;
+        let (base, tip) = chain_ends(&urdf, base_link, tip_link)?;
+        Self::from_urdf_str_with_rule(&text, &base, &tip, PairRule::for_robot_file(path)?)
     }
 
     /// Reads URDF text whose links form one chain: from its root link to its only leaf link.
@@ -256,7 +269,7 @@ impl Robot {
     fn chain_with_rule(text: &str, pair_rule: PairRule) -> Result<Self, RobotError> {
         let urdf =
             urdf_rs::read_from_string(text).map_err(|e| RobotError::Malformed(e.to_string()))?;
-        let (base, tip) = chain_ends(&urdf)?;
+        let (base, tip) = chain_ends(&urdf, None, None)?;
         Self::from_urdf_str_with_rule(text, &base, &tip, pair_rule)
     }
 
@@ -461,8 +474,12 @@ impl Robot {
 }
 
 /// The joints from `base` down to `tip`, in order, checking the chain is serial.
-/// The root and the leaf of a file whose links form one unbranched chain.
-fn chain_ends(urdf: &urdf_rs::Robot) -> Result<(String, String), RobotError> {
+/// The chain's base and tip: those named, else the file's only root and only leaf link.
+fn chain_ends(
+    urdf: &urdf_rs::Robot,
+    base: Option<&str>,
+    tip: Option<&str>,
+) -> Result<(String, String), RobotError> {
     let is_child = |name: &str| urdf.joints.iter().any(|j| j.child.link == name);
     let is_parent = |name: &str| urdf.joints.iter().any(|j| j.parent.link == name);
     let names = |keep: &dyn Fn(&str) -> bool| {
@@ -474,8 +491,13 @@ fn chain_ends(urdf: &urdf_rs::Robot) -> Result<(String, String), RobotError> {
     };
     let roots = names(&|name| !is_child(name));
     let leaves = names(&|name| !is_parent(name));
-    match (roots.as_slice(), leaves.as_slice()) {
-        ([root], [leaf]) => Ok((root.to_string(), leaf.to_string())),
+    let only = |given: Option<&str>, found: &[&str]| match (given, found) {
+        (Some(name), _) => Some(name.to_string()),
+        (None, [one]) => Some(one.to_string()),
+        (None, _) => None,
+    };
+    match (only(base, &roots), only(tip, &leaves)) {
+        (Some(base), Some(tip)) => Ok((base, tip)),
         _ => Err(RobotError::AmbiguousChain {
             roots: roots.join(", "),
             leaves: leaves.join(", "),

@@ -59,6 +59,50 @@ impl Shape {
         }
     }
 
+    /// The work plate of a task: the box [`Plate`] describes, its top face in the plane through
+    /// `p0` with normal `n`, its length along the unit direction `d`, its material on the side
+    /// `(x − p0)·n > 0`.
+    pub fn work_plate(p0: &Vec3, d: &Vec3, n: &Vec3, plate: &Plate) -> Self {
+        let across = n.cross(d);
+        let centre =
+            p0 + d * (0.5 * (plate.ahead_m - plate.behind_m)) + n * (0.5 * plate.thickness_m);
+        Self::Cuboid {
+            centre,
+            rotation: Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_columns(&[
+                *d, across, *n,
+            ])),
+            half_extents: Vec3::new(
+                0.5 * (plate.ahead_m + plate.behind_m),
+                plate.half_width_m,
+                0.5 * plate.thickness_m,
+            ),
+        }
+    }
+
+    /// A lower bound (m) on [`Shape::segment_distance`] that costs a few dot products: for a box
+    /// the largest gap between the segment and one of the six slabs' half-spaces holding it
+    /// (the box lies inside each), else the distance itself.
+    pub fn segment_distance_lower_bound(&self, a: &Vec3, b: &Vec3) -> f64 {
+        match self {
+            Self::Cuboid {
+                centre,
+                rotation,
+                half_extents,
+            } => {
+                let la = rotation.inverse_transform_vector(&(a - centre));
+                let lb = rotation.inverse_transform_vector(&(b - centre));
+                (0..3)
+                    .map(|i| {
+                        let above = la[i].min(lb[i]) - half_extents[i];
+                        let below = -la[i].max(lb[i]) - half_extents[i];
+                        above.max(below)
+                    })
+                    .fold(f64::NEG_INFINITY, f64::max)
+            }
+            _ => self.segment_distance(a, b),
+        }
+    }
+
     /// Signed distance (m) between the segment `a`–`b` and the solid: the gap between them when
     /// apart, minus the depth of the segment's deepest point when it enters the solid.
     pub fn segment_distance(&self, a: &Vec3, b: &Vec3) -> f64 {
@@ -127,6 +171,155 @@ fn cuboid_segment_distance(a: &Vec3, b: &Vec3, h: &Vec3) -> f64 {
         }
     }
     gap
+}
+
+/// The part a task's line is drawn on, which every capsule of the arm but the tool's keeps off
+/// (SPEC §9 with a finite part): JSON `"plate"` (the default [`Plate`]), `{"plate": {...}}`
+/// (its fields, unset ones at their defaults), `"half_space"` (the whole half-space behind the
+/// plane through `p0` with normal `n`; `true` reads as this, as files written before plates
+/// existed mean it) or `"off"` (`false`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "WorkSurfaceFile", into = "WorkSurfaceFile")]
+pub enum WorkSurface {
+    /// No work surface: the paper's protocol.
+    #[default]
+    Off,
+    /// A finite plate under the line.
+    Plate(Plate),
+    /// The infinite half-space behind the plane through `p0` with normal `n`.
+    HalfSpace,
+}
+
+impl WorkSurface {
+    /// The default plate.
+    pub fn plate() -> Self {
+        Self::Plate(Plate::default())
+    }
+
+    /// Whether there is no work surface.
+    pub fn is_off(&self) -> bool {
+        *self == Self::Off
+    }
+
+    /// The solid of the task `(p0, d, n)`'s work surface, if any.
+    pub fn shape(&self, p0: &Vec3, d: &Vec3, n: &Vec3) -> Option<Shape> {
+        match self {
+            Self::Off => None,
+            Self::Plate(plate) => Some(Shape::work_plate(p0, d, n, plate)),
+            Self::HalfSpace => Some(Shape::work_surface(p0, n)),
+        }
+    }
+}
+
+impl std::fmt::Display for WorkSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Off => f.write_str("off"),
+            Self::HalfSpace => f.write_str("half-space"),
+            Self::Plate(p) => write!(
+                f,
+                "plate {:.2} m wide, {:.2} m behind p0 to {:.2} m ahead, {:.3} m thick",
+                2.0 * p.half_width_m,
+                p.behind_m,
+                p.ahead_m,
+                p.thickness_m
+            ),
+        }
+    }
+}
+
+impl std::str::FromStr for WorkSurface {
+    type Err = String;
+
+    /// `plate`, `half-space` (or `half_space`) or `off`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "plate" => Ok(Self::plate()),
+            "half-space" | "half_space" => Ok(Self::HalfSpace),
+            "off" => Ok(Self::Off),
+            other => Err(format!(
+                "unknown work surface '{other}': give plate (a finite part under the line), \
+                 half-space (the whole plane) or off"
+            )),
+        }
+    }
+}
+
+/// A work plate's extent around the task line, in the line's frame: from `behind_m` before
+/// `p0` to `ahead_m` beyond it along `d`, `half_width_m` to each side, `thickness_m` deep below
+/// the plane through `p0` with normal `n`. The defaults (0.2 m wide, 0.05 m behind, 2 m ahead,
+/// 0.05 m thick) make a strip longer than any line a 7-DoF arm of a metre's reach can draw, so
+/// the plate never ends a line, and narrow enough that an arm beside it keeps clear of it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Plate {
+    /// Half the plate's width across the line (m).
+    pub half_width_m: f64,
+    /// How far the plate reaches behind `p0`, against `d` (m).
+    pub behind_m: f64,
+    /// How far the plate reaches beyond `p0`, along `d` (m).
+    pub ahead_m: f64,
+    /// The plate's thickness below the surface (m).
+    pub thickness_m: f64,
+}
+
+impl Default for Plate {
+    fn default() -> Self {
+        Self {
+            half_width_m: 0.1,
+            behind_m: 0.05,
+            ahead_m: 2.0,
+            thickness_m: 0.05,
+        }
+    }
+}
+
+/// The serialised form of a [`WorkSurface`].
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+enum WorkSurfaceFile {
+    Flag(bool),
+    Name(String),
+    Plate { plate: Plate },
+}
+
+impl TryFrom<WorkSurfaceFile> for WorkSurface {
+    type Error = String;
+
+    fn try_from(file: WorkSurfaceFile) -> Result<Self, String> {
+        let surface = match file {
+            WorkSurfaceFile::Flag(true) => Self::HalfSpace,
+            WorkSurfaceFile::Flag(false) => Self::Off,
+            WorkSurfaceFile::Name(name) => name.parse()?,
+            WorkSurfaceFile::Plate { plate } => Self::Plate(plate),
+        };
+        if let Self::Plate(plate) = &surface {
+            let sizes = [
+                ("plate.half_width_m", plate.half_width_m),
+                ("plate.behind_m", plate.behind_m),
+                ("plate.ahead_m", plate.ahead_m),
+                ("plate.thickness_m", plate.thickness_m),
+            ];
+            for (field, value) in sizes {
+                if !(value.is_finite() && value >= 0.0) {
+                    return Err(format!(
+                        "work_surface.{field} must be a finite length ≥ 0, got {value}"
+                    ));
+                }
+            }
+        }
+        Ok(surface)
+    }
+}
+
+impl From<WorkSurface> for WorkSurfaceFile {
+    fn from(surface: WorkSurface) -> Self {
+        match surface {
+            WorkSurface::Off => Self::Name("off".to_string()),
+            WorkSurface::HalfSpace => Self::Name("half_space".to_string()),
+            WorkSurface::Plate(plate) => Self::Plate { plate },
+        }
+    }
 }
 
 /// One obstacle of the cell: a named solid and the clearance the arm keeps from it.
@@ -206,6 +399,9 @@ impl Robot {
             let capsule = &self.capsules[index];
             let start = kin.segment_point(capsule.segment, &capsule.start);
             let end = kin.segment_point(capsule.segment, &capsule.end);
+            if shape.segment_distance_lower_bound(&start, &end) - capsule.radius >= clearance {
+                return None;
+            }
             let distance = shape.segment_distance(&start, &end) - capsule.radius;
             // NaN counts as a contact.
             (distance.is_nan() || distance < clearance).then_some(ContactHit {

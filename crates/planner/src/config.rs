@@ -6,6 +6,7 @@ use std::path::Path;
 
 use emg_control::{ClassicalGains, OutOfRange, RolloutConfig};
 use emg_hybrid::{BoundaryMeasure, SwitchConfig, SwitchConfigError};
+use emg_kinematics::WorkSurface;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ExecutorConfig;
@@ -39,6 +40,9 @@ pub struct PlannerConfig {
     pub search: SearchConfig,
 }
 
+/// Where a configuration's JSON sets the work surface.
+const SURFACE_FIELD: &str = "/rollout/constraints/work_surface";
+
 /// Why a configuration file cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
@@ -68,6 +72,16 @@ pub enum ConfigError {
 }
 
 impl PlannerConfig {
+    /// The configuration of a work cell, what `emg plan` and Python plan with when given none:
+    /// the defaults with the task's work plate on ([`WorkSurface::plate`]: the arm keeps off a
+    /// plate under the line). [`PlannerConfig::default`] is the paper's protocol, with no work
+    /// surface.
+    pub fn cell() -> Self {
+        let mut config = Self::default();
+        config.rollout.constraints.work_surface = WorkSurface::plate();
+        config
+    }
+
     /// The controllers' settings.
     pub fn executor(&self) -> ExecutorConfig {
         ExecutorConfig {
@@ -106,12 +120,19 @@ impl PlannerConfig {
         Self::from_json(&path.display().to_string(), &text)
     }
 
-    /// Parses and validates a configuration's JSON text; `origin` names it in errors.
+    /// Parses and validates a configuration's JSON text; `origin` names it in errors. Unset
+    /// fields keep the values of [`PlannerConfig::cell`]: a text that sets no
+    /// `rollout.constraints.work_surface` plans with the work plate.
     pub fn from_json(origin: &str, text: &str) -> Result<Self, ConfigError> {
-        let config: Self = serde_json::from_str(text).map_err(|e| ConfigError::Parse {
+        let parse_error = |e: serde_json::Error| ConfigError::Parse {
             path: origin.to_string(),
             message: e.to_string(),
-        })?;
+        };
+        let mut config: Self = serde_json::from_str(text).map_err(parse_error)?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(parse_error)?;
+        if value.pointer(SURFACE_FIELD).is_none() {
+            config.rollout.constraints.work_surface = WorkSurface::plate();
+        }
         config.validate()?;
         Ok(config)
     }

@@ -22,6 +22,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod cartesian;
 mod config;
 mod controller;
 mod demo;
@@ -36,6 +37,7 @@ mod shipped;
 mod timing;
 mod track;
 
+pub use cartesian::{CartesianConfig, CartesianEnd, CartesianPath, cartesian_path};
 pub use config::{ConfigError, PlannerConfig};
 pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
 pub use demo::demo_task;
@@ -50,6 +52,8 @@ pub use reach::{
     MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE, reach, shortfall, witness_chains,
 };
 pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig};
-pub use seed::{Seed, SeedError, SeedSource, prepare_seed};
+pub use seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed, seed_source_meaning};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
-pub use timing::{DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside};
+pub use timing::{
+    ASSUMED_LIMITS, DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside,
+};

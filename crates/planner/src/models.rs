@@ -8,6 +8,8 @@ use emg_kinematics::Robot;
 use emg_learning::{RobotStamp, StampError, check_stamp};
 use emg_policy::{PolicyWeights, RlController};
 
+use crate::controller::ControllerKind;
+
 /// File name of a robot's shipped diffusion-seeder weights, in its `models/` directory.
 pub const DIFFUSION_WEIGHTS_FILE: &str = "diffusion-v1.weights";
 
@@ -60,6 +62,16 @@ pub enum ModelsError {
 }
 
 impl Models {
+    /// The strongest controller these models allow: the hybrid with a policy, else the
+    /// classical controller (what `emg plan` and Python run unless told otherwise).
+    pub fn best_controller(&self) -> ControllerKind {
+        if self.policy.is_some() {
+            ControllerKind::Hybrid
+        } else {
+            ControllerKind::Classical
+        }
+    }
+
     /// Loads the models of `robot` whose files are given (with the default DP seed settings);
     /// each file must have been trained for `robot`.
     pub fn load(

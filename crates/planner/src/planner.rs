@@ -11,7 +11,7 @@ use crate::models::Models;
 use crate::parse::ParseError;
 use crate::reach::{Reach, reach};
 use crate::search::{SearchContext, search};
-use crate::seed::{Seed, SeedError, SeedSource, prepare_seed};
+use crate::seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed};
 
 /// What to plan with: the planner, the seed source (`None` picks `dp` when the seeder is
 /// loaded, else `generating` when the task has a `q0_seed`, else `home`) and the controller.
@@ -27,8 +27,20 @@ pub struct PlanRequest {
 }
 
 impl Default for PlanRequest {
-    /// The paper's full pipeline: one DP seed (when loaded) and the hybrid controller.
+    /// What `emg plan` and Python run: the search ([`PlannerKind::Search`]) from the default
+    /// seed, with the hybrid controller.
     fn default() -> Self {
+        Self {
+            planner: PlannerKind::Search,
+            ..Self::pipeline()
+        }
+    }
+}
+
+impl PlanRequest {
+    /// The paper's full pipeline: one DP seed (when loaded) and one rollout of the hybrid
+    /// controller.
+    pub fn pipeline() -> Self {
         Self {
             planner: PlannerKind::Controller,
             seed: None,
@@ -148,8 +160,26 @@ impl Planner {
         let executor = self.config.executor();
         let mut controller =
             Executor::new(request.controller, self.models.policy.as_ref(), &executor)?;
-        let seed = self.seed(task, request)?;
         if request.planner == PlannerKind::Search {
+            // A seed that cannot be put on the start pose leaves the search its other starts,
+            // from the scan's configuration at p0.
+            let (seed, mut reach) = match self.seed(task, request) {
+                Ok(seed) => {
+                    let reach = self.reach(task, &[seed.q]);
+                    (seed, reach)
+                }
+                Err(error @ SeedError::Projection { .. }) => {
+                    let reach = self.reach(task, &[]);
+                    let q = *reach.witnesses.first().ok_or(error)?;
+                    let seed = Seed {
+                        q,
+                        source: SCAN_SOURCE,
+                        projection_iterations: None,
+                    };
+                    (seed, reach)
+                }
+                Err(error) => return Err(error.into()),
+            };
             let context = SearchContext {
                 robot: &self.robot,
                 rollout: &self.config.rollout,
@@ -158,7 +188,6 @@ impl Planner {
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
             };
-            let mut reach = self.reach(task, &[seed.q]);
             let (seed, trajectory) =
                 search(&context, task, seed, request.controller, controller, &reach)?;
             reach.witness(&trajectory);
@@ -168,6 +197,7 @@ impl Planner {
                 reach: Some(reach),
             });
         }
+        let seed = self.seed(task, request)?;
         let trajectory = rollout(
             &self.robot,
             task,

@@ -79,13 +79,41 @@ impl FromStr for SeedSource {
     }
 }
 
+/// The source of a search's start taken from the reachability scan's configuration at `p0`
+/// when the requested seed cannot be put on the start pose.
+pub const SCAN_SOURCE: &str = "scan";
+
+/// What a seed's source (its name in output and files) means: the sources of
+/// [`SeedSource::name`] and the search's own starts (`ik`, [`crate::CHAIN_SOURCE`],
+/// [`SCAN_SOURCE`]).
+pub fn seed_source_meaning(name: &str) -> &'static str {
+    match name {
+        "dp" => "the diffusion seeder's start",
+        "generating" => "the configuration the task was generated from",
+        "home" => "the mid-range configuration, projected onto the start pose",
+        "given" => "the configuration given",
+        "q_mu" => "a manipulability ascent from the generating configuration",
+        "q_jl" => "a joint-centring ascent from the generating configuration",
+        "ik" => "a start the search found by inverse kinematics at p0 within the cone",
+        crate::search::CHAIN_SOURCE => {
+            "the reachability scan's chain of configurations from p0, followed by the search"
+        }
+        SCAN_SOURCE => {
+            "the reachability scan's configuration at p0 (the requested seed could not be put \
+             on the start pose)"
+        }
+        _ => "a start of the search",
+    }
+}
+
 /// A seed ready for the rollout.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Seed {
     /// The configuration the rollout starts from.
     pub q: JointVector,
-    /// Where it came from (`dp`, `generating`, `home`, `given`, `q_mu`, `q_jl`); a DP or
-    /// heuristic seed that fell back to `q0_seed` reports `generating`.
+    /// Where it came from (`dp`, `generating`, `home`, `given`, `q_mu`, `q_jl`, or a search's
+    /// own start: [`seed_source_meaning`]); a DP or heuristic seed that fell back to `q0_seed`
+    /// reports `generating`.
     pub source: &'static str,
     /// Newton iterations spent projecting it onto `(p0, n)`; `None` when it was already there.
     pub projection_iterations: Option<usize>,

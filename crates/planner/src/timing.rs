@@ -36,11 +36,56 @@ pub enum TimingSetupError {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MotionTiming {
     limits_file: String,
+    assumed: bool,
     scaling: Scaling,
     request: TimingRequest,
 }
 
+/// What [`MotionTiming::record`] names as the limits' file when they were assumed.
+pub const ASSUMED_LIMITS: &str = "assumed";
+
 impl MotionTiming {
+    /// Timing for the robot read from `robot_file`, as [`MotionTiming::new`], with the limits
+    /// of `limits` (a MoveIt joint_limits.yaml), else of the one beside the robot file
+    /// ([`limits_file_beside`]), else assumed ([`DynamicLimits::assumed`]: the robot file's
+    /// velocities with conservative acceleration and jerk limits; [`MotionTiming::assumed`]
+    /// says so).
+    pub fn for_robot_file(
+        robot: &Robot,
+        robot_file: &Path,
+        limits: Option<&Path>,
+        scaling: Scaling,
+        tool_speed_m_per_s: f64,
+        rate_hz: f64,
+        constraints: &ConstraintConfig,
+    ) -> Result<Self, TimingSetupError> {
+        let beside = limits_file_beside(robot_file);
+        let (limits, origin, assumed) = match limits {
+            Some(path) => (DynamicLimits::read(path, robot)?, path, false),
+            None if beside.exists() => (
+                DynamicLimits::read(&beside, robot)?,
+                beside.as_path(),
+                false,
+            ),
+            None => (
+                DynamicLimits::assumed(robot),
+                Path::new(ASSUMED_LIMITS),
+                true,
+            ),
+        };
+        let mut timing = Self::with_limits(
+            robot,
+            limits,
+            origin,
+            scaling,
+            tool_speed_m_per_s,
+            rate_hz,
+            constraints,
+        )?;
+        timing.assumed = assumed;
+        Ok(timing)
+    }
+
     /// Timing for `robot` with the limits of `limits_file` scaled by `scaling`, each velocity
     /// limit at most the robot file's times `constraints.velocity_limit_fraction` (the bound
     /// every planned step holds), the tool at most `tool_speed_m_per_s`, sampled at `rate_hz`.
@@ -52,13 +97,33 @@ impl MotionTiming {
         rate_hz: f64,
         constraints: &ConstraintConfig,
     ) -> Result<Self, TimingSetupError> {
+        let limits = DynamicLimits::read(limits_file, robot)?;
+        Self::with_limits(
+            robot,
+            limits,
+            limits_file,
+            scaling,
+            tool_speed_m_per_s,
+            rate_hz,
+            constraints,
+        )
+    }
+
+    /// Timing with `limits` (read from `origin`), as [`MotionTiming::new`].
+    fn with_limits(
+        robot: &Robot,
+        limits: DynamicLimits,
+        origin: &Path,
+        scaling: Scaling,
+        tool_speed_m_per_s: f64,
+        rate_hz: f64,
+        constraints: &ConstraintConfig,
+    ) -> Result<Self, TimingSetupError> {
         let fraction = constraints
             .velocity_limit_fraction
             .map_or(1.0, |fraction| fraction.get());
         let ceiling: JointVector = robot.limits().velocity * fraction;
-        let limits = DynamicLimits::read(limits_file, robot)?
-            .scaled(scaling)
-            .with_velocity_ceiling(&ceiling);
+        let limits = limits.scaled(scaling).with_velocity_ceiling(&ceiling);
         let request = TimingRequest {
             limits,
             tool_speed_m_per_s,
@@ -66,10 +131,16 @@ impl MotionTiming {
         };
         request.validate()?;
         Ok(Self {
-            limits_file: limits_file.display().to_string(),
+            limits_file: origin.display().to_string(),
+            assumed: false,
             scaling,
             request,
         })
+    }
+
+    /// Whether the acceleration and jerk limits were assumed, no limits file being found.
+    pub fn assumed(&self) -> bool {
+        self.assumed
     }
 
     /// What the timing asks for (the effective limits, tool speed and rate).

@@ -314,7 +314,7 @@ fn plan_briefly(robot: &Robot, mut config: PlannerConfig, task: &Task) {
     let request = PlanRequest {
         seed: None,
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let _ = planner.plan(task, &request);
 }
@@ -424,7 +424,7 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
     let request = PlanRequest {
         seed: Some(SeedSource::Home),
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let plan = planner.plan(&task, &request).expect("the demo task plans");
     let trajectory = &plan.trajectory;
@@ -661,7 +661,7 @@ fn option_values_are_read_or_refused() {
         let request = PlanRequest {
             seed: Some(seed),
             controller: ControllerKind::Classical,
-            ..PlanRequest::default()
+            ..PlanRequest::pipeline()
         };
         let _ = planner.plan(&demo_task(fr3()).expect("demo task"), &request);
         true

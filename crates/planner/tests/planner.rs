@@ -57,7 +57,7 @@ fn each_kind_plans_what_its_controller_rolls_out() {
             let request = PlanRequest {
                 seed: Some(SeedSource::Generating),
                 controller: kind,
-                ..PlanRequest::default()
+                ..PlanRequest::pipeline()
             };
             let plan = planner.plan(&task, &request).expect("plans");
             assert_eq!(plan.seed.q, seed);
@@ -93,7 +93,7 @@ fn each_kind_plans_what_its_controller_rolls_out() {
 fn plans_pass_the_checker_and_do_not_depend_on_the_thread_count() {
     let planner = planner(shipped_models());
     let tasks = eval_tasks(planner.robot(), 24);
-    let request = PlanRequest::default();
+    let request = PlanRequest::pipeline();
     let on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -129,7 +129,7 @@ fn the_demo_plans_on_every_shipped_robot() {
         let models = Models::shipped(&robot, &shipped.data_dir(&data())).expect("models load");
         let planner = Planner::new(robot, models, PlannerConfig::default()).unwrap();
         let task = demo_task(planner.robot()).expect("demo task");
-        let plan = planner.plan(&task, &PlanRequest::default()).unwrap();
+        let plan = planner.plan(&task, &PlanRequest::pipeline()).unwrap();
         assert!(plan.trajectory.path_length_m > 0.1, "{}", shipped.name);
     }
 }
@@ -141,7 +141,7 @@ fn missing_models_and_seeds_are_named() {
     let learned = PlanRequest {
         seed: None,
         controller: ControllerKind::Rl,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let error = planner.plan(&task, &learned).unwrap_err();
     assert!(matches!(error, PlanError::Controller(_)), "{error}");
@@ -150,7 +150,7 @@ fn missing_models_and_seeds_are_named() {
     let dp = PlanRequest {
         seed: Some(SeedSource::Dp),
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let error = planner.plan(&task, &dp).unwrap_err();
     assert!(
@@ -165,7 +165,7 @@ fn missing_models_and_seeds_are_named() {
     let generating = PlanRequest {
         seed: Some(SeedSource::Generating),
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let error = planner.plan(&unseeded, &generating).unwrap_err();
     assert!(error.to_string().contains("q0_seed"), "{error}");
@@ -173,7 +173,7 @@ fn missing_models_and_seeds_are_named() {
     let default = PlanRequest {
         seed: None,
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let plan = planner.plan(&unseeded, &default).unwrap();
     assert_eq!(plan.seed.source, "home");

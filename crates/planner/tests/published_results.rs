@@ -61,11 +61,11 @@ fn plan_the_published_lengths(shipped: ShippedRobot) {
     assert!(rows.len() >= 2, "a pipeline row and at least one budget");
     for row in rows {
         let (request, config) = match row["budget_steps"].as_u64() {
-            None => (PlanRequest::default(), PlannerConfig::default()),
+            None => (PlanRequest::pipeline(), PlannerConfig::default()),
             Some(budget_steps) => (
                 PlanRequest {
                     planner: PlannerKind::Search,
-                    ..PlanRequest::default()
+                    ..PlanRequest::pipeline()
                 },
                 PlannerConfig {
                     search: SearchConfig {

@@ -83,7 +83,7 @@ fn no_plan_goes_beyond_the_bound_and_every_witness_holds() {
     let request = PlanRequest {
         seed: Some(SeedSource::Generating),
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let mut beyond_plan = 0;
     for task in &tasks[..8] {
@@ -116,7 +116,7 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
     let request = PlanRequest {
         planner: emg_planner::PlannerKind::Search,
         controller: ControllerKind::Classical,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     };
     let constraints = &planner.config().rollout.constraints;
     for task in &tasks[..6] {

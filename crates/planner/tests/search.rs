@@ -51,7 +51,7 @@ fn tasks(robot: &Robot, count: usize) -> Vec<Task> {
 fn search_request() -> PlanRequest {
     PlanRequest {
         planner: PlannerKind::Search,
-        ..PlanRequest::default()
+        ..PlanRequest::pipeline()
     }
 }
 
@@ -65,7 +65,9 @@ fn search_never_returns_less_and_often_more() {
     let constraints = &planner.config().rollout.constraints;
     let (mut pipeline_total, mut search_total, mut longer, mut detoured) = (0.0, 0.0, 0, 0);
     for task in tasks(robot, 10) {
-        let pipeline = planner.plan(&task, &PlanRequest::default()).expect("plans");
+        let pipeline = planner
+            .plan(&task, &PlanRequest::pipeline())
+            .expect("plans");
         let searched = planner.plan(&task, &search_request()).expect("searches");
         checker
             .check(&task, &searched.trajectory, constraints)
@@ -129,7 +131,9 @@ fn a_spent_budget_gives_the_pipeline_plan() {
     let planner = planner(config);
     for task in tasks(planner.robot(), 4) {
         let searched = planner.plan(&task, &search_request()).expect("searches");
-        let pipeline = planner.plan(&task, &PlanRequest::default()).expect("plans");
+        let pipeline = planner
+            .plan(&task, &PlanRequest::pipeline())
+            .expect("plans");
         assert_eq!(
             (searched.seed, searched.trajectory),
             (pipeline.seed, pipeline.trajectory)
@@ -156,7 +160,7 @@ fn search_does_not_depend_on_the_thread_count() {
 #[test]
 fn search_holds_the_work_surface_and_the_scene() {
     let mut config = small_search();
-    config.rollout.constraints.work_surface = true;
+    config.rollout.constraints.work_surface = emg_kinematics::WorkSurface::plate();
     let free = planner(small_search());
     let robot = free.robot();
     let checker =

@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use emg_control::Trajectory;
 use emg_io::PlanPaths;
-use emg_kinematics::Vec3;
+use emg_kinematics::{Vec3, WorkSurface};
 use emg_planner::{
     ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, POLICY_WEIGHTS_FILE, PlanError, PlanFiles,
     PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
@@ -26,10 +26,12 @@ use emg_timing::Scaling;
 ///
 /// `robot`: a shipped robot (`"fr3"`, `"iiwa14"`) or a robot file. `models`: a directory holding
 /// `diffusion-v1.weights` and/or `ppo-v1.weights` (default: the ones shipped for a shipped
-/// robot; none for another robot file, which then plans with `seed` other than `"dp"` and
-/// `controller="classical"`). `config`: a planner configuration, as a JSON file or a dict of its
-/// fields (`rollout`, `gains`, `switch`, `measure`, `reach`, `search`); unset fields keep the
-/// defaults.
+/// robot; none for another robot file, which then plans with the classical controller).
+/// `config`: a planner configuration, as a JSON file or a dict of its fields (`rollout`,
+/// `gains`, `switch`, `measure`, `reach`, `search`); unset fields keep the defaults, the work
+/// plate on. `surface`: the part the line is drawn on, `"plate"` (the default: a plate under
+/// the line), `"half-space"` or `"off"` (the paper's protocol), over the config's; the same
+/// defaults as `emg plan`.
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct Planner {
     inner: Arc<emg_planner::Planner>,
@@ -63,8 +65,9 @@ struct Request {
 
 impl Request {
     fn parse(
+        models: &Models,
         seed: Option<&Bound<'_, PyAny>>,
-        controller: &str,
+        controller: Option<&str>,
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Self> {
@@ -83,9 +86,12 @@ impl Request {
                 )?)),
             }),
         };
-        let controller = controller
-            .parse::<ControllerKind>()
-            .map_err(|e| input_error("controller", &e))?;
+        let controller = match controller {
+            Some(name) => name
+                .parse::<ControllerKind>()
+                .map_err(|e| input_error("controller", &e))?,
+            None => models.best_controller(),
+        };
         let planner = match planner {
             Some(name) => name
                 .parse::<PlannerKind>()
@@ -170,7 +176,7 @@ fn plan_error(error: PlanError, request: &PlanRequest, index: Option<usize>) -> 
 /// The configuration a `config` argument gives: a JSON file or a dict of its fields.
 fn read_config(config: Option<&Bound<'_, PyAny>>) -> PyResult<PlannerConfig> {
     let Some(config) = config else {
-        return Ok(PlannerConfig::default());
+        return Ok(PlannerConfig::cell());
     };
     if config.is_instance_of::<PyDict>() {
         let text: String = config
@@ -224,15 +230,21 @@ pub(crate) fn array1<'py>(
 #[pymethods]
 impl Planner {
     #[new]
-    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None))]
+    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None, surface = None))]
     fn new(
         py: Python<'_>,
         robot: PathBuf,
         models: Option<PathBuf>,
         config: Option<&Bound<'_, PyAny>>,
+        surface: Option<&str>,
     ) -> PyResult<Self> {
         let robot = Robot::load(&robot)?;
-        let config = read_config(config)?;
+        let mut config = read_config(config)?;
+        if let Some(surface) = surface {
+            config.rollout.constraints.work_surface = surface
+                .parse::<WorkSurface>()
+                .map_err(|e| InputError::new_err(format!("surface: {e}")))?;
+        }
         let [diffusion, policy] = model_files(&robot.file, models.as_deref())?;
         let loaded = Models::load(&robot.inner, diffusion.as_deref(), policy.as_deref())
             .map_err(|e| input_error("models", &e))?;
@@ -266,11 +278,12 @@ impl Planner {
     ///
     /// `seed`: `"dp"`, `"generating"`, `"home"`, `"q_mu"`, `"q_jl"` or 7 joint angles (rad);
     /// `None` picks `"dp"` when the seeder is loaded, else `"home"`. `controller`: `"hybrid"`,
-    /// `"rl"` or `"classical"`. `planner`: `"controller"` (the paper's pipeline: one seed, one
-    /// rollout; the default) or `"search"` (many starts within a step budget, never shorter).
-    /// `reach`: also compute the task's reachability bound (`Plan.reachable_m`). The GIL is
-    /// released while planning.
-    #[pyo3(signature = (p0, d, n, seed = None, controller = "hybrid", planner = None, reach = false))]
+    /// `"rl"` or `"classical"`; `None` picks `"hybrid"` when the policy is loaded, else
+    /// `"classical"`. `planner`: `"search"` (the default, as `emg plan`: many starts within a
+    /// step budget, never shorter than the pipeline) or `"controller"` (the paper's pipeline:
+    /// one seed, one rollout). `reach`: also the task's reachability bound
+    /// (`Plan.reachable_m`), as `emg plan` prints it. The GIL is released while planning.
+    #[pyo3(signature = (p0, d, n, seed = None, controller = None, planner = None, reach = true))]
     #[allow(clippy::too_many_arguments)]
     fn plan(
         &self,
@@ -279,11 +292,11 @@ impl Planner {
         d: [f64; 3],
         n: [f64; 3],
         seed: Option<&Bound<'_, PyAny>>,
-        controller: &str,
+        controller: Option<&str>,
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Plan> {
-        let request = Request::parse(seed, controller, planner, reach)?;
+        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
         let task = self.task(p0, d, n, None)?;
         let planned = py
             .detach(|| self.plan_one(&task, &request))
@@ -295,17 +308,17 @@ impl Planner {
     /// triples) in parallel on all cores with the GIL released; the plans come in task order
     /// and do not depend on the number of threads. Arguments as for `plan`; the first task
     /// that fails raises, naming its index.
-    #[pyo3(signature = (tasks, seed = None, controller = "hybrid", planner = None, reach = false))]
+    #[pyo3(signature = (tasks, seed = None, controller = None, planner = None, reach = true))]
     fn plan_many(
         &self,
         py: Python<'_>,
         tasks: &Bound<'_, PyAny>,
         seed: Option<&Bound<'_, PyAny>>,
-        controller: &str,
+        controller: Option<&str>,
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Vec<Plan>> {
-        let request = Request::parse(seed, controller, planner, reach)?;
+        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
         let mut parsed = Vec::new();
         for (index, item) in tasks.try_iter()?.enumerate() {
             let item = item?;
@@ -490,7 +503,9 @@ impl Plan {
 
     /// Writes the files `emg plan --out STEM` writes, byte for byte: `STEM.json`
     /// (emg-trajectory/1), `STEM.csv` and `STEM.joint_trajectory.json` (timed as `timed` says,
-    /// with the same keyword arguments as `emg plan`'s options); returns their paths.
+    /// with the same keyword arguments as `emg plan`'s options); returns their paths. A plan
+    /// refused at its start (`termination` `"invalid_start"`) has nothing to save and raises
+    /// `PlanningError`, as `emg plan` writes nothing for it.
     #[pyo3(signature = (stem, limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = emg_planner::DEFAULT_RATE_HZ))]
     fn save(
         &self,
@@ -501,6 +516,14 @@ impl Plan {
         tool_speed: Option<f64>,
         rate_hz: f64,
     ) -> PyResult<Vec<PathBuf>> {
+        if let emg_control::Termination::InvalidStart { violation } =
+            &self.plan.trajectory.termination
+        {
+            return Err(PlanningError::new_err(format!(
+                "refused, nothing to save: the start configuration breaks a constraint: \
+                 {violation}"
+            )));
+        }
         let timing = motion_timing(
             &self.planner,
             Path::new(&self.robot),

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use emg_planner::{MotionTiming, limits_file_beside};
+use emg_planner::MotionTiming;
 use emg_timing::{Scaling, TimedMotion};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -12,7 +12,8 @@ use crate::planner::{array1, array2};
 
 /// The timing the keyword arguments of `Plan.timed` and `Plan.save` ask for, for `planner`'s
 /// robot read from `robot_file`: `limits` a MoveIt joint_limits.yaml (default: the one beside
-/// the robot file), `tool_speed` in m/s (default: the rollout's line speed).
+/// the robot file, else the robot file's velocities with assumed acceleration and jerk limits),
+/// `tool_speed` in m/s (default: the rollout's line speed).
 pub fn motion_timing(
     planner: &emg_planner::Planner,
     robot_file: &Path,
@@ -21,11 +22,11 @@ pub fn motion_timing(
     tool_speed: Option<f64>,
     rate_hz: f64,
 ) -> PyResult<MotionTiming> {
-    let limits = limits.unwrap_or_else(|| limits_file_beside(robot_file));
     let config = planner.config();
-    MotionTiming::new(
+    MotionTiming::for_robot_file(
         planner.robot(),
-        &limits,
+        robot_file,
+        limits.as_deref(),
         scaling,
         tool_speed.unwrap_or(config.rollout.speed_m_per_s),
         rate_hz,

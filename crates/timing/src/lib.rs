@@ -21,7 +21,9 @@ mod spline;
 mod topp;
 
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
-pub use limits::{DynamicLimits, LimitsError, Scaling};
+pub use limits::{
+    ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
+};
 pub use path::{CHECKS_PER_SEGMENT, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{

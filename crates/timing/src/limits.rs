@@ -7,6 +7,16 @@ use std::path::Path;
 use emg_kinematics::{DOF, JointVector, Robot};
 use serde::Deserialize;
 
+/// Acceleration limit (rad/s²) assumed for every joint of a robot whose vendor publishes none:
+/// conservative, half the 10 rad/s² a MoveIt configuration of the KUKA LBR iiwa uses
+/// (lbr_fri_ros2_stack), and half the FR3's published 10 rad/s².
+pub const ASSUMED_ACCELERATION_RAD_S2: f64 = 5.0;
+
+/// Jerk limit (rad/s³) assumed for every joint of a robot whose vendor publishes none: the jerk
+/// limit of the iiwa's MoveIt configuration in ICube-Robotics/iiwa_ros2, far below the FR3's
+/// published 5,000 rad/s³.
+pub const ASSUMED_JERK_RAD_S3: f64 = 300.0;
+
 /// Per-joint velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits, base to tip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DynamicLimits {
@@ -115,6 +125,36 @@ impl Scaling {
 }
 
 impl DynamicLimits {
+    /// Limits for a robot whose vendor gives no acceleration or jerk limits: the robot file's
+    /// velocity limits, [`ASSUMED_ACCELERATION_RAD_S2`] and [`ASSUMED_JERK_RAD_S3`].
+    pub fn assumed(robot: &Robot) -> Self {
+        Self {
+            velocity: robot.limits().velocity,
+            acceleration: JointVector::repeat(ASSUMED_ACCELERATION_RAD_S2),
+            jerk: JointVector::repeat(ASSUMED_JERK_RAD_S3),
+        }
+    }
+
+    /// These limits as a MoveIt `joint_limits.yaml` for `robot`'s joints, after the comment
+    /// lines of `header` (each prefixed with `# `); [`DynamicLimits::parse`] reads it back
+    /// exactly.
+    pub fn to_yaml(&self, robot: &Robot, header: &str) -> String {
+        let mut text: String = header.lines().map(|line| format!("# {line}\n")).collect();
+        text.push_str(
+            "default_velocity_scaling_factor: 1.0\ndefault_acceleration_scaling_factor: 1.0\n\
+             joint_limits:\n",
+        );
+        for (i, name) in robot.joint_names().iter().enumerate().take(DOF) {
+            text.push_str(&format!(
+                "  {name}:\n    has_velocity_limits: true\n    max_velocity: {:?}\n    \
+                 has_acceleration_limits: true\n    max_acceleration: {:?}\n    \
+                 has_jerk_limits: true\n    max_jerk: {:?}\n",
+                self.velocity[i], self.acceleration[i], self.jerk[i]
+            ));
+        }
+        text
+    }
+
     /// The limits of `robot`'s joints from a MoveIt `joint_limits.yaml` file.
     pub fn read(path: impl AsRef<Path>, robot: &Robot) -> Result<Self, LimitsError> {
         let path = path.as_ref();
@@ -201,5 +241,24 @@ impl DynamicLimits {
             velocity: self.velocity.inf(ceiling),
             ..self.clone()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn assumed_limits_written_as_yaml_read_back_exactly() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/iiwa14_pen.urdf");
+        let robot = Robot::from_chain_file(&path).unwrap();
+        let limits = DynamicLimits::assumed(&robot);
+        assert_eq!(limits.velocity, robot.limits().velocity);
+        let text = limits.to_yaml(&robot, "assumed limits\nsecond line");
+        assert!(
+            text.starts_with("# assumed limits\n# second line\n"),
+            "{text}"
+        );
+        assert_eq!(DynamicLimits::parse(&text, "t", &robot).unwrap(), limits);
     }
 }

@@ -87,7 +87,7 @@ fn a_rollout_becomes_a_rest_to_rest_motion_within_every_limit() {
         theta_max_deg: config.constraints.theta_max_deg,
         collision_margin_m: config.constraints.collision_margin_m,
         velocity_limit_fraction: None,
-        work_surface: false,
+        work_surface: None,
         obstacles: Vec::new(),
     };
     for sample in samples {

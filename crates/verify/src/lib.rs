@@ -19,7 +19,7 @@
 //!     theta_max_deg: 30.0,
 //!     collision_margin_m: 0.0,
 //!     velocity_limit_fraction: Some(1.0),
-//!     work_surface: false,
+//!     work_surface: None,
 //!     obstacles: Vec::new(),
 //! };
 //! let start = RecordedStep { time_s: 0.0, q, tcp, tool_angle_deg: 0.0 };
@@ -41,7 +41,7 @@ pub use dynamics::{
 };
 pub use model::{ModelError, ReferenceModel};
 pub use record::{
-    Blame, Bounds, Ending, JOINTS, Joints, Line, Obstacle, RecordedStep, Recording, Solid,
+    Blame, Bounds, Ending, JOINTS, Joints, Line, Obstacle, RecordedStep, Recording, Solid, Surface,
 };
 pub use replay::{
     DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,

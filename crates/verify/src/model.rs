@@ -356,13 +356,10 @@ impl ReferenceModel {
         bounds: &Bounds,
     ) -> Option<(f64, String, String)> {
         let frames = self.link_frames(q);
-        let surface = Solid::HalfSpace {
-            point: line.p0,
-            outward: -line.n,
-        };
-        let surface = bounds
-            .work_surface
-            .then_some((&surface, 0.0, WORK_SURFACE, true));
+        let surface = bounds.work_surface.map(|surface| surface.solid(line));
+        let surface = surface
+            .as_ref()
+            .map(|solid| (solid, 0.0, WORK_SURFACE, true));
         let obstacles = bounds
             .obstacles
             .iter()

@@ -46,11 +46,58 @@ pub struct Bounds {
     /// Joint speeds stay within this fraction of the robot file's velocity limits; `None` when
     /// joint speeds are not bounded.
     pub velocity_limit_fraction: Option<f64>,
-    /// Whether every capsule but the tool's stays on the free side of the line's work surface:
-    /// the plane through `p0` with normal `n`, the material where `(x − p0)·n > 0`.
-    pub work_surface: bool,
+    /// The line's work surface, which every capsule but the tool's stays off; `None` when
+    /// there is none.
+    pub work_surface: Option<Surface>,
     /// Obstacles every capsule of the arm keeps its distance from.
     pub obstacles: Vec<Obstacle>,
+}
+
+/// The part a line is drawn on, its material where `(x − p0)·n > 0`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Surface {
+    /// Everything beyond the plane through `p0` with normal `n`.
+    HalfSpace,
+    /// A plate whose top face lies in that plane: from `behind_m` before `p0` to `ahead_m`
+    /// beyond it along `d`, `half_width_m` to each side of the line, `thickness_m` deep.
+    Plate {
+        /// Half the width across the line (m).
+        half_width_m: f64,
+        /// Extent before `p0`, against `d` (m).
+        behind_m: f64,
+        /// Extent beyond `p0`, along `d` (m).
+        ahead_m: f64,
+        /// Depth along `n` (m).
+        thickness_m: f64,
+    },
+}
+
+impl Surface {
+    /// The solid of this surface under `line`.
+    pub fn solid(&self, line: &Line) -> Solid {
+        match *self {
+            Self::HalfSpace => Solid::HalfSpace {
+                point: line.p0,
+                outward: -line.n,
+            },
+            Self::Plate {
+                half_width_m,
+                behind_m,
+                ahead_m,
+                thickness_m,
+            } => Solid::Box {
+                centre: line.p0
+                    + line.d * ((ahead_m - behind_m) / 2.0)
+                    + line.n * (thickness_m / 2.0),
+                axes: Matrix3::from_columns(&[line.d, line.n.cross(&line.d), line.n]),
+                half_extents: Vector3::new(
+                    (ahead_m + behind_m) / 2.0,
+                    half_width_m,
+                    thickness_m / 2.0,
+                ),
+            },
+        }
+    }
 }
 
 /// A solid in the base frame that the arm must not come near.

@@ -1,7 +1,7 @@
 //! The data blob a page animates: world-frame geometry of every recorded step.
 
 use emg_control::{ActingController, StepRecord};
-use emg_kinematics::{DOF, Shape, Vec3};
+use emg_kinematics::{DOF, Shape, Vec3, WorkSurface};
 use serde::Serialize;
 
 use crate::ViewerInput;
@@ -39,7 +39,8 @@ struct SceneTask {
 struct SceneConstraints {
     line_tolerance_m: f64,
     theta_max_deg: f64,
-    /// Whether the work surface (the plane through `p0` with normal `n`) is a constraint.
+    /// Whether the work surface is the half-space behind the plane through `p0` with normal
+    /// `n` (a work plate is drawn as an obstacle named [`emg_control::WORK_SURFACE`]).
     work_surface: bool,
 }
 
@@ -156,15 +157,28 @@ impl<'a> Scene<'a> {
                 pen: tool.contains(&index),
             })
             .collect();
-        let obstacles = constraints
-            .scene
-            .obstacles
-            .iter()
-            .map(|obstacle| SceneObstacle {
-                name: &obstacle.name,
-                clearance_m: length(obstacle.clearance_m),
-                solid: SceneSolid::new(&obstacle.shape),
+        let plate = match constraints.work_surface {
+            WorkSurface::Plate(_) => constraints.work_surface.shape(&task.p0, &task.d, &task.n),
+            WorkSurface::Off | WorkSurface::HalfSpace => None,
+        };
+        let obstacles = plate
+            .map(|shape| SceneObstacle {
+                name: emg_control::WORK_SURFACE,
+                clearance_m: 0.0,
+                solid: SceneSolid::new(&shape),
             })
+            .into_iter()
+            .chain(
+                constraints
+                    .scene
+                    .obstacles
+                    .iter()
+                    .map(|obstacle| SceneObstacle {
+                        name: &obstacle.name,
+                        clearance_m: length(obstacle.clearance_m),
+                        solid: SceneSolid::new(&obstacle.shape),
+                    }),
+            )
             .collect();
         let steps = trajectory
             .steps
@@ -182,7 +196,7 @@ impl<'a> Scene<'a> {
             constraints: SceneConstraints {
                 line_tolerance_m: constraints.line_tolerance_m,
                 theta_max_deg: constraints.theta_max_deg,
-                work_surface: constraints.work_surface,
+                work_surface: constraints.work_surface == WorkSurface::HalfSpace,
             },
             obstacles,
             capsules,

@@ -331,7 +331,7 @@ fn cell_page() -> (Trajectory, String) {
         {"name": "ball", "sphere": {"centre": [-0.3, -0.4, 0.5], "radius": 0.08}}
     ]}"#;
     let mut config = RolloutConfig::default();
-    config.constraints.work_surface = true;
+    config.constraints.work_surface = emg_kinematics::WorkSurface::HalfSpace;
     config.constraints.scene = serde_json::from_str(scene).expect("a valid scene");
     page_with(&config, "FR3 line in a cell")
 }
