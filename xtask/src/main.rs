@@ -14,6 +14,7 @@ mod ablate_control;
 mod backend_choice;
 mod bench_report;
 mod cartesian_eval;
+mod readme_picture;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
@@ -73,6 +74,9 @@ enum Command {
     /// The baseline of motion-planning frameworks, a MoveIt-style Cartesian path, on the tasks
     /// of search-eval beside their bounds (docs/results/cartesian.*).
     CartesianEval(cartesian_eval::Args),
+    /// The README's picture: its `emg plan` task planned and drawn by the viewer, a still taken
+    /// by headless Chromium (docs/figures/readme-demo.png).
+    ReadmePicture(readme_picture::Args),
     /// Best-known lengths (a large search) and reachability bounds of an evaluation subset
     /// (resumable, --shard i/n, --merge → docs/results/limit.*).
     Limit(limit::Args),
@@ -100,6 +104,7 @@ fn main() -> anyhow::Result<()> {
         Command::StampWeights(args) => stamp_weights::run(&args),
         Command::SearchEval(args) => search_eval::run(&args),
         Command::CartesianEval(args) => cartesian_eval::run(&args),
+        Command::ReadmePicture(args) => readme_picture::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Timing(args) => timing::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),

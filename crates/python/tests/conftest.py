@@ -11,7 +11,8 @@ EVAL_TASKS = Path(__file__).resolve().parents[3] / "data" / "tasks" / "eval-v1.t
 
 @pytest.fixture(scope="session")
 def planner():
-    return elm.Planner("fr3")
+    """The FR3 under the paper's protocol (no work surface), as `emg plan --surface off`."""
+    return elm.Planner("fr3", surface="off")
 
 
 @pytest.fixture(scope="session")

@@ -73,7 +73,7 @@ def test_plan_many_equals_the_cli_on_a_task_file(tmp_path, planner, tasks):
         {"p0": t.p0.tolist(), "d": t.d.tolist(), "n": t.n.tolist(), "q0_seed": t.q0_seed.tolist()}
         for t in chosen
     ]))
-    plans = planner.plan_many(chosen, controller="hybrid", planner="controller")
+    plans = planner.plan_many(chosen, controller="hybrid", planner="controller", reach=False)
     run_cli("plan", "--task-file", task_file, "--controller", "hybrid", "--planner", "controller",
             "--reach", "off", "--surface", "off", "--out", tmp_path / "cli")
     for index, plan in enumerate(plans):
@@ -95,14 +95,14 @@ def test_the_work_surface_and_a_scene_plan_as_the_cli_plans_them(tmp_path, plann
         "rollout": {"constraints": {"work_surface": True, "scene": scene}},
     })
     plan = cell.plan(task.p0, task.d, task.n, seed="dp", controller="hybrid",
-                     planner="controller")
+                     planner="controller", reach=False)
     assert len(plan.t) <= 10
     assert "ball" in plan.termination or "work surface" in plan.termination, plan.termination
     plan.save(tmp_path / "python")
     run_cli(
         "plan", "--p0", vector(task.p0), "--d", vector(task.d), "--n", vector(task.n),
         "--seed", "dp", "--controller", "hybrid", "--planner", "controller", "--reach", "off",
-        "--scene", tmp_path / "scene.json", "--out", tmp_path / "cli",
+        "--surface", "half-space", "--scene", tmp_path / "scene.json", "--out", tmp_path / "cli",
     )
     assert_same_files(tmp_path / "python", tmp_path / "cli")
     assert elm.check(tmp_path / "python.joint_trajectory.json").points > 0
@@ -204,8 +204,11 @@ def test_a_robot_file_without_models_plans_classically_and_refuses_learned_contr
     assert planner.models == {"diffusion": False, "policy": False}
     task = elm.load_tasks(ROOT / "data" / "iiwa14" / "tasks" / "eval-v1.tasks", robot_file)[0]
     p0, d, n = task.p0, task.d, task.n
-    plan = planner.plan(p0, d, n, controller="classical")
-    assert plan.seed_source == "home" and plan.path_length_m > 0
+    # The defaults plan it: the classical controller, the search.
+    plan = planner.plan(p0, d, n)
+    assert plan.path_length_m > 0
+    pipeline = planner.plan(p0, d, n, controller="classical", planner="controller")
+    assert pipeline.seed_source == "home" and plan.path_length_m >= pipeline.path_length_m
     with pytest.raises(elm.InputError, match="ppo-v1.weights"):
         planner.plan(p0, d, n, controller="hybrid")
     with pytest.raises(elm.InputError, match=r"tasks\[0\]: controller \"rl\""):

@@ -679,6 +679,12 @@ window.addEventListener("unhandledrejection", function (event) {
       data.path_length_m.toFixed(3) + " m \u00b7 ended: " + data.termination,
   );
   buildLegend();
+  // `page.html#t=0.6` opens paused at that share of the motion (a still, e.g. for a picture).
+  const still = /(?:^#|&)t=([0-9.]+)/.exec(window.location.hash);
+  if (still && Number.isFinite(Number(still[1]))) {
+    current = Math.min(1, Math.max(0, Number(still[1]))) * duration;
+    playing = false;
+  }
   setPlaying(playing);
   resize();
   draw();
