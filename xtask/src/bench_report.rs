@@ -1,5 +1,5 @@
 //! `cargo xtask bench-report`: runs the criterion benchmarks and writes their medians to
-//! `docs/results/benchmarks.md` and the README's benchmark table, with the instructions one
+//! `docs/results/benchmarks.md`, with the instructions one
 //! `full_step` step executes, counted by valgrind (a figure that, unlike a time, does not move
 //! with the machine's load).
 
@@ -11,8 +11,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::workspace;
 
-const README_START: &str = "<!-- benchmarks:start -->";
-const README_END: &str = "<!-- benchmarks:end -->";
 
 /// Repetitions of the `full_step` rollout in the two counted runs: the difference of their
 /// instruction counts is the rollouts' alone, without the loading both runs share.
@@ -59,7 +57,7 @@ struct Row {
     median_ns: f64,
 }
 
-/// Runs the benchmarks (unless `--no-run`) and writes the report and the README table.
+/// Runs the benchmarks (unless `--no-run`) and writes the report.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let root = workspace::root();
     let criterion_dir = root.join("target/criterion");
@@ -98,8 +96,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     );
     let report_path = root.join("docs/results/benchmarks.md");
     emg_io::write_atomically(&report_path, report)?;
-    workspace::replace_readme_section(README_START, README_END, &table)?;
-    println!("wrote {} and the README table", report_path.display());
+    println!("wrote {}", report_path.display());
     Ok(())
 }
 

@@ -3,22 +3,29 @@
 //! direction `d`, normal `n`) into a trajectory that moves the tool along the line as far as it
 //! can while every step holds every constraint.
 //!
-//! A plan is the paper's pipeline: a seed ([`SeedSource`]: the diffusion seeder by default,
-//! Sec. 4.1) put exactly on the start pose, then one rollout of the chosen null-space controller
-//! ([`ControllerKind`]: classical, RL or the hybrid of Sec. 4.3) through the shared step.
+//! The paper's pipeline ([`PlanRequest::pipeline`]) is a seed ([`SeedSource`]: the diffusion
+//! seeder by default, Sec. 4.1) put exactly on the start pose, then one rollout of the chosen
+//! null-space controller ([`ControllerKind`]: classical, RL or the hybrid of Sec. 4.3) through
+//! the shared step; the default request ([`PlanRequest::default`], what `emg plan` and Python
+//! run) is the search: the pipeline's plan first, then many other starts within a step budget,
+//! guided by the task's reachability bound. [`PlannerConfig::cell`] keeps the arm off a work
+//! plate under the line; [`PlannerConfig::default`] is the paper's protocol.
 //! [`PlanFiles`] turns a plan into the files `emg plan` writes, its joint trajectory timed rest to
 //! rest within the joint limits by [`MotionTiming`].
 //!
+//! The README's example (there the data directory is `data/` of the checkout):
+//!
 //! ```
-//! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig, demo_task};
+//! use emg_planner::{Models, PlanRequest, Planner, PlannerConfig};
 //! let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
 //! let robot = emg_kinematics::Robot::from_chain_file(data.join("robots/fr3_pen.urdf"))?;
 //! let models = Models::shipped(&robot, &data)?;
-//! let planner = Planner::new(robot, models, PlannerConfig::default())?;
-//! let task = demo_task(planner.robot())?;
-//! let plan = planner.plan(&task, &PlanRequest::default())?;
+//! let planner = Planner::new(robot, models, PlannerConfig::cell())?; // the work plate on
+//! let (p0, d, n) = ([0.45, -0.2, 0.25].into(), [0.0, 1.0, 0.0].into(), [0.0, 0.0, -1.0].into());
+//! let task = emg_control::Task::new(planner.robot(), p0, d, n, None)?;
+//! let plan = planner.plan(&task, &PlanRequest::default())?; // the search, as `emg plan`
 //! println!("{:.3} m, ended: {}", plan.trajectory.path_length_m, plan.trajectory.termination);
-//! assert!(plan.trajectory.path_length_m > 0.1);
+//! assert!(plan.trajectory.path_length_m > 0.9);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
