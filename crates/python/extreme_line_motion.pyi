@@ -186,6 +186,7 @@ class Planner:
         robot: PathLike = "fr3",
         models: Optional[PathLike] = None,
         config: Union[PathLike, dict, None] = None,
+        surface: Optional[str] = None,
     ) -> None: ...
     @property
     def robot(self) -> Robot:
@@ -199,18 +200,18 @@ class Planner:
         d: Vector3,
         n: Vector3,
         seed: SeedArg = None,
-        controller: ControllerArg = "hybrid",
+        controller: Optional[ControllerArg] = None,
         planner: PlannerArg = None,
-        reach: bool = False,
+        reach: bool = True,
     ) -> Plan:
         """Plans the task (p0, d, n); the GIL is released while planning."""
     def plan_many(
         self,
         tasks: Iterable[TaskArg],
         seed: SeedArg = None,
-        controller: ControllerArg = "hybrid",
+        controller: Optional[ControllerArg] = None,
         planner: PlannerArg = None,
-        reach: bool = False,
+        reach: bool = True,
     ) -> list[Plan]:
         """Plans every task in parallel with the GIL released; plans come in task order."""
     def reach(self, p0: Vector3, d: Vector3, n: Vector3) -> float:

@@ -11,7 +11,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::workspace;
 
-
 /// Repetitions of the `full_step` rollout in the two counted runs: the difference of their
 /// instruction counts is the rollouts' alone, without the loading both runs share.
 const COUNTED_REPETITIONS: [usize; 2] = [20, 200];

@@ -107,7 +107,12 @@ fn screenshot(args: &Args, html: &Path) -> anyhow::Result<()> {
         .arg(format!("--screenshot={}", args.out.display()))
         .arg(url)
         .output()
-        .with_context(|| format!("running {} (install Chromium or pass --chromium)", chromium.display()))?;
+        .with_context(|| {
+            format!(
+                "running {} (install Chromium or pass --chromium)",
+                chromium.display()
+            )
+        })?;
     if !output.status.success() || !args.out.exists() {
         bail!(
             "{} failed: {}",

@@ -139,6 +139,19 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "cartesian-eval",
+        args: &["cartesian-eval"],
+        writes: &["docs/results/cartesian.json", "docs/results/cartesian.md"],
+    },
+    Stage {
+        name: "cartesian-eval-iiwa14",
+        args: &["cartesian-eval", "--robot", "iiwa14"],
+        writes: &[
+            "docs/results/iiwa14/cartesian.json",
+            "docs/results/iiwa14/cartesian.md",
+        ],
+    },
+    Stage {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],
@@ -343,6 +356,11 @@ const STAGES: &[Stage] = &[
         name: "figure-branches",
         args: &["figure-branches"],
         writes: &["docs/figures/self-motion-branches.svg"],
+    },
+    Stage {
+        name: "readme-picture",
+        args: &["readme-picture"],
+        writes: &["docs/figures/readme-demo.png"],
     },
     Stage {
         name: "report",

@@ -48,6 +48,9 @@ pub struct Args {
     /// Output figure.
     #[arg(long, default_value_os_t = workspace::figure(BUDGET_FIGURE))]
     figure: PathBuf,
+    /// Plan nothing: write search.md and the figure again from the search.json there.
+    #[arg(long)]
+    render_only: bool,
 }
 
 /// One planner setting over the tasks.
@@ -115,6 +118,17 @@ impl Record {
 
 /// Runs the comparison and writes the record, its table and its figure.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if args.render_only {
+        let path = args.out_dir.join("search.json");
+        let record: Record = serde_json::from_str(
+            &std::fs::read_to_string(&path)
+                .with_context(|| format!("reading {}", path.display()))?,
+        )?;
+        workspace::write_results(&args.out_dir, "search", &record, &markdown(&record))?;
+        draw(&record, &args.figure)?;
+        println!("wrote {}", args.figure.display());
+        return Ok(());
+    }
     let workspace::PlannerSetup {
         planner,
         checker,
@@ -338,15 +352,15 @@ fn markdown(record: &Record) -> String {
         "# Search planner vs the paper's pipeline\n\nWritten by `cargo xtask search-eval`. Do not \
          edit by hand. Robot `{}`, the first {} tasks of `{}`. The pipeline is Hybrid + DP (one \
          seed, one rollout). The search first scans the task's reachability bound, rolls the \
-         pipeline's plan out, then ranks candidate starts (q0_seed, q_mu, q_jl, {} diffusion \
-         samples, cone IK from {} restarts) by classical rollouts and re-rolls the best {} with \
-         the hybrid controller; then it searches backwards (the reversed task from the scan's \
-         configuration at the far end of the bound, classical rollouts from its candidate \
-         starts) and follows every reversed motion that gets past `p0` forwards; then it \
-         repairs the longest rollouts of the best {} starts where they failed (each null-space \
-         basis direction held for {} steps from 1 to 32 steps before the end, then the hybrid \
-         or the classical controller). It stops when its budget of control steps is spent or a \
-         plan comes within {} m of the bound. Every plan is re-checked by the independent \
+         pipeline's plan out, follows up to {} of the scan's chains of configurations from `p0` \
+         (its witnesses split where neighbours jump more than {} rad, later pieces joined back \
+         to `p0`) with a tracking action, then ranks candidate starts (q0_seed, q_mu, q_jl, {} \
+         diffusion samples, cone IK from {} restarts) by classical rollouts and re-rolls the \
+         best {} with the hybrid controller; then it repairs the longest rollouts of the best \
+         {} starts where they failed (each null-space basis direction held for {} steps from 1 \
+         to 32 steps before the end, then the hybrid or the classical controller). It stops \
+         when its budget of control steps is spent or a plan comes within {} m of the first \
+         grid point the scan missed. Every plan is re-checked by the independent \
          checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
          plan beyond the scan's bound on {} tasks); it ignores continuity, so it may be loose. \
          Bound (m, mean / std / min / max): {}. Times are on {} ({} threads) and depend on the \
@@ -357,6 +371,8 @@ fn markdown(record: &Record) -> String {
         record.robot,
         record.task_count,
         record.tasks,
+        record.search.chains,
+        record.search.chain_jump_rad,
         record.search.dp_samples,
         record.search.ik_restarts,
         record.search.finalists,

@@ -73,7 +73,7 @@ use emg_control::{Task, Trajectory};
 use emg_io::{PlanPaths, html_path};
 use emg_planner::{
     ControllerKind, Models, MotionTiming, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest,
-    Planner, PlannerConfig, SeedSource,
+    Planner, PlannerConfig, PlannerKind, SeedSource,
 };
 
 use crate::args::{Cli, Command, OnOff, PlanArgs};
@@ -173,6 +173,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         };
         let plan = match planner.plan(task, &request) {
             Ok(plan) => plan,
+            Err(error) if !many => return Err(plan_error(error, &request)),
             Err(error) => {
                 let error = plan_error(error, &request);
                 eprintln!("{label}error: {error:#}");
@@ -181,6 +182,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
             }
         };
         if let Some(reason) = refusal(planner.robot(), &plan.trajectory) {
+            anyhow::ensure!(many, "refused, nothing written: {reason}");
             eprintln!("{label}refused, nothing written: {reason}");
             refused.push((index, reason));
             continue;
@@ -191,18 +193,12 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         };
         match write_plan(&planner, args, &record, task, &plan, many.then_some(index)) {
             Ok(report) => println!("{label}{report}"),
+            Err(error) if !many => return Err(error),
             Err(error) => {
                 eprintln!("{label}error: {error:#}");
                 failures.push((index, format!("{error:#}")));
             }
         }
-    }
-    if !many {
-        return match (refused.pop(), failures.pop()) {
-            (Some(_), _) => Err(anyhow::anyhow!("the task was refused at its start")),
-            (_, Some((_, error))) => Err(anyhow::anyhow!(error)),
-            (None, None) => Ok(()),
-        };
     }
     if refused.is_empty() && failures.is_empty() {
         return Ok(());
@@ -281,7 +277,7 @@ struct Record<'a> {
     timing: &'a MotionTiming,
 }
 
-/// A planning error with the option it comes from.
+/// A planning error with the option it comes from, and what to try.
 fn plan_error(error: PlanError, request: &PlanRequest) -> anyhow::Error {
     let option = match &error {
         PlanError::Seed(_) => match &request.seed {
@@ -290,7 +286,17 @@ fn plan_error(error: PlanError, request: &PlanRequest) -> anyhow::Error {
         },
         PlanError::Controller(_) => format!("--controller {}", request.controller),
     };
-    anyhow::Error::new(error).context(option)
+    let hint = match (&error, request.planner) {
+        (PlanError::Seed(emg_planner::SeedError::Projection { .. }), PlannerKind::Controller) => {
+            " (try --planner search, which goes on from other starts, or another --seed)"
+        }
+        (PlanError::Seed(emg_planner::SeedError::Projection { .. }), PlannerKind::Search) => {
+            " (no configuration at p0 holds every constraint: move the part nearer the arm, or \
+             tilt n)"
+        }
+        _ => "",
+    };
+    anyhow::Error::new(error).context(format!("{option}{hint}"))
 }
 
 /// The diffusion weights to load: `--weights`, or the robot's shipped ones when the seed may

@@ -578,3 +578,39 @@ fn search_plan_records_its_planner_and_bound_and_checks() {
             .is_none()
     );
 }
+
+/// A seed that cannot be put on the start pose ends the paper's pipeline with an error that says
+/// what to try, and does not stop the search, which goes on from its other starts.
+#[test]
+fn an_unprojectable_seed_leaves_the_search_its_other_starts() {
+    let tmp = temp_dir("unprojectable");
+    let stem = tmp.path().join("up");
+    let line = [
+        "--p0",
+        "0.45,-0.2,0.25",
+        "--d",
+        "0,1,0",
+        "--n",
+        "0,0,1",
+        "--seed",
+        "home",
+        "--reach",
+        "off",
+        "--out",
+        stem.to_str().unwrap(),
+    ];
+    let error = plan_err(&[&line[..], &["--planner", "controller"]].concat());
+    assert!(
+        error.contains("cannot project the home seed") && error.contains("try --planner search"),
+        "{error}"
+    );
+    assert_eq!(
+        error.matches("cannot project").count(),
+        1,
+        "said once: {error}"
+    );
+    let out = plan_ok(&line);
+    let doc = read_json(&tmp.path().join("up.json"));
+    assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{out}");
+    assert_ne!(doc["seed_source"], "home", "{out}");
+}

@@ -108,11 +108,6 @@ impl Reach {
     pub fn shortfall(&self, trajectory: &Trajectory) -> Option<String> {
         shortfall(trajectory, self.reachable_m)
     }
-
-    /// Whether a witnessed plan went beyond the scan's own bound.
-    pub fn scan_missed(&self) -> bool {
-        self.reachable_m > self.scanned_m
-    }
 }
 
 /// The reachability bound of `task` under `constraints` (module documentation); `hints` are

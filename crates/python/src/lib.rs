@@ -15,6 +15,7 @@
 //! planned, [`CheckFailed`] when a file does not hold up; failed file writes raise `OSError`.
 
 mod check;
+mod embedded;
 mod planner;
 mod robot;
 mod timing;
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 
 use emg_planner::DataDir;
 use pyo3::create_exception;
-use pyo3::exceptions::PyException;
+use pyo3::exceptions::{PyException, PyOSError};
 use pyo3::prelude::*;
 
 create_exception!(
@@ -51,15 +52,23 @@ create_exception!(
     "A trajectory file that does not hold up under the independent checker; the message names the point and the constraint."
 );
 
-/// The shipped data: `$EMG_DATA` when set, else the `data/` directory of the checkout the
-/// module was built from.
-fn data_dir() -> DataDir {
-    DataDir::locate(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+/// The shipped data: `$EMG_DATA` when set, else the copy compiled into the module
+/// ([`embedded::extracted`]), so an installed wheel needs no checkout.
+fn data_dir() -> PyResult<DataDir> {
+    match std::env::var_os(DataDir::ENV) {
+        Some(dir) if !dir.is_empty() => Ok(DataDir::new(dir)),
+        _ => embedded::extracted().map_err(|e| {
+            PyOSError::new_err(format!(
+                "cannot write the shipped robots and models to the cache directory: {e} (set \
+                 XDG_CACHE_HOME to a writable directory, or EMG_DATA to a copy of data/)"
+            ))
+        }),
+    }
 }
 
 /// The robot file a `robot` argument selects: a shipped robot's name or a path.
-fn robot_file(robot: &Path) -> PathBuf {
-    data_dir().robot_file(&robot.to_string_lossy())
+fn robot_file(robot: &Path) -> PyResult<PathBuf> {
+    Ok(data_dir()?.robot_file(&robot.to_string_lossy()))
 }
 
 /// `error` and its causes, each once, joined by `": "`.

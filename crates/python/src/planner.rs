@@ -194,11 +194,10 @@ fn read_config(config: Option<&Bound<'_, PyAny>>) -> PyResult<PlannerConfig> {
 
 /// The model files to load: those in `models`, or those shipped for `robot_file`.
 fn model_files(robot_file: &Path, models: Option<&Path>) -> PyResult<[Option<PathBuf>; 2]> {
+    let data = data_dir()?;
     let pick = |name: &str| match models {
         Some(dir) => Some(dir.join(name)).filter(|p| p.is_file()),
-        None => data_dir()
-            .shipped_model(robot_file, name)
-            .filter(|p| p.is_file()),
+        None => data.shipped_model(robot_file, name).filter(|p| p.is_file()),
     };
     if let Some(dir) = models.filter(|dir| !dir.is_dir()) {
         return Err(InputError::new_err(format!(

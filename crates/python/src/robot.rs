@@ -21,7 +21,7 @@ pub struct Robot {
 impl Robot {
     /// Loads the robot `robot` selects (shipped name or path).
     pub(crate) fn load(robot: &Path) -> PyResult<Self> {
-        let file = robot_file(robot);
+        let file = robot_file(robot)?;
         let inner = emg_kinematics::Robot::from_chain_file(&file)
             .map_err(|e| input_error(format!("robot {}", file.display()), &e))?;
         Ok(Self {
