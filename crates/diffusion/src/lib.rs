@@ -31,22 +31,28 @@
 //! ```
 
 mod config;
+#[cfg(feature = "train")]
 mod dataset;
 mod embedding;
 mod forward;
+#[cfg(feature = "train")]
 mod model;
 mod sampler;
 mod schedule;
 mod seed;
+#[cfg(feature = "train")]
 mod train;
 mod weights;
 
 pub use config::{Backend, DiffusionConfig, SampleConfig, TrainConfig};
+#[cfg(feature = "train")]
 pub use dataset::{MIRROR_CONDITION_SIGNS, MIRROR_JOINT_SIGNS, has_mirror_symmetry, training_set};
 pub use embedding::sinusoidal_embedding;
+#[cfg(feature = "train")]
 pub use emg_learning::checkpoint::CheckpointError;
 pub use emg_learning::container::ContainerError;
 pub use forward::{ForwardScratch, PlainDenoiser};
+#[cfg(feature = "train")]
 pub use model::{Denoiser, DenoiserInput, ResidualBlock};
 pub use sampler::{DdimSampler, SampleError, SamplerWorkspace};
 pub use schedule::CosineSchedule;
@@ -54,6 +60,7 @@ pub use seed::{
     CONDITION_DIM, DpSeed, DpSeedConfig, DpSeedError, DpSeeder, RollTarget, SeedOrigin,
     SeedWorkspace, condition_of, denormalise,
 };
+#[cfg(feature = "train")]
 pub use train::{LossRow, Mirror, TrainError, Trainer, TrainingSet};
 pub use weights::{
     DenoiserWeights, TensorSpec, WEIGHTS_FORMAT_VERSION, WeightsError, WeightsHeader,

@@ -6,13 +6,17 @@
 
 use std::path::Path;
 
+#[cfg(feature = "train")]
 use burn::module::Param;
+#[cfg(feature = "train")]
 use burn::nn::{LayerNorm, Linear};
+#[cfg(feature = "train")]
 use burn::tensor::{Device, Tensor, TensorData};
 use emg_learning::container::{self, ContainerError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::DiffusionConfig;
+#[cfg(feature = "train")]
 use crate::model::Denoiser;
 
 const MAGIC: &[u8; 8] = b"EMGDIFFW";
@@ -157,6 +161,7 @@ impl DenoiserWeights {
     }
 
     /// Reads the weights of a Burn denoiser built with `config`.
+    #[cfg(feature = "train")]
     pub fn from_model(
         model: &Denoiser,
         config: &DiffusionConfig,
@@ -186,6 +191,7 @@ impl DenoiserWeights {
     }
 
     /// A Burn denoiser on `device` holding these weights.
+    #[cfg(feature = "train")]
     pub fn to_model(&self, device: &Device) -> Denoiser {
         let config = &self.header.config;
         let layout = parameter_layout(config);
@@ -248,11 +254,13 @@ impl DenoiserWeights {
     }
 
     /// Mutable flat values (for the EMA update).
+    #[cfg(feature = "train")]
     pub(crate) fn values_mut(&mut self) -> &mut [f32] {
         &mut self.values
     }
 
     /// Sets the training step count recorded in the header.
+    #[cfg(feature = "train")]
     pub(crate) fn set_train_steps(&mut self, steps: usize) {
         self.header.train_steps = steps;
     }
@@ -319,6 +327,7 @@ impl DenoiserWeights {
 }
 
 /// Calls `f` with the data of every parameter in [`parameter_layout`] order.
+#[cfg(feature = "train")]
 fn visit_parameters(model: &Denoiser, mut f: impl FnMut(&TensorData)) {
     let norm = |n: &LayerNorm, f: &mut dyn FnMut(&TensorData)| {
         f(&n.gamma.val().into_data());

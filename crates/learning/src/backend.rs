@@ -15,6 +15,7 @@ pub enum Backend {
 
 impl Backend {
     /// The (non-autodiff) device of this backend.
+    #[cfg(feature = "train")]
     pub fn device(self) -> burn::tensor::Device {
         match self {
             Self::Flex => burn::tensor::Device::flex(),

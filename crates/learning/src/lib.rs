@@ -22,6 +22,7 @@
 //! ```
 
 mod backend;
+#[cfg(feature = "train")]
 pub mod checkpoint;
 pub mod container;
 mod normal;

@@ -35,8 +35,10 @@ mod config;
 mod controller;
 mod env;
 mod inference;
+#[cfg(feature = "train")]
 mod network;
 mod observation;
+#[cfg(feature = "train")]
 mod ppo;
 mod vec_env;
 mod weights;
@@ -44,12 +46,15 @@ mod weights;
 pub use advantage::{ReturnScaler, RunningMoments, Targets, generalised_advantages};
 pub use config::{Backend, EnvConfig, NetworkConfig, PpoConfig};
 pub use controller::RlController;
+#[cfg(feature = "train")]
 pub use emg_learning::checkpoint::CheckpointError;
 pub use emg_learning::container::ContainerError;
 pub use env::{ArmEnvironment, TrainingPool};
 pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
+#[cfg(feature = "train")]
 pub use network::{ActorCritic, PolicyOutput, Trunk};
 pub use observation::{ACTION_DIM, OBSERVATION_DIM, observe};
+#[cfg(feature = "train")]
 pub use ppo::{IterationLog, IterationTiming, Trainer};
 pub use vec_env::{Environment, EpisodeEnd, MAX_ENVS, Rollout, Transition, VecEnv, VecEnvSnapshot};
 pub use weights::{
@@ -68,6 +73,7 @@ pub enum PolicyError {
         problem: String,
     },
     /// A checkpoint file could not be read or written.
+    #[cfg(feature = "train")]
     #[error(transparent)]
     Checkpoint(#[from] CheckpointError),
     /// A checkpoint made with other settings.

@@ -7,13 +7,17 @@
 
 use std::path::Path;
 
+#[cfg(feature = "train")]
 use burn::module::Param;
+#[cfg(feature = "train")]
 use burn::nn::Linear;
+#[cfg(feature = "train")]
 use burn::tensor::{Device, Tensor, TensorData};
 use emg_learning::container::{self, ContainerError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::NetworkConfig;
+#[cfg(feature = "train")]
 use crate::network::ActorCritic;
 use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
 
@@ -136,6 +140,7 @@ impl PolicyWeights {
     }
 
     /// The current weights of `model` (on any device, autodiff or not).
+    #[cfg(feature = "train")]
     pub fn from_model(
         model: &ActorCritic,
         network: &NetworkConfig,
@@ -171,6 +176,7 @@ impl PolicyWeights {
     }
 
     /// A Burn model holding these weights on `device`.
+    #[cfg(feature = "train")]
     pub fn to_model(&self, device: &Device) -> ActorCritic {
         let mut model = ActorCritic::new(&self.header.network, 0.0, device);
         let mut offset = 0;
@@ -251,6 +257,7 @@ impl PolicyWeights {
     }
 }
 
+#[cfg(feature = "train")]
 fn layers(model: &ActorCritic) -> impl Iterator<Item = &Linear> {
     model
         .actor
