@@ -23,8 +23,8 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     let carried = contents.carried();
     // A CSV carries no task: by default it is taken from the JSON written beside it.
     let beside = (carried.is_none() && args.line.p0.is_none() && args.task_from.is_none())
-        .then(|| file.with_extension("json"))
-        .filter(|path| path.is_file());
+        .then(|| emg_io::task_file_beside(file))
+        .flatten();
     let task_from = match args.task_from.as_deref().or(beside.as_deref()) {
         Some(path) => Some((path, read_task_from(path)?)),
         None => None,

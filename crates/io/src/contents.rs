@@ -1,7 +1,7 @@
 //! Any trajectory file, told apart by its content: JSON starts with `{` and its `format` field
 //! names the layout; anything else is read as the CSV.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use emg_control::{ConstraintConfig, Task};
 use emg_verify::{
@@ -58,6 +58,13 @@ pub struct Carried {
     pub task: Task,
     /// The constraints.
     pub constraints: ConstraintConfig,
+}
+
+/// The file carrying the task of the CSV at `csv`, which carries none: the `emg-trajectory/1`
+/// JSON of the same stem beside it (`emg plan` and Python's `Plan.save` write them together),
+/// when it exists.
+pub fn task_file_beside(csv: &Path) -> Option<PathBuf> {
+    Some(csv.with_extension("json")).filter(|path| path.is_file())
 }
 
 impl TrajectoryContents {

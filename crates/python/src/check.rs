@@ -1,8 +1,8 @@
 //! `check`: a trajectory file verified by the independent checker.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use emg_io::{ReadError, TrajectoryContents};
+use emg_io::{ReadError, TrajectoryContents, task_file_beside};
 use emg_verify::ReferenceModel;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
@@ -55,25 +55,40 @@ impl CheckReport {
     }
 }
 
-/// Verifies a trajectory file written by `Plan.save` or `emg plan` (either JSON layout) with
-/// the independent checker, against the task, constraints and robot it carries (`robot`
-/// overrides the robot: a shipped robot's name or a robot file). Returns the report; raises
-/// `CheckFailed` naming the first failing point and constraint.
+/// Verifies a trajectory file written by `Plan.save` or `emg plan` (either JSON layout, or the
+/// CSV with the JSON of the same stem beside it) with the independent checker, against the
+/// task, constraints and robot it carries (`robot` overrides the robot: a shipped robot's name
+/// or a robot file). Returns the report; raises `CheckFailed` naming the first failing point
+/// and constraint.
 #[pyfunction]
 #[pyo3(signature = (path, robot = None))]
 pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
-    let contents = TrajectoryContents::read(&path).map_err(|e| match &e {
-        ReadError::Io { .. } => PyOSError::new_err(message(&e)),
-        ReadError::Format { .. } => InputError::new_err(message(&e)),
-    })?;
-    let carried = contents.carried().ok_or_else(|| {
-        InputError::new_err(format!(
-            "{} is a CSV file, which carries no task: check it with `emg check {} --task-from \
-             <emg-trajectory JSON>`",
-            path.display(),
-            path.display()
-        ))
-    })?;
+    let read = |path: &Path| {
+        TrajectoryContents::read(path).map_err(|e| match &e {
+            ReadError::Io { .. } => PyOSError::new_err(message(&e)),
+            ReadError::Format { .. } => InputError::new_err(message(&e)),
+        })
+    };
+    let contents = read(&path)?;
+    let own = contents.carried();
+    let own_task = own.is_some();
+    let beside = match &own {
+        Some(_) => None,
+        None => task_file_beside(&path)
+            .map(|json| read(&json))
+            .transpose()?,
+    };
+    let carried = own
+        .or_else(|| beside.as_ref().and_then(TrajectoryContents::carried))
+        .ok_or_else(|| {
+            InputError::new_err(format!(
+                "{} is a CSV file, which carries no task, and no {} lies beside it: check it \
+                 with `emg check {} --task-from <emg-trajectory JSON>`",
+                path.display(),
+                path.with_extension("json").display(),
+                path.display()
+            ))
+        })?;
     let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(&carried.robot)))?;
     let model = ReferenceModel::from_urdf_file(
         &robot.file,
@@ -90,7 +105,7 @@ pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
             robot.inner.joint_names(),
             &task,
             &carried.constraints,
-            true,
+            own_task,
             None,
         )
         .map_err(|failure| {

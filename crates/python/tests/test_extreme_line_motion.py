@@ -160,8 +160,11 @@ def test_check_reports_a_saved_plan_and_refuses_a_tampered_one(tmp_path, planner
     (tmp_path / "bad.joint_trajectory.json").write_text(json.dumps(tampered))
     with pytest.raises(elm.CheckFailed, match=f"point {point} of"):
         elm.check(tmp_path / "bad.joint_trajectory.json")
+    # The CSV takes its task from the JSON beside it; alone, it carries none.
+    assert elm.check(tmp_path / "line.csv").points == plan.q.shape[0]
+    shutil.copy(tmp_path / "line.csv", tmp_path / "alone.csv")
     with pytest.raises(elm.InputError, match="carries no task"):
-        elm.check(tmp_path / "line.csv")
+        elm.check(tmp_path / "alone.csv")
     with pytest.raises(OSError):
         elm.check(tmp_path / "missing.json")
 
