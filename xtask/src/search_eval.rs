@@ -288,36 +288,43 @@ pub fn shares_table(results: &Path) -> anyhow::Result<String> {
             let baseline: crate::cartesian_eval::Record =
                 serde_json::from_str(&std::fs::read_to_string(&cartesian)?)
                     .with_context(|| format!("reading {}", cartesian.display()))?;
-            md += &format!("| {} | MoveIt-style Cartesian path |", shipped.name);
-            for bucket in &baseline.bound_shares {
-                md += &format!(" {:.3} |", bucket.share);
-            }
-            let below = baseline
-                .bound_shares
-                .last()
-                .map_or(0, |all| all.below_half.len());
-            md += &format!(
-                " {below} of {} | {:.1} |\n",
-                baseline.task_count, baseline.mean_ms
+            md += &share_row(
+                shipped.name,
+                "MoveIt-style Cartesian path",
+                &baseline.bound_shares,
+                baseline.task_count,
+                baseline.mean_ms,
             );
         }
         let pipeline = record.rows.iter().find(|r| r.budget_steps.is_none());
         for row in pipeline.into_iter().chain(record.default_budget_row()) {
-            md += &format!("| {} | {} |", shipped.name, row_name(row));
-            for bucket in &row.bound_shares {
-                md += &format!(" {:.3} |", bucket.share);
-            }
-            let below = row
-                .bound_shares
-                .last()
-                .map_or(0, |all| all.below_half.len());
-            md += &format!(
-                " {below} of {} | {:.1} |\n",
-                record.task_count, row.plan_ms.mean
+            md += &share_row(
+                shipped.name,
+                &row_name(row),
+                &row.bound_shares,
+                record.task_count,
+                row.plan_ms.mean,
             );
         }
     }
     Ok(md)
+}
+
+/// One row of [`shares_table`]: the arm, the planner, its shares per bucket, the tasks below
+/// half their bound and the mean time per plan.
+fn share_row(
+    arm: &str,
+    planner: &str,
+    shares: &[BoundShare],
+    tasks: usize,
+    mean_ms: f64,
+) -> String {
+    let mut row = format!("| {arm} | {planner} |");
+    for bucket in shares {
+        row += &format!(" {:.3} |", bucket.share);
+    }
+    let below = shares.last().map_or(0, |all| all.below_half.len());
+    row + &format!(" {below} of {tasks} | {mean_ms:.1} |\n")
 }
 
 /// A row's planner for tables: the pipeline, or the search with its budget.
