@@ -152,7 +152,7 @@ impl ReferenceModel {
                 return fail(
                     k,
                     FailedCheck::SelfCollision,
-                    format!("{a} and {b} collide (clearance {gap} m)"),
+                    format!("{a} and {b} collide (clearance {:.2} mm)", gap * 1e3),
                 );
             }
             if let Some((margin, link, obstacle)) = self.scene_margin(q, line, bounds)
@@ -161,7 +161,10 @@ impl ReferenceModel {
                 return fail(
                     k,
                     FailedCheck::SceneContact,
-                    format!("{link} is {margin} m inside the clearance of the {obstacle}"),
+                    format!(
+                        "{link} is {:.2} mm inside the clearance of the {obstacle}",
+                        -margin * 1e3
+                    ),
                 );
             }
             if !step.time_s.is_finite() {
