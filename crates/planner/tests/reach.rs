@@ -32,6 +32,11 @@ fn checker(robot: &Robot) -> ReferenceModel {
         .expect("checker loads")
 }
 
+/// The FR3's shipped evaluation tasks.
+fn eval_tasks(robot: &Robot) -> Vec<Task> {
+    read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot).expect("shipped tasks")
+}
+
 /// Checks every witness of `reach` for `task` with the independent checker.
 fn check_witnesses(planner: &Planner, checker: &ReferenceModel, task: &Task, reach: &Reach) {
     let constraints = &planner.config().rollout.constraints;
@@ -78,8 +83,7 @@ fn no_plan_goes_beyond_the_bound_and_every_witness_holds() {
     let planner = planner();
     let robot = planner.robot();
     let checker = checker(robot);
-    let tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
-        .expect("shipped tasks");
+    let tasks = eval_tasks(robot);
     let request = PlanRequest {
         seed: Some(SeedSource::Generating),
         controller: ControllerKind::Classical,
@@ -111,8 +115,7 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
     let planner = planner();
     let robot = planner.robot();
     let checker = checker(robot);
-    let tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
-        .expect("shipped tasks");
+    let tasks = eval_tasks(robot);
     let request = PlanRequest {
         planner: emg_planner::PlannerKind::Search,
         controller: ControllerKind::Classical,

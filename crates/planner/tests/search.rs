@@ -41,6 +41,11 @@ fn small_search() -> PlannerConfig {
     }
 }
 
+fn checker(robot: &Robot) -> ReferenceModel {
+    ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
+        .expect("checker")
+}
+
 fn tasks(robot: &Robot, count: usize) -> Vec<Task> {
     let mut tasks = read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot)
         .expect("shipped tasks");
@@ -59,9 +64,7 @@ fn search_request() -> PlanRequest {
 fn search_never_returns_less_and_often_more() {
     let planner = planner(small_search());
     let robot = planner.robot();
-    let checker =
-        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
-            .expect("checker");
+    let checker = checker(robot);
     let constraints = &planner.config().rollout.constraints;
     let (mut pipeline_total, mut search_total, mut longer, mut detoured) = (0.0, 0.0, 0, 0);
     for task in tasks(robot, 10) {
@@ -106,9 +109,7 @@ fn long_lines_are_planned_along_the_scans_chains() {
     // The first tasks of the evaluation set whose bound is at least 1 m.
     let planner = planner(small_search());
     let robot = planner.robot();
-    let checker =
-        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
-            .expect("checker");
+    let checker = checker(robot);
     let constraints = &planner.config().rollout.constraints;
     let mut followed = 0;
     for task in tasks(robot, 40) {
@@ -163,9 +164,7 @@ fn search_holds_the_work_surface_and_the_scene() {
     config.rollout.constraints.work_surface = emg_kinematics::WorkSurface::plate();
     let free = planner(small_search());
     let robot = free.robot();
-    let checker =
-        ReferenceModel::from_urdf_file(&fr3().path(&data()), robot.base_link(), robot.tip_link())
-            .expect("checker");
+    let checker = checker(robot);
     let (mut scene_ends, mut moved) = (0, 0);
     for (index, task) in tasks(robot, 12).into_iter().enumerate() {
         // A ball where the unconstrained search's pen tip is a third of the way along.
