@@ -248,7 +248,11 @@ impl ClassicalGains {
             self.cone_gate_width_deg,
             "(0, ∞)",
             |v| v > 0.0,
-        )
+        )?;
+        OutOfRange::require("gains.k_lead", self.k_lead, "[0, ∞)", non_negative)?;
+        OutOfRange::require("gains.lead_deg", self.lead_deg, "[0, 90)", |v| {
+            (0.0..90.0).contains(&v)
+        })
     }
 }
 
@@ -280,6 +284,20 @@ pub struct ClassicalGains {
     pub k_theta: f64,
     /// Width of the cone gate `g(θ)` (degrees): active only this close to `θ_max`.
     pub cone_gate_width_deg: f64,
+    /// `k_lead`: weight of the leading tilt term `k_lead ∇(z·m)`, which turns the tool axis
+    /// ahead of the tilt the line's motion causes (`crate::lead_axis`); 0, the paper's
+    /// controller, leaves it out.
+    #[serde(default)]
+    pub k_lead: f64,
+    /// Angle (degrees) from `n`, against the tilt drift, of the axis `m` the leading tilt term
+    /// aims the tool at.
+    #[serde(default = "default_lead_deg")]
+    pub lead_deg: f64,
+}
+
+/// The leading tilt term's default angle (degrees): two thirds of the paper's cone.
+fn default_lead_deg() -> f64 {
+    20.0
 }
 
 impl Default for ClassicalGains {
@@ -289,6 +307,8 @@ impl Default for ClassicalGains {
             k_jl: 0.4,
             k_theta: 0.2,
             cone_gate_width_deg: 8.0,
+            k_lead: 0.0,
+            lead_deg: default_lead_deg(),
         }
     }
 }

@@ -34,7 +34,7 @@ mod step;
 mod task;
 mod verification;
 
-pub use classical::ClassicalController;
+pub use classical::{ClassicalController, lead_axis};
 pub use config::{
     ClassicalGains, ConstraintConfig, MAX_STEPS_CAP, OutOfRange, RolloutConfig,
     VelocityLimitFraction,

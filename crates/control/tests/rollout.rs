@@ -19,7 +19,7 @@ mod common;
 use emg_control::{
     ActingController, CheckRollout, ClassicalController, ClassicalGains, NullAction,
     NullSpaceController, RolloutConfig, StepContext, Task, Termination, Trajectory, Violation,
-    first_contact, first_violation, rollout, tool_angle_deg,
+    first_contact, first_violation, lead_axis, rollout, tool_angle_deg,
 };
 use emg_kinematics::{JointVector, Robot, null_space_basis};
 use rand::RngExt;
@@ -493,6 +493,7 @@ fn classical_action_is_the_clipped_projection_of_eq3() {
         k_jl: 20.0,
         k_theta: 10.0,
         cone_gate_width_deg: 8.0,
+        ..ClassicalGains::default()
     };
     let (saturated, interior, _) = check_classical_action(strong);
     assert!(
@@ -605,6 +606,63 @@ fn step_context_gradients_match_finite_differences() {
             tool_angle_deg(&context.kinematics.tool_axis(), &task.n)
         );
     }
+}
+
+/// The tool axis at `q`.
+fn tool_axis(robot: &Robot, q: &JointVector) -> emg_kinematics::Vec3 {
+    robot.forward(q).tool_axis()
+}
+
+#[test]
+fn the_leading_tilt_term_aims_the_tool_ahead_of_its_drift() {
+    let robot = robot();
+    let config = RolloutConfig::default();
+    let sampled = tasks(&robot, 10);
+    let gains = ClassicalGains {
+        k_lead: 5.0,
+        lead_deg: 20.0,
+        ..ClassicalGains::default()
+    };
+    let paper = ClassicalController::default();
+    let leading = ClassicalController::new(gains.clone());
+    let h = 1e-6;
+    let mut checked = 0;
+    for context in contexts(&robot, &sampled, &config) {
+        let n = context.task.n;
+        // The tilt the task command alone causes, by finite differences of the tool axis.
+        let task_rate = context.pseudo_inverse.matrix * context.task_velocity();
+        let rate = (tool_axis(&robot, &(context.q + task_rate * h))
+            - tool_axis(&robot, &(context.q - task_rate * h)))
+            / (2.0 * h);
+        let tilt = rate - n * n.dot(&rate);
+        if tilt.norm() < 1e-3 {
+            continue;
+        }
+        let m = lead_axis(&context, gains.lead_deg);
+        assert!((m.norm() - 1.0).abs() < 1e-12);
+        assert!((m.dot(&n) - 20f64.to_radians().cos()).abs() < 1e-12);
+        // Its part across n points against the drift.
+        let across = m - n * n.dot(&m);
+        let cosine = across.dot(&tilt) / (across.norm() * tilt.norm());
+        assert!(cosine < -1.0 + 1e-6, "cos = {cosine}");
+        // ξ gains k_lead ∇(z·m), the gradient by finite differences.
+        let gradient = JointVector::from_fn(|i, _| {
+            let mut e = JointVector::zeros();
+            e[i] = h;
+            (tool_axis(&robot, &(context.q + e)).dot(&m)
+                - tool_axis(&robot, &(context.q - e)).dot(&m))
+                / (2.0 * h)
+        });
+        // The paper's gains otherwise, so the difference is the lead term alone.
+        let extra = leading.secondary_command(&context) - paper.secondary_command(&context);
+        assert!(
+            (extra - gradient * gains.k_lead).amax() < 1e-6,
+            "{extra} against {}",
+            gradient * gains.k_lead
+        );
+        checked += 1;
+    }
+    assert!(checked > 20, "only {checked} steps tilted the tool");
 }
 
 #[test]

@@ -58,7 +58,7 @@ pub use planner::{Plan, PlanError, PlanRequest, Planner, PlannerKind};
 pub use reach::{
     MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE, reach, shortfall, witness_chains,
 };
-pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig};
+pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig, search_classical_gains};
 pub use seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed, seed_source_meaning};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 pub use timing::{

@@ -184,7 +184,6 @@ impl Planner {
                 robot: &self.robot,
                 rollout: &self.config.rollout,
                 reach: &self.config.reach,
-                executor: &executor,
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
             };
