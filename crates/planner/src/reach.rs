@@ -10,7 +10,8 @@
 //! point, but configurations found independently need not join into one continuous motion. So
 //! no planner goes further than the true bound, and this estimate of it is an upper bound only as
 //! good as its IK sampling (warm starts from the previous point's solutions, then seeded random
-//! restarts): a point the sampling misses ends the scan early. Every configuration a plan
+//! restarts, each given up once it stops converging): a point the sampling misses ends the
+//! scan early. Every configuration a plan
 //! visits is valid too, so a plan witnesses its own length ([`Reach::witness`]): the bound a
 //! plan reports never reads below the plan.
 //!
@@ -174,6 +175,11 @@ pub fn shortfall(trajectory: &Trajectory, reachable_m: f64) -> Option<String> {
     })
 }
 
+/// The scan's IK gives a restart up once its residual has not fallen by a tenth in this many
+/// iterations (`IkConfig::stall_iterations`). Measured on 300 FR3 evaluation tasks: the scan
+/// takes 20 ms per task instead of 43, and the bounds sum to 210.506 m instead of 210.526.
+const SCAN_STALL_ITERATIONS: usize = 10;
+
 /// One task's scan: what every grid point is searched with.
 struct Scan<'a> {
     robot: &'a Robot,
@@ -200,6 +206,9 @@ impl<'a> Scan<'a> {
                 // Strictly inside the limits, which the rollout's check treats as closed.
                 joint_margin_rad: 1e-6,
                 max_iterations: 100,
+                // A restart that stopped converging is given up: the restarts at the point that
+                // ends the scan, all of which fail, were most of the scan's work.
+                stall_iterations: SCAN_STALL_ITERATIONS,
                 ..IkConfig::default()
             },
         }

@@ -28,7 +28,17 @@ pub struct IkConfig {
     pub position_tolerance_m: f64,
     /// Solutions closer than this (max-norm, rad) are duplicates.
     pub dedup_rad: f64,
+    /// A restart is given up once its residual (position and the orientation beyond the cone)
+    /// has not fallen below [`STALL_RATIO`] of what it was this many iterations before: it
+    /// has settled in a local minimum short of the target. 0 runs every restart to
+    /// `max_iterations`.
+    #[serde(default)]
+    pub stall_iterations: usize,
 }
+
+/// Share of its residual a restart must shed every [`IkConfig::stall_iterations`] iterations
+/// to go on.
+pub const STALL_RATIO: f64 = 0.9;
 
 impl Default for IkConfig {
     fn default() -> Self {
@@ -43,6 +53,7 @@ impl Default for IkConfig {
             max_step_rad: 0.3,
             position_tolerance_m: 1e-4,
             dedup_rad: 0.08,
+            stall_iterations: 0,
         }
     }
 }

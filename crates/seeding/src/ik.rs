@@ -6,7 +6,7 @@ use nalgebra::SMatrix;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use crate::config::IkConfig;
+use crate::config::{IkConfig, STALL_RATIO};
 
 /// Distinct IK solutions of `(p0, tool axis within cfg.cone_deg of n)`, each at least
 /// `cfg.joint_margin_rad` inside every joint limit, pairwise at least `cfg.dedup_rad` apart
@@ -79,6 +79,8 @@ pub fn solve_cone_ik(
     let mut q = *start;
     // One buffer for every iteration's kinematics, written in place.
     let mut kin = robot.forward(&q);
+    // The residual norm at the start of the current stall window.
+    let mut window_start = f64::INFINITY;
     for iteration in 0..=cfg.max_iterations {
         if iteration > 0 {
             robot.forward_into(&q, &mut kin);
@@ -93,6 +95,13 @@ pub fn solve_cone_ik(
         }
         if error.fixed_rows::<3>(0).norm() < cfg.position_tolerance_m && excess == 0.0 {
             return Some(q);
+        }
+        if cfg.stall_iterations > 0 && iteration % cfg.stall_iterations == 0 {
+            let residual = error.norm();
+            if residual > STALL_RATIO * window_start {
+                return None;
+            }
+            window_start = residual;
         }
         let gram = rows * rows.transpose()
             + SMatrix::<f64, 6, 6>::identity() * (cfg.damping * cfg.damping);

@@ -51,7 +51,9 @@ mod tangent;
 pub use branch::{
     BranchSamples, SelfMotionWalk, WalkEnd, connected, sample_branches, tangent_directions, walk,
 };
-pub use config::{BranchConfig, HeuristicConfig, IkConfig, LabelConfig, StabilityConfig};
+pub use config::{
+    BranchConfig, HeuristicConfig, IkConfig, LabelConfig, STALL_RATIO, StabilityConfig,
+};
 pub use heuristic::{HeuristicError, HeuristicObjective, HeuristicSeed, heuristic_seed};
 pub use ik::{cone_ik_solutions, solve_cone_ik};
 pub use journal::{LabelJob, RunProgress, Shard, ShardError};
