@@ -238,17 +238,20 @@ struct LimitFile {
     rows: Vec<LimitRow>,
 }
 
-/// The search settings a `limit.json` was made with.
+/// The search settings a `limit.json` was made with, as written: a setting the file lacks
+/// (one added since) makes it another search's, not today's default.
 #[derive(Deserialize)]
 struct LimitIdentity {
-    limit: SearchConfig,
-    search: SearchConfig,
+    limit: serde_json::Value,
+    search: serde_json::Value,
 }
 
 impl LimitIdentity {
     /// Whether the limit's searches are today's: its own settings and the default search's.
     fn is_current(&self) -> bool {
-        self.limit == crate::limit::limit_search() && self.search == SearchConfig::default()
+        let today = |config: SearchConfig| serde_json::to_value(config).ok();
+        Some(&self.limit) == today(crate::limit::limit_search()).as_ref()
+            && Some(&self.search) == today(SearchConfig::default()).as_ref()
     }
 }
 

@@ -362,10 +362,12 @@ fn markdown(record: &Record) -> String {
          pipeline's plan out, follows up to {} of the scan's chains of configurations from `p0` \
          (its witnesses split where neighbours jump more than {} rad, later pieces joined back \
          to `p0`) with a tracking action, then ranks candidate starts (q0_seed, q_mu, q_jl, {} \
-         diffusion samples, cone IK from {} restarts) by classical rollouts and re-rolls the \
-         best {} with the hybrid controller; then it repairs the longest rollouts of the best \
-         {} starts where they failed (each null-space basis direction held for {} steps from 1 \
-         to 32 steps before the end, then the hybrid or the classical controller). It stops \
+         diffusion samples, cone IK from {} restarts) by rollouts of its own classical \
+         controller (Eq. 3 with k_θ {} gated from {}° before the cone's edge, and the tool axis \
+         led {}° ahead of its drift with k_lead {}) and re-rolls the best {} with the hybrid \
+         controller; then it repairs the longest rollouts of the best {} starts where they \
+         failed (each null-space basis direction held for {} steps from 1 to 32 steps before \
+         the end, then the hybrid or the search's classical controller). It stops \
          when its budget of control steps is spent or a plan comes within {} m of the first \
          grid point the scan missed. Every plan is re-checked by the independent \
          checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
@@ -382,6 +384,10 @@ fn markdown(record: &Record) -> String {
         record.search.chain_jump_rad,
         record.search.dp_samples,
         record.search.ik_restarts,
+        record.search.classical_gains.k_theta,
+        record.search.classical_gains.cone_gate_width_deg,
+        record.search.classical_gains.lead_deg,
+        record.search.classical_gains.k_lead,
         record.search.finalists,
         record.search.repaired_starts,
         record.search.detour_steps,

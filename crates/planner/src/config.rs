@@ -17,7 +17,8 @@ use crate::search::SearchConfig;
 /// `rollout` ([`RolloutConfig`]: `dt_s` 0.05 s, `speed_m_per_s` 0.2 m/s, `max_steps` 500,
 /// `null_speed_max_rad_per_s` 0.5, `lateral_gain_per_s` 5, constraints: `line_tolerance_m` 0.02,
 /// `theta_max_deg` 30, `collision_margin_m` 0, `velocity_limit_fraction` 1), `gains`
-/// ([`ClassicalGains`]: `k_mu` 0.8, `k_jl` 0.4, `k_theta` 0.2, `cone_gate_width_deg` 8),
+/// ([`ClassicalGains`]: `k_mu` 0.8, `k_jl` 0.4, `k_theta` 0.2, `cone_gate_width_deg` 8,
+/// `k_lead` 0),
 /// `switch` ([`SwitchConfig`]: `tau_enter` 0.98, `tau_exit` 0.94), `measure`
 /// ([`BoundaryMeasure`], default `rho`), `reach` ([`ReachConfig`]) and `search`
 /// ([`SearchConfig`]).
@@ -36,7 +37,8 @@ pub struct PlannerConfig {
     /// `offsets` 6).
     pub reach: ReachConfig,
     /// The search planner ([`SearchConfig`]: `budget_steps` 10,000, `dp_samples` 32,
-    /// `ik_restarts` 64, `finalists` 8, `repaired_starts` 8, `detour_steps` 10).
+    /// `ik_restarts` 64, `finalists` 8, `repaired_starts` 8, `detour_steps` 10, its own
+    /// `classical_gains`).
     pub search: SearchConfig,
 }
 

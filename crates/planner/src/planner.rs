@@ -187,8 +187,7 @@ impl Planner {
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
             };
-            let (seed, trajectory) =
-                search(&context, task, seed, request.controller, controller, &reach)?;
+            let (seed, trajectory) = search(&context, task, seed, controller, &reach);
             reach.witness(&trajectory);
             return Ok(Plan {
                 seed,

@@ -15,12 +15,12 @@
 //! branches. Each valid start is ranked by a rollout of the search's own classical controller
 //! (cheap, no network; [`SearchConfig::classical_gains`]: the paper's Eq. 3 with a far
 //! stronger cone term and the tool axis led ahead of its drift, since on long lines the tool
-//! tilt ends most motions); the best [`SearchConfig::finalists`] are rolled out again with the requested
-//! controller. Then the longest rollouts of the best [`SearchConfig::repaired_starts`] starts
-//! are repaired in turn where they failed: from 1, 2, 4, … 32 steps before the end, each
+//! tilt ends most motions); the best [`SearchConfig::finalists`] are rolled out again with the
+//! requested controller. Then the longest rollouts of the best [`SearchConfig::repaired_starts`]
+//! starts are repaired in turn where they failed: from 1, 2, 4, … 32 steps before the end, each
 //! null-space basis direction (±`e_i` of `B(q)`) is held for a few steps and the requested and
-//! the search's classical controller take over again; a round that goes further starts the next round
-//! from the new rollout. The longest rollout of all is the plan. The search ends early once a
+//! the search's classical controller take over again; a round that goes further starts the
+//! next round from the new rollout. The longest rollout of all is the plan. The search ends early once a
 //! rollout reaches the first grid point the scan found no configuration at: nothing is left
 //! that the bound can tell.
 //!
@@ -48,7 +48,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{ControllerKind, Executor, ExecutorError};
+use crate::controller::Executor;
 use crate::reach::{Reach, ReachConfig, witness_chains};
 use crate::seed::Seed;
 use crate::track::{Reference, progress_per_step, tracking_action};
@@ -83,7 +83,8 @@ pub struct SearchConfig {
     pub chains: usize,
     /// Gains of the search's own classical controller, which ranks the candidate starts and
     /// takes over after detours and chains beside the requested controller
-    /// ([`search_classical_gains`]).
+    /// ([`search_classical_gains`]). Given in a configuration file, it replaces the whole set:
+    /// the gains it leaves out take the paper's values (`ClassicalGains::default`).
     pub classical_gains: ClassicalGains,
     /// Seed of the IK restarts.
     pub seed: u64,
@@ -173,7 +174,24 @@ impl SearchConfig {
         OutOfRange::require("search.chains", count(self.chains), "[0, 64]", |n| {
             n <= 64.0
         })?;
-        self.classical_gains.validate()
+        self.classical_gains.validate().map_err(|error| OutOfRange {
+            field: search_gain_field(error.field),
+            ..error
+        })
+    }
+}
+
+/// The name under `search` of a classical gain's field (`gains.k_mu` is
+/// `search.classical_gains.k_mu` there).
+fn search_gain_field(field: &'static str) -> &'static str {
+    match field {
+        "gains.k_mu" => "search.classical_gains.k_mu",
+        "gains.k_jl" => "search.classical_gains.k_jl",
+        "gains.k_theta" => "search.classical_gains.k_theta",
+        "gains.cone_gate_width_deg" => "search.classical_gains.cone_gate_width_deg",
+        "gains.k_lead" => "search.classical_gains.k_lead",
+        "gains.lead_deg" => "search.classical_gains.lead_deg",
+        other => other,
     }
 }
 
@@ -449,26 +467,22 @@ impl<'a> Search<'a> {
 const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
 
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
-/// rolled out by `finalist`, the executor of `controller`) is always evaluated first, so the
+/// rolled out by `finalist`, the requested controller) is always evaluated first, so the
 /// search never returns less; then the scan's chains of configurations (`reach`) are followed
 /// from `p0`, the other candidates are ranked by rollouts of the search's classical controller,
-/// the best
-/// [`SearchConfig::finalists`] rolled out by `controller`, and the longest rollouts of the best
+/// the best [`SearchConfig::finalists`] rolled out by `finalist`, and the longest rollouts of the best
 /// starts repaired by detours near their ends, while budget is left and no rollout has come
 /// within [`SearchConfig::stop_within_m`] of the first grid point the scan missed.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
     seed: Seed,
-    controller: ControllerKind,
     finalist: Executor,
     reach: &Reach,
-) -> Result<(Seed, Trajectory), ExecutorError> {
+) -> (Seed, Trajectory) {
     let config = context.config;
-    let mut tails = vec![finalist];
-    tails.push(Executor::Classical(ClassicalController::new(
-        config.classical_gains.clone(),
-    )));
+    let ranking = Executor::Classical(ClassicalController::new(config.classical_gains.clone()));
+    let mut tails = [finalist, ranking];
     let enough_m = reach.scanned_m + reach.grid_m - config.stop_within_m;
     let mut search = Search::new(context, task, config.budget_steps, enough_m);
     search.try_start(&seed, &mut tails[0]);
@@ -486,19 +500,17 @@ pub(crate) fn search(
         let length = search.try_start(&candidate.seed(), &mut tails[1]);
         ranked.push((index, length));
     }
-    if controller != ControllerKind::Classical {
-        // Longest first; equal lengths keep the candidates' order.
-        ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
-        for &(index, _) in ranked.iter().take(config.finalists) {
-            if search.done() {
-                break;
-            }
-            search.try_start(&candidates[index].seed(), &mut tails[0]);
+    // Longest first; equal lengths keep the candidates' order.
+    ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+    for &(index, _) in ranked.iter().take(config.finalists) {
+        if search.done() {
+            break;
         }
+        search.try_start(&candidates[index].seed(), &mut tails[0]);
     }
     search.repair(&mut tails);
     let best = search.leaders.swap_remove(0);
-    Ok((best.seed, best.trajectory))
+    (best.seed, best.trajectory)
 }
 
 impl Search<'_> {

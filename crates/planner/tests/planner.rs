@@ -255,6 +255,14 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
             "gains.k_mu must be in [0, ∞), got -1",
         ),
         (
+            r#"{"gains": {"lead_deg": 90}}"#,
+            "gains.lead_deg must be in [0, 90), got 90",
+        ),
+        (
+            r#"{"search": {"classical_gains": {"k_lead": -5}}}"#,
+            "search.classical_gains.k_lead must be in [0, ∞), got -5",
+        ),
+        (
             r#"{"measure": {"kind": "all_constraints", "clearance_scale_m": 0}}"#,
             "measure.clearance_scale_m must be in (0, ∞), got 0",
         ),

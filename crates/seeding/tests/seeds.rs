@@ -1,4 +1,5 @@
-//! IK solutions are distinct and on the cone; branch walks stay on the pose; heuristic seeds
+//! IK solutions are distinct and on the cone, and restarts given up when they stop converging
+//! lose few of them; branch walks stay on the pose; heuristic seeds
 //! stay on the exact pose and raise their objective; the tangent projector is a projector onto
 //! motions that keep the pose (finite differences).
 
@@ -42,6 +43,43 @@ fn cone_ik_solutions_are_distinct_and_inside_the_cone_and_margin() {
             }
         }
     }
+}
+
+#[test]
+fn restarts_given_up_when_they_stall_miss_few_solutions() {
+    let robot = robot();
+    let full = IkConfig {
+        restarts: 64,
+        cone_deg: 30.0,
+        max_iterations: 100,
+        ..IkConfig::default()
+    };
+    let stalling = IkConfig {
+        stall_iterations: 10,
+        ..full.clone()
+    };
+    let (mut found_full, mut found_stalling) = (0, 0);
+    for (i, task) in eval_tasks(&robot, 8).iter().enumerate() {
+        // A reachable target (the task's start) and one beyond reach along the line.
+        for target in [task.p0, task.p0 + task.d * 1.5] {
+            let solve = |cfg: &IkConfig| {
+                let mut rng = ChaCha8Rng::seed_from_u64(i as u64);
+                cone_ik_solutions(&robot, &target, &task.n, cfg, &mut rng)
+            };
+            let (a, b) = (solve(&full), solve(&stalling));
+            // What the stalling solver returns is a solution all the same.
+            for q in &b {
+                assert!((robot.forward(q).tcp() - target).norm() < full.position_tolerance_m);
+            }
+            found_full += a.len();
+            found_stalling += b.len();
+        }
+    }
+    assert!(found_full > 50, "only {found_full} solutions");
+    assert!(
+        found_stalling as f64 >= 0.9 * found_full as f64,
+        "{found_stalling} of {found_full} solutions kept"
+    );
 }
 
 #[test]
