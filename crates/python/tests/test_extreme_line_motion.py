@@ -119,7 +119,12 @@ def test_plan_arrays_describe_the_motion(planner, tasks):
     assert plan.path_length_m == pytest.approx(float((plan.tcp[-1] - task.p0) @ task.d), abs=1e-9)
     assert 0 < plan.path_length_m <= plan.reachable_m + 0.02
     np.testing.assert_array_equal(plan.q[0], plan.seed)
-    assert plan.seed_source == "dp"
+    # The search starts from whichever of its candidates goes furthest, never less far than
+    # the paper's pipeline (one DP seed, one rollout).
+    assert plan.seed_source in ("dp", "generating", "q_mu", "q_jl", "ik", "scan-chain", "scan")
+    pipeline = planner.plan(task.p0, task.d, task.n, planner="controller")
+    assert pipeline.seed_source == "dp"
+    assert plan.path_length_m >= pipeline.path_length_m
     assert plan.termination
     np.testing.assert_array_equal(plan.task.p0, task.p0)
 
