@@ -19,8 +19,8 @@
 //! requested controller. Then the longest rollouts of the best [`SearchConfig::repaired_starts`]
 //! starts are repaired in turn where they failed: from 1, 2, 4, … 32 steps before the end, each
 //! null-space basis direction (±`e_i` of `B(q)`) is held for a few steps and the requested and
-//! the search's classical controller take over again; a round that goes further starts the
-//! next round from the new rollout. The longest rollout of all is the plan. The search ends early once a
+//! the search's classical controller take over again; a round that goes further starts the next
+//! round from the new rollout. The longest rollout of all is the plan. The search ends early once a
 //! rollout reaches the first grid point the scan found no configuration at: nothing is left
 //! that the bound can tell.
 //!
@@ -469,10 +469,10 @@ const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
 /// rolled out by `finalist`, the requested controller) is always evaluated first, so the
 /// search never returns less; then the scan's chains of configurations (`reach`) are followed
-/// from `p0`, the other candidates are ranked by rollouts of the search's classical controller,
-/// the best [`SearchConfig::finalists`] rolled out by `finalist`, and the longest rollouts of the best
-/// starts repaired by detours near their ends, while budget is left and no rollout has come
-/// within [`SearchConfig::stop_within_m`] of the first grid point the scan missed.
+/// from `p0`, the other candidates are ranked by rollouts of the search's classical controller, the
+/// best [`SearchConfig::finalists`] rolled out by `finalist`, and the longest rollouts of the best
+/// starts repaired by detours near their ends, while budget is left and no rollout has come within
+/// [`SearchConfig::stop_within_m`] of the first grid point the scan missed.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
