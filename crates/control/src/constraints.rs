@@ -152,7 +152,7 @@ pub(crate) fn admit(
             limit_rad: limit,
         });
     }
-    let distance = task.lateral_error(&kin.tcp()).norm();
+    let distance = task.distance(&kin.tcp());
     // NaN counts as a violation.
     if distance.is_nan() || distance > cfg.line_tolerance_m {
         return Err(Violation::LineTolerance {

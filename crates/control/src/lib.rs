@@ -1,4 +1,4 @@
-//! Straight-line tasks, their constraints, the one rollout loop every controller shares, the
+//! Straight-line and path tasks, their constraints, the one rollout loop every controller shares, the
 //! classical null-space controller, the task population, and the hand-over of rollouts to the
 //! independent checker (`emg-verify`).
 //!
@@ -28,6 +28,7 @@ mod classical;
 mod config;
 mod constraints;
 mod controller;
+mod path;
 mod rollout;
 mod sampler;
 mod step;
@@ -41,10 +42,17 @@ pub use config::{
 };
 pub use constraints::{Violation, WORK_SURFACE, first_contact, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
+pub use path::{
+    CORNER_RAD, Located, MIN_SEGMENT_M, PATH_FORMAT_VERSION, PLANE_TOLERANCE_M, Path, PathError,
+    PathSpec, Piece, SegmentSpec,
+};
 pub use rollout::{
     Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,
 };
 pub use sampler::{SamplerConfig, TaskSampler, candidate, surface_clears};
 pub use step::{NullAction, StepContext};
-pub use task::{PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, Task, TaskError};
+pub use task::{
+    ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task,
+    TaskError,
+};
 pub use verification::CheckRollout;

@@ -50,6 +50,8 @@ pub enum Termination {
     },
     /// The step cap was reached with every constraint held.
     StepCap,
+    /// The tool reached the end of its path (path tasks only).
+    Completed,
 }
 
 impl Termination {
@@ -59,6 +61,7 @@ impl Termination {
             Self::Violation { violation, .. } => violation.kind(),
             Self::InvalidStart { .. } => "invalid_start",
             Self::StepCap => "step_cap",
+            Self::Completed => "completed",
         }
     }
 }
@@ -69,6 +72,7 @@ impl std::fmt::Display for Termination {
             Self::Violation { violation, .. } => write!(f, "{violation}"),
             Self::InvalidStart { violation } => write!(f, "the seed is invalid: {violation}"),
             Self::StepCap => write!(f, "reached the step cap with every constraint held"),
+            Self::Completed => write!(f, "reached the end of the path"),
         }
     }
 }
@@ -80,19 +84,22 @@ pub struct Trajectory {
     pub steps: Vec<StepRecord>,
     /// Why the rollout ended.
     pub termination: Termination,
-    /// Path length `L = (p_T − p0)·d` at the last accepted step (m).
+    /// Path length `L = (p_T − p0)·d` at the last accepted step (m); on a path task, the arc
+    /// length reached.
     pub path_length_m: f64,
 }
 
 /// What one applied step did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StepOutcome {
-    /// The step was accepted; the episode goes on. `progress_m` is its advance along `d`.
+    /// The step was accepted; the episode goes on. `progress_m` is its advance along `d` (on a
+    /// path, the arc length it gained).
     Continued {
         /// `(p_{t+1} − p_t)·d` (m).
         progress_m: f64,
     },
-    /// The step was accepted and reached the step cap (a truncation, not a failure).
+    /// The step was accepted and reached the step cap or the end of its path (a truncation,
+    /// not a failure).
     Truncated {
         /// `(p_{t+1} − p_t)·d` (m).
         progress_m: f64,
@@ -203,10 +210,18 @@ impl<'a> Episode<'a> {
                 return StepOutcome::Terminated;
             }
         };
-        let progress_m = (self.current.kinematics.tcp() - previous_tcp).dot(&task.d);
+        let progress_m = match task.path {
+            None => (self.current.kinematics.tcp() - previous_tcp).dot(&task.d),
+            Some(_) => derived.along.s_m - self.current.along.s_m,
+        };
         self.time_s += self.step_duration(&velocity);
         self.current
             .advance(self.steps.len(), tool_angle_deg, action, derived);
+        if task.completed(self.current.along.s_m) {
+            self.record(None);
+            self.termination = Some(Termination::Completed);
+            return StepOutcome::Truncated { progress_m };
+        }
         if self.steps.len() == config.max_steps {
             self.record(None);
             self.termination = Some(Termination::StepCap);
@@ -239,7 +254,10 @@ impl<'a> Episode<'a> {
             .steps
             .last()
             .expect("a trajectory holds at least its seed");
-        let path_length_m = self.current.task.progress(&last.tcp);
+        let path_length_m = match self.current.task.path {
+            None => self.current.task.progress(&last.tcp),
+            Some(_) => self.current.along.s_m,
+        };
         Trajectory {
             steps: self.steps,
             termination,

@@ -8,7 +8,7 @@ use nalgebra::SVector;
 
 use crate::config::RolloutConfig;
 use crate::constraints::tool_angle_deg;
-use crate::task::Task;
+use crate::task::{Along, Task};
 
 /// A null-space action `a ∈ [−1, 1]⁴`: coordinates in the basis `B(q)` (Sec. 4.2).
 pub type NullAction = SVector<f64, 4>;
@@ -34,6 +34,8 @@ pub struct StepContext<'a> {
     pub rho: f64,
     /// Angle between tool axis and `n` (degrees).
     pub tool_angle_deg: f64,
+    /// Where the TCP stands along the task (its progress, heading and lateral error).
+    pub along: Along,
     /// Directional manipulability `w_d` along `d`.
     pub manipulability: f64,
     /// `∇w_d` (SPEC §4).
@@ -52,7 +54,8 @@ pub struct StepContext<'a> {
 
 impl<'a> StepContext<'a> {
     /// Computes every quantity of the step at the configuration whose forward kinematics
-    /// ([`Robot::forward`]) `kinematics` is (no allocation).
+    /// ([`Robot::forward`]) `kinematics` is (no allocation); on a path task the TCP is located
+    /// near the path's start.
     pub fn new(
         robot: &'a Robot,
         task: &'a Task,
@@ -64,6 +67,7 @@ impl<'a> StepContext<'a> {
         let tool_angle_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n);
         let Derived {
             q,
+            along,
             q_normalised,
             rho,
             manipulability,
@@ -72,7 +76,7 @@ impl<'a> StepContext<'a> {
             centring_gradient,
             pseudo_inverse,
             basis,
-        } = Derived::of(robot, task, config, &kinematics);
+        } = Derived::of(robot, task, config, &kinematics, 0.0);
         Self {
             robot,
             task,
@@ -83,6 +87,7 @@ impl<'a> StepContext<'a> {
             q_normalised,
             rho,
             tool_angle_deg,
+            along,
             manipulability,
             manipulability_gradient,
             alignment_gradient,
@@ -111,6 +116,7 @@ impl<'a> StepContext<'a> {
         self.q_normalised = derived.q_normalised;
         self.rho = derived.rho;
         self.tool_angle_deg = tool_angle_deg;
+        self.along = derived.along;
         self.manipulability = derived.manipulability;
         self.manipulability_gradient = derived.manipulability_gradient;
         self.alignment_gradient = derived.alignment_gradient;
@@ -120,19 +126,33 @@ impl<'a> StepContext<'a> {
         self.previous_action = previous_action;
     }
 
-    /// The quantities that follow from `self.kinematics` alone, for [`StepContext::advance`].
+    /// The quantities that follow from `self.kinematics` alone (and, on a path, the progress
+    /// the last accepted step had), for [`StepContext::advance`].
     /// The step computes them before its constraint check, which needs none of them, so that
     /// the check's work overlaps the tail of their chain of dependent square roots and
     /// divisions (the null-space basis); on a rejected step they are dropped.
     #[inline(always)]
     pub(crate) fn derive(&self) -> Derived {
-        Derived::of(self.robot, self.task, self.config, &self.kinematics)
+        Derived::of(
+            self.robot,
+            self.task,
+            self.config,
+            &self.kinematics,
+            self.along.s_m,
+        )
     }
 
-    /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3).
+    /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3); on a path, `d` is the heading
+    /// there and the speed is lowered where a full step would pass the next corner or the end.
     pub fn task_velocity(&self) -> Vec3 {
-        let lateral = self.task.lateral_error(&self.kinematics.tcp());
-        self.task.d * self.config.speed_m_per_s + lateral * self.config.lateral_gain_per_s
+        let speed = match self.task.path {
+            None => self.config.speed_m_per_s,
+            Some(_) => self
+                .config
+                .speed_m_per_s
+                .min(self.task.stop_ahead_m(self.along.s_m) / self.config.dt_s),
+        };
+        self.along.heading * speed + self.along.lateral * self.config.lateral_gain_per_s
     }
 
     /// Joint velocity `q̇ = J⁺ẋ + a_max B a` for a (clipped) action `a` (Eq. 2).
@@ -154,6 +174,7 @@ impl<'a> StepContext<'a> {
 /// share.
 pub(crate) struct Derived {
     q: JointVector,
+    pub(crate) along: Along,
     q_normalised: JointVector,
     rho: f64,
     manipulability: f64,
@@ -165,10 +186,18 @@ pub(crate) struct Derived {
 }
 
 impl Derived {
-    /// Computes them at the configuration of `kinematics` (no allocation).
+    /// Computes them at the configuration of `kinematics` (no allocation), locating a path
+    /// task's TCP near the progress `s_hint`.
     #[inline(always)]
-    fn of(robot: &Robot, task: &Task, config: &RolloutConfig, kinematics: &Kinematics) -> Self {
+    fn of(
+        robot: &Robot,
+        task: &Task,
+        config: &RolloutConfig,
+        kinematics: &Kinematics,
+        s_hint: f64,
+    ) -> Self {
         let q = *kinematics.configuration();
+        let along = task.along(&kinematics.tcp(), s_hint);
         let limits = robot.limits();
         let q_normalised = limits.normalise(&q);
         let rho = q_normalised.amax();
@@ -177,7 +206,7 @@ impl Derived {
         let (manipulability, manipulability_gradient) = directional_manipulability(
             kinematics,
             pseudo_inverse.gram(),
-            &task.d,
+            &along.heading,
             config.manipulability_damping,
         );
         let alignment_gradient = tool_alignment_gradient(kinematics, &task.n);
@@ -194,6 +223,7 @@ impl Derived {
         );
         Self {
             q,
+            along,
             q_normalised,
             rho,
             manipulability,

@@ -3,6 +3,8 @@
 use emg_kinematics::{JointVector, Robot, Vec3};
 use serde::{Deserialize, Serialize};
 
+use crate::path::{Path, PathError};
+
 /// Largest `|d·n|` accepted as perpendicular; smaller deviations are removed exactly.
 pub const PERPENDICULAR_TOLERANCE: f64 = 1e-6;
 
@@ -14,7 +16,8 @@ const ROUNDING: f64 = 4.0 * f64::EPSILON;
 pub const SEED_POSITION_TOLERANCE_M: f64 = 1e-6;
 
 /// A straight-line task: start `p0`, unit direction `d`, unit task-plane normal `n` (`d ⟂ n`),
-/// and optionally the configuration that generated it (`q0_seed`, the fallback seed).
+/// and optionally the configuration that generated it (`q0_seed`, the fallback seed); or a
+/// path task ([`Task::on_path`]): a [`Path`] from `p0`, with `d` its tangent at the start.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Task {
     /// Start position `p0` (m).
@@ -26,7 +29,31 @@ pub struct Task {
     /// Configuration that generated the task, if known (`q0_seed`).
     #[serde(default)]
     pub q0_seed: Option<JointVector>,
+    /// The path the tool follows, when it is not the straight line from `p0` along `d`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<Path>,
 }
+
+/// Where the TCP stands along its task: how far it has come, which way the task goes on, and
+/// its offset from the line or path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Along {
+    /// Progress along the line or arc length along the path (m).
+    pub s_m: f64,
+    /// Unit direction the task commands from here: `d` on a line, the path's tangent on a path
+    /// (the next piece's once the TCP is at a corner).
+    pub heading: Vec3,
+    /// Lateral error vector from the TCP to the line or to its nearest path point.
+    pub lateral: Vec3,
+}
+
+/// Arc length (m) within which the TCP counts as at a corner or at the end of its path.
+pub const ARRIVAL_M: f64 = 1e-4;
+
+/// Arc length (m) around the last known progress that a path task searches for the TCP's
+/// nearest path point: far more than one step goes, far less than any path takes to come back
+/// near itself.
+pub const TRACKING_WINDOW_M: f64 = 0.05;
 
 /// Why a task was rejected; names the field and what is wrong.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -65,12 +92,21 @@ pub enum TaskError {
         /// The arm's reach (m).
         reach_m: f64,
     },
+    /// The task's path is malformed.
+    #[error(transparent)]
+    Path(PathError),
     /// `q0_seed` is not a valid generating configuration of this task.
     #[error("task field 'q0_seed' {problem}")]
     BadSeed {
         /// What is wrong with it.
         problem: String,
     },
+}
+
+impl From<PathError> for TaskError {
+    fn from(error: PathError) -> Self {
+        Self::Path(error)
+    }
 }
 
 impl Task {
@@ -130,7 +166,82 @@ impl Task {
                 });
             }
         }
-        Ok(Self { p0, d, n, q0_seed })
+        Ok(Self {
+            p0,
+            d,
+            n,
+            q0_seed,
+            path: None,
+        })
+    }
+
+    /// A path task: the tool follows `path` from its start, the tool axis within the cone
+    /// around its normal; `d` is the path's tangent at the start. Validated as [`Task::new`]
+    /// validates a line from the path's start along that tangent.
+    pub fn on_path(
+        robot: &Robot,
+        path: Path,
+        q0_seed: Option<JointVector>,
+    ) -> Result<Self, TaskError> {
+        let start = path.point_at(0.0);
+        let line = Self::new(robot, start, path.tangent_at(0.0), path.normal(), q0_seed)?;
+        Ok(Self {
+            path: Some(path),
+            ..line
+        })
+    }
+
+    /// Where the TCP at `p` stands along the task; on a path, its nearest path point within
+    /// [`TRACKING_WINDOW_M`] of the progress `s_hint` it last had.
+    #[inline]
+    pub fn along(&self, p: &Vec3, s_hint: f64) -> Along {
+        match &self.path {
+            None => Along {
+                s_m: self.progress(p),
+                heading: self.d,
+                lateral: self.lateral_error(p),
+            },
+            Some(path) => {
+                let located = path.locate(p, s_hint, TRACKING_WINDOW_M);
+                let at_corner = path
+                    .next_corner_m(located.s - ARRIVAL_M)
+                    .filter(|&corner| corner <= located.s + ARRIVAL_M);
+                Along {
+                    s_m: located.s,
+                    heading: at_corner.map_or(located.tangent, |corner| path.tangent_at(corner)),
+                    lateral: located.point - p,
+                }
+            }
+        }
+    }
+
+    /// The distance (m) from `p` to the line, or to the nearest point of the whole path.
+    pub fn distance(&self, p: &Vec3) -> f64 {
+        match &self.path {
+            None => self.lateral_error(p).norm(),
+            Some(path) => (path.locate(p, 0.0, path.length_m()).point - p).norm(),
+        }
+    }
+
+    /// How far (m) the TCP at arc length `s_m` may go before it must stop: the next corner or
+    /// the end of its path; unbounded on a line.
+    pub fn stop_ahead_m(&self, s_m: f64) -> f64 {
+        match &self.path {
+            None => f64::INFINITY,
+            Some(path) => {
+                let stop = path
+                    .next_corner_m(s_m + ARRIVAL_M)
+                    .unwrap_or(path.length_m());
+                (stop - s_m).max(0.0)
+            }
+        }
+    }
+
+    /// Whether the TCP at arc length `s_m` has reached the end of its path (never on a line).
+    pub fn completed(&self, s_m: f64) -> bool {
+        self.path
+            .as_ref()
+            .is_some_and(|path| s_m >= path.length_m() - ARRIVAL_M)
     }
 
     /// Signed progress `(p − p0)·d` of a TCP position along the line (m).

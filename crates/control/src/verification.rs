@@ -4,8 +4,8 @@
 
 use emg_kinematics::{Shape, WorkSurface};
 use emg_verify::{
-    Blame, Bounds, CheckFailure, Ending, Line, Obstacle, RecordedStep, Recording, ReferenceModel,
-    Solid, Surface,
+    Blame, Bounds, CheckFailure, Ending, Line, Obstacle, PathPiece, RecordedStep, Recording,
+    ReferenceModel, Solid, Surface,
 };
 
 use crate::config::ConstraintConfig;
@@ -15,10 +15,23 @@ use crate::task::Task;
 
 impl From<&Task> for Line {
     fn from(task: &Task) -> Self {
+        let pieces = task.path.as_ref().map_or(&[][..], |path| path.pieces());
         Self {
             p0: task.p0,
             d: task.d,
             n: task.n,
+            path: pieces
+                .iter()
+                .map(|piece| match piece.outline() {
+                    (start, end, None) => PathPiece::Straight { start, end },
+                    (start, _, Some((centre, axis))) => PathPiece::Arc {
+                        centre,
+                        start,
+                        axis,
+                        sweep_rad: piece.length_m / (start - centre).norm(),
+                    },
+                })
+                .collect(),
         }
     }
 }
@@ -108,6 +121,7 @@ impl From<&Trajectory> for Recording {
                 blame: violation.into(),
             },
             Termination::StepCap => Ending::Stopped,
+            Termination::Completed => Ending::Completed,
         };
         Self {
             steps: trajectory

@@ -132,6 +132,7 @@ fn assert_invariants(robot: &Robot, task: &Task, trajectory: &Trajectory, config
         }
         Termination::StepCap => assert_eq!(steps.len(), config.max_steps + 1),
         Termination::InvalidStart { .. } => panic!("sampled seeds are valid"),
+        Termination::Completed => panic!("a line has no end"),
     }
 }
 

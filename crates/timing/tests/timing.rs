@@ -77,11 +77,7 @@ fn a_rollout_becomes_a_rest_to_rest_motion_within_every_limit() {
     // The tool moves at the requested speed for most of a long, easy line.
     assert!(report.tool_speed_share > 0.5, "{report:?}");
     // Every sample holds the task's constraints by the independent checker's kinematics.
-    let line = Line {
-        p0: task.p0,
-        d: task.d,
-        n: task.n,
-    };
+    let line = Line::straight(task.p0, task.d, task.n);
     let bounds = Bounds {
         line_tolerance_m: config.constraints.line_tolerance_m,
         theta_max_deg: config.constraints.theta_max_deg,

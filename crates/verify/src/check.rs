@@ -9,6 +9,9 @@ const SLACK: f64 = 1e-9;
 /// Slack of angles (degrees).
 const ANGLE_SLACK_DEG: f64 = 1e-6;
 
+/// How far short (m) of its path's end a motion that claims to have reached it may stop.
+const PATH_END_SLACK_M: f64 = 2e-4;
+
 /// Which check a recorded motion fails.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FailedCheck {
@@ -121,7 +124,7 @@ impl ReferenceModel {
                     format!("recorded TCP {:?} but FK gives {:?}", step.tcp, tcp),
                 );
             }
-            let lateral = line.lateral_distance(&tcp);
+            let lateral = line.distance(&tcp);
             if !within(lateral, bounds.line_tolerance_m + SLACK) {
                 return fail(
                     k,
@@ -202,23 +205,30 @@ impl ReferenceModel {
                 }
             }
         }
-        if let Some(last) = steps.last() {
-            let length = line.progress(&last.tcp);
-            if !within((length - recording.path_length_m).abs(), SLACK) {
-                return fail(
-                    steps.len() - 1,
-                    FailedCheck::PathLength,
-                    format!(
-                        "reported path length {} but the last step gives {length}",
-                        recording.path_length_m
-                    ),
-                );
-            }
+        let length = line.reached(steps.iter().map(|step| step.tcp));
+        if let (Ending::Completed, Some(path_length)) = (&recording.ending, line.path_length())
+            && !within(path_length - PATH_END_SLACK_M, length)
+        {
+            return fail(
+                steps.len() - 1,
+                FailedCheck::Ending,
+                format!("claims the end of the path ({path_length} m) but reaches {length} m"),
+            );
+        }
+        if !within((length - recording.path_length_m).abs(), SLACK) {
+            return fail(
+                steps.len() - 1,
+                FailedCheck::PathLength,
+                format!(
+                    "reported path length {} but the last step gives {length}",
+                    recording.path_length_m
+                ),
+            );
         }
         let blamed = match &recording.ending {
             Ending::Rejected { blame, rejected_q } => Some((blame, *rejected_q)),
             Ending::InvalidStart { blame } => Some((blame, steps[0].q)),
-            Ending::Stopped => None,
+            Ending::Stopped | Ending::Completed => None,
         };
         if let Some((blame, q)) = blamed
             && !self.breaks(line, &q, blame, bounds)
@@ -246,9 +256,7 @@ impl ReferenceModel {
                     None => false,
                 }
             }
-            Blame::LineTolerance => {
-                !within(line.lateral_distance(&tcp), bounds.line_tolerance_m - SLACK)
-            }
+            Blame::LineTolerance => !within(line.distance(&tcp), bounds.line_tolerance_m - SLACK),
             Blame::ToolCone => !within(
                 angle_deg(&z, &line.n),
                 bounds.theta_max_deg - ANGLE_SLACK_DEG,

@@ -13,7 +13,7 @@
 //! let model = ReferenceModel::from_urdf_file(&path, "link0", "pen_tip")?;
 //! let q = emg_verify::Joints::from_column_slice(&[0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.8]);
 //! let (tcp, axis) = model.tcp_pose(&q);
-//! let line = Line { p0: tcp, d: axis.cross(&nalgebra::Vector3::x()).normalize(), n: axis };
+//! let line = Line::straight(tcp, axis.cross(&nalgebra::Vector3::x()).normalize(), axis);
 //! let bounds = Bounds {
 //!     line_tolerance_m: 0.02,
 //!     theta_max_deg: 30.0,
@@ -41,7 +41,8 @@ pub use dynamics::{
 };
 pub use model::{ModelError, ReferenceModel};
 pub use record::{
-    Blame, Bounds, Ending, JOINTS, Joints, Line, Obstacle, RecordedStep, Recording, Solid, Surface,
+    Blame, Bounds, Ending, JOINTS, Joints, Line, Obstacle, PATH_WINDOW_M, PathPiece, RecordedStep,
+    Recording, Solid, Surface,
 };
 pub use replay::{
     DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,

@@ -10,7 +10,7 @@ pub const JOINTS: usize = 7;
 pub type Joints = SVector<f64, JOINTS>;
 
 /// The task line: start `p0`, unit direction `d`, unit normal `n` (the tool axis must stay near
-/// it).
+/// it); on a path task, also the path's pieces from `p0` (`d` then is its tangent at the start).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Line {
     /// Start position (m).
@@ -19,9 +19,128 @@ pub struct Line {
     pub d: Vector3<f64>,
     /// Unit task-plane normal.
     pub n: Vector3<f64>,
+    /// The path's pieces in the order travelled; empty on a straight-line task.
+    pub path: Vec<PathPiece>,
 }
 
+/// One piece of a path, as plain data.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PathPiece {
+    /// The segment from `start` to `end`.
+    Straight {
+        /// Start point (m).
+        start: Vector3<f64>,
+        /// End point (m).
+        end: Vector3<f64>,
+    },
+    /// The arc from `start` about `centre`, swept by `sweep_rad` about the unit `axis` (right
+    /// hand).
+    Arc {
+        /// Centre of the circle (m).
+        centre: Vector3<f64>,
+        /// Start point (m).
+        start: Vector3<f64>,
+        /// Unit rotation axis.
+        axis: Vector3<f64>,
+        /// Signed angle swept (rad).
+        sweep_rad: f64,
+    },
+}
+
+impl PathPiece {
+    /// Length of the piece (m).
+    fn length(&self) -> f64 {
+        match *self {
+            Self::Straight { start, end } => (end - start).norm(),
+            Self::Arc {
+                centre,
+                start,
+                sweep_rad,
+                ..
+            } => (start - centre).norm() * sweep_rad.abs(),
+        }
+    }
+
+    /// The point `length` (m) along the piece.
+    fn point(&self, length: f64) -> Vector3<f64> {
+        match *self {
+            Self::Straight { start, end } => start + (end - start).normalize() * length,
+            Self::Arc {
+                centre,
+                start,
+                axis,
+                sweep_rad,
+            } => {
+                let radius = (start - centre).norm();
+                let angle = sweep_rad.signum() * length / radius;
+                let r = start - centre;
+                // Rodrigues' rotation of `r` about `axis` by `angle`.
+                centre
+                    + r * angle.cos()
+                    + axis.cross(&r) * angle.sin()
+                    + axis * axis.dot(&r) * (1.0 - angle.cos())
+            }
+        }
+    }
+
+    /// The lengths along the piece, each within `[low, high]`, of its point nearest `point`:
+    /// on a closed circle, also that point one turn on.
+    fn nearest(&self, point: &Vector3<f64>, low: f64, high: f64) -> Vec<f64> {
+        match *self {
+            Self::Straight { start, end } => {
+                vec![
+                    (point - start)
+                        .dot(&(end - start).normalize())
+                        .clamp(low, high),
+                ]
+            }
+            Self::Arc {
+                centre,
+                start,
+                axis,
+                sweep_rad,
+            } => {
+                let r = start - centre;
+                let radius = r.norm();
+                let offset = point - centre;
+                let turned = axis.cross(&r) * sweep_rad.signum();
+                let angle = offset.dot(&turned).atan2(offset.dot(&r));
+                let full = std::f64::consts::TAU;
+                let angle = if angle < 0.0 { angle + full } else { angle };
+                let sweep = sweep_rad.abs();
+                // Past the sweep: whichever end lies at the smaller angle.
+                let angle = if angle <= sweep {
+                    angle
+                } else if angle - sweep < full - angle {
+                    sweep
+                } else {
+                    0.0
+                };
+                let mut lengths = vec![(angle * radius).clamp(low, high)];
+                if angle + full <= sweep {
+                    lengths.push(((angle + full) * radius).clamp(low, high));
+                }
+                lengths
+            }
+        }
+    }
+}
+
+/// How far (m, of arc length) from its last known place along a path the checker looks for a
+/// recorded TCP's nearest path point.
+pub const PATH_WINDOW_M: f64 = 0.05;
+
 impl Line {
+    /// A straight-line task.
+    pub fn straight(p0: Vector3<f64>, d: Vector3<f64>, n: Vector3<f64>) -> Self {
+        Self {
+            p0,
+            d,
+            n,
+            path: Vec::new(),
+        }
+    }
+
     /// Lateral distance of `point` from the line (m).
     pub fn lateral_distance(&self, point: &Vector3<f64>) -> f64 {
         let offset = point - self.p0;
@@ -31,6 +150,74 @@ impl Line {
     /// Progress `(point − p0)·d` of `point` along the line (m).
     pub fn progress(&self, point: &Vector3<f64>) -> f64 {
         (point - self.p0).dot(&self.d)
+    }
+
+    /// The distance (m) of `point` from the line, or from the nearest point of the path.
+    pub fn distance(&self, point: &Vector3<f64>) -> f64 {
+        if self.path.is_empty() {
+            return self.lateral_distance(point);
+        }
+        let (s, _) = self.nearest_on_path(point, 0.0, f64::INFINITY);
+        (self.point_on_path(s) - point).norm()
+    }
+
+    /// The path's length (m); `None` on a line.
+    pub fn path_length(&self) -> Option<f64> {
+        (!self.path.is_empty()).then(|| self.path.iter().map(PathPiece::length).sum())
+    }
+
+    /// How far `points` (a motion's TCPs in order) get: on a line the last one's progress, on
+    /// a path the arc length of its nearest point, followed from the start within
+    /// [`PATH_WINDOW_M`] per point.
+    pub fn reached(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> f64 {
+        let mut s = 0.0;
+        let mut last = None;
+        for point in points {
+            if !self.path.is_empty() {
+                s = self.nearest_on_path(&point, s, PATH_WINDOW_M).0;
+            }
+            last = Some(point);
+        }
+        match last {
+            Some(point) if self.path.is_empty() => self.progress(&point),
+            _ => s,
+        }
+    }
+
+    /// The arc length within `window` of `hint` whose path point lies nearest `point`, and its
+    /// distance.
+    fn nearest_on_path(&self, point: &Vector3<f64>, hint: f64, window: f64) -> (f64, f64) {
+        let mut best = (hint, f64::INFINITY);
+        let mut start = 0.0;
+        for piece in &self.path {
+            let length = piece.length();
+            let low = (hint - window - start).max(0.0);
+            let high = (hint + window - start).min(length);
+            if low <= high {
+                for along in piece.nearest(point, low, high) {
+                    let distance = (piece.point(along) - point).norm();
+                    if distance < best.1 {
+                        best = (start + along, distance);
+                    }
+                }
+            }
+            start += length;
+        }
+        best
+    }
+
+    /// The path point at arc length `s`.
+    fn point_on_path(&self, s: f64) -> Vector3<f64> {
+        let mut start = 0.0;
+        for piece in &self.path {
+            let length = piece.length();
+            if s <= start + length {
+                return piece.point((s - start).max(0.0));
+            }
+            start += length;
+        }
+        let last = self.path.last().expect("a path holds a piece");
+        last.point(last.length())
     }
 }
 
@@ -197,6 +384,8 @@ pub enum Ending {
     /// The planner stopped with every constraint held (a step cap, or a file of points that
     /// says nothing about why the motion ended).
     Stopped,
+    /// The tool reached the end of its path (path tasks only).
+    Completed,
 }
 
 /// A recorded motion: its points, why it ended and the length it reports.
@@ -206,6 +395,6 @@ pub struct Recording {
     pub steps: Vec<RecordedStep>,
     /// Why it ended.
     pub ending: Ending,
-    /// The reported path length `(p_last − p0)·d` (m).
+    /// The reported path length `(p_last − p0)·d` (m); on a path, the arc length reached.
     pub path_length_m: f64,
 }

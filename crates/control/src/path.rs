@@ -1,0 +1,712 @@
+//! Paths on a work surface: a start point and a sequence of straight and circular segments in
+//! the plane through it normal to `n`, parameterised by arc length `s`.
+//!
+//! A path is given as a [`PathSpec`] (the JSON path format, docs/paths.md) and validated into a
+//! [`Path`]: every segment starts where the one before it ends, lies in the plane through the
+//! start normal to `n`, and is longer than [`MIN_SEGMENT_M`]; a corner between two straight
+//! segments may be rounded by a blend arc of the radius the spec gives. A straight line is the
+//! one-segment path.
+
+use std::f64::consts::PI;
+
+use emg_kinematics::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// The version of the path format this build reads and writes.
+pub const PATH_FORMAT_VERSION: u32 = 1;
+
+/// Shortest segment (m) a path may hold.
+pub const MIN_SEGMENT_M: f64 = 1e-4;
+
+/// Largest distance (m) of a given point from the plane through the start normal to `n`.
+pub const PLANE_TOLERANCE_M: f64 = 1e-6;
+
+/// Smallest turn (rad) between the tangents of two segments that counts as a corner; a
+/// smaller one is passed as if smooth.
+pub const CORNER_RAD: f64 = 1e-6;
+
+/// A path as written in a path file: its start, the surface normal and the segments in the
+/// order travelled.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathSpec {
+    /// The path format version ([`PATH_FORMAT_VERSION`]).
+    pub version: u32,
+    /// Start point (m).
+    pub start: [f64; 3],
+    /// Normal `n` of the work surface; the tool axis stays within the cone around it.
+    pub normal: [f64; 3],
+    /// Radius (m) of the arcs that round the corners between straight segments; 0 passes every
+    /// corner at rest.
+    #[serde(default)]
+    pub blend_radius_m: f64,
+    /// The segments, each starting where the one before it ends.
+    pub segments: Vec<SegmentSpec>,
+}
+
+/// One segment of a [`PathSpec`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum SegmentSpec {
+    /// A straight segment to `to`.
+    Line {
+        /// End point (m).
+        to: [f64; 3],
+    },
+    /// A circular arc, given as a circular motion command takes it: by its `centre` and its end
+    /// `to` (the shorter way round), by its `centre` and its signed `sweep_deg` about `n`
+    /// (counter-clockwise seen from where `n` points; a full circle is ±360), or by a point
+    /// `through` which it passes on its way to `to`.
+    Arc {
+        /// Centre of the circle (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        centre: Option<[f64; 3]>,
+        /// A point the arc passes through between its start and `to` (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        through: Option<[f64; 3]>,
+        /// End point (m).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        to: Option<[f64; 3]>,
+        /// Signed angle swept about `n` (degrees).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        sweep_deg: Option<f64>,
+    },
+}
+
+/// Why a path was refused; names the field and what is wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PathError {
+    /// The file is of another format version.
+    #[error("path field 'version' is {found}; this build reads version {PATH_FORMAT_VERSION}")]
+    Version {
+        /// The version given.
+        found: u32,
+    },
+    /// A field is malformed: what is wrong with it.
+    #[error("path field '{field}' {problem}")]
+    Field {
+        /// The field, e.g. `segments[2].arc.to`.
+        field: String,
+        /// What is wrong.
+        problem: String,
+    },
+}
+
+impl PathError {
+    fn field(field: impl Into<String>, problem: impl Into<String>) -> Self {
+        Self::Field {
+            field: field.into(),
+            problem: problem.into(),
+        }
+    }
+}
+
+/// A straight piece of a path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Straight {
+    start: Vec3,
+    direction: Vec3,
+}
+
+/// A circular piece of a path: `centre + r (u cos(σ/r) + w sin(σ/r))` for `σ ∈ [0, length]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Circular {
+    centre: Vec3,
+    radius_m: f64,
+    /// Unit vector from the centre to the start.
+    u: Vec3,
+    /// Unit direction of travel at the start (`±n × u`).
+    w: Vec3,
+}
+
+/// The shape of one piece.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Shape {
+    Straight(Straight),
+    Circular(Circular),
+}
+
+/// One piece of a validated path: its shape, its length and where along the path it starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Piece {
+    shape: Shape,
+    /// Arc length of the path where the piece starts (m).
+    pub start_s: f64,
+    /// The piece's length (m).
+    pub length_m: f64,
+    /// Whether the tool must come to rest where the piece starts: its tangent turns there.
+    pub corner_before: bool,
+}
+
+impl Piece {
+    /// The piece's start and end points, and for an arc its centre and the unit axis it turns
+    /// about (right hand).
+    pub fn outline(&self) -> (Vec3, Vec3, Option<(Vec3, Vec3)>) {
+        let arc = match self.shape {
+            Shape::Straight(_) => None,
+            Shape::Circular(arc) => Some((arc.centre, arc.u.cross(&arc.w))),
+        };
+        (self.point(0.0), self.point(self.length_m), arc)
+    }
+
+    /// The point at `σ` (m) along the piece.
+    fn point(&self, sigma: f64) -> Vec3 {
+        match self.shape {
+            Shape::Straight(line) => line.start + line.direction * sigma,
+            Shape::Circular(arc) => {
+                let angle = sigma / arc.radius_m;
+                arc.centre + (arc.u * angle.cos() + arc.w * angle.sin()) * arc.radius_m
+            }
+        }
+    }
+
+    /// The unit tangent at `σ` (m) along the piece.
+    fn tangent(&self, sigma: f64) -> Vec3 {
+        match self.shape {
+            Shape::Straight(line) => line.direction,
+            Shape::Circular(arc) => {
+                let angle = sigma / arc.radius_m;
+                arc.w * angle.cos() - arc.u * angle.sin()
+            }
+        }
+    }
+
+    /// The `σ ∈ [0, length]` of the piece's point nearest `p`.
+    fn nearest(&self, p: &Vec3) -> f64 {
+        let sigma = match self.shape {
+            Shape::Straight(line) => (p - line.start).dot(&line.direction),
+            Shape::Circular(arc) => {
+                let offset = p - arc.centre;
+                let angle = offset.dot(&arc.w).atan2(offset.dot(&arc.u));
+                let sweep = self.length_m / arc.radius_m;
+                // Angles past the sweep are nearer one end or the other.
+                let angle = if angle < 0.0 && angle + 2.0 * PI <= sweep {
+                    angle + 2.0 * PI
+                } else if angle < 0.0 || angle > sweep {
+                    let beyond_end = angle.rem_euclid(2.0 * PI) - sweep;
+                    let before_start = 2.0 * PI - angle.rem_euclid(2.0 * PI);
+                    if beyond_end <= before_start {
+                        sweep
+                    } else {
+                        0.0
+                    }
+                } else {
+                    angle
+                };
+                angle * arc.radius_m
+            }
+        };
+        sigma.clamp(0.0, self.length_m)
+    }
+}
+
+/// Where a point lies relative to a path: the nearest path point in the window searched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Located {
+    /// Arc length of the nearest point (m).
+    pub s: f64,
+    /// The nearest point.
+    pub point: Vec3,
+    /// Unit tangent there.
+    pub tangent: Vec3,
+}
+
+/// A validated path (see the module documentation).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "PathSpec", into = "PathSpec")]
+pub struct Path {
+    spec: PathSpec,
+    normal: Vec3,
+    pieces: Vec<Piece>,
+    length_m: f64,
+}
+
+impl TryFrom<PathSpec> for Path {
+    type Error = PathError;
+
+    fn try_from(spec: PathSpec) -> Result<Self, PathError> {
+        Path::new(spec)
+    }
+}
+
+impl From<Path> for PathSpec {
+    fn from(path: Path) -> Self {
+        path.spec
+    }
+}
+
+impl Path {
+    /// Validates `spec` (see the module documentation); errors name the field.
+    pub fn new(spec: PathSpec) -> Result<Self, PathError> {
+        if spec.version != PATH_FORMAT_VERSION {
+            return Err(PathError::Version {
+                found: spec.version,
+            });
+        }
+        let start = point("start", spec.start)?;
+        let normal = point("normal", spec.normal)?;
+        if normal.norm() < 1e-9 {
+            return Err(PathError::field(
+                "normal",
+                "is a zero vector; it must be a direction",
+            ));
+        }
+        let normal = normal.normalize();
+        let blend = spec.blend_radius_m;
+        if !blend.is_finite() || blend < 0.0 {
+            return Err(PathError::field(
+                "blend_radius_m",
+                format!("is {blend}; it must be 0 or more"),
+            ));
+        }
+        if spec.segments.is_empty() {
+            return Err(PathError::field(
+                "segments",
+                "is empty; a path needs a segment",
+            ));
+        }
+        let in_plane = |field: String, p: Vec3| {
+            let height = (p - start).dot(&normal);
+            if height.abs() > PLANE_TOLERANCE_M {
+                Err(PathError::field(
+                    field,
+                    format!(
+                        "lies {height:.3e} m off the plane through 'start' normal to 'normal' \
+                         (at most {PLANE_TOLERANCE_M:e})"
+                    ),
+                ))
+            } else {
+                Ok(p - normal * height)
+            }
+        };
+        let mut shapes: Vec<(Shape, f64)> = Vec::new();
+        let mut at = start;
+        for (index, segment) in spec.segments.iter().enumerate() {
+            let name = |field: &str| format!("segments[{index}].{field}");
+            let (shape, length) = match segment {
+                SegmentSpec::Line { to } => {
+                    let to = in_plane(name("line.to"), point(&name("line.to"), *to)?)?;
+                    let length = (to - at).norm();
+                    if length < MIN_SEGMENT_M {
+                        return Err(zero_length(name("line.to"), length));
+                    }
+                    let direction = (to - at) / length;
+                    (
+                        Shape::Straight(Straight {
+                            start: at,
+                            direction,
+                        }),
+                        length,
+                    )
+                }
+                SegmentSpec::Arc {
+                    centre,
+                    through,
+                    to,
+                    sweep_deg,
+                } => arc(
+                    &name, at, normal, *centre, *through, *to, *sweep_deg, &in_plane,
+                )?,
+            };
+            at = end_of(&shape, length);
+            shapes.push((shape, length));
+        }
+        let pieces = blended(shapes, blend)?;
+        let length_m = pieces.last().map_or(0.0, |p| p.start_s + p.length_m);
+        Ok(Self {
+            spec,
+            normal,
+            pieces,
+            length_m,
+        })
+    }
+
+    /// A straight path from `start` along the unit direction `direction` for `length_m`, on the
+    /// surface of normal `normal` (perpendicular to `direction`).
+    pub fn straight(
+        start: Vec3,
+        direction: Vec3,
+        normal: Vec3,
+        length_m: f64,
+    ) -> Result<Self, PathError> {
+        let to = start + direction * length_m;
+        Self::new(PathSpec {
+            version: PATH_FORMAT_VERSION,
+            start: start.into(),
+            normal: normal.into(),
+            blend_radius_m: 0.0,
+            segments: vec![SegmentSpec::Line { to: to.into() }],
+        })
+    }
+
+    /// The spec the path was validated from.
+    pub fn spec(&self) -> &PathSpec {
+        &self.spec
+    }
+
+    /// The unit surface normal `n`.
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    /// The path's length (m).
+    pub fn length_m(&self) -> f64 {
+        self.length_m
+    }
+
+    /// The pieces in the order travelled (segments and blend arcs).
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+
+    /// The arc lengths (m) at which the tool must come to rest: the corners left unblended.
+    pub fn corners_m(&self) -> impl Iterator<Item = f64> + '_ {
+        self.pieces
+            .iter()
+            .filter(|piece| piece.corner_before)
+            .map(|piece| piece.start_s)
+    }
+
+    /// The first corner (m) after `s`, if any.
+    pub fn next_corner_m(&self, s: f64) -> Option<f64> {
+        self.corners_m().find(|&corner| corner > s)
+    }
+
+    /// The point at arc length `s` (clamped to the path).
+    pub fn point_at(&self, s: f64) -> Vec3 {
+        let (piece, sigma) = self.piece_at(s);
+        piece.point(sigma)
+    }
+
+    /// The unit tangent at arc length `s` (clamped to the path); at a corner, the tangent of
+    /// the piece that starts there.
+    pub fn tangent_at(&self, s: f64) -> Vec3 {
+        let (piece, sigma) = self.piece_at(s);
+        piece.tangent(sigma)
+    }
+
+    /// The piece holding arc length `s` and how far into it `s` lies.
+    fn piece_at(&self, s: f64) -> (&Piece, f64) {
+        let s = s.clamp(0.0, self.length_m);
+        let index = self
+            .pieces
+            .iter()
+            .rposition(|piece| piece.start_s <= s)
+            .unwrap_or(0);
+        let piece = &self.pieces[index];
+        (piece, (s - piece.start_s).min(piece.length_m))
+    }
+
+    /// The point of the path nearest `p` among those within `window_m` of arc length of
+    /// `s_hint`: the path's progress is followed locally, so that a path passing near itself
+    /// (a full circle at its start) is never taken for its other part.
+    pub fn locate(&self, p: &Vec3, s_hint: f64, window_m: f64) -> Located {
+        let low = (s_hint - window_m).max(0.0);
+        let high = (s_hint + window_m).min(self.length_m);
+        let mut best: Option<(f64, f64)> = None;
+        for piece in &self.pieces {
+            if piece.start_s > high || piece.start_s + piece.length_m < low {
+                continue;
+            }
+            // On a closed circle the nearest angle is also one turn further or back.
+            let turn = match piece.shape {
+                Shape::Straight(_) => f64::INFINITY,
+                Shape::Circular(arc) => 2.0 * PI * arc.radius_m,
+            };
+            let sigma = piece.nearest(p);
+            for sigma in [sigma, sigma - turn, sigma + turn] {
+                if !(0.0..=piece.length_m).contains(&sigma) {
+                    continue;
+                }
+                let s = (piece.start_s + sigma).clamp(low, high);
+                let distance = (self.point_at(s) - p).norm();
+                if best.is_none_or(|(_, d)| distance < d) {
+                    best = Some((s, distance));
+                }
+            }
+        }
+        let s = best.map_or(s_hint.clamp(0.0, self.length_m), |(s, _)| s);
+        Located {
+            s,
+            point: self.point_at(s),
+            tangent: self.tangent_at(s),
+        }
+    }
+}
+
+fn zero_length(field: String, length: f64) -> PathError {
+    PathError::field(
+        field,
+        format!("makes a segment {length:.3e} m long; the shortest allowed is {MIN_SEGMENT_M:e} m"),
+    )
+}
+
+/// A finite point or vector from a path file.
+fn point(field: &str, values: [f64; 3]) -> Result<Vec3, PathError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(Vec3::from(values))
+    } else {
+        Err(PathError::field(
+            field,
+            format!("is not finite: {values:?}"),
+        ))
+    }
+}
+
+/// The end point of a piece of `length`.
+fn end_of(shape: &Shape, length: f64) -> Vec3 {
+    Piece {
+        shape: *shape,
+        start_s: 0.0,
+        length_m: length,
+        corner_before: false,
+    }
+    .point(length)
+}
+
+/// A circular segment from `at` in one of the three forms of [`SegmentSpec::Arc`].
+#[allow(clippy::too_many_arguments)]
+fn arc(
+    name: &dyn Fn(&str) -> String,
+    at: Vec3,
+    normal: Vec3,
+    centre: Option<[f64; 3]>,
+    through: Option<[f64; 3]>,
+    to: Option<[f64; 3]>,
+    sweep_deg: Option<f64>,
+    in_plane: &dyn Fn(String, Vec3) -> Result<Vec3, PathError>,
+) -> Result<(Shape, f64), PathError> {
+    let given = |field: &str, value: Option<[f64; 3]>| -> Result<Option<Vec3>, PathError> {
+        value
+            .map(|v| in_plane(name(field), point(&name(field), v)?))
+            .transpose()
+    };
+    let centre = given("arc.centre", centre)?;
+    let through = given("arc.through", through)?;
+    let to = given("arc.to", to)?;
+    let forms = "an arc takes 'centre' and 'to', 'centre' and 'sweep_deg', or 'through' and 'to'";
+    // The centre and the signed sweep about `n` of each form.
+    let (centre, sweep) = match (centre, through, to, sweep_deg) {
+        (Some(centre), None, Some(to), None) => {
+            let (u, v) = (at - centre, to - centre);
+            let radius = u.norm();
+            if radius < MIN_SEGMENT_M {
+                return Err(PathError::field(
+                    name("arc.centre"),
+                    "lies on the arc's start; the radius must be positive",
+                ));
+            }
+            if (v.norm() - radius).abs() > 1e-6 * radius.max(1.0) {
+                return Err(PathError::field(
+                    name("arc.to"),
+                    format!(
+                        "lies {:.4} m from 'centre', the start {:.4} m: not on one circle",
+                        v.norm(),
+                        radius
+                    ),
+                ));
+            }
+            let sweep = normal.dot(&u.cross(&v)).atan2(u.dot(&v));
+            if sweep.abs() > PI - 1e-9 {
+                return Err(PathError::field(
+                    name("arc.to"),
+                    "lies opposite the start across 'centre': the way round is ambiguous \
+                     (give 'sweep_deg' or 'through')",
+                ));
+            }
+            (centre, sweep)
+        }
+        (Some(centre), None, None, Some(sweep_deg)) => {
+            if !sweep_deg.is_finite() || sweep_deg == 0.0 || sweep_deg.abs() > 360.0 {
+                return Err(PathError::field(
+                    name("arc.sweep_deg"),
+                    format!("is {sweep_deg}; it must be nonzero and within [−360, 360]"),
+                ));
+            }
+            (centre, sweep_deg.to_radians())
+        }
+        (None, Some(through), Some(to), None) => {
+            if (to - at).norm() < MIN_SEGMENT_M {
+                return Err(PathError::field(
+                    name("arc.to"),
+                    "is the arc's start: a full circle takes 'centre' and 'sweep_deg'",
+                ));
+            }
+            let centre = circumcentre(at, through, to, normal).ok_or_else(|| {
+                PathError::field(
+                    name("arc.through"),
+                    "lies on the line through the start and 'to': no circle passes",
+                )
+            })?;
+            let angle = |p: Vec3| {
+                let (u, v) = (at - centre, p - centre);
+                normal
+                    .dot(&u.cross(&v))
+                    .atan2(u.dot(&v))
+                    .rem_euclid(2.0 * PI)
+            };
+            // Counter-clockwise about `n` reaches `to` after `through`, or the arc runs the
+            // other way.
+            let (to_ccw, through_ccw) = (angle(to), angle(through));
+            let sweep = if through_ccw < to_ccw {
+                to_ccw
+            } else {
+                to_ccw - 2.0 * PI
+            };
+            (centre, sweep)
+        }
+        _ => return Err(PathError::field(name("arc"), forms)),
+    };
+    let offset = at - centre;
+    let radius = offset.norm();
+    if radius < MIN_SEGMENT_M {
+        return Err(PathError::field(
+            name("arc.centre"),
+            "lies on the arc's start; the radius must be positive",
+        ));
+    }
+    let u = offset / radius;
+    let w = normal.cross(&u) * sweep.signum();
+    let length = radius * sweep.abs();
+    if length < MIN_SEGMENT_M {
+        return Err(zero_length(name("arc"), length));
+    }
+    Ok((
+        Shape::Circular(Circular {
+            centre,
+            radius_m: radius,
+            u,
+            w,
+        }),
+        length,
+    ))
+}
+
+/// The centre of the circle through `a`, `b`, `c` (in the plane normal to `normal`), or `None`
+/// when they lie on one line.
+fn circumcentre(a: Vec3, b: Vec3, c: Vec3, normal: Vec3) -> Option<Vec3> {
+    let (ab, ac) = (b - a, c - a);
+    let cross = ab.cross(&ac);
+    let area2 = cross.dot(&normal);
+    if area2.abs() < 1e-12 * ab.norm().max(1.0) * ac.norm().max(1.0) {
+        return None;
+    }
+    // a + (|ac|² n × ab − |ab|² n × ac) / (2 (ab × ac)·n).
+    let offset = (normal.cross(&ab) * ac.norm_squared() - normal.cross(&ac) * ab.norm_squared())
+        / (2.0 * area2);
+    Some(a + offset)
+}
+
+/// The pieces of the segments in order, with each corner between two straight segments
+/// rounded by a blend arc of `radius` (when positive) and the remaining corners marked.
+fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathError> {
+    let count = shapes.len();
+    // How much of each segment's start and end the blends take (m).
+    let mut trimmed = vec![(0.0, 0.0); count];
+    let mut blends: Vec<Option<(Shape, f64)>> = vec![None; count];
+    let tangent_at = |(shape, length): &(Shape, f64), end: bool| {
+        let piece = Piece {
+            shape: *shape,
+            start_s: 0.0,
+            length_m: *length,
+            corner_before: false,
+        };
+        piece.tangent(if end { *length } else { 0.0 })
+    };
+    for index in 1..count {
+        let (before, after) = (&shapes[index - 1], &shapes[index]);
+        let (a, b) = (tangent_at(before, true), tangent_at(after, false));
+        let turn = a.dot(&b).clamp(-1.0, 1.0).acos();
+        if radius == 0.0 || turn <= CORNER_RAD {
+            continue;
+        }
+        let (Shape::Straight(_), Shape::Straight(line)) = (before.0, after.0) else {
+            return Err(PathError::field(
+                "blend_radius_m",
+                format!(
+                    "cannot round the corner between segments {} and {}: blends join two \
+                     straight segments, and one of these is an arc",
+                    index - 1,
+                    index
+                ),
+            ));
+        };
+        if turn > PI - 1e-6 {
+            return Err(PathError::field(
+                "blend_radius_m",
+                format!(
+                    "cannot round the corner between segments {} and {}: the path turns back on \
+                     itself there",
+                    index - 1,
+                    index
+                ),
+            ));
+        }
+        let reach = radius * (turn / 2.0).tan();
+        trimmed[index - 1].1 = reach;
+        trimmed[index].0 = reach;
+        let corner = line.start;
+        let start = corner - a * reach;
+        let inward = (b - a).normalize();
+        let centre = start + (inward - a * inward.dot(&a)).normalize() * radius;
+        let u = (start - centre) / radius;
+        blends[index] = Some((
+            Shape::Circular(Circular {
+                centre,
+                radius_m: radius,
+                u,
+                w: a,
+            }),
+            radius * turn,
+        ));
+    }
+    let mut pieces = Vec::new();
+    let mut s = 0.0;
+    for (index, (shape, length)) in shapes.into_iter().enumerate() {
+        let (head, tail) = trimmed[index];
+        if head + tail > length + 1e-12 {
+            return Err(PathError::field(
+                "blend_radius_m",
+                format!(
+                    "is too large for segment {index}: its blends need {:.4} m of it, which is \
+                     {length:.4} m long",
+                    head + tail
+                ),
+            ));
+        }
+        let mut corner_before = index > 0 && blends[index].is_none();
+        if let Some((blend, blend_length)) = blends[index] {
+            pieces.push(Piece {
+                shape: blend,
+                start_s: s,
+                length_m: blend_length,
+                corner_before: false,
+            });
+            s += blend_length;
+        }
+        let shape = match shape {
+            Shape::Straight(line) => Shape::Straight(Straight {
+                start: line.start + line.direction * head,
+                direction: line.direction,
+            }),
+            circular => circular,
+        };
+        if index > 0 && corner_before {
+            let before = pieces.last().expect("a piece before the corner");
+            let a = before.tangent(before.length_m);
+            let b = tangent_at(&(shape, length), false);
+            corner_before = a.dot(&b).clamp(-1.0, 1.0).acos() > CORNER_RAD;
+        }
+        let remaining = length - head - tail;
+        if remaining > 0.0 {
+            pieces.push(Piece {
+                shape,
+                start_s: s,
+                length_m: remaining,
+                corner_before,
+            });
+            s += remaining;
+        }
+    }
+    Ok(pieces)
+}

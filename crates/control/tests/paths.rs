@@ -1,0 +1,478 @@
+//! Paths: their geometry, the errors that name a malformed field, and rollouts that follow them.
+//!
+//! - Arc length parameterises every path: each piece starts where the one before it ends, the
+//!   tangent is the derivative of the point by finite differences, blends join their two
+//!   segments tangentially, and every form of arc lands where its spec says.
+//! - A TCP is located along the path near where it was last, so a full circle's end is never
+//!   taken for its start.
+//! - A malformed path is refused with an error naming the field.
+//! - The classical controller follows a rectangle and a circle, stops at corners exactly, ends
+//!   with `Completed` where it gets round, and the independent checker accepts every rollout;
+//!   a one-segment path is followed as the line it lies on.
+
+mod common;
+
+use emg_control::{
+    CheckRollout, ClassicalController, Path, PathError, PathSpec, RolloutConfig, SegmentSpec, Task,
+    Termination, rollout,
+};
+use emg_kinematics::Vec3;
+
+use common::{checker, robot, tasks};
+
+fn spec(start: Vec3, normal: Vec3, blend: f64, segments: Vec<SegmentSpec>) -> PathSpec {
+    PathSpec {
+        version: 1,
+        start: start.into(),
+        normal: normal.into(),
+        blend_radius_m: blend,
+        segments,
+    }
+}
+
+fn line(to: Vec3) -> SegmentSpec {
+    SegmentSpec::Line { to: to.into() }
+}
+
+fn arc(
+    centre: Option<Vec3>,
+    through: Option<Vec3>,
+    to: Option<Vec3>,
+    sweep: Option<f64>,
+) -> SegmentSpec {
+    SegmentSpec::Arc {
+        centre: centre.map(Into::into),
+        through: through.map(Into::into),
+        to: to.map(Into::into),
+        sweep_deg: sweep,
+    }
+}
+
+/// A rectangle `a × b` from `p` along `d` then `n × d`, back to `p`.
+fn rectangle(p: Vec3, d: Vec3, n: Vec3, a: f64, b: f64, blend: f64) -> PathSpec {
+    let e = n.cross(&d);
+    spec(
+        p,
+        n,
+        blend,
+        vec![
+            line(p + d * a),
+            line(p + d * a + e * b),
+            line(p + e * b),
+            line(p),
+        ],
+    )
+}
+
+fn assert_close(a: Vec3, b: Vec3, tolerance: f64, what: &str) {
+    assert!((a - b).norm() <= tolerance, "{what}: {a:?} vs {b:?}");
+}
+
+/// Continuity of points, tangents by finite differences, unit tangents.
+fn assert_parameterised(path: &Path) {
+    let h = 1e-6;
+    for piece in path.pieces() {
+        let (start, end, _) = piece.outline();
+        assert_close(path.point_at(piece.start_s), start, 1e-12, "piece start");
+        assert_close(
+            path.point_at(piece.start_s + piece.length_m),
+            end,
+            1e-9,
+            "piece end",
+        );
+        for k in 1..10 {
+            let s = piece.start_s + piece.length_m * k as f64 / 10.0;
+            let derivative = (path.point_at(s + h) - path.point_at(s - h)) / (2.0 * h);
+            assert_close(derivative, path.tangent_at(s), 1e-6, "tangent");
+            assert!((path.tangent_at(s).norm() - 1.0).abs() < 1e-12);
+            assert!(
+                (path.point_at(s) - path.point_at(0.0))
+                    .dot(&path.normal())
+                    .abs()
+                    < 1e-12
+            );
+        }
+    }
+    for pair in path.pieces().windows(2) {
+        let (_, end, _) = pair[0].outline();
+        let (start, _, _) = pair[1].outline();
+        assert_close(end, start, 1e-9, "pieces join");
+        assert!((pair[0].start_s + pair[0].length_m - pair[1].start_s).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_rectangle_has_four_corners_and_its_perimeter_for_length() {
+    let (p, d, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::y(), Vec3::z());
+    let path = Path::new(rectangle(p, d, n, 0.2, 0.1, 0.0)).unwrap();
+    assert!((path.length_m() - 0.6).abs() < 1e-12);
+    assert_eq!(path.corners_m().collect::<Vec<_>>().len(), 3);
+    assert_eq!(path.next_corner_m(0.0), Some(0.2));
+    assert_eq!(path.next_corner_m(0.25), Some(0.3));
+    assert_close(path.point_at(0.6), p, 1e-12, "closed");
+    assert_parameterised(&path);
+}
+
+#[test]
+fn blends_round_the_corners_tangentially_and_shorten_the_path() {
+    let (p, d, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::y(), Vec3::z());
+    let radius = 0.02;
+    let path = Path::new(rectangle(p, d, n, 0.2, 0.1, radius)).unwrap();
+    // Each right-angle corner trades 2r of straight for a quarter circle.
+    let expected = 0.6 - 3.0 * (2.0 * radius - std::f64::consts::FRAC_PI_2 * radius);
+    assert!(
+        (path.length_m() - expected).abs() < 1e-12,
+        "{}",
+        path.length_m()
+    );
+    assert_eq!(path.corners_m().count(), 0);
+    assert_eq!(path.pieces().len(), 7);
+    for pair in path.pieces().windows(2) {
+        let s = pair[1].start_s;
+        assert_close(
+            path.tangent_at(s - 1e-9),
+            path.tangent_at(s),
+            1e-6,
+            "tangent continuity",
+        );
+    }
+    assert_parameterised(&path);
+}
+
+#[test]
+fn every_arc_form_lands_where_its_spec_says() {
+    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::new(0.0, 0.0, 1.0));
+    let centre = p + Vec3::new(0.0, 0.05, 0.0);
+    let top = centre + Vec3::new(0.05, 0.0, 0.0);
+    let opposite = centre + Vec3::new(0.0, 0.05, 0.0);
+    // Centre and end: the shorter way round, a quarter circle.
+    let quarter = Path::new(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(Some(centre), None, Some(top), None)],
+    ))
+    .unwrap();
+    assert!((quarter.length_m() - 0.05 * std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_close(
+        quarter.point_at(quarter.length_m()),
+        top,
+        1e-12,
+        "quarter end",
+    );
+    // Through a point: the long way round the same circle (three quarters) via the opposite side.
+    let long = Path::new(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(None, Some(opposite), Some(top), None)],
+    ))
+    .unwrap();
+    assert!((long.length_m() - 0.05 * 1.5 * std::f64::consts::PI).abs() < 1e-9);
+    assert_close(long.point_at(long.length_m()), top, 1e-9, "through end");
+    assert_close(
+        long.point_at(long.length_m() * 2.0 / 3.0),
+        opposite,
+        1e-9,
+        "passes through",
+    );
+    // A full circle by sweep, clockwise about n.
+    let circle = Path::new(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(Some(centre), None, None, Some(-360.0))],
+    ))
+    .unwrap();
+    assert!((circle.length_m() - 0.1 * std::f64::consts::PI).abs() < 1e-12);
+    assert_close(
+        circle.point_at(circle.length_m()),
+        p,
+        1e-12,
+        "closed circle",
+    );
+    let ahead = circle.tangent_at(0.0);
+    assert_close(
+        ahead,
+        -Vec3::x(),
+        1e-12,
+        "clockwise about +z from -y of the centre",
+    );
+    for path in [&quarter, &long, &circle] {
+        assert_parameterised(path);
+    }
+}
+
+#[test]
+fn a_tcp_is_located_near_where_it_was_last() {
+    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::z());
+    let circle = Path::new(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(
+            Some(p + Vec3::new(0.0, 0.05, 0.0)),
+            None,
+            None,
+            Some(360.0),
+        )],
+    ))
+    .unwrap();
+    let length = circle.length_m();
+    let near_start = p + Vec3::new(0.0, 0.001, 0.0);
+    assert!(circle.locate(&near_start, 0.0, 0.05).s < 1e-12);
+    assert!((circle.locate(&near_start, length - 0.01, 0.05).s - length).abs() < 1e-12);
+    let quarter = circle.point_at(length / 4.0) + Vec3::new(0.003, 0.0, 0.0);
+    let located = circle.locate(&quarter, length / 4.0 - 0.01, 0.05);
+    assert!((located.s - length / 4.0).abs() < 1e-9, "{}", located.s);
+    assert_close(
+        located.point,
+        circle.point_at(length / 4.0),
+        1e-9,
+        "nearest point",
+    );
+}
+
+#[test]
+fn a_malformed_path_is_refused_naming_its_field() {
+    let (p, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::z());
+    let refused = |spec: PathSpec| match Path::new(spec) {
+        Err(PathError::Field { field, problem }) => format!("{field}: {problem}"),
+        other => panic!("expected a field error, got {other:?}"),
+    };
+    let message = refused(spec(
+        p,
+        n,
+        0.0,
+        vec![line(p + Vec3::x() * 0.1), line(p + Vec3::x() * 0.1)],
+    ));
+    assert!(
+        message.starts_with("segments[1].line.to: makes a segment"),
+        "{message}"
+    );
+    let message = refused(spec(p, n, 0.0, vec![line(p + Vec3::new(0.1, 0.0, 0.01))]));
+    assert!(
+        message.starts_with("segments[0].line.to: lies"),
+        "{message}"
+    );
+    let message = refused(spec(p, n, 0.0, vec![]));
+    assert!(message.starts_with("segments: is empty"), "{message}");
+    let centre = p + Vec3::y() * 0.05;
+    let message = refused(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(
+            Some(centre),
+            None,
+            Some(centre + Vec3::y() * 0.05),
+            None,
+        )],
+    ));
+    assert!(message.contains("ambiguous"), "{message}");
+    let message = refused(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(Some(centre), None, Some(p + Vec3::x()), None)],
+    ));
+    assert!(message.starts_with("segments[0].arc.to: lies"), "{message}");
+    let message = refused(spec(p, n, 0.0, vec![arc(Some(centre), None, None, None)]));
+    assert!(
+        message.starts_with("segments[0].arc: an arc takes"),
+        "{message}"
+    );
+    let message = refused(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(
+            None,
+            Some(p + Vec3::x() * 0.1),
+            Some(p + Vec3::x() * 0.2),
+            None,
+        )],
+    ));
+    assert!(message.contains("no circle passes"), "{message}");
+    let message = refused(rectangle(p, Vec3::y(), n, 0.2, 0.1, 0.06));
+    assert!(
+        message.starts_with("blend_radius_m: is too large for segment 1"),
+        "{message}"
+    );
+    let message = refused(spec(
+        p,
+        n,
+        0.01,
+        vec![
+            line(p + Vec3::x() * 0.1),
+            arc(Some(p + Vec3::new(0.15, 0.0, 0.0)), None, None, Some(90.0)),
+        ],
+    ));
+    assert!(message.contains("one of these is an arc"), "{message}");
+    let mut wrong_version = spec(p, n, 0.0, vec![line(p + Vec3::x() * 0.1)]);
+    wrong_version.version = 2;
+    assert_eq!(
+        Path::new(wrong_version),
+        Err(PathError::Version { found: 2 })
+    );
+    let text = r#"{"version": 1, "start": [0.4, 0, 0.3], "normal": [0, 0, 1], "segments": [{"spline": {}}]}"#;
+    assert!(serde_json::from_str::<Path>(text).is_err());
+}
+
+#[test]
+fn a_path_round_trips_through_json() {
+    let path = Path::new(rectangle(
+        Vec3::new(0.4, 0.0, 0.3),
+        Vec3::y(),
+        Vec3::z(),
+        0.2,
+        0.1,
+        0.01,
+    ))
+    .unwrap();
+    let text = serde_json::to_string(&path).unwrap();
+    assert_eq!(serde_json::from_str::<Path>(&text).unwrap(), path);
+}
+
+/// A sampled task's start and seed, with the rollout settings of the paper.
+fn start() -> (emg_kinematics::Robot, Task) {
+    let robot = robot();
+    let (_, task) = tasks(&robot, 1).remove(0);
+    (robot, task)
+}
+
+#[test]
+fn a_one_segment_path_is_followed_as_its_line() {
+    let (robot, task) = start();
+    let config = RolloutConfig::default();
+    let line_rollout = rollout(
+        &robot,
+        &task,
+        &task.q0_seed.unwrap(),
+        &mut ClassicalController::default(),
+        &config,
+    );
+    let length = line_rollout.path_length_m.max(0.05) + 0.2;
+    let path = Path::straight(task.p0, task.d, task.n, length).unwrap();
+    let on_path = Task::on_path(&robot, path, task.q0_seed).unwrap();
+    let path_rollout = rollout(
+        &robot,
+        &on_path,
+        &task.q0_seed.unwrap(),
+        &mut ClassicalController::default(),
+        &config,
+    );
+    assert_eq!(path_rollout.steps.len(), line_rollout.steps.len());
+    for (a, b) in path_rollout.steps.iter().zip(&line_rollout.steps) {
+        assert!((a.q - b.q).amax() < 1e-9, "{:?} vs {:?}", a.q, b.q);
+    }
+    assert!((path_rollout.path_length_m - line_rollout.path_length_m).abs() < 1e-9);
+    checker()
+        .check(&on_path, &path_rollout, &config.constraints)
+        .unwrap();
+}
+
+#[test]
+fn the_classical_controller_follows_a_rectangle_and_a_circle_checked_independently() {
+    let (robot, task) = start();
+    let config = RolloutConfig::default();
+    let (p, d, n) = (task.p0, task.d, task.n);
+    let e = n.cross(&d);
+    let shapes = [
+        rectangle(p, d, n, 0.06, 0.04, 0.0),
+        rectangle(p, d, n, 0.06, 0.04, 0.01),
+        spec(
+            p,
+            n,
+            0.0,
+            vec![arc(Some(p + e * 0.03), None, None, Some(360.0))],
+        ),
+    ];
+    for shape in shapes {
+        let path = Path::new(shape).unwrap();
+        let corners: Vec<f64> = path.corners_m().collect();
+        let length = path.length_m();
+        let path_task = Task::on_path(&robot, path, task.q0_seed).unwrap();
+        let trajectory = rollout(
+            &robot,
+            &path_task,
+            &task.q0_seed.unwrap(),
+            &mut ClassicalController::default(),
+            &config,
+        );
+        checker()
+            .check(&path_task, &trajectory, &config.constraints)
+            .unwrap();
+        assert_eq!(
+            trajectory.termination,
+            Termination::Completed,
+            "{length} m path"
+        );
+        assert!((trajectory.path_length_m - length).abs() < 2e-4);
+        // The tool comes to each corner and turns there.
+        for corner in corners {
+            let point = path_task.path.as_ref().unwrap().point_at(corner);
+            let nearest = trajectory
+                .steps
+                .iter()
+                .map(|step| (step.tcp - point).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest < 1e-3,
+                "corner at {corner} m passed {nearest} m away"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_checker_refuses_a_path_rollout_checked_against_another_path_or_a_false_ending() {
+    let (robot, task) = start();
+    let config = RolloutConfig::default();
+    let (p, d, n) = (task.p0, task.d, task.n);
+    let path_task = Task::on_path(
+        &robot,
+        Path::new(rectangle(p, d, n, 0.06, 0.04, 0.0)).unwrap(),
+        task.q0_seed,
+    )
+    .unwrap();
+    let trajectory = rollout(
+        &robot,
+        &path_task,
+        &task.q0_seed.unwrap(),
+        &mut ClassicalController::default(),
+        &config,
+    );
+    checker()
+        .check(&path_task, &trajectory, &config.constraints)
+        .unwrap();
+    // The same motion against the rectangle drawn the other way from the same start leaves it.
+    let mirrored = Task::on_path(
+        &robot,
+        Path::new(rectangle(p, -d, n, 0.06, 0.04, 0.0)).unwrap(),
+        task.q0_seed,
+    )
+    .unwrap();
+    let failure = checker()
+        .check(&mirrored, &trajectory, &config.constraints)
+        .unwrap_err();
+    assert!(format!("{failure}").contains("off the line"), "{failure}");
+    // Claiming the end of the path after only part of it.
+    let mut short = trajectory.clone();
+    short.steps.truncate(10);
+    let located: f64 = {
+        let mut s = 0.0;
+        for step in &short.steps {
+            s = path_task.along(&step.tcp, s).s_m;
+        }
+        s
+    };
+    short.path_length_m = located;
+    let failure = checker()
+        .check(&path_task, &short, &config.constraints)
+        .unwrap_err();
+    assert!(
+        format!("{failure}").contains("claims the end of the path"),
+        "{failure}"
+    );
+}
