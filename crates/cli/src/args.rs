@@ -164,6 +164,11 @@ pub struct PlanArgs {
     /// Task set to plan: JSON or the binary EMGTASKS layout (told apart by the content).
     #[arg(long, value_name = "FILE", conflicts_with = "p0")]
     pub task_file: Option<PathBuf>,
+    /// A path to follow instead of a line: a JSON path file (start, surface normal, straight
+    /// and circular segments, blend radius; docs/paths.md). The plan says how far along the
+    /// path the tool gets.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["p0", "task_file"])]
+    pub path: Option<PathBuf>,
     /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`
     /// (mid-range of the joint limits), `q_mu` / `q_jl` (heuristic ascents from q0_seed) or
     /// `q=v1,...,v7` (radians). Default: `dp` when the --weights file exists, else `generating`

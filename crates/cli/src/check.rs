@@ -170,9 +170,9 @@ fn named_robot(robot: &str, file: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// `task` validated by [`Task::new`] (a validated task comes back bit for bit).
+/// `task` validated again for `robot` (a validated task comes back bit for bit).
 fn validated(robot: &Robot, task: &Task) -> Result<Task> {
-    Ok(Task::new(robot, task.p0, task.d, task.n, task.q0_seed)?)
+    Ok(task.revalidated(robot)?)
 }
 
 fn describe(constraints: &ConstraintConfig) -> String {

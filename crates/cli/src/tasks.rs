@@ -1,14 +1,22 @@
-//! Where the tasks to plan come from: the command line, a task file, or the built-in demo.
+//! Where the tasks to plan come from: the command line, a task file, a path file, or the
+//! built-in demo.
 
 use anyhow::{Context, Result};
 use emg_control::Task;
-use emg_io::read_tasks;
+use emg_io::{read_path, read_tasks};
 use emg_kinematics::{Robot, Vec3};
 
 use crate::args::PlanArgs;
 
-/// The tasks requested by `args`, each validated by [`Task::new`].
+/// The tasks requested by `args`, each validated by [`Task::new`] (a path by
+/// [`Task::on_path`]).
 pub fn requested_tasks(robot: &Robot, args: &PlanArgs) -> Result<Vec<Task>> {
+    if let Some(file) = &args.path {
+        let path = read_path(file)?;
+        let task = Task::on_path(robot, path, None)
+            .with_context(|| format!("the path of {} is not a task", file.display()))?;
+        return Ok(vec![task]);
+    }
     if let Some(path) = &args.task_file {
         let tasks = read_tasks(path, robot)
             .with_context(|| format!("cannot read task file {}", path.display()))?;

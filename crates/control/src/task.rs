@@ -215,6 +215,37 @@ impl Task {
         }
     }
 
+    /// The point at progress `s_m` along the line, or at arc length `s_m` along the path
+    /// (clamped to it).
+    pub fn point_at(&self, s_m: f64) -> Vec3 {
+        match &self.path {
+            None => self.p0 + self.d * s_m,
+            Some(path) => path.point_at(s_m),
+        }
+    }
+
+    /// The unit direction of the line, or the path's tangent at arc length `s_m`.
+    pub fn heading_at(&self, s_m: f64) -> Vec3 {
+        match &self.path {
+            None => self.d,
+            Some(path) => path.tangent_at(s_m),
+        }
+    }
+
+    /// The path's length (m); `None` for a line, which goes on as far as the arm can follow it.
+    pub fn length_m(&self) -> Option<f64> {
+        self.path.as_ref().map(Path::length_m)
+    }
+
+    /// The task validated again for `robot` (a task read from a file): a validated task comes
+    /// back bit for bit, its path kept.
+    pub fn revalidated(&self, robot: &Robot) -> Result<Self, TaskError> {
+        match &self.path {
+            None => Self::new(robot, self.p0, self.d, self.n, self.q0_seed),
+            Some(path) => Self::on_path(robot, path.clone(), self.q0_seed),
+        }
+    }
+
     /// The distance (m) from `p` to the line, or to the nearest point of the whole path.
     pub fn distance(&self, p: &Vec3) -> f64 {
         match &self.path {

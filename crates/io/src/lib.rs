@@ -10,6 +10,7 @@
 //!   checker's [`emg_verify::JointSamples`].
 //! * [`read_tasks`] / [`write_task_set`]: task sets (binary `EMGTASKS` or JSON).
 //! * [`read_scene`]: the obstacles of a cell (JSON, see [`emg_kinematics::Scene`]).
+//! * [`read_path`]: a path task's segments (JSON, see [`emg_control::PathSpec`]).
 //! * [`import_robot`]: a vendor description (boxes, cylinders, STL/OBJ meshes) as a standard
 //!   capsule URDF with a pen, and [`read_mesh`]: mesh files as triangles.
 //! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
@@ -65,6 +66,7 @@ mod csv;
 mod error;
 mod joint_trajectory;
 mod mesh;
+mod path_file;
 mod paths;
 mod robot_import;
 mod rollout_file;
@@ -80,6 +82,7 @@ pub use joint_trajectory::{
     TimingSummary,
 };
 pub use mesh::{MeshError, mesh_volume, read_mesh};
+pub use path_file::{PathFileError, parse_path, read_path};
 pub use paths::{PlanPaths, html_path};
 pub use robot_import::{
     DisabledBecause, ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath,

@@ -1,6 +1,7 @@
 //! The reachability bound of a task: how far along the line the arm can be placed at all.
 //!
-//! Every point `p0 + s·d` of a 1 cm grid is searched, in order from `s = 0`, for a configuration
+//! Every point `p0 + s·d` of a 1 cm grid (on a path: every point 1 cm of arc length apart, and
+//! its end) is searched, in order from `s = 0`, for a configuration
 //! that puts the TCP on the point (or, failing that, within the line tolerance of it) with the
 //! tool axis inside the cone around `n`, inside the joint limits, free of self-collision and
 //! clear of the work surface and the scene's obstacles when the constraints hold them. The
@@ -126,15 +127,26 @@ pub fn reach(
     let offsets = offset_directions(&task.n, &task.d, config.offsets);
     let mut carried: Vec<JointVector> = hints.to_vec();
     let mut witnesses = Vec::new();
+    let mut scanned_m = 0.0;
     for k in 0u64.. {
-        let s = k as f64 * config.grid_m;
-        let point = task.p0 + task.d * s;
+        let Some(s) = grid_point(task, k, config.grid_m) else {
+            break;
+        };
+        let point = task.point_at(s);
         // Beyond the sphere every link could span, no configuration exists.
         if (point - centre).norm() > radius {
             break;
         }
         let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
         rng.set_stream(k);
+        let turned;
+        let offsets = match task.path {
+            None => &offsets,
+            Some(_) => {
+                turned = offset_directions(&task.n, &task.heading_at(s), config.offsets);
+                &turned
+            }
+        };
         let mut targets = std::iter::once(point).chain(
             offsets
                 .iter()
@@ -147,14 +159,31 @@ pub fn reach(
         };
         witnesses.push(found[0]);
         carried = found;
+        scanned_m = s;
     }
-    let scanned_m = witnesses.len().saturating_sub(1) as f64 * config.grid_m;
     Reach {
         reachable_m: scanned_m,
         scanned_m,
         reachable_p0: !witnesses.is_empty(),
         grid_m: config.grid_m,
         witnesses,
+    }
+}
+
+/// The arc length of the `k`-th grid point of `task`'s scan: `k · grid_m` along a line; along
+/// a path the same, its last point at the path's end, and `None` past it.
+fn grid_point(task: &Task, k: u64, grid_m: f64) -> Option<f64> {
+    let s = k as f64 * grid_m;
+    let Some(length) = task.length_m() else {
+        return Some(s);
+    };
+    let before_end = |s: f64| s < length - 1e-9;
+    if before_end(s) {
+        Some(s)
+    } else if k == 0 || before_end((k - 1) as f64 * grid_m) {
+        Some(length)
+    } else {
+        None
     }
 }
 
@@ -244,7 +273,7 @@ pub fn witness_chains(
         let end = starts.get(piece + 1).copied().unwrap_or(witnesses.len());
         let mut chain = vec![witnesses[start]];
         for k in (0..start).rev() {
-            let point = task.p0 + task.d * (k as f64 * reach.grid_m);
+            let point = task.point_at(k as f64 * reach.grid_m);
             let after = chain[chain.len() - 1];
             match scan
                 .nearest_on_pose(&point, &after)

@@ -35,7 +35,7 @@
 //! the task and the configuration, whatever the machine or the thread count.
 
 use emg_control::{
-    ActingController, ClassicalController, ClassicalGains, Episode, NullAction,
+    ARRIVAL_M, ActingController, ClassicalController, ClassicalGains, Episode, NullAction,
     NullSpaceController, OutOfRange, RolloutConfig, StepContext, Task, Termination, Trajectory,
     continue_rollout, first_violation,
 };
@@ -248,7 +248,7 @@ impl NullSpaceController for Branch<'_, '_> {
         let led = match self.lead {
             Some(Lead::Detour(detour)) if self.issued.len() < detour.steps => Some(detour.action),
             Some(Lead::Track(reference)) => {
-                let next_m = step.task.progress(&step.kinematics.tcp()) + progress_per_step(step);
+                let next_m = step.along.s_m + progress_per_step(step);
                 reference
                     .at(next_m)
                     .map(|target| tracking_action(step, &target))
@@ -483,7 +483,12 @@ pub(crate) fn search(
     let config = context.config;
     let ranking = Executor::Classical(ClassicalController::new(config.classical_gains.clone()));
     let mut tails = [finalist, ranking];
-    let enough_m = reach.scanned_m + reach.grid_m - config.stop_within_m;
+    // On a path, a rollout that reaches its end leaves nothing to find.
+    let past_scan_m = (reach.scanned_m + reach.grid_m).min(
+        task.length_m()
+            .map_or(f64::INFINITY, |length| length - ARRIVAL_M),
+    );
+    let enough_m = past_scan_m - config.stop_within_m;
     let mut search = Search::new(context, task, config.budget_steps, enough_m);
     search.try_start(&seed, &mut tails[0]);
     search.track_chains(reach, &mut tails);

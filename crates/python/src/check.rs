@@ -97,7 +97,8 @@ pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
     )
     .map_err(|e| input_error(format!("the checker's robot {}", robot.file.display()), &e))?;
     let task = &carried.task;
-    let task = emg_control::Task::new(&robot.inner, task.p0, task.d, task.n, task.q0_seed)
+    let task = task
+        .revalidated(&robot.inner)
         .map_err(|e| input_error(format!("field 'task' of {}", path.display()), &e))?;
     let report = contents
         .verify(

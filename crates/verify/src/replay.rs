@@ -40,7 +40,8 @@ impl JointSamples {
     }
 
     /// The points as a [`Recording`] of `line`: TCP and tool angle from the checker's own
-    /// forward kinematics, the path length from the last point's TCP, and [`Ending::Stopped`].
+    /// forward kinematics, the path length from the last point's TCP (along a path, followed
+    /// point by point), and [`Ending::Stopped`].
     ///
     /// A file of points says nothing about why the motion ended, so the check of such a
     /// recording verifies every point but no reason for the end. Since the TCP and tool angles
@@ -61,7 +62,7 @@ impl JointSamples {
                 }
             })
             .collect();
-        let path_length_m = steps.last().map_or(0.0, |last| line.progress(&last.tcp));
+        let path_length_m = line.reached(steps.iter().map(|step| step.tcp));
         Recording {
             steps,
             ending: Ending::Stopped,
@@ -111,7 +112,8 @@ pub struct ReplayReport {
     pub points: usize,
     /// Time of the last point (s).
     pub duration_s: f64,
-    /// `(p_last − p0)·d` (m), from the checker's forward kinematics.
+    /// `(p_last − p0)·d` (m), from the checker's forward kinematics; along a path, the arc
+    /// length reached.
     pub path_length_m: f64,
     /// Per joint, the fastest segment speed `|Δq_i| / Δt` as a fraction of the robot file's
     /// velocity limit of that joint (0 for a single point).
@@ -365,9 +367,11 @@ pub fn check_replay(
     let mut max_line_deviation_m = 0.0_f64;
     let mut max_tool_angle_deg = 0.0_f64;
     let mut min_clearance = (f64::INFINITY, String::new(), String::new());
+    let mut tcps = Vec::with_capacity(samples.len());
     for q in &samples.q {
         let (tcp, axis) = model.tcp_pose(q);
-        max_line_deviation_m = max_line_deviation_m.max(line.lateral_distance(&tcp));
+        tcps.push(tcp);
+        max_line_deviation_m = max_line_deviation_m.max(line.distance(&tcp));
         max_tool_angle_deg = max_tool_angle_deg.max(angle_deg(&axis, &line.n));
         let clearance = model.min_clearance(q);
         if clearance.0 < min_clearance.0 {
@@ -375,11 +379,10 @@ pub fn check_replay(
         }
     }
     let last = samples.len() - 1;
-    let (tcp, _) = model.tcp_pose(&samples.q[last]);
     Ok(ReplayReport {
         points: samples.len(),
         duration_s: samples.time_s[last],
-        path_length_m: line.progress(&tcp),
+        path_length_m: line.reached(tcps),
         peak_speed_fraction,
         peak_acceleration_rad_s2,
         boundary_speed_fraction,
