@@ -162,7 +162,10 @@ class Motion:
         """The path parameter (m of TCP travel) at each waypoint, shape (K,)."""
     @property
     def waypoints(self) -> FloatArray:
-        """The waypoints of the natural cubic spline path (rad), shape (K, 7)."""
+        """The waypoints of the path (rad), shape (K, 7): a natural cubic spline between rests."""
+    @property
+    def rest_knots(self) -> npt.NDArray[np.uint64]:
+        """Indices of the knots where the motion rests inside the path (unblended corners), shape (R,)."""
     @property
     def grid(self) -> FloatArray:
         """The TOPP-RA grid along the path, shape (M,)."""

@@ -368,6 +368,11 @@ fn write_plan(
         }
         _ => String::new(),
     };
+    let rests = match timed.rests_s.len() {
+        0 => String::new(),
+        1 => ", at rest at its corner".to_string(),
+        corners => format!(", at rest at each of its {corners} corners"),
+    };
     let viewer = match &args.html {
         Some(html) => write_viewer(
             planner,
@@ -396,7 +401,7 @@ fn write_plan(
         "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
          seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
-         requested speed {:.0} % of the time, {} points at {} Hz{cut}\n  \
+         requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}\n  \
          wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,

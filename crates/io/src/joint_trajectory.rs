@@ -95,6 +95,10 @@ pub struct TimingSummary {
     pub cut_reason: Option<String>,
     /// Rounds of local slow-down the limits needed.
     pub slowdowns: usize,
+    /// Times (s) at which the motion rests inside its path (a path task's unblended corners);
+    /// absent on a line.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rests_s: Vec<f64>,
 }
 
 impl TimingSummary {
@@ -110,6 +114,7 @@ impl TimingSummary {
             cut_at_point: report.cut.as_ref().map(|(point, _)| *point),
             cut_reason: report.cut.as_ref().map(|(_, reason)| reason.clone()),
             slowdowns: report.slowdowns,
+            rests_s: report.rests_s.clone(),
         }
     }
 }

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use emg_kinematics::JointVector;
 use emg_planner::MotionTiming;
 use emg_timing::{Scaling, TimedMotion};
 use numpy::{PyArray1, PyArray2};
@@ -42,6 +43,37 @@ pub fn motion_timing(
 pub struct Motion {
     pub(crate) motion: TimedMotion,
     pub(crate) timing: MotionTiming,
+}
+
+impl Motion {
+    /// The knots and waypoints of every stretch one after another (each stretch's parameters
+    /// after the previous one's end, the knot two stretches share once), and the indices of
+    /// the shared knots (the rests).
+    fn joined(&self) -> (Vec<(f64, JointVector)>, Vec<usize>) {
+        let mut knots: Vec<(f64, JointVector)> = Vec::new();
+        let mut rests = Vec::new();
+        for path in &self.motion.paths {
+            let Some(spline) = path.spline() else {
+                continue;
+            };
+            let (offset, skip) = match knots.last() {
+                Some(&(s, _)) => {
+                    rests.push(knots.len() - 1);
+                    (s, 1)
+                }
+                None => (0.0, 0),
+            };
+            knots.extend(
+                spline
+                    .knots()
+                    .iter()
+                    .zip(spline.values())
+                    .skip(skip)
+                    .map(|(s, q)| (s + offset, *q)),
+            );
+        }
+        (knots, rests)
+    }
 }
 
 #[pymethods]
@@ -89,20 +121,26 @@ impl Motion {
         self.motion.report.tool_speed_share
     }
 
-    /// The path's knots: its parameter (m of TCP travel) at each waypoint, shape (K,).
+    /// The path's knots: its parameter (m of TCP travel) at each waypoint, shape (K,); the
+    /// stretches between rests ([`rest_knots`]) one after another.
     #[getter]
     fn knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let knots = self.motion.path.spline().map_or(&[][..], |s| s.knots());
-        array1(py, knots.iter().copied())
+        array1(py, self.joined().0.into_iter().map(|(s, _)| s))
     }
 
-    /// The waypoints the path passes through at its knots (rad), shape (K, 7): the path is the
-    /// natural cubic spline through them (`scipy.interpolate.CubicSpline(knots, waypoints,
-    /// bc_type="natural")`).
+    /// The waypoints the path passes through at its knots (rad), shape (K, 7): between two
+    /// rests (`rest_knots`, and the ends) the path is the natural cubic spline through them
+    /// (`scipy.interpolate.CubicSpline(knots[a:b+1], waypoints[a:b+1], bc_type="natural")`).
     #[getter]
     fn waypoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let values = self.motion.path.spline().map_or(&[][..], |s| s.values());
-        array2(py, values.iter().map(|q| (*q).into()))
+        array2(py, self.joined().0.into_iter().map(|(_, q)| q.into()))
+    }
+
+    /// Indices of the knots at which the motion rests inside the path (the corners a path task
+    /// does not blend), shape (R,); empty on a line.
+    #[getter]
+    fn rest_knots<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<usize>> {
+        PyArray1::from_vec(py, self.joined().1)
     }
 
     /// Path parameters of the TOPP-RA grid, shape (M,).

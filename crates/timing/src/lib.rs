@@ -8,7 +8,8 @@
 //!    a tool-speed cap (Pham & Pham 2018), from rest to rest;
 //! 3. [`SmoothedProfile`]: jerk limiting by a moving average of the path position in time;
 //! 4. [`time_motion`]: all of it, sampled at a fixed rate, slowed down locally wherever a sample
-//!    still breaks a limit ([`first_breach`]).
+//!    still breaks a limit ([`first_breach`]); a path task's motion comes to rest at every corner
+//!    its path does not blend ([`rest_waypoints`]), each stretch between rests timed on its own.
 //!
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
@@ -28,8 +29,8 @@ pub use path::{CHECKS_PER_SEGMENT, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
     ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SAMPLES, MAX_SLOWDOWNS,
-    MIN_GRID_INTERVALS, SLOWDOWN, TimedMotion, TimingError, TimingReport, TimingRequest,
-    time_motion,
+    MIN_GRID_INTERVALS, REST_SNAP_M, SLOWDOWN, TimedMotion, TimingError, TimingReport,
+    TimingRequest, rest_waypoints, time_motion,
 };
 pub use spline::{JointSpline, PathPoint};
 pub use topp::{GridPoint, profile_duration, topp_ra};

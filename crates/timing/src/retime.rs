@@ -33,6 +33,10 @@ pub const MAX_SLOWDOWNS: usize = 60;
 /// (ten million samples are almost three hours at 1 kHz).
 pub const MAX_SAMPLES: f64 = 1e7;
 
+/// Largest distance (m of arc length) between an unblended corner of a path and the waypoint
+/// the motion rests at for it.
+pub const REST_SNAP_M: f64 = 1e-3;
+
 /// Share of the requested tool speed above which the tool counts as moving at it.
 pub const AT_TOOL_SPEED: f64 = 0.99;
 
@@ -69,6 +73,9 @@ pub struct TimingReport {
     pub grid_points: usize,
     /// Rounds of local slow-down the limits needed.
     pub slowdowns: usize,
+    /// Times (s) at which the motion rests inside its path, at the corners a path task does not
+    /// blend ([`rest_waypoints`]); empty on a line.
+    pub rests_s: Vec<f64>,
 }
 
 /// A rest-to-rest motion at a fixed rate, with its path and report.
@@ -76,9 +83,11 @@ pub struct TimingReport {
 pub struct TimedMotion {
     /// Samples at `k / rate` (rounded to whole nanoseconds), from rest to rest.
     pub samples: Vec<TimedSample>,
-    /// The smooth path the samples follow.
-    pub path: SmoothPath,
-    /// Path parameters of the TOPP-RA grid.
+    /// The smooth paths the samples follow, one per stretch between rests (one unless a path
+    /// task's motion rests at its corners).
+    pub paths: Vec<SmoothPath>,
+    /// Path parameters of the TOPP-RA grid (over the stretches one after another, each
+    /// stretch's parameters after the last one's end).
     pub grid_s: Vec<f64>,
     /// What the timing did.
     pub report: TimingReport,
@@ -145,10 +154,9 @@ impl TimingRequest {
 }
 
 /// The rest-to-rest motion through `waypoints` (each holding `constraints` for `task`, the
-/// first the start): the smooth path, then TOPP-RA on a grid of at most [`GRID_STEP_M`], the
-/// moving average over `w = 2 max_j a_j / j_j`, samples at the requested rate, and, while a
-/// sample breaks a limit, the speed and acceleration bounds around it lowered by
-/// [`SLOWDOWN`].
+/// first the start). On a path task the motion also comes to rest at every corner the path
+/// does not blend ([`rest_waypoints`]): each stretch between rests is timed on its own and the
+/// stretches follow one another on the sample grid.
 pub fn time_motion(
     robot: &Robot,
     task: &Task,
@@ -157,6 +165,123 @@ pub fn time_motion(
     request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
     request.validate()?;
+    let rests = rest_waypoints(robot, task, waypoints);
+    if rests.is_empty() {
+        return time_stretch(robot, task, constraints, waypoints, request);
+    }
+    let mut bounds = vec![0];
+    bounds.extend(rests);
+    bounds.push(waypoints.len() - 1);
+    let mut joined: Option<TimedMotion> = None;
+    for pair in bounds.windows(2) {
+        let stretch = time_stretch(
+            robot,
+            task,
+            constraints,
+            &waypoints[pair[0]..=pair[1]],
+            request,
+        )?;
+        let cut = stretch.report.cut.is_some();
+        joined = Some(match joined {
+            None => stretch,
+            Some(before) => before.followed_by(stretch, pair[0], request.rate_hz),
+        });
+        if cut {
+            break;
+        }
+    }
+    Ok(joined.expect("a path task's motion has a stretch"))
+}
+
+/// The interior waypoints at which a path task's motion comes to rest: for each corner the
+/// path does not blend, the waypoint nearest it along the path, when that lies within
+/// [`REST_SNAP_M`] of it (a rollout's step lands on a corner, to the step's linearisation).
+/// None on a line.
+pub fn rest_waypoints(robot: &Robot, task: &Task, waypoints: &[JointVector]) -> Vec<usize> {
+    let Some(path) = &task.path else {
+        return Vec::new();
+    };
+    let mut s = 0.0;
+    let along: Vec<f64> = waypoints
+        .iter()
+        .map(|q| {
+            s = task.along(&robot.forward(q).tcp(), s).s_m;
+            s
+        })
+        .collect();
+    let interior = 1..waypoints.len().saturating_sub(1);
+    let mut rests: Vec<usize> = path
+        .corners_m()
+        .filter_map(|corner| {
+            interior
+                .clone()
+                .map(|k| (k, (along[k] - corner).abs()))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|&(_, gap)| gap <= REST_SNAP_M)
+                .map(|(k, _)| k)
+        })
+        .collect();
+    rests.dedup();
+    rests
+}
+
+impl TimedMotion {
+    /// This motion, then `next` (which starts at rest where this one ends, at waypoint
+    /// `first_waypoint` of the whole motion): its samples after its first follow on the grid
+    /// of `rate_hz`, its grid after this one's path parameters, its report added to this one's.
+    fn followed_by(mut self, next: TimedMotion, first_waypoint: usize, rate_hz: f64) -> Self {
+        let rest_s = self.samples.last().map_or(0.0, TimedSample::time_s);
+        let offset_samples = self.samples.len() as u64 - 1;
+        self.samples
+            .extend(next.samples.iter().skip(1).enumerate().map(|(k, sample)| {
+                let index = offset_samples + k as u64 + 1;
+                TimedSample {
+                    time_ns: (index as f64 * 1e9 / rate_hz).round() as u64,
+                    ..sample.clone()
+                }
+            }));
+        let offset_s = self.grid_s.last().copied().unwrap_or(0.0);
+        self.grid_s
+            .extend(next.grid_s.iter().skip(1).map(|s| s + offset_s));
+        let (before, after) = (&self.report, &next.report);
+        let duration_s = self.samples.last().map_or(0.0, TimedSample::time_s);
+        self.report = TimingReport {
+            duration_s,
+            time_optimal_s: before.time_optimal_s + after.time_optimal_s,
+            tool_speed_share: (before.tool_speed_share * before.duration_s
+                + after.tool_speed_share * after.duration_s)
+                / (before.duration_s + after.duration_s).max(f64::MIN_POSITIVE),
+            path_travel_m: before.path_travel_m + after.path_travel_m,
+            refined_knots: before.refined_knots + after.refined_knots,
+            cut: after
+                .cut
+                .as_ref()
+                .map(|(waypoint, why)| (first_waypoint + waypoint, why.clone())),
+            grid_points: before.grid_points + after.grid_points,
+            slowdowns: before.slowdowns.max(after.slowdowns),
+            rests_s: before
+                .rests_s
+                .iter()
+                .copied()
+                .chain(std::iter::once(rest_s))
+                .collect(),
+        };
+        self.paths.extend(next.paths);
+        self
+    }
+}
+
+/// One stretch from rest to rest through `waypoints`: the smooth path, then TOPP-RA on a grid of
+/// at most [`GRID_STEP_M`], the moving average over `w = 2 max_j a_j / j_j`, samples at the
+/// requested rate, and, while a sample breaks a limit, the speed and acceleration bounds around
+/// it lowered by [`SLOWDOWN`].
+fn time_stretch(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    waypoints: &[JointVector],
+    request: &TimingRequest,
+) -> Result<TimedMotion, TimingError> {
     let path = SmoothPath::fit(robot, task, constraints, waypoints);
     let cut = path
         .cut
@@ -181,8 +306,9 @@ pub fn time_motion(
                 cut,
                 grid_points: 0,
                 slowdowns: 0,
+                rests_s: Vec::new(),
             },
-            path,
+            paths: vec![path],
         });
     };
     let length = spline.end();
@@ -249,8 +375,9 @@ pub fn time_motion(
                     cut,
                     grid_points: grid.len(),
                     slowdowns,
+                    rests_s: Vec::new(),
                 },
-                path,
+                paths: vec![path],
             });
         };
         if slowdowns == MAX_SLOWDOWNS {

@@ -200,3 +200,85 @@ fn limits_files_name_what_is_wrong() {
         })
     ));
 }
+
+/// A rectangle of `a × b` from the mid-range pose's TCP on its tool plane, corners unblended.
+fn rectangle_task(robot: &Robot, a: f64, b: f64) -> Task {
+    let seed = robot.mid_range();
+    let kin = robot.forward(&seed);
+    let (p, n) = (kin.tcp(), kin.tool_axis());
+    let d = (Vec3::y() - n * Vec3::y().dot(&n)).normalize();
+    let e = n.cross(&d);
+    let line = |to: Vec3| emg_control::SegmentSpec::Line { to: to.into() };
+    let spec = emg_control::PathSpec {
+        version: 1,
+        start: p.into(),
+        normal: n.into(),
+        blend_radius_m: 0.0,
+        segments: vec![
+            line(p + d * a),
+            line(p + d * a + e * b),
+            line(p + e * b),
+            line(p),
+        ],
+    };
+    Task::on_path(robot, emg_control::Path::new(spec).unwrap(), Some(seed)).unwrap()
+}
+
+#[test]
+fn a_path_motion_comes_to_rest_at_every_unblended_corner_within_every_limit() {
+    let (robot, checker) = fr3();
+    let task = rectangle_task(&robot, 0.08, 0.05);
+    let config = RolloutConfig::default();
+    let seed = task.q0_seed.unwrap();
+    let trajectory = rollout(
+        &robot,
+        &task,
+        &seed,
+        &mut ClassicalController::default(),
+        &config,
+    );
+    assert_eq!(trajectory.termination, emg_control::Termination::Completed);
+    let waypoints: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
+    let rests = emg_timing::rest_waypoints(&robot, &task, &waypoints);
+    assert_eq!(rests.len(), 3, "three corners inside a closed rectangle");
+    let request = TimingRequest {
+        limits: shipped_limits(&robot),
+        tool_speed_m_per_s: 0.2,
+        rate_hz: 1000.0,
+    };
+    let motion = time_motion(&robot, &task, &config.constraints, &waypoints, &request).unwrap();
+    assert_eq!(motion.paths.len(), 4);
+    assert_eq!(first_breach(&motion.samples, &request.limits), None);
+    assert!(
+        motion
+            .samples
+            .windows(2)
+            .all(|w| w[1].time_ns - w[0].time_ns == 1_000_000)
+    );
+    let path = task.path.as_ref().unwrap();
+    for rest in rests {
+        let corner = waypoints[rest];
+        let at = motion
+            .samples
+            .iter()
+            .find(|sample| sample.q == corner)
+            .expect("the motion passes the corner's waypoint exactly");
+        assert_eq!(at.qd, JointVector::zeros(), "at rest on the corner");
+        let tcp = robot.forward(&corner).tcp();
+        let nearest = path
+            .corners_m()
+            .map(|c| (path.point_at(c) - tcp).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < 1e-3, "rest {nearest} m from a corner");
+    }
+    let line: Line = (&task).into();
+    for sample in &motion.samples {
+        let (tcp, _) = checker.tcp_pose(&sample.q);
+        assert!(line.distance(&tcp) <= config.constraints.line_tolerance_m + 1e-9);
+    }
+    assert!(
+        (line.reached(motion.samples.iter().map(|s| checker.tcp_pose(&s.q).0)) - path.length_m())
+            .abs()
+            < 2e-4
+    );
+}
