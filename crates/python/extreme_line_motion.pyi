@@ -69,6 +69,9 @@ class Task:
     def n(self) -> FloatArray:
         """Unit surface normal, shape (3,)."""
     @property
+    def path_length_m(self) -> Optional[float]:
+        """The length of the task's path (m), or None for a line."""
+    @property
     def q0_seed(self) -> Optional[FloatArray]:
         """The configuration the task was generated from (rad), shape (7,), or None."""
 
@@ -208,6 +211,15 @@ class Planner:
         reach: bool = True,
     ) -> Plan:
         """Plans the task (p0, d, n); the GIL is released while planning."""
+    def plan_path(
+        self,
+        path: Union[str, os.PathLike[str], dict],
+        seed: SeedArg = None,
+        controller: Optional[ControllerArg] = None,
+        planner: PlannerArg = None,
+        reach: bool = True,
+    ) -> Plan:
+        """Plans a path task (a path file or a dict in its layout, docs/paths.md) as far along the path as it goes."""
     def plan_many(
         self,
         tasks: Iterable[TaskArg],

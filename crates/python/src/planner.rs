@@ -303,6 +303,41 @@ impl Planner {
         Ok(self.wrap(task, &request, planned))
     }
 
+    /// Plans a path task: the tool follows `path` — a path file (`str` or `os.PathLike`) or a
+    /// `dict` in the same layout (docs/paths.md: `version`, `start`, `normal`, `segments` of
+    /// lines and arcs, `blend_radius_m`) — as far as it can; the plan's `termination` is
+    /// `"completed"` when it reaches the end. Other arguments as for `plan`. A malformed path
+    /// raises `InputError` naming the field.
+    #[pyo3(signature = (path, seed = None, controller = None, planner = None, reach = true))]
+    fn plan_path(
+        &self,
+        py: Python<'_>,
+        path: &Bound<'_, PyAny>,
+        seed: Option<&Bound<'_, PyAny>>,
+        controller: Option<&str>,
+        planner: Option<&str>,
+        reach: bool,
+    ) -> PyResult<Plan> {
+        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
+        let path = if path.is_instance_of::<PyDict>() {
+            let text: String = py
+                .import("json")?
+                .call_method1("dumps", (path,))?
+                .extract()?;
+            emg_io::parse_path(&text)
+                .map_err(|message| InputError::new_err(format!("path: {message}")))?
+        } else {
+            let file: PathBuf = path.extract()?;
+            emg_io::read_path(&file).map_err(|e| input_error("path", &e))?
+        };
+        let task = emg_control::Task::on_path(self.inner.robot(), path, None)
+            .map_err(|e| input_error("path", &e))?;
+        let planned = py
+            .detach(|| self.plan_one(&task, &request))
+            .map_err(|e| plan_error(e, &request.request, None))?;
+        Ok(self.wrap(task, &request, planned))
+    }
+
     /// Plans every task of `tasks` (`Task` objects, e.g. from `load_tasks`, or `(p0, d, n)`
     /// triples) in parallel on all cores with the GIL released; the plans come in task order
     /// and do not depend on the number of threads. Arguments as for `plan`; the first task
@@ -575,6 +610,12 @@ impl Task {
     #[getter]
     fn n<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         array1(py, self.inner.n.iter().copied())
+    }
+
+    /// The length of the task's path (m), or `None` for a line.
+    #[getter]
+    fn path_length_m(&self) -> Option<f64> {
+        self.inner.length_m()
     }
 
     /// The configuration the task was generated from (rad), shape (7,), or `None`.

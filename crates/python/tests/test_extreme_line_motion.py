@@ -252,3 +252,35 @@ def test_plan_many_releases_the_gil_and_matches_plan(planner, tasks):
         alone = planner.plan_many([chosen[index]])[0]
         np.testing.assert_array_equal(alone.q, plans[index].q)
     assert all(math.isfinite(p.path_length_m) for p in plans)
+
+
+def documented_path():
+    """The JSON example of docs/paths.md."""
+    doc = (ROOT / "docs" / "paths.md").read_text()
+    start = doc.index("```json\n") + len("```json\n")
+    return json.loads(doc[start:doc.index("```", start)])
+
+
+def test_plan_path_follows_the_documented_slot_as_the_cli_does(tmp_path, planner):
+    path = documented_path()
+    plan = planner.plan_path(path)
+    assert plan.termination == "reached the end of the path"
+    assert plan.task.path_length_m == pytest.approx(0.6 + math.pi * 0.1)
+    assert plan.path_length_m == pytest.approx(plan.task.path_length_m, abs=2e-4)
+    motion = plan.timed()
+    assert len(motion.rest_knots) == 0, "the slot's segments meet tangentially"
+    plan.save(tmp_path / "python")
+    file = tmp_path / "slot.json"
+    file.write_text(json.dumps(path))
+    assert planner.plan_path(file).path_length_m == plan.path_length_m
+    run_cli("plan", "--path", file, "--surface", "off", "--out", tmp_path / "cli")
+    assert_same_files(tmp_path / "python", tmp_path / "cli")
+
+
+def test_plan_path_refuses_a_malformed_path_naming_the_field(planner):
+    path = documented_path()
+    path["segments"][1]["arc"]["sweep_deg"] = 400
+    with pytest.raises(elm.InputError, match=r"segments\[1\]\.arc\.sweep_deg"):
+        planner.plan_path(path)
+    with pytest.raises(elm.InputError, match="cannot read path file"):
+        planner.plan_path("/nonexistent/path.json")
