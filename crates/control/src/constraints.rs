@@ -191,7 +191,9 @@ pub fn first_contact(
         obstacle: obstacle.to_string(),
         clearance_m: hit.clearance,
     };
-    if let Some(surface) = cfg.work_surface.shape(&task.p0, &task.d, &task.n)
+    if let Some(surface) = task
+        .work_surface(&cfg.work_surface)
+        .shape(&task.p0, &task.d, &task.n)
         && let Some(hit) = robot.first_contact(kin, &surface, 0.0, ToolContact::Allowed)
     {
         return Some(scene_contact(WORK_SURFACE, hit));

@@ -44,7 +44,7 @@ pub use constraints::{Violation, WORK_SURFACE, first_contact, first_violation, t
 pub use controller::{ActingController, NullSpaceController};
 pub use path::{
     CORNER_RAD, Located, MIN_SEGMENT_M, PATH_FORMAT_VERSION, PLANE_TOLERANCE_M, Path, PathError,
-    PathSpec, Piece, SegmentSpec,
+    PathExtent, PathSpec, Piece, SegmentSpec,
 };
 pub use rollout::{
     Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,
@@ -55,4 +55,4 @@ pub use task::{
     ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task,
     TaskError,
 };
-pub use verification::CheckRollout;
+pub use verification::{CheckRollout, task_bounds};

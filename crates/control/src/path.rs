@@ -149,6 +149,26 @@ impl Piece {
         (self.point(0.0), self.point(self.length_m), arc)
     }
 
+    /// The smallest and largest `x·direction` over the piece's points `x`.
+    fn range_along(&self, direction: &Vec3) -> (f64, f64) {
+        let ends = [self.point(0.0), self.point(self.length_m)].map(|p| p.dot(direction));
+        let (mut low, mut high) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+        if let Shape::Circular(arc) = self.shape {
+            // `x·v = c·v + r (u·v cos φ + w·v sin φ)` is extreme at `φ*` and `φ* + π`.
+            let extreme = direction.dot(&arc.w).atan2(direction.dot(&arc.u));
+            let sweep = self.length_m / arc.radius_m;
+            for angle in [extreme, extreme + PI] {
+                let angle = angle.rem_euclid(2.0 * PI);
+                if angle <= sweep {
+                    let value = self.point(angle * arc.radius_m).dot(direction);
+                    low = low.min(value);
+                    high = high.max(value);
+                }
+            }
+        }
+        (low, high)
+    }
+
     /// The point at `σ` (m) along the piece.
     fn point(&self, sigma: f64) -> Vec3 {
         match self.shape {
@@ -211,6 +231,18 @@ pub struct Located {
     pub tangent: Vec3,
 }
 
+/// How far a path reaches from its start in the surface, in the frame of its start tangent
+/// `d` and `n × d`: the extent a work plate must cover.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathExtent {
+    /// Farthest reach against `d` (m, ≥ 0).
+    pub behind_m: f64,
+    /// Farthest reach along `d` (m, ≥ 0).
+    pub ahead_m: f64,
+    /// Farthest reach to either side, along `±(n × d)` (m, ≥ 0).
+    pub across_m: f64,
+}
+
 /// A validated path (see the module documentation).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "PathSpec", into = "PathSpec")]
@@ -219,6 +251,7 @@ pub struct Path {
     normal: Vec3,
     pieces: Vec<Piece>,
     length_m: f64,
+    extent: PathExtent,
 }
 
 impl TryFrom<PathSpec> for Path {
@@ -313,12 +346,48 @@ impl Path {
         }
         let pieces = blended(shapes, blend)?;
         let length_m = pieces.last().map_or(0.0, |p| p.start_s + p.length_m);
-        Ok(Self {
+        let mut path = Self {
             spec,
             normal,
             pieces,
             length_m,
-        })
+            extent: PathExtent {
+                behind_m: 0.0,
+                ahead_m: 0.0,
+                across_m: 0.0,
+            },
+        };
+        path.extent = path.measured_extent();
+        Ok(path)
+    }
+
+    /// The path's extent: each piece's range along `d` and across it (exact for arcs).
+    fn measured_extent(&self) -> PathExtent {
+        let start = self.point_at(0.0);
+        let d = self.tangent_at(0.0);
+        let across = self.normal.cross(&d);
+        let range = |direction: &Vec3| {
+            self.pieces
+                .iter()
+                .map(|piece| piece.range_along(direction))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(low, high), (l, h)| {
+                    (low.min(l), high.max(h))
+                })
+        };
+        let (back, ahead) = range(&d);
+        let (left, right) = range(&across);
+        PathExtent {
+            behind_m: (start.dot(&d) - back).max(0.0),
+            ahead_m: (ahead - start.dot(&d)).max(0.0),
+            across_m: (start.dot(&across) - left)
+                .max(right - start.dot(&across))
+                .max(0.0),
+        }
+    }
+
+    /// How far the path reaches from its start ([`PathExtent`]).
+    pub fn extent(&self) -> PathExtent {
+        self.extent
     }
 
     /// A straight path from `start` along the unit direction `direction` for `length_m`, on the

@@ -1,6 +1,6 @@
 //! The task model `c = [p0, d, n]` (Eq. 1) and its validation.
 
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, Plate, Robot, Vec3, WorkSurface};
 use serde::{Deserialize, Serialize};
 
 use crate::path::{Path, PathError};
@@ -243,6 +243,24 @@ impl Task {
         match &self.path {
             None => Self::new(robot, self.p0, self.d, self.n, self.q0_seed),
             Some(path) => Self::on_path(robot, path.clone(), self.q0_seed),
+        }
+    }
+
+    /// The work surface `surface` names, for this task: on a path task a plate grows to cover
+    /// the whole path, keeping its margins (half its width to each side of the path, `behind_m`
+    /// behind its rearmost point) and reaching at least as far ahead as it would along a line.
+    pub fn work_surface(&self, surface: &WorkSurface) -> WorkSurface {
+        match (surface, &self.path) {
+            (WorkSurface::Plate(plate), Some(path)) => {
+                let extent = path.extent();
+                WorkSurface::Plate(Plate {
+                    half_width_m: plate.half_width_m + extent.across_m,
+                    behind_m: plate.behind_m + extent.behind_m,
+                    ahead_m: plate.ahead_m.max(extent.ahead_m + plate.half_width_m),
+                    thickness_m: plate.thickness_m,
+                })
+            }
+            _ => *surface,
         }
     }
 

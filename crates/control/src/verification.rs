@@ -43,16 +43,7 @@ impl From<&ConstraintConfig> for Bounds {
             theta_max_deg: constraints.theta_max_deg,
             collision_margin_m: constraints.collision_margin_m,
             velocity_limit_fraction: constraints.velocity_limit_fraction.map(|f| f.get()),
-            work_surface: match constraints.work_surface {
-                WorkSurface::Off => None,
-                WorkSurface::HalfSpace => Some(Surface::HalfSpace),
-                WorkSurface::Plate(plate) => Some(Surface::Plate {
-                    half_width_m: plate.half_width_m,
-                    behind_m: plate.behind_m,
-                    ahead_m: plate.ahead_m,
-                    thickness_m: plate.thickness_m,
-                }),
-            },
+            work_surface: surface(&constraints.work_surface),
             obstacles: constraints
                 .scene
                 .obstacles
@@ -64,6 +55,29 @@ impl From<&ConstraintConfig> for Bounds {
                 })
                 .collect(),
         }
+    }
+}
+
+/// The bounds `constraints` set for `task`, as the checker's plain data: the work surface the
+/// task's own ([`Task::work_surface`]: on a path task, a plate grown to cover the path).
+pub fn task_bounds(task: &Task, constraints: &ConstraintConfig) -> Bounds {
+    Bounds {
+        work_surface: surface(&task.work_surface(&constraints.work_surface)),
+        ..Bounds::from(constraints)
+    }
+}
+
+/// The checker's plain description of a work surface.
+fn surface(work_surface: &WorkSurface) -> Option<Surface> {
+    match *work_surface {
+        WorkSurface::Off => None,
+        WorkSurface::HalfSpace => Some(Surface::HalfSpace),
+        WorkSurface::Plate(plate) => Some(Surface::Plate {
+            half_width_m: plate.half_width_m,
+            behind_m: plate.behind_m,
+            ahead_m: plate.ahead_m,
+            thickness_m: plate.thickness_m,
+        }),
     }
 }
 
@@ -159,6 +173,10 @@ impl CheckRollout for ReferenceModel {
         trajectory: &Trajectory,
         constraints: &ConstraintConfig,
     ) -> Result<(), CheckFailure> {
-        self.check_recording(&task.into(), &trajectory.into(), &constraints.into())
+        self.check_recording(
+            &task.into(),
+            &trajectory.into(),
+            &task_bounds(task, constraints),
+        )
     }
 }

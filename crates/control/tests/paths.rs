@@ -476,3 +476,44 @@ fn the_checker_refuses_a_path_rollout_checked_against_another_path_or_a_false_en
         "{failure}"
     );
 }
+
+#[test]
+fn a_work_plate_grows_to_cover_a_path_and_stays_as_it_is_on_a_line() {
+    use emg_kinematics::{Plate, WorkSurface};
+    let (robot, task) = start();
+    let plate = WorkSurface::Plate(Plate::default());
+    assert_eq!(task.work_surface(&plate), plate);
+    let (p, d, n) = (task.p0, task.d, task.n);
+    let path = Path::new(rectangle(p, d, n, 0.3, 0.15, 0.0)).unwrap();
+    let extent = path.extent();
+    assert!((extent.ahead_m - 0.3).abs() < 1e-12 && extent.behind_m.abs() < 1e-12);
+    assert!((extent.across_m - 0.15).abs() < 1e-12);
+    let on_path = Task::on_path(&robot, path, None).unwrap();
+    let WorkSurface::Plate(grown) = on_path.work_surface(&plate) else {
+        panic!("a plate stays a plate");
+    };
+    let default = Plate::default();
+    assert!((grown.half_width_m - (default.half_width_m + 0.15)).abs() < 1e-12);
+    assert!((grown.behind_m - default.behind_m).abs() < 1e-12);
+    assert_eq!(grown.ahead_m, default.ahead_m);
+    // A circle of radius 0.1 m whose start tangent is across `d`: it reaches 0.1 m behind its
+    // start and 0.2 m to one side, in the frame of that tangent.
+    let circle = spec(
+        p,
+        n,
+        0.0,
+        vec![arc(Some(p - d * 0.1), None, None, Some(360.0))],
+    );
+    let on_circle = Task::on_path(&robot, Path::new(circle).unwrap(), None).unwrap();
+    let WorkSurface::Plate(grown) = on_circle.work_surface(&plate) else {
+        panic!("a plate stays a plate");
+    };
+    assert!(
+        (grown.behind_m - (default.behind_m + 0.1)).abs() < 1e-12,
+        "{grown:?}"
+    );
+    assert!(
+        (grown.half_width_m - (default.half_width_m + 0.2)).abs() < 1e-12,
+        "{grown:?}"
+    );
+}

@@ -201,7 +201,7 @@ impl TrajectoryContents {
         check_replay(
             model,
             &task.into(),
-            &constraints.into(),
+            &emg_control::task_bounds(task, constraints),
             &samples,
             recording.as_ref(),
             dynamics.as_ref(),

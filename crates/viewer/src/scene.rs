@@ -33,6 +33,38 @@ struct SceneTask {
     p0: [f64; 3],
     d: [f64; 3],
     n: [f64; 3],
+    /// A path task's path, sampled; absent for a line.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    path: Option<ScenePath>,
+}
+
+/// A path sampled every [`PATH_SAMPLE_M`] of arc length (and at its end), with the unit
+/// direction across it in the surface (`n × t`) at each sample.
+#[derive(Debug, Serialize)]
+struct ScenePath {
+    step_m: f64,
+    length_m: f64,
+    points: Vec<[f64; 3]>,
+    sides: Vec<[f64; 3]>,
+}
+
+/// Arc length (m) between the samples of a path the page draws.
+const PATH_SAMPLE_M: f64 = 0.005;
+
+impl ScenePath {
+    fn new(task: &emg_control::Task) -> Option<Self> {
+        let length = task.length_m()?;
+        let count = (length / PATH_SAMPLE_M).ceil() as usize;
+        let at = |k: usize| (k as f64 * PATH_SAMPLE_M).min(length);
+        Some(Self {
+            step_m: PATH_SAMPLE_M,
+            length_m: self::length(length),
+            points: (0..=count).map(|k| point(&task.point_at(at(k)))).collect(),
+            sides: (0..=count)
+                .map(|k| point(&task.n.cross(&task.heading_at(at(k)))))
+                .collect(),
+        })
+    }
 }
 
 #[derive(Debug, Serialize)]
@@ -122,9 +154,9 @@ struct SceneCapsule<'a> {
 #[derive(Debug, Serialize)]
 struct SceneStep {
     t: f64,
-    /// Progress `(p − p0)·d` along the line (m).
+    /// Progress `(p − p0)·d` along the line, or the arc length along the path (m).
     s: f64,
-    /// Lateral distance of the TCP from the line (m).
+    /// Lateral distance of the TCP from the line or the path (m).
     lateral: f64,
     tool_angle_deg: f64,
     rho: f64,
@@ -158,7 +190,9 @@ impl<'a> Scene<'a> {
             })
             .collect();
         let plate = match constraints.work_surface {
-            WorkSurface::Plate(_) => constraints.work_surface.shape(&task.p0, &task.d, &task.n),
+            WorkSurface::Plate(_) => task
+                .work_surface(&constraints.work_surface)
+                .shape(&task.p0, &task.d, &task.n),
             WorkSurface::Off | WorkSurface::HalfSpace => None,
         };
         let obstacles = plate
@@ -180,10 +214,11 @@ impl<'a> Scene<'a> {
                     }),
             )
             .collect();
+        let mut s_m = 0.0;
         let steps = trajectory
             .steps
             .iter()
-            .map(|step| scene_step(input, step))
+            .map(|step| scene_step(input, step, &mut s_m))
             .collect();
         Self {
             title,
@@ -192,6 +227,7 @@ impl<'a> Scene<'a> {
                 p0: point(&task.p0),
                 d: point(&task.d),
                 n: point(&task.n),
+                path: ScenePath::new(task),
             },
             constraints: SceneConstraints {
                 line_tolerance_m: constraints.line_tolerance_m,
@@ -207,9 +243,13 @@ impl<'a> Scene<'a> {
     }
 }
 
-fn scene_step(input: &ViewerInput<'_>, step: &StepRecord) -> SceneStep {
+/// A recorded step as the page draws it; `s_m` is the progress of the step before (followed
+/// along a path), updated to this one's.
+fn scene_step(input: &ViewerInput<'_>, step: &StepRecord, s_m: &mut f64) -> SceneStep {
     let kin = input.robot.forward(&step.q);
     let tcp = kin.tcp();
+    let along = input.task.along(&tcp, *s_m);
+    *s_m = along.s_m;
     let mut joints = Vec::with_capacity(DOF + 2);
     joints.push(point(&kin.segment_point(0, &Vec3::zeros())));
     joints.extend((0..DOF).map(|i| point(&kin.joint_origin(i))));
@@ -225,8 +265,8 @@ fn scene_step(input: &ViewerInput<'_>, step: &StepRecord) -> SceneStep {
         .collect();
     SceneStep {
         t: round(step.time_s, TIME_SCALE),
-        s: length(input.task.progress(&tcp)),
-        lateral: length(input.task.lateral_error(&tcp).norm()),
+        s: length(along.s_m),
+        lateral: length(along.lateral.norm()),
         tool_angle_deg: round(step.tool_angle_deg, VALUE_SCALE),
         rho: round(step.rho, VALUE_SCALE),
         controller: step.controller,

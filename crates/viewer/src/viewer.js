@@ -94,7 +94,19 @@ window.addEventListener("unhandledrejection", function (event) {
   const lateralDir = unit(cross(task.n, task.d));
   const coneU = perpendicular(task.n);
   const coneV = cross(task.n, coneU);
-  const onLine = (s) => add(task.p0, scale(task.d, s));
+  // A path task's path, sampled every path.step_m of arc length; undefined for a line.
+  const path = task.path;
+  // The point at progress (arc length) s and the unit direction across the task there.
+  function alongTask(s) {
+    if (!path) return { point: add(task.p0, scale(task.d, s)), side: lateralDir };
+    const last = path.points.length - 1;
+    const x = Math.min(Math.max(s / path.step_m, 0), last);
+    const i = Math.min(Math.floor(x), Math.max(last - 1, 0));
+    const f = Math.min(1, x - i);
+    const j = Math.min(i + 1, last);
+    return { point: mix3(path.points[i], path.points[j], f), side: unit(mix3(path.sides[i], path.sides[j], f)) };
+  }
+  const onLine = (s) => alongTask(s).point;
 
   let sMin = 0;
   let sMax = 0;
@@ -102,7 +114,9 @@ window.addEventListener("unhandledrejection", function (event) {
     sMin = Math.min(sMin, step.s);
     sMax = Math.max(sMax, step.s);
   }
-  const extension = Math.max(0.05, 0.15 * (sMax - sMin));
+  // A line is drawn a bit beyond the planned range; a path to its end.
+  const extension = path ? 0 : Math.max(0.05, 0.15 * (sMax - sMin));
+  const sEnd = path ? path.length_m : sMax + extension;
 
   // The last step at or before time t (timestamps need not be uniform).
   function stepAt(t) {
@@ -162,7 +176,8 @@ window.addEventListener("unhandledrejection", function (event) {
     }
   }
   include(onLine(sMin - extension), 0);
-  include(onLine(sMax + extension), 0);
+  include(onLine(sEnd), 0);
+  if (path) for (const p of path.points) include(p, 0);
   include([0, 0, 0], 0);
   const centre = scale(add(bounds.lo, bounds.hi), 0.5);
   const radius = Math.max(0.2, 0.5 * norm(sub(bounds.hi, bounds.lo)));
@@ -384,18 +399,22 @@ window.addEventListener("unhandledrejection", function (event) {
     const items = [];
     const queue = (depth, draw) => items.push({ depth, draw });
 
-    // Task line: the planned range solid, a bit beyond it faint; the start marked.
-    const lineSegment = (s0, s1, lineWidth, colour) =>
-      pieces(cam, onLine(s0), onLine(s1), PIECE_LENGTH, (a, b, z) =>
-        queue(z, () => stroke(a, b, lineWidth, colour)));
+    // Task line or path: the planned range solid, the rest faint; the tolerance on each side;
+    // the start marked. A path is drawn piece by piece between its samples.
+    const lineSegment = (s0, s1, lineWidth, colour, offset = 0) => {
+      const cuts = [s0];
+      if (path) for (let s = Math.ceil(s0 / path.step_m) * path.step_m; s < s1; s += path.step_m) if (s > s0) cuts.push(s);
+      cuts.push(s1);
+      for (let k = 0; k + 1 < cuts.length; k++) {
+        const [a, b] = [alongTask(cuts[k]), alongTask(cuts[k + 1])];
+        pieces(cam, add(a.point, scale(a.side, offset)), add(b.point, scale(b.side, offset)), PIECE_LENGTH,
+          (pa, pb, z) => queue(z, () => stroke(pa, pb, lineWidth, colour)));
+      }
+    };
     lineSegment(sMin - extension, sMin, 1.5, "rgba(31, 157, 85, 0.45)");
     lineSegment(sMin, sMax, 3, LINE_COLOUR);
-    lineSegment(sMax, sMax + extension, 1.5, "rgba(31, 157, 85, 0.45)");
-    for (const sign of [-1, 1]) {
-      const offset = scale(lateralDir, sign * tolerance);
-      pieces(cam, add(onLine(sMin), offset), add(onLine(sMax), offset), PIECE_LENGTH, (a, b, z) =>
-        queue(z, () => stroke(a, b, 1, "rgba(31, 157, 85, 0.35)")));
-    }
+    lineSegment(sMax, sEnd, 1.5, "rgba(31, 157, 85, 0.45)");
+    for (const sign of [-1, 1]) lineSegment(sMin, sMax, 1, "rgba(31, 157, 85, 0.35)", sign * tolerance);
     const start = project(cam, task.p0);
     if (start) {
       queue(start.z - 0.01, () => {
@@ -407,12 +426,12 @@ window.addEventListener("unhandledrejection", function (event) {
     }
     queueCell(cam, queue);
 
-    // Tolerance ring around the line at the TCP's foot point.
-    const foot = onLine(frame.s);
+    // Tolerance ring around the line (path) at the TCP's foot point.
+    const { point: foot, side } = alongTask(frame.s);
     const ring = [];
     for (let k = 0; k <= 32; k++) {
       const phi = (2 * Math.PI * k) / 32;
-      ring.push(add(foot, add(scale(lateralDir, tolerance * Math.cos(phi)), scale(task.n, tolerance * Math.sin(phi)))));
+      ring.push(add(foot, add(scale(side, tolerance * Math.cos(phi)), scale(task.n, tolerance * Math.sin(phi)))));
     }
     for (let k = 0; k < 32; k++) {
       const a = project(cam, ring[k]);
@@ -524,7 +543,8 @@ window.addEventListener("unhandledrejection", function (event) {
   };
   function showReadout(frame) {
     text("r-time", current.toFixed(2) + " s of " + duration.toFixed(2) + " s");
-    const total = data.path_length_m;
+    // Of the plan's length on a line, of the whole path on a path task.
+    const total = path ? path.length_m : data.path_length_m;
     const percent = total > 0 ? " (" + Math.round((100 * frame.s) / total) + " %)" : "";
     text("r-path", frame.s.toFixed(3) + " m of " + total.toFixed(3) + " m" + percent);
     text("r-lateral", (1000 * frame.lateral).toFixed(1) + " mm (limit " + (1000 * tolerance).toFixed(1) + " mm)");
@@ -552,7 +572,7 @@ window.addEventListener("unhandledrejection", function (event) {
     }
     entry(LINK_COLOUR, "links");
     entry(PEN_COLOUR, "pen / TCP");
-    entry(LINE_COLOUR, "task line (p0 + s\u00b7d) and tolerance");
+    entry(LINE_COLOUR, path ? "task path and tolerance" : "task line (p0 + s\u00b7d) and tolerance");
     entry(CONE_EDGE, "tool cone (" + thetaMax + "\u00b0 about n)");
     entry(AXIS_COLOUR, "tool axis");
     if (data.constraints.work_surface) entry(SURFACE_EDGE, "work surface (only the pen may touch it)");

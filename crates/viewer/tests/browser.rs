@@ -528,3 +528,65 @@ fn data_dir() -> std::path::PathBuf {
 fn fr3_path() -> std::path::PathBuf {
     data_dir().join("robots/fr3_pen.urdf")
 }
+
+/// A classical rollout round a circle of radius 5 cm on the mid-range pose's tool plane, and
+/// its page.
+fn circle_page() -> (Trajectory, String) {
+    let robot =
+        Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("the FR3 robot file loads");
+    let seed = robot.mid_range();
+    let kin = robot.forward(&seed);
+    let (p, n) = (kin.tcp(), kin.tool_axis());
+    let across = n.cross(&(Vec3::y() - n * Vec3::y().dot(&n)).normalize());
+    let spec = emg_control::PathSpec {
+        version: 1,
+        start: p.into(),
+        normal: n.into(),
+        blend_radius_m: 0.0,
+        segments: vec![emg_control::SegmentSpec::Arc {
+            centre: Some((p + across * 0.05).into()),
+            through: None,
+            to: None,
+            sweep_deg: Some(360.0),
+        }],
+    };
+    let path = emg_control::Path::new(spec).expect("a valid circle");
+    let task = Task::on_path(&robot, path, Some(seed)).expect("a valid path task");
+    let config = RolloutConfig::default();
+    let trajectory = rollout(
+        &robot,
+        &task,
+        &seed,
+        &mut ClassicalController::default(),
+        &config,
+    );
+    let page = render_html(&ViewerInput {
+        robot: &robot,
+        task: &task,
+        trajectory: &trajectory,
+        constraints: &config.constraints,
+        title: "FR3 circle",
+    });
+    (trajectory, page)
+}
+
+#[test]
+fn a_path_task_draws_its_path() {
+    let (trajectory, page) = circle_page();
+    assert_eq!(trajectory.termination, emg_control::Termination::Completed);
+    assert!(
+        page.contains(r#""path":{"step_m":0.005"#),
+        "the page holds the sampled path"
+    );
+    let Some(browser) = browser() else { return };
+    let tmp = temp_dir("path");
+    let dir = tmp.path();
+    let run = dump_dom(&browser, dir, &page);
+    if let Err(problems) = page_problems(&run) {
+        panic!("the path page did not run cleanly:\n{problems}");
+    }
+    let (_, _, pixels) = screenshot(&browser, dir, &page);
+    if let Some(problem) = blank_screenshot_problem(&pixels) {
+        panic!("{problem} (page in {})", dir.display());
+    }
+}
