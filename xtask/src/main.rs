@@ -20,6 +20,7 @@ mod figure_dp_seeds;
 mod label_seeds;
 mod limit;
 mod make_tasks;
+mod path_eval;
 mod progress;
 mod protocol;
 mod readme_picture;
@@ -83,6 +84,10 @@ enum Command {
     /// Every task planned as `emg plan` plans it, timed rest to rest within the joint limits,
     /// written and checked as `emg check` checks it (docs/results/timing.*).
     Timing(timing::Args),
+    /// The path population (rectangles, circles, arcs, S-curves) planned by the classical
+    /// controller and the search beside the bound, checked and timed; rectangles also one line
+    /// at a time (docs/results/paths.*).
+    PathEval(path_eval::Args),
     /// Every shipped task set, label file, model and result, each pipeline in dependency order
     /// (resumable: finished stages are journaled in target/regenerate/; --list, --from STAGE).
     Regenerate(regenerate::Args),
@@ -107,6 +112,7 @@ fn main() -> anyhow::Result<()> {
         Command::ReadmePicture(args) => readme_picture::run(&args),
         Command::Limit(args) => limit::run(&args),
         Command::Timing(args) => timing::run(&args),
+        Command::PathEval(args) => path_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
     }
 }

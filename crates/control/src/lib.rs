@@ -1,5 +1,5 @@
 //! Straight-line and path tasks, their constraints, the one rollout loop every controller shares, the
-//! classical null-space controller, the task population, and the hand-over of rollouts to the
+//! classical null-space controller, the task and path populations, and the hand-over of rollouts to the
 //! independent checker (`emg-verify`).
 //!
 //! A controller implements [`NullSpaceController`]: at each step it sees a [`StepContext`]
@@ -29,6 +29,7 @@ mod config;
 mod constraints;
 mod controller;
 mod path;
+mod path_population;
 mod rollout;
 mod sampler;
 mod step;
@@ -46,6 +47,7 @@ pub use path::{
     CORNER_RAD, Located, MIN_SEGMENT_M, PATH_FORMAT_VERSION, PLANE_TOLERANCE_M, Path, PathError,
     PathExtent, PathSpec, Piece, SegmentSpec,
 };
+pub use path_population::{PathShape, path_tasks, population_path};
 pub use rollout::{
     Episode, StepOutcome, StepRecord, Termination, Trajectory, continue_rollout, rollout,
 };

@@ -517,3 +517,44 @@ fn a_work_plate_grows_to_cover_a_path_and_stays_as_it_is_on_a_line() {
         "{grown:?}"
     );
 }
+
+#[test]
+fn the_path_population_takes_each_shape_in_turn_from_its_anchors_start_along_d() {
+    use emg_control::{PathShape, path_tasks};
+    let robot = robot();
+    let anchors: Vec<Task> = tasks(&robot, 8).into_iter().map(|(_, task)| task).collect();
+    let population = path_tasks(&robot, &anchors, 7).unwrap();
+    assert_eq!(
+        population,
+        path_tasks(&robot, &anchors, 7).unwrap(),
+        "deterministic"
+    );
+    assert_ne!(
+        population,
+        path_tasks(&robot, &anchors, 8).unwrap(),
+        "seeded"
+    );
+    for (index, ((shape, task), anchor)) in population.iter().zip(&anchors).enumerate() {
+        assert_eq!(*shape, PathShape::ALL[index % 4]);
+        let path = task.path.as_ref().unwrap();
+        assert_close(path.point_at(0.0), anchor.p0, 1e-12, "starts at the anchor");
+        assert_close(path.tangent_at(0.0), anchor.d, 1e-9, "leaves along d");
+        assert_eq!(task.q0_seed, anchor.q0_seed);
+        assert_parameterised(path);
+        let ends_at_start = (path.point_at(path.length_m()) - anchor.p0).norm() < 1e-9;
+        match shape {
+            PathShape::Rectangle => {
+                assert_eq!(path.corners_m().count(), 3);
+                assert!(ends_at_start);
+            }
+            PathShape::Circle => {
+                assert!(ends_at_start);
+                assert!(path.length_m() > 2.0 * std::f64::consts::PI * 0.03 - 1e-9);
+            }
+            PathShape::Arc | PathShape::SCurve => {
+                assert_eq!(path.corners_m().count(), 0, "smooth");
+                assert!(!ends_at_start);
+            }
+        }
+    }
+}

@@ -11,10 +11,13 @@
 //!   or from shards merged bit for bit; [`EvalRecord`] is the typed result file.
 //! * [`BucketConfig`], [`cell_stats`]: the difficulty buckets and per-cell statistics.
 //! * [`bound_shares`]: length-weighted shares of a reference by bucket of the reachability bound.
+//! * [`lines_one_at_a_time`]: a polyline stroke planned as a line-only planner plans it, for the
+//!   path evaluation's comparison.
 
 mod batch;
 mod bound_share;
 mod buckets;
+mod lines;
 mod progress;
 mod protocol;
 mod setup;
@@ -24,6 +27,7 @@ pub use bound_share::{BOUND_BUCKET_EDGES_M, BoundShare, bound_bucket, bound_shar
 pub use buckets::{
     BucketConfig, CellStats, Difficulty, MIN_REFERENCE_M, bucket_members, cell_stats,
 };
+pub use lines::{LinesOutcome, SAME_CONFIGURATION_RAD, lines_one_at_a_time};
 pub use progress::{Progress, Silent};
 pub use protocol::{
     Cell, EvalRecord, PROTOCOL_SEEDS, RawSet, SetResult, four, markdown, merge_sets, run_set,
