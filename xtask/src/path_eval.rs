@@ -55,6 +55,10 @@ pub struct PathRow {
     pub length_m: f64,
     /// Arc length the classical controller reaches from `q0_seed` (m).
     pub classical_m: f64,
+    /// Arc length the paper's pipeline (hybrid controller from the DP seed) reaches (m).
+    pub pipeline_m: f64,
+    /// Arc length the search reaches with the classical controller as its requested one (m).
+    pub search_classical_m: f64,
     /// Arc length the search reaches (m).
     pub search_m: f64,
     /// The reachability bound along the path (m).
@@ -79,10 +83,15 @@ pub struct ShapeRow {
     pub paths: usize,
     /// Mean path length (m).
     pub mean_length_m: f64,
-    /// Σ reached / Σ path length: the classical controller, the search, the bound.
+    /// Σ reached / Σ path length: the classical controller, the pipeline, the search, the
+    /// search with the classical controller, the bound.
     pub classical_share: f64,
     /// See `classical_share`.
+    pub pipeline_share: f64,
+    /// See `classical_share`.
     pub search_share: f64,
+    /// See `classical_share`.
+    pub search_classical_share: f64,
     /// See `classical_share`.
     pub bound_share: f64,
     /// Σ search / Σ bound.
@@ -124,6 +133,8 @@ pub struct LinesRow {
 pub struct Record {
     /// Robot name.
     pub robot: String,
+    /// The command that wrote the record.
+    pub command: String,
     /// Task set the paths start from.
     pub tasks: String,
     /// Seed of the population.
@@ -174,7 +185,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         seed: Some(SeedSource::Generating),
         controller: ControllerKind::Classical,
     };
+    let pipeline = PlanRequest::pipeline();
     let search = PlanRequest::default();
+    let search_classical = PlanRequest {
+        controller: ControllerKind::Classical,
+        ..PlanRequest::default()
+    };
     let robot_name = args.robot.display().to_string();
     let bar = progress::bar(paths.len() as u64, "paths");
     let outcomes: Vec<(PathRow, Vec<String>)> = pool.install(|| {
@@ -195,6 +211,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         .check(task, &base.trajectory, constraints)
                         .map_err(|e| e.to_string()),
                 );
+                let learned = planner.plan(task, &pipeline)?;
+                let classical_search = planner.plan(task, &search_classical)?;
+                for (what, plan) in [
+                    ("pipeline", &learned),
+                    ("classical search", &classical_search),
+                ] {
+                    check(
+                        what,
+                        checker
+                            .check(task, &plan.trajectory, constraints)
+                            .map_err(|e| e.to_string()),
+                    );
+                }
                 let started = Instant::now();
                 let plan = planner.plan(task, &search)?;
                 let reach = planner.reach_of(task, &plan);
@@ -246,6 +275,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         shape: *shape,
                         length_m,
                         classical_m: base.trajectory.path_length_m,
+                        pipeline_m: learned.trajectory.path_length_m,
+                        search_classical_m: classical_search.trajectory.path_length_m,
                         search_m: plan.trajectory.path_length_m,
                         bound_m: reach.reachable_m,
                         search_completed: plan.trajectory.termination == Termination::Completed,
@@ -261,8 +292,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
     let (rows, failures): (Vec<PathRow>, Vec<Vec<String>>) = outcomes.into_iter().unzip();
     let failures: Vec<String> = failures.into_iter().flatten().collect();
+    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
+        command: match shipped.map(|robot| robot.name) {
+            Some("fr3") => "cargo xtask path-eval".to_string(),
+            Some(name) => format!("cargo xtask path-eval --robot {name}"),
+            None => format!("cargo xtask path-eval --robot {}", args.robot.display()),
+        },
         tasks: workspace::relative(&args.task_file),
         seed: args.seed,
         machine: workspace::machine(),
@@ -309,7 +346,9 @@ fn shape_rows(rows: &[PathRow], paths: &[(PathShape, Task)]) -> Vec<ShapeRow> {
             paths: members.len(),
             mean_length_m: length / members.len().max(1) as f64,
             classical_share: sum(|r| r.classical_m) / length,
+            pipeline_share: sum(|r| r.pipeline_m) / length,
             search_share: sum(|r| r.search_m) / length,
+            search_classical_share: sum(|r| r.search_classical_m) / length,
             bound_share: bound / length,
             search_of_bound: sum(|r| r.search_m) / bound,
             classical_completed: members.iter().filter(|&&i| classical_done[i]).count(),
@@ -372,20 +411,21 @@ fn lines_row(rows: &[PathRow]) -> LinesRow {
 fn markdown(record: &Record) -> String {
     let mut md = format!(
         "# Paths: rectangles, circles, arcs and S-curves ({})\n\n\
-         Generated by `cargo xtask path-eval{}` on {} ({} threads): one path from the start of \
+         Generated by `{}` on {} ({} threads): one path from the start of \
          each of the first {} tasks of `{}` (`emg_control::path_tasks`, seed {}), along the \
          task's direction on its surface, the paper's protocol (no work surface). The \
          classical controller rolls out from the task's generating configuration; the search is \
-         `emg plan`'s default. Shares are Σ arc length reached / Σ path length (the bound \
-         capped at the path's end); *completed* counts the paths planned to their end.\n\n\
-         | shape | paths | mean length (m) | classical | search | bound | search / bound | \
-         completed: classical | search | bound |\n|---|---|---|---|---|---|---|---|---|---|\n",
+         `emg plan`'s default (hybrid controller, DP samples among its starts); the pipeline is \
+         the paper's (hybrid controller from the DP seed), both learned on lines and given the \
+         path's local tangent as the line direction; *search, classical* is the search with the \
+         classical controller as its requested one. Shares are Σ arc length reached / Σ path \
+         length (the bound capped at the path's end); *completed* counts the paths planned to \
+         their end.\n\n\
+         | shape | paths | mean length (m) | classical | pipeline | search | search, classical | \
+         bound | search / bound | completed: classical | search | bound |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
         record.robot,
-        if record.robot == "fr3" {
-            ""
-        } else {
-            " --robot iiwa14"
-        },
+        record.command,
         record.machine,
         record.threads,
         record.rows.len(),
@@ -394,12 +434,14 @@ fn markdown(record: &Record) -> String {
     );
     for row in &record.shapes {
         md.push_str(&format!(
-            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} |\n",
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {} |\n",
             row.shape,
             row.paths,
             row.mean_length_m,
             row.classical_share,
+            row.pipeline_share,
             row.search_share,
+            row.search_classical_share,
             row.bound_share,
             row.search_of_bound,
             row.classical_completed,
@@ -450,4 +492,64 @@ fn markdown(record: &Record) -> String {
         record.duration_s.max,
     ));
     md
+}
+
+/// The report's section on paths: per shipped arm with a `paths.json` under `results`, the
+/// shares over all paths and per shape, and one line at a time on the rectangles.
+pub fn report_section(results: &std::path::Path) -> anyhow::Result<String> {
+    let mut rows = String::new();
+    let mut lines = String::new();
+    for shipped in emg_planner::SHIPPED_ROBOTS {
+        let path = results.join(shipped.data_subdir()).join("paths.json");
+        if !path.exists() {
+            continue;
+        }
+        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
+            .with_context(|| format!("reading {}", path.display()))?;
+        for row in &record.shapes {
+            rows += &format!(
+                "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {} / {} / {} |\n",
+                shipped.name,
+                row.shape,
+                row.paths,
+                row.classical_share,
+                row.pipeline_share,
+                row.search_share,
+                row.bound_share,
+                row.classical_completed,
+                row.search_completed,
+                row.bound_completed
+            );
+        }
+        let compared = &record.lines;
+        lines += &format!(
+            "| {} | {} | {:.3} ({}) | {:.3} ({}) | {:.2} | {:.3} ({}) |\n",
+            shipped.name,
+            compared.paths,
+            compared.path_share,
+            compared.path_completed,
+            compared.lines_drawn_share,
+            compared.lines_completed,
+            compared.mean_reconfigurations,
+            compared.lines_continuous_share,
+            compared.lines_completed_continuous
+        );
+    }
+    if rows.is_empty() {
+        return Ok(String::new());
+    }
+    Ok(format!(
+        "## Paths: rectangles, circles, arcs and S-curves\n\n\
+         Σ arc length reached / Σ path length over the path population (`cargo xtask \
+         path-eval`; `docs/results/paths.md`), and the paths planned to their end (classical / \
+         search / bound):\n\n\
+         | arm | shape | paths | classical | pipeline | search | bound | completed |\n\
+         |---|---|---|---|---|---|---|---|\n{rows}\n\
+         The rectangles one line at a time (each side planned from scratch by the same search, \
+         the arm reconfiguring where the next side's plan starts elsewhere) against the search \
+         on the whole path, Σ drawn / Σ length (completed):\n\n\
+         | arm | rectangles | search on the path | one line at a time | reconfigurations per \
+         rectangle | one line at a time, without reconfiguring |\n\
+         |---|---|---|---|---|---|\n{lines}\n"
+    ))
 }

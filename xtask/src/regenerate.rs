@@ -152,6 +152,19 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "path-eval",
+        args: &["path-eval"],
+        writes: &["docs/results/paths.json", "docs/results/paths.md"],
+    },
+    Stage {
+        name: "path-eval-iiwa14",
+        args: &["path-eval", "--robot", "iiwa14"],
+        writes: &[
+            "docs/results/iiwa14/paths.json",
+            "docs/results/iiwa14/paths.md",
+        ],
+    },
+    Stage {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],

@@ -167,6 +167,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          unseen tasks whose bound lies in each bucket (`cargo xtask search-eval`; \
          `docs/results/search.md` per budget):\n\n{shares}\n"
     );
+    md += &crate::path_eval::report_section(&args.results)?;
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     if args.results == workspace::root().join("docs/results") {

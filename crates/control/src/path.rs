@@ -477,13 +477,14 @@ impl Path {
             if piece.start_s > high || piece.start_s + piece.length_m < low {
                 continue;
             }
-            // On a closed circle the nearest angle is also one turn further or back.
+            // On a closed circle the nearest angle is also one turn further or back, and a
+            // point just before the start is just before the end: the ends are candidates too.
             let turn = match piece.shape {
                 Shape::Straight(_) => f64::INFINITY,
                 Shape::Circular(arc) => 2.0 * PI * arc.radius_m,
             };
             let sigma = piece.nearest(p);
-            for sigma in [sigma, sigma - turn, sigma + turn] {
+            for sigma in [sigma, sigma - turn, sigma + turn, 0.0, piece.length_m] {
                 if !(0.0..=piece.length_m).contains(&sigma) {
                     continue;
                 }

@@ -113,7 +113,9 @@ pub enum StepOutcome {
 ///
 /// Each step: read the [`StepContext`] at `q_t` ([`Episode::context`], computed once when the
 /// step was accepted), choose an action, and [`Episode::apply`] it: clip to `[−1, 1]⁴`,
-/// integrate `q̇ = J⁺ẋ + a_max B a` for `Δt`, and accept `q_{t+1}` only if it holds every
+/// integrate `q̇ = J⁺ẋ + a_max B a` for `Δt` (on a path, for the share of it that lands on the
+/// next corner or the end when a full step would pass it, [`StepContext::step_fraction`]), and
+/// accept `q_{t+1}` only if it holds every
 /// constraint.
 ///
 /// Joint-velocity limits are honoured by time scaling: a step whose `q̇` would exceed
@@ -188,7 +190,8 @@ impl<'a> Episode<'a> {
         } = self.current;
         let action = action.map(|a| a.clamp(-1.0, 1.0));
         let velocity = self.current.joint_velocity(&action);
-        let next = self.current.q + velocity * config.dt_s;
+        let fraction = self.current.step_fraction();
+        let next = self.current.q + velocity * (config.dt_s * fraction);
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
         // The next configuration's kinematics are written in place; the rest of the context is
@@ -214,7 +217,7 @@ impl<'a> Episode<'a> {
             None => (self.current.kinematics.tcp() - previous_tcp).dot(&task.d),
             Some(_) => derived.along.s_m - self.current.along.s_m,
         };
-        self.time_s += self.step_duration(&velocity);
+        self.time_s += self.step_duration(&velocity) * fraction;
         self.current
             .advance(self.steps.len(), tool_angle_deg, action, derived);
         if task.completed(self.current.along.s_m) {

@@ -143,16 +143,23 @@ impl<'a> StepContext<'a> {
     }
 
     /// The task-space command `ẋ = v d + k_lat e_lat` (SPEC §3); on a path, `d` is the heading
-    /// there and the speed is lowered where a full step would pass the next corner or the end.
+    /// there.
     pub fn task_velocity(&self) -> Vec3 {
-        let speed = match self.task.path {
-            None => self.config.speed_m_per_s,
-            Some(_) => self
-                .config
-                .speed_m_per_s
-                .min(self.task.stop_ahead_m(self.along.s_m) / self.config.dt_s),
-        };
-        self.along.heading * speed + self.along.lateral * self.config.lateral_gain_per_s
+        self.along.heading * self.config.speed_m_per_s
+            + self.along.lateral * self.config.lateral_gain_per_s
+    }
+
+    /// The share of the control period `Δt` this step lasts: 1, except on a path where a full
+    /// step would pass the next corner or the end, which the shortened step lands on (the
+    /// joints move that share of a full step, so the arm's self-motion slows with the tool).
+    pub fn step_fraction(&self) -> f64 {
+        match self.task.path {
+            None => 1.0,
+            Some(_) => {
+                let full_m = self.config.speed_m_per_s * self.config.dt_s;
+                (self.task.stop_ahead_m(self.along.s_m) / full_m).min(1.0)
+            }
+        }
     }
 
     /// Joint velocity `q̇ = J⁺ẋ + a_max B a` for a (clipped) action `a` (Eq. 2).

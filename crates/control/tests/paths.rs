@@ -558,3 +558,38 @@ fn the_path_population_takes_each_shape_in_turn_from_its_anchors_start_along_d()
         }
     }
 }
+
+#[test]
+fn a_point_just_before_a_full_circles_start_is_located_at_its_start_and_checked_so() {
+    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::z());
+    let circle = Path::new(spec(
+        p,
+        n,
+        0.0,
+        vec![arc(
+            Some(p + Vec3::new(0.0, 0.05, 0.0)),
+            None,
+            None,
+            Some(360.0),
+        )],
+    ))
+    .unwrap();
+    // Counter-clockwise about +z from -y of the centre the circle leaves along +x: a point a
+    // hair towards -x lies at an angle just below zero.
+    let before = p - Vec3::x() * 1e-9;
+    let located = circle.locate(&before, 0.0, 0.05);
+    assert!(located.s < 1e-6, "{}", located.s);
+    let line = emg_verify::Line {
+        p0: p,
+        d: circle.tangent_at(0.0),
+        n,
+        path: vec![emg_verify::PathPiece::Arc {
+            centre: p + Vec3::new(0.0, 0.05, 0.0),
+            start: p,
+            axis: n,
+            sweep_rad: 2.0 * std::f64::consts::PI,
+        }],
+    };
+    assert!(line.reached([before]) < 1e-6);
+    assert!(line.distance(&before) < 1e-8);
+}

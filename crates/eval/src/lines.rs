@@ -62,7 +62,12 @@ fn plan_lines(
         let Ok(line) = Task::new(planner.robot(), start, direction, task.n, None) else {
             break;
         };
-        let plan = planner.plan(&line, request)?;
+        // Nor one whose start no seed can be prepared at.
+        let plan = match planner.plan(&line, request) {
+            Ok(plan) => plan,
+            Err(PlanError::Seed(_)) => break,
+            Err(error) => return Err(error),
+        };
         if let Some(previous) = corner_q {
             let jump = (plan.seed.q - previous).amax();
             if jump > SAME_CONFIGURATION_RAD {

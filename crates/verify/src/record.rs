@@ -116,11 +116,13 @@ impl PathPiece {
                 } else {
                     0.0
                 };
-                let mut lengths = vec![(angle * radius).clamp(low, high)];
+                // One turn on lies on a closed circle too, and a point just before the start
+                // is just before the end: the ends are candidates as well.
+                let mut lengths = vec![angle * radius, 0.0, sweep * radius];
                 if angle + full <= sweep {
-                    lengths.push(((angle + full) * radius).clamp(low, high));
+                    lengths.push((angle + full) * radius);
                 }
-                lengths
+                lengths.iter().map(|l| l.clamp(low, high)).collect()
             }
         }
     }
