@@ -1,0 +1,121 @@
+//! Path tasks on both shipped arms: a rectangle, a full circle and an S-curve of the path
+//! population planned by the search (a small budget, so that the test stays short), timed rest
+//! to rest within each arm's joint limits (at rest at the rectangle's corners) and their files
+//! verified as `emg check` verifies them; the search never returns less than the pipeline's plan
+//! and a plan that reaches the end says so.
+
+use emg_control::{PathShape, Task, Termination, path_tasks};
+use emg_io::{TrajectoryContents, read_tasks};
+use emg_kinematics::Robot;
+use emg_planner::{
+    DataDir, Models, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig,
+    SearchConfig, ShippedRobot, limits_file_beside,
+};
+use emg_timing::Scaling;
+use emg_verify::ReferenceModel;
+
+fn data() -> DataDir {
+    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+}
+
+/// The first eight paths of the population from `arm`'s evaluation tasks (two of each shape).
+fn population(arm: ShippedRobot, planner: &Planner) -> Vec<(PathShape, Task)> {
+    let mut anchors = read_tasks(
+        &arm.data_dir(&data()).join("tasks/eval-v1.tasks"),
+        planner.robot(),
+    )
+    .expect("shipped tasks");
+    anchors.truncate(8);
+    path_tasks(planner.robot(), &anchors, 20_261_126).expect("valid path tasks")
+}
+
+#[test]
+fn rectangles_circles_and_s_curves_plan_time_and_check_on_both_arms() {
+    for name in ["fr3", "iiwa14"] {
+        let arm = ShippedRobot::by_name(name).expect("a shipped arm");
+        let file = arm.path(&data());
+        let robot = Robot::from_chain_file(&file).expect("robot loads");
+        let models = Models::shipped(&robot, &arm.data_dir(&data())).expect("shipped models");
+        let config = PlannerConfig {
+            search: SearchConfig {
+                budget_steps: 2_000,
+                dp_samples: 8,
+                ik_restarts: 16,
+                ..SearchConfig::default()
+            },
+            ..PlannerConfig::default()
+        };
+        let planner = Planner::new(robot, models, config).expect("valid config");
+        let checker = ReferenceModel::from_urdf_file(
+            &file,
+            planner.robot().base_link(),
+            planner.robot().tip_link(),
+        )
+        .expect("checker");
+        let constraints = &planner.config().rollout.constraints;
+        let timing = MotionTiming::new(
+            planner.robot(),
+            &limits_file_beside(&file),
+            Scaling::default(),
+            planner.config().rollout.speed_m_per_s,
+            1000.0,
+            constraints,
+        )
+        .expect("shipped joint limits");
+        let mut completed = Vec::new();
+        for (shape, task) in population(arm, &planner) {
+            if shape == PathShape::Arc {
+                continue;
+            }
+            let pipeline = planner
+                .plan(&task, &PlanRequest::pipeline())
+                .expect("a plan");
+            let request = PlanRequest::default();
+            let plan = planner.plan(&task, &request).expect("a plan");
+            assert!(plan.trajectory.path_length_m >= pipeline.trajectory.path_length_m);
+            let length = task.length_m().expect("a path task");
+            let done = plan.trajectory.termination == Termination::Completed;
+            assert_eq!(
+                done,
+                plan.trajectory.path_length_m >= length - 2e-4,
+                "{name} {shape:?}"
+            );
+            if done {
+                completed.push(shape);
+            }
+            let record = PlanRecord {
+                robot: name,
+                request: &request,
+                reachable_m: None,
+                timing: &timing,
+            };
+            let files = PlanFiles::new(&planner, &task, &plan, &record).expect("timed");
+            if shape == PathShape::Rectangle && done {
+                assert_eq!(
+                    files.timing.rests_s.len(),
+                    3,
+                    "{name}: at rest at each corner"
+                );
+            }
+            for text in [&files.json, &files.joint_trajectory] {
+                TrajectoryContents::parse(text)
+                    .expect("a trajectory file")
+                    .verify(
+                        &checker,
+                        planner.robot().joint_names(),
+                        &task,
+                        constraints,
+                        true,
+                        None,
+                    )
+                    .unwrap_or_else(|e| panic!("{name} {shape:?}: {e}"));
+            }
+        }
+        for shape in [PathShape::Rectangle, PathShape::Circle, PathShape::SCurve] {
+            assert!(
+                completed.contains(&shape),
+                "{name}: no {shape:?} planned to its end"
+            );
+        }
+    }
+}
