@@ -155,7 +155,7 @@ impl Piece {
         let (mut low, mut high) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
         if let Shape::Circular(arc) = self.shape {
             // `x·v = c·v + r (u·v cos φ + w·v sin φ)` is extreme at `φ*` and `φ* + π`.
-            let extreme = direction.dot(&arc.w).atan2(direction.dot(&arc.u));
+            let extreme = libm::atan2(direction.dot(&arc.w), direction.dot(&arc.u));
             let sweep = self.length_m / arc.radius_m;
             for angle in [extreme, extreme + PI] {
                 let angle = angle.rem_euclid(2.0 * PI);
@@ -175,7 +175,8 @@ impl Piece {
             Shape::Straight(line) => line.start + line.direction * sigma,
             Shape::Circular(arc) => {
                 let angle = sigma / arc.radius_m;
-                arc.centre + (arc.u * angle.cos() + arc.w * angle.sin()) * arc.radius_m
+                let (sin, cos) = libm::sincos(angle);
+                arc.centre + (arc.u * cos + arc.w * sin) * arc.radius_m
             }
         }
     }
@@ -186,7 +187,8 @@ impl Piece {
             Shape::Straight(line) => line.direction,
             Shape::Circular(arc) => {
                 let angle = sigma / arc.radius_m;
-                arc.w * angle.cos() - arc.u * angle.sin()
+                let (sin, cos) = libm::sincos(angle);
+                arc.w * cos - arc.u * sin
             }
         }
     }
@@ -197,7 +199,7 @@ impl Piece {
             Shape::Straight(line) => (p - line.start).dot(&line.direction),
             Shape::Circular(arc) => {
                 let offset = p - arc.centre;
-                let angle = offset.dot(&arc.w).atan2(offset.dot(&arc.u));
+                let angle = libm::atan2(offset.dot(&arc.w), offset.dot(&arc.u));
                 let sweep = self.length_m / arc.radius_m;
                 // Angles past the sweep are nearer one end or the other.
                 let angle = if angle < 0.0 && angle + 2.0 * PI <= sweep {
@@ -576,7 +578,7 @@ fn arc(
                     ),
                 ));
             }
-            let sweep = normal.dot(&u.cross(&v)).atan2(u.dot(&v));
+            let sweep = libm::atan2(normal.dot(&u.cross(&v)), u.dot(&v));
             if sweep.abs() > PI - 1e-9 {
                 return Err(PathError::field(
                     name("arc.to"),
@@ -610,10 +612,7 @@ fn arc(
             })?;
             let angle = |p: Vec3| {
                 let (u, v) = (at - centre, p - centre);
-                normal
-                    .dot(&u.cross(&v))
-                    .atan2(u.dot(&v))
-                    .rem_euclid(2.0 * PI)
+                libm::atan2(normal.dot(&u.cross(&v)), u.dot(&v)).rem_euclid(2.0 * PI)
             };
             // Counter-clockwise about `n` reaches `to` after `through`, or the arc runs the
             // other way.
@@ -686,7 +685,7 @@ fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathErr
     for index in 1..count {
         let (before, after) = (&shapes[index - 1], &shapes[index]);
         let (a, b) = (tangent_at(before, true), tangent_at(after, false));
-        let turn = a.dot(&b).clamp(-1.0, 1.0).acos();
+        let turn = libm::acos(a.dot(&b).clamp(-1.0, 1.0));
         if radius == 0.0 || turn <= CORNER_RAD {
             continue;
         }
@@ -712,7 +711,7 @@ fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathErr
                 ),
             ));
         }
-        let reach = radius * (turn / 2.0).tan();
+        let reach = radius * libm::tan(turn / 2.0);
         trimmed[index - 1].1 = reach;
         trimmed[index].0 = reach;
         let corner = line.start;
@@ -765,7 +764,7 @@ fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathErr
             let before = pieces.last().expect("a piece before the corner");
             let a = before.tangent(before.length_m);
             let b = tangent_at(&(shape, length), false);
-            corner_before = a.dot(&b).clamp(-1.0, 1.0).acos() > CORNER_RAD;
+            corner_before = libm::acos(a.dot(&b).clamp(-1.0, 1.0)) > CORNER_RAD;
         }
         let remaining = length - head - tail;
         if remaining > 0.0 {

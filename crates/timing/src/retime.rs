@@ -237,7 +237,7 @@ impl TimedMotion {
                 let index = offset_samples + k as u64 + 1;
                 TimedSample {
                     time_ns: (index as f64 * 1e9 / rate_hz).round() as u64,
-                    ..sample.clone()
+                    ..*sample
                 }
             }));
         let offset_s = self.grid_s.last().copied().unwrap_or(0.0);

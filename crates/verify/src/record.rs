@@ -75,10 +75,8 @@ impl PathPiece {
                 let angle = sweep_rad.signum() * length / radius;
                 let r = start - centre;
                 // Rodrigues' rotation of `r` about `axis` by `angle`.
-                centre
-                    + r * angle.cos()
-                    + axis.cross(&r) * angle.sin()
-                    + axis * axis.dot(&r) * (1.0 - angle.cos())
+                let (sin, cos) = libm::sincos(angle);
+                centre + r * cos + axis.cross(&r) * sin + axis * axis.dot(&r) * (1.0 - cos)
             }
         }
     }
@@ -104,7 +102,7 @@ impl PathPiece {
                 let radius = r.norm();
                 let offset = point - centre;
                 let turned = axis.cross(&r) * sweep_rad.signum();
-                let angle = offset.dot(&turned).atan2(offset.dot(&r));
+                let angle = libm::atan2(offset.dot(&turned), offset.dot(&r));
                 let full = std::f64::consts::TAU;
                 let angle = if angle < 0.0 { angle + full } else { angle };
                 let sweep = sweep_rad.abs();
