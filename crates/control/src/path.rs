@@ -3,9 +3,9 @@
 //!
 //! A path is given as a [`PathSpec`] (the JSON path format, docs/paths.md) and validated into a
 //! [`Path`]: every segment starts where the one before it ends, lies in the plane through the
-//! start normal to `n`, and is longer than [`MIN_SEGMENT_M`]; a corner between two straight
-//! segments may be rounded by a blend arc of the radius the spec gives. A straight line is the
-//! one-segment path.
+//! start normal to `n`, and is longer than [`MIN_SEGMENT_M`]; a corner between two segments,
+//! straight or circular, may be rounded by a blend arc of the radius the spec gives, tangent to
+//! both. A straight line is the one-segment path.
 
 use std::f64::consts::PI;
 
@@ -36,8 +36,8 @@ pub struct PathSpec {
     pub start: [f64; 3],
     /// Normal `n` of the work surface; the tool axis stays within the cone around it.
     pub normal: [f64; 3],
-    /// Radius (m) of the arcs that round the corners between straight segments; 0 passes every
-    /// corner at rest.
+    /// Radius (m) of the arcs that round the corners between segments (tangent to both); 0
+    /// passes every corner at rest.
     #[serde(default)]
     pub blend_radius_m: f64,
     /// The segments, each starting where the one before it ends.
@@ -167,6 +167,21 @@ impl Piece {
             }
         }
         (low, high)
+    }
+
+    /// The shape of the piece's part from `σ` (m) on.
+    fn from(&self, sigma: f64) -> Shape {
+        match self.shape {
+            Shape::Straight(line) => Shape::Straight(Straight {
+                start: line.start + line.direction * sigma,
+                direction: line.direction,
+            }),
+            Shape::Circular(arc) => Shape::Circular(Circular {
+                u: (self.point(sigma) - arc.centre) / arc.radius_m,
+                w: self.tangent(sigma),
+                ..arc
+            }),
+        }
     }
 
     /// The point at `σ` (m) along the piece.
@@ -346,7 +361,7 @@ impl Path {
             at = end_of(&shape, length);
             shapes.push((shape, length));
         }
-        let pieces = blended(shapes, blend)?;
+        let pieces = blended(shapes, normal, blend)?;
         let length_m = pieces.last().map_or(0.0, |p| p.start_s + p.length_m);
         let mut path = Self {
             spec,
@@ -666,73 +681,53 @@ fn circumcentre(a: Vec3, b: Vec3, c: Vec3, normal: Vec3) -> Option<Vec3> {
     Some(a + offset)
 }
 
-/// The pieces of the segments in order, with each corner between two straight segments
-/// rounded by a blend arc of `radius` (when positive) and the remaining corners marked.
-fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathError> {
-    let count = shapes.len();
+/// The pieces of the segments in order, with each corner rounded by a blend arc of `radius`
+/// tangent to both its segments (when positive; [`fillet`]) and the remaining corners marked.
+fn blended(shapes: Vec<(Shape, f64)>, normal: Vec3, radius: f64) -> Result<Vec<Piece>, PathError> {
+    let segments: Vec<Piece> = shapes
+        .into_iter()
+        .map(|(shape, length_m)| Piece {
+            shape,
+            start_s: 0.0,
+            length_m,
+            corner_before: false,
+        })
+        .collect();
+    let count = segments.len();
     // How much of each segment's start and end the blends take (m).
     let mut trimmed = vec![(0.0, 0.0); count];
-    let mut blends: Vec<Option<(Shape, f64)>> = vec![None; count];
-    let tangent_at = |(shape, length): &(Shape, f64), end: bool| {
-        let piece = Piece {
-            shape: *shape,
-            start_s: 0.0,
-            length_m: *length,
-            corner_before: false,
-        };
-        piece.tangent(if end { *length } else { 0.0 })
-    };
+    let mut blends: Vec<Option<Piece>> = vec![None; count];
     for index in 1..count {
-        let (before, after) = (&shapes[index - 1], &shapes[index]);
-        let (a, b) = (tangent_at(before, true), tangent_at(after, false));
+        let (before, after) = (&segments[index - 1], &segments[index]);
+        let (a, b) = (before.tangent(before.length_m), after.tangent(0.0));
         let turn = libm::acos(a.dot(&b).clamp(-1.0, 1.0));
         if radius == 0.0 || turn <= CORNER_RAD {
             continue;
         }
-        let (Shape::Straight(_), Shape::Straight(line)) = (before.0, after.0) else {
-            return Err(PathError::field(
+        let corner = |problem: &str| {
+            PathError::field(
                 "blend_radius_m",
                 format!(
-                    "cannot round the corner between segments {} and {}: blends join two \
-                     straight segments, and one of these is an arc",
+                    "cannot round the corner between segments {} and {}: {problem}",
                     index - 1,
                     index
                 ),
-            ));
+            )
         };
         if turn > PI - 1e-6 {
-            return Err(PathError::field(
-                "blend_radius_m",
-                format!(
-                    "cannot round the corner between segments {} and {}: the path turns back on \
-                     itself there",
-                    index - 1,
-                    index
-                ),
-            ));
+            return Err(corner("the path turns back on itself there"));
         }
-        let reach = radius * libm::tan(turn / 2.0);
-        trimmed[index - 1].1 = reach;
-        trimmed[index].0 = reach;
-        let corner = line.start;
-        let start = corner - a * reach;
-        let inward = (b - a).normalize();
-        let centre = start + (inward - a * inward.dot(&a)).normalize() * radius;
-        let u = (start - centre) / radius;
-        blends[index] = Some((
-            Shape::Circular(Circular {
-                centre,
-                radius_m: radius,
-                u,
-                w: a,
-            }),
-            radius * turn,
-        ));
+        let (before_m, after_m, blend) = fillet(before, after, normal, radius)
+            .ok_or_else(|| corner("the radius is too large for the segments that meet there"))?;
+        trimmed[index - 1].1 = before_m;
+        trimmed[index].0 = after_m;
+        blends[index] = Some(blend);
     }
-    let mut pieces = Vec::new();
+    let mut pieces: Vec<Piece> = Vec::new();
     let mut s = 0.0;
-    for (index, (shape, length)) in shapes.into_iter().enumerate() {
+    for (index, segment) in segments.into_iter().enumerate() {
         let (head, tail) = trimmed[index];
+        let length = segment.length_m;
         if head + tail > length + 1e-12 {
             return Err(PathError::field(
                 "blend_radius_m",
@@ -743,27 +738,20 @@ fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathErr
                 ),
             ));
         }
-        let mut corner_before = index > 0 && blends[index].is_none();
-        if let Some((blend, blend_length)) = blends[index] {
+        if let Some(blend) = blends[index] {
             pieces.push(Piece {
-                shape: blend,
                 start_s: s,
-                length_m: blend_length,
-                corner_before: false,
+                ..blend
             });
-            s += blend_length;
+            s += blend.length_m;
         }
-        let shape = match shape {
-            Shape::Straight(line) => Shape::Straight(Straight {
-                start: line.start + line.direction * head,
-                direction: line.direction,
-            }),
-            circular => circular,
-        };
-        if index > 0 && corner_before {
-            let before = pieces.last().expect("a piece before the corner");
+        let shape = segment.from(head);
+        let mut corner_before = false;
+        if let Some(before) = pieces.last()
+            && blends[index].is_none()
+        {
             let a = before.tangent(before.length_m);
-            let b = tangent_at(&(shape, length), false);
+            let b = segment.tangent(head);
             corner_before = libm::acos(a.dot(&b).clamp(-1.0, 1.0)) > CORNER_RAD;
         }
         let remaining = length - head - tail;
@@ -778,4 +766,87 @@ fn blended(shapes: Vec<(Shape, f64)>, radius: f64) -> Result<Vec<Piece>, PathErr
         }
     }
     Ok(pieces)
+}
+
+/// Steps in which [`fillet`] scans a segment for where its blend starts.
+const FILLET_SCAN_STEPS: usize = 1000;
+
+/// The arc of `radius` tangent to `before` near its end and to `after` near its start, on the
+/// side the path turns to at their corner (lines and arcs alike): how much of `before`'s end and
+/// of `after`'s start it replaces, and the arc; `None` when no such arc fits on the two
+/// segments.
+///
+/// The blend's start lies `t` before `before`'s end, its centre `radius` from there on the
+/// turning side; `t` is found where that centre lies `radius` from `after`'s line or circle on
+/// the same side (bisection: the distance grows with `t`, from `radius · cos(turn)` at the
+/// corner; for two lines `t = radius · tan(turn / 2)`).
+fn fillet(before: &Piece, after: &Piece, normal: Vec3, radius: f64) -> Option<(f64, f64, Piece)> {
+    let turning = normal
+        .dot(&before.tangent(before.length_m).cross(&after.tangent(0.0)))
+        .signum();
+    let centre_at = |t: f64| {
+        let sigma = before.length_m - t;
+        before.point(sigma) + normal.cross(&before.tangent(sigma)) * (turning * radius)
+    };
+    // How far `centre` lies from `after`'s line or circle, on the turning side.
+    let beside_after = |centre: Vec3| match after.shape {
+        Shape::Straight(line) => {
+            (centre - line.start).dot(&(normal.cross(&line.direction) * turning))
+        }
+        Shape::Circular(arc) => {
+            let inward = normal.cross(&arc.w).dot(&arc.u) < 0.0;
+            let from_centre = (centre - arc.centre).norm();
+            // The turning side of a circle is its inside when it turns the way the path does.
+            let arc_turning = if inward { 1.0 } else { -1.0 };
+            if arc_turning == turning {
+                arc.radius_m - from_centre
+            } else {
+                from_centre - arc.radius_m
+            }
+        }
+    };
+    let gap = |t: f64| beside_after(centre_at(t)) - radius;
+    // The first `t` where the gap closes: scanned in steps, then bisected (inside a circle the
+    // gap opens again further back, so only the first crossing is the blend).
+    let step = before.length_m / FILLET_SCAN_STEPS as f64;
+    let crossing = (1..=FILLET_SCAN_STEPS).find(|&k| gap(k as f64 * step) >= 0.0)?;
+    let (mut low, mut high) = ((crossing - 1) as f64 * step, crossing as f64 * step);
+    for _ in 0..200 {
+        let middle = 0.5 * (low + high);
+        if middle <= low || middle >= high {
+            break;
+        }
+        if gap(middle) < 0.0 {
+            low = middle;
+        } else {
+            high = middle;
+        }
+    }
+    let before_m = high;
+    let centre = centre_at(before_m);
+    let after_m = after.nearest(&centre);
+    let start = before.point(before.length_m - before_m);
+    let end = after.point(after_m);
+    if after_m >= after.length_m || ((end - centre).norm() - radius).abs() > 1e-9 * radius.max(1.0)
+    {
+        return None;
+    }
+    let u = (start - centre) / radius;
+    let v = (end - centre) / radius;
+    let sweep = libm::atan2(turning * normal.dot(&u.cross(&v)), u.dot(&v)).rem_euclid(2.0 * PI);
+    Some((
+        before_m,
+        after_m,
+        Piece {
+            shape: Shape::Circular(Circular {
+                centre,
+                radius_m: radius,
+                u,
+                w: before.tangent(before.length_m - before_m),
+            }),
+            start_s: 0.0,
+            length_m: radius * sweep,
+            corner_before: false,
+        },
+    ))
 }

@@ -140,6 +140,81 @@ fn blends_round_the_corners_tangentially_and_shorten_the_path() {
 }
 
 #[test]
+fn corners_with_arcs_blend_tangentially_on_either_side() {
+    let (p, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::z());
+    let corner = p + Vec3::x() * 0.1;
+    let shapes = [
+        // A line into an arc turning away from the corner's turn (the blend outside the circle).
+        vec![
+            line(corner),
+            arc(Some(corner + Vec3::x() * 0.05), None, None, Some(90.0)),
+        ],
+        // A line into an arc leaving 45° to the right and turning right on (the blend inside
+        // the circle).
+        vec![
+            line(corner),
+            arc(
+                Some(corner - Vec3::new(1.0, 1.0, 0.0).normalize() * 0.05),
+                None,
+                None,
+                Some(-120.0),
+            ),
+        ],
+        // An arc into a line, and two arcs meeting at an angle.
+        vec![
+            arc(Some(p + Vec3::y() * 0.05), None, None, Some(90.0)),
+            line(p + Vec3::new(0.05, 0.05, 0.0) + Vec3::new(-0.1, 0.0, 0.0)),
+        ],
+        vec![
+            arc(Some(p + Vec3::y() * 0.05), None, None, Some(90.0)),
+            arc(
+                Some(p + Vec3::new(0.05, 0.05, 0.0) + Vec3::new(0.0, -0.06, 0.0)),
+                None,
+                None,
+                Some(-150.0),
+            ),
+        ],
+    ];
+    for (index, segments) in shapes.into_iter().enumerate() {
+        let plain = Path::new(spec(p, n, 0.0, segments.clone())).unwrap();
+        let path = Path::new(spec(p, n, 0.01, segments)).unwrap();
+        assert_eq!(plain.corners_m().count(), 1, "case {index} has a corner");
+        assert_eq!(
+            path.corners_m().count(),
+            0,
+            "case {index}: the blend leaves no corner"
+        );
+        assert_eq!(path.pieces().len(), 3, "case {index}");
+        assert!(
+            path.length_m() < plain.length_m(),
+            "case {index}: a blend cuts the corner"
+        );
+        for pair in path.pieces().windows(2) {
+            let s = pair[1].start_s;
+            assert_close(
+                path.tangent_at(s - 1e-9),
+                path.tangent_at(s),
+                1e-6,
+                &format!("case {index}: tangent continuity"),
+            );
+        }
+        assert_parameterised(&path);
+        // The blend stays within its radius's reach of the corner it rounds.
+        let blend = &path.pieces()[1];
+        let (start, end, Some(_)) = blend.outline() else {
+            panic!("case {index}: the blend is an arc");
+        };
+        let join = plain.point_at(plain.corners_m().next().unwrap());
+        for point in [start, end] {
+            assert!(
+                (point - join).norm() < 0.1,
+                "case {index}: {point:?} far from {join:?}"
+            );
+        }
+    }
+}
+
+#[test]
 fn every_arc_form_lands_where_its_spec_says() {
     let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::new(0.0, 0.0, 1.0));
     let centre = p + Vec3::new(0.0, 0.05, 0.0);
@@ -302,13 +377,18 @@ fn a_malformed_path_is_refused_naming_its_field() {
     let message = refused(spec(
         p,
         n,
-        0.01,
+        0.2,
         vec![
             line(p + Vec3::x() * 0.1),
             arc(Some(p + Vec3::new(0.15, 0.0, 0.0)), None, None, Some(90.0)),
         ],
     ));
-    assert!(message.contains("one of these is an arc"), "{message}");
+    assert!(
+        message.starts_with(
+            "blend_radius_m: cannot round the corner between segments 0 and 1: the radius is too large"
+        ),
+        "{message}"
+    );
     let mut wrong_version = spec(p, n, 0.0, vec![line(p + Vec3::x() * 0.1)]);
     wrong_version.version = 2;
     assert_eq!(
