@@ -74,7 +74,7 @@ fn a_malformed_path_file_is_refused_naming_the_field() {
         ),
         (
             r#"{"version": 1, "start": [0.5, 0, 0.2], "normal": [0, 0, -1], "blend_radius_m": 0.2, "segments": [{"line": {"to": [0.5, 0.1, 0.2]}}, {"line": {"to": [0.6, 0.1, 0.2]}}]}"#,
-            "path field 'blend_radius_m' is too large for segment 0",
+            "path field 'blend_radius_m' cannot round the corner between segments 0 and 1",
         ),
         (
             r#"{"version": 3, "start": [0.5, 0, 0.2], "normal": [0, 0, -1], "segments": []}"#,
