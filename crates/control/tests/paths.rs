@@ -278,21 +278,17 @@ fn every_arc_form_lands_where_its_spec_says() {
     }
 }
 
+/// A full circle of radius 5 cm counter-clockwise about +z from `p`, its centre 5 cm along +y.
+fn unit_circle() -> (Vec3, Vec3, Path) {
+    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::z());
+    let centre = p + Vec3::new(0.0, 0.05, 0.0);
+    let circle = spec(p, n, 0.0, vec![arc(Some(centre), None, None, Some(360.0))]);
+    (p, n, Path::new(circle).unwrap())
+}
+
 #[test]
 fn a_tcp_is_located_near_where_it_was_last() {
-    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::z());
-    let circle = Path::new(spec(
-        p,
-        n,
-        0.0,
-        vec![arc(
-            Some(p + Vec3::new(0.0, 0.05, 0.0)),
-            None,
-            None,
-            Some(360.0),
-        )],
-    ))
-    .unwrap();
+    let (p, _, circle) = unit_circle();
     let length = circle.length_m();
     let near_start = p + Vec3::new(0.0, 0.001, 0.0);
     assert!(circle.locate(&near_start, 0.0, 0.05).s < 1e-12);
@@ -641,19 +637,7 @@ fn the_path_population_takes_each_shape_in_turn_from_its_anchors_start_along_d()
 
 #[test]
 fn a_point_just_before_a_full_circles_start_is_located_at_its_start_and_checked_so() {
-    let (p, n) = (Vec3::new(0.5, 0.1, 0.2), Vec3::z());
-    let circle = Path::new(spec(
-        p,
-        n,
-        0.0,
-        vec![arc(
-            Some(p + Vec3::new(0.0, 0.05, 0.0)),
-            None,
-            None,
-            Some(360.0),
-        )],
-    ))
-    .unwrap();
+    let (p, n, circle) = unit_circle();
     // Counter-clockwise about +z from -y of the centre the circle leaves along +x: a point a
     // hair towards -x lies at an angle just below zero.
     let before = p - Vec3::x() * 1e-9;

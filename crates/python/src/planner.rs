@@ -136,6 +136,19 @@ impl Planner {
         Ok((plan, reachable_m))
     }
 
+    /// The plan of one validated `task`, made without the GIL, as its Python object.
+    fn plan_task(
+        &self,
+        py: Python<'_>,
+        task: emg_control::Task,
+        request: &Request,
+    ) -> PyResult<Plan> {
+        let planned = py
+            .detach(|| self.plan_one(&task, request))
+            .map_err(|e| plan_error(e, &request.request, None))?;
+        Ok(self.wrap(task, request, planned))
+    }
+
     /// The Python object of a plan of `task`.
     fn wrap(&self, task: emg_control::Task, request: &Request, planned: Planned) -> Plan {
         let (plan, reachable_m) = planned;
@@ -297,10 +310,7 @@ impl Planner {
     ) -> PyResult<Plan> {
         let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
         let task = self.task(p0, d, n, None)?;
-        let planned = py
-            .detach(|| self.plan_one(&task, &request))
-            .map_err(|e| plan_error(e, &request.request, None))?;
-        Ok(self.wrap(task, &request, planned))
+        self.plan_task(py, task, &request)
     }
 
     /// Plans a path task: the tool follows `path` — a path file (`str` or `os.PathLike`) or a
@@ -332,10 +342,7 @@ impl Planner {
         };
         let task = emg_control::Task::on_path(self.inner.robot(), path, None)
             .map_err(|e| input_error("path", &e))?;
-        let planned = py
-            .detach(|| self.plan_one(&task, &request))
-            .map_err(|e| plan_error(e, &request.request, None))?;
-        Ok(self.wrap(task, &request, planned))
+        self.plan_task(py, task, &request)
     }
 
     /// Plans every task of `tasks` (`Task` objects, e.g. from `load_tasks`, or `(p0, d, n)`
