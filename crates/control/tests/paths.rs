@@ -13,12 +13,11 @@
 mod common;
 
 use emg_control::{
-    CheckRollout, ClassicalController, Path, PathError, PathSpec, RolloutConfig, SegmentSpec, Task,
-    Termination, rollout,
+    CheckRollout, Path, PathError, PathSpec, RolloutConfig, SegmentSpec, Task, Termination,
 };
 use emg_kinematics::Vec3;
 
-use common::{checker, robot, tasks};
+use common::{checker, classical, robot, tasks};
 
 fn spec(start: Vec3, normal: Vec3, blend: f64, segments: Vec<SegmentSpec>) -> PathSpec {
     PathSpec {
@@ -421,23 +420,11 @@ fn start() -> (emg_kinematics::Robot, Task) {
 fn a_one_segment_path_is_followed_as_its_line() {
     let (robot, task) = start();
     let config = RolloutConfig::default();
-    let line_rollout = rollout(
-        &robot,
-        &task,
-        &task.q0_seed.unwrap(),
-        &mut ClassicalController::default(),
-        &config,
-    );
+    let line_rollout = classical(&robot, &task, &config);
     let length = line_rollout.path_length_m.max(0.05) + 0.2;
     let path = Path::straight(task.p0, task.d, task.n, length).unwrap();
     let on_path = Task::on_path(&robot, path, task.q0_seed).unwrap();
-    let path_rollout = rollout(
-        &robot,
-        &on_path,
-        &task.q0_seed.unwrap(),
-        &mut ClassicalController::default(),
-        &config,
-    );
+    let path_rollout = classical(&robot, &on_path, &config);
     assert_eq!(path_rollout.steps.len(), line_rollout.steps.len());
     for (a, b) in path_rollout.steps.iter().zip(&line_rollout.steps) {
         assert!((a.q - b.q).amax() < 1e-9, "{:?} vs {:?}", a.q, b.q);
@@ -469,13 +456,7 @@ fn the_classical_controller_follows_a_rectangle_and_a_circle_checked_independent
         let corners: Vec<f64> = path.corners_m().collect();
         let length = path.length_m();
         let path_task = Task::on_path(&robot, path, task.q0_seed).unwrap();
-        let trajectory = rollout(
-            &robot,
-            &path_task,
-            &task.q0_seed.unwrap(),
-            &mut ClassicalController::default(),
-            &config,
-        );
+        let trajectory = classical(&robot, &path_task, &config);
         checker()
             .check(&path_task, &trajectory, &config.constraints)
             .unwrap();
@@ -512,13 +493,7 @@ fn the_checker_refuses_a_path_rollout_checked_against_another_path_or_a_false_en
         task.q0_seed,
     )
     .unwrap();
-    let trajectory = rollout(
-        &robot,
-        &path_task,
-        &task.q0_seed.unwrap(),
-        &mut ClassicalController::default(),
-        &config,
-    );
+    let trajectory = classical(&robot, &path_task, &config);
     checker()
         .check(&path_task, &trajectory, &config.constraints)
         .unwrap();
