@@ -253,14 +253,9 @@ impl<'a> Episode<'a> {
                 Termination::StepCap
             }
         };
-        let last = self
-            .steps
-            .last()
-            .expect("a trajectory holds at least its seed");
-        let path_length_m = match self.current.task.path {
-            None => self.current.task.progress(&last.tcp),
-            Some(_) => self.current.along.s_m,
-        };
+        // The last record is the current configuration, whose progress (on a line
+        // `(p − p0)·d`, on a path the arc length) the context holds.
+        let path_length_m = self.current.along.s_m;
         Trajectory {
             steps: self.steps,
             termination,

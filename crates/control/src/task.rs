@@ -3,7 +3,7 @@
 use emg_kinematics::{JointVector, Plate, Robot, Vec3, WorkSurface};
 use serde::{Deserialize, Serialize};
 
-use crate::path::{Path, PathError};
+use crate::path::Path;
 
 /// Largest `|d·n|` accepted as perpendicular; smaller deviations are removed exactly.
 pub const PERPENDICULAR_TOLERANCE: f64 = 1e-6;
@@ -92,21 +92,12 @@ pub enum TaskError {
         /// The arm's reach (m).
         reach_m: f64,
     },
-    /// The task's path is malformed.
-    #[error(transparent)]
-    Path(PathError),
     /// `q0_seed` is not a valid generating configuration of this task.
     #[error("task field 'q0_seed' {problem}")]
     BadSeed {
         /// What is wrong with it.
         problem: String,
     },
-}
-
-impl From<PathError> for TaskError {
-    fn from(error: PathError) -> Self {
-        Self::Path(error)
-    }
 }
 
 impl Task {
