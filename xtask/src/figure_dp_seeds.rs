@@ -7,7 +7,7 @@ use anyhow::{Context, bail};
 use emg_control::{ClassicalController, RolloutConfig, first_violation, rollout};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
 use emg_io::read_tasks;
-use emg_kinematics::{DOF, PoseTarget, Vec3, project_to_pose};
+use emg_kinematics::{MAX_DOF, PoseTarget, Vec3, project_to_pose};
 use plotters::prelude::*;
 
 use crate::workspace;
@@ -76,7 +76,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             continue;
         }
         let mut points = vec![Vec3::zeros()];
-        points.extend((0..DOF).map(|i| kinematics.joint_origin(i)));
+        points.extend((0..MAX_DOF).map(|i| kinematics.joint_origin(i)));
         points.push(kinematics.tcp());
         let trajectory = rollout(
             &robot,

@@ -140,10 +140,11 @@ fn checked_limits(
     // Tool speed and rate play no part in the limits.
     let timing = MotionTiming::new(robot, path, scaling, 1.0, 1.0, constraints)?;
     let limits = &timing.request().limits;
+    let joints = ..robot.dof();
     Ok(JointDynamics {
-        velocity: limits.velocity,
-        acceleration: limits.acceleration,
-        jerk: limits.jerk,
+        velocity: limits.velocity.as_slice()[joints].to_vec(),
+        acceleration: limits.acceleration.as_slice()[joints].to_vec(),
+        jerk: limits.jerk.as_slice()[joints].to_vec(),
     })
 }
 

@@ -1,6 +1,6 @@
 //! The task population of SPEC §2: tasks generated from random collision-free configurations.
 
-use emg_kinematics::{JointVector, Kinematics, Robot, Shape, ToolContact, Vec3, rotation_about};
+use emg_kinematics::{Kinematics, Robot, Shape, ToolContact, Vec3, rotation_about};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -126,7 +126,7 @@ pub fn candidate(robot: &Robot, config: &SamplerConfig, index: u64) -> Option<Ta
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     rng.set_stream(index);
     let limits = robot.limits();
-    let q = JointVector::from_fn(|i, _| rng.random_range(limits.lower[i]..limits.upper[i]));
+    let q = robot.configuration_from_fn(|i| rng.random_range(limits.lower[i]..limits.upper[i]));
     let kinematics = robot.forward(&q);
     if robot.first_collision(&kinematics, 0.0).is_some() {
         return None;

@@ -10,7 +10,8 @@ use crate::config::RolloutConfig;
 use crate::constraints::tool_angle_deg;
 use crate::task::{Along, Task};
 
-/// A null-space action `a ∈ [−1, 1]⁴`: coordinates in the basis `B(q)` (Sec. 4.2).
+/// A null-space action `a ∈ [−1, 1]⁴`: coordinates in the basis `B(q)` (Sec. 4.2); an arm of six
+/// joints uses the first three (the fourth column of its `B(q)` is zero).
 pub type NullAction = SVector<f64, 4>;
 
 /// The state of one control step, computed once and shared by every controller.
@@ -28,7 +29,7 @@ pub struct StepContext<'a> {
     pub q: JointVector,
     /// Forward kinematics at `q`.
     pub kinematics: Kinematics,
-    /// Normalised configuration `q̄ ∈ [−1, 1]⁷`.
+    /// Normalised configuration `q̄ ∈ [−1, 1]ⁿ` (zero past the arm's joints).
     pub q_normalised: JointVector,
     /// Joint-limit proximity `ρ(q) = max_i |q̄_i|` (Eq. 8).
     pub rho: f64,
@@ -218,9 +219,9 @@ impl Derived {
         );
         let alignment_gradient = tool_alignment_gradient(kinematics, &task.n);
         let centring_gradient =
-            -q_normalised.component_div(&limits.half_range()) * (2.0 / q.len() as f64);
+            -q_normalised.component_div(&limits.half_range()) * (2.0 / robot.dof() as f64);
         let basis = task_aligned_basis(
-            jacobian,
+            kinematics,
             [
                 &manipulability_gradient,
                 &alignment_gradient,

@@ -551,7 +551,7 @@ fn null_space_motion_leaves_the_tcp_velocity_unchanged() {
         }
         // The first column follows the projected manipulability gradient unless it fell back.
         if !context.basis.fallback[0] {
-            let n = null_space_basis(j);
+            let n = null_space_basis(&context.kinematics);
             let projected = n * (n.transpose() * context.manipulability_gradient);
             assert!((b.column(0) - projected.normalize()).norm() < 1e-8);
         }

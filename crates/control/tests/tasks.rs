@@ -417,7 +417,10 @@ fn task_files_are_told_apart_by_content_not_by_name() {
     assert_eq!(read_tasks(&binary.path, &robot).unwrap(), set);
     // A JSON list under a `.tasks` name.
     let json = TempFile::new("hand.tasks");
-    let specs: Vec<emg_io::TaskSpec> = set.iter().map(emg_io::TaskSpec::from).collect();
+    let specs: Vec<emg_io::TaskSpec> = set
+        .iter()
+        .map(|t| emg_io::TaskSpec::of(t, &robot))
+        .collect();
     std::fs::write(&json.path, serde_json::to_string(&specs).unwrap()).unwrap();
     assert_eq!(read_tasks(&json.path, &robot).unwrap().len(), set.len());
     // Neither.

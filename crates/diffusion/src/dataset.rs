@@ -2,7 +2,7 @@
 //! xz-plane mirror augmentation (SPEC §6) when the robot has that symmetry.
 
 use emg_control::Task;
-use emg_kinematics::{DOF, JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use emg_seeding::LabelSet;
 
 use crate::seed::{CONDITION_DIM, condition_of};
@@ -12,7 +12,7 @@ use crate::train::{Mirror, TrainError, TrainingSet};
 pub const MIRROR_CONDITION_SIGNS: [f32; CONDITION_DIM] =
     [1.0, -1.0, 1.0, 1.0, -1.0, 1.0, 1.0, -1.0, 1.0];
 /// … and joints 1, 3, 5, 7.
-pub const MIRROR_JOINT_SIGNS: [f32; DOF] = [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
+pub const MIRROR_JOINT_SIGNS: [f32; MAX_DOF] = [-1.0, 1.0, -1.0, 1.0, -1.0, 1.0, -1.0];
 
 /// Configurations on which [`has_mirror_symmetry`] compares a pose with its mirror image.
 const SYMMETRY_PROBES: usize = 64;
@@ -24,14 +24,16 @@ const SYMMETRY_PROBES: usize = 64;
 /// iiwa 14; any other arm is checked rather than assumed.
 pub fn has_mirror_symmetry(robot: &Robot) -> bool {
     let limits = robot.limits();
-    let flipped: Vec<usize> = (0..DOF).filter(|&j| MIRROR_JOINT_SIGNS[j] < 0.0).collect();
+    let flipped: Vec<usize> = (0..MAX_DOF)
+        .filter(|&j| MIRROR_JOINT_SIGNS[j] < 0.0)
+        .collect();
     if flipped.iter().any(|&j| limits.mid()[j].abs() > 1e-9) {
         return false;
     }
     let mirror = |v: Vec3| Vec3::new(v.x, -v.y, v.z);
     (0..SYMMETRY_PROBES).all(|k| {
         // A deterministic spread: joint j at fraction frac((k + 1)·φ_j) of its range.
-        let q = JointVector::from_fn(|j, _| {
+        let q = robot.configuration_from_fn(|j| {
             let fraction = ((k + 1) as f64 * (0.618_033_988_75 + 0.1 * j as f64)).fract();
             limits.lower[j] + fraction * (limits.upper[j] - limits.lower[j])
         });
@@ -71,7 +73,7 @@ pub fn training_set(
             samples.extend(robot.limits().normalise(&label.q).iter().map(|v| *v as f32));
         }
     }
-    let set = TrainingSet::new(conditions, samples, CONDITION_DIM, DOF, name)?;
+    let set = TrainingSet::new(conditions, samples, CONDITION_DIM, MAX_DOF, name)?;
     if !has_mirror_symmetry(robot) {
         return Ok(set);
     }

@@ -4,7 +4,7 @@
 use std::time::{Duration, Instant};
 
 use emg_control::{ConstraintConfig, Task, first_violation};
-use emg_kinematics::{DOF, JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
+use emg_kinematics::{JointVector, MAX_DOF, PoseTarget, ProjectionConfig, Robot, project_to_pose};
 use emg_learning::StandardNormal;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -129,7 +129,7 @@ pub struct DpSeeder {
 impl DpSeeder {
     /// A seeder over `weights` (which must map a 9-D task condition to a 7-D configuration).
     pub fn new(weights: &DenoiserWeights, config: DpSeedConfig) -> Result<Self, DpSeedError> {
-        weights.require_dimensions(DOF, CONDITION_DIM)?;
+        weights.require_dimensions(MAX_DOF, CONDITION_DIM)?;
         if config.max_tries == 0 {
             return Err(DpSeedError::Config {
                 field: "max_tries",
@@ -165,7 +165,7 @@ impl DpSeeder {
         self.sample_batch(task, count, &mut rng, workspace)?;
         Ok(workspace
             .candidates
-            .chunks_exact(DOF)
+            .chunks_exact(MAX_DOF)
             .map(|x| denormalise(robot, x))
             .collect())
     }
@@ -200,7 +200,7 @@ impl DpSeeder {
             };
             let batch = wanted.min(self.config.max_tries - tries);
             self.sample_batch(task, batch, &mut rng, workspace)?;
-            for x in workspace.candidates.chunks_exact(DOF) {
+            for x in workspace.candidates.chunks_exact(MAX_DOF) {
                 tries += 1;
                 let start = denormalise(robot, x);
                 let Ok((q, _)) = project_to_pose(robot, &start, &target, &self.config.projection)
@@ -247,7 +247,7 @@ impl DpSeeder {
         workspace.candidates.clear();
         workspace
             .candidates
-            .extend((0..count * DOF).map(|_| rng.sample::<f32, _>(StandardNormal)));
+            .extend((0..count * MAX_DOF).map(|_| rng.sample::<f32, _>(StandardNormal)));
         let condition = condition_of(task);
         self.sampler.sample(
             &condition,
@@ -274,10 +274,10 @@ pub fn condition_of(task: &Task) -> [f32; CONDITION_DIM] {
     c
 }
 
-/// Joint configuration of a normalised sample `x ∈ [−1, 1]⁷`: `q = q_mid + x · q_half`.
+/// Joint configuration of a normalised sample `x ∈ [−1, 1]ⁿ`: `q = q_mid + x · q_half`.
 pub fn denormalise(robot: &Robot, x: &[f32]) -> JointVector {
     let limits = robot.limits();
-    JointVector::from_fn(|i, _| limits.mid()[i] + f64::from(x[i]) * limits.half_range()[i])
+    robot.configuration_from_fn(|i| limits.mid()[i] + f64::from(x[i]) * limits.half_range()[i])
 }
 
 /// FNV-1a over the bits of `p0`, `d`, `n`: the task's own noise stream.

@@ -5,7 +5,7 @@
 //! documented in `docs/joint-trajectory-format.md`.
 
 use emg_control::{ConstraintConfig, Task};
-use emg_kinematics::{DOF, JointVector};
+use emg_kinematics::{JointVector, MAX_DOF, MIN_DOF};
 use emg_timing::{TimedMotion, TimingReport};
 use emg_verify::{JointDynamics, JointSamples};
 use serde::{Deserialize, Serialize};
@@ -64,11 +64,10 @@ pub struct TimingLimits {
 impl TimingLimits {
     /// The limits as the checker takes them.
     pub fn dynamics(&self) -> JointDynamics {
-        let vector = |values: &[f64]| JointVector::from_column_slice(values);
         JointDynamics {
-            velocity: vector(&self.max_velocity),
-            acceleration: vector(&self.max_acceleration),
-            jerk: vector(&self.max_jerk),
+            velocity: self.max_velocity.clone(),
+            acceleration: self.max_acceleration.clone(),
+            jerk: self.max_jerk.clone(),
         }
     }
 }
@@ -141,7 +140,8 @@ pub struct JointTrajectory {
     pub format: String,
     /// The robot file the motion was planned for (the path as given to the planner).
     pub robot: String,
-    /// The seven revolute joints, base to tip (the order of every position and velocity).
+    /// The arm's `n` revolute joints (6 or 7), base to tip (the order of every position and
+    /// velocity).
     pub joint_names: Vec<String>,
     /// The task the motion follows.
     pub task: Task,
@@ -158,7 +158,7 @@ pub struct JointTrajectory {
 impl JointTrajectory {
     /// The file of `motion` (timed for `limits`, at `rate_hz`).
     ///
-    /// Fails when there are not seven joint names or a sample lies past 2³¹ s.
+    /// Fails when there are not 6 or 7 joint names or a sample lies past 2³¹ s.
     pub fn new(
         robot: &str,
         joint_names: &[String],
@@ -168,12 +168,7 @@ impl JointTrajectory {
         motion: &TimedMotion,
         rate_hz: f64,
     ) -> Result<Self, FormatError> {
-        if joint_names.len() != DOF {
-            return Err(field_error(
-                "joint_names",
-                format!("has {} entries, expected {DOF}", joint_names.len()),
-            ));
-        }
+        let joints = joint_count(joint_names.len())?;
         let points = motion
             .samples
             .iter()
@@ -184,9 +179,9 @@ impl JointTrajectory {
                         field_error(format!("points[{k}].time_from_start"), "is past 2^31 s")
                     })?;
                 Ok(JointTrajectoryPoint {
-                    positions: sample.q.as_slice().to_vec(),
-                    velocities: sample.qd.as_slice().to_vec(),
-                    accelerations: sample.qdd.as_slice().to_vec(),
+                    positions: sample.q.as_slice()[..joints].to_vec(),
+                    velocities: sample.qd.as_slice()[..joints].to_vec(),
+                    accelerations: sample.qdd.as_slice()[..joints].to_vec(),
                     time_from_start,
                 })
             })
@@ -208,8 +203,8 @@ impl JointTrajectory {
         serde_json::to_string(self).expect("a joint trajectory serialises")
     }
 
-    /// Reads a file's text. Checks the `format`, that there are seven joint names, that the
-    /// limits hold seven positive numbers each, that every point has seven finite positions,
+    /// Reads a file's text. Checks the `format`, that there are `n` = 6 or 7 joint names, that
+    /// the limits hold `n` positive numbers each, that every point has `n` finite positions,
     /// velocities and accelerations and a `time_from_start` with `nanosec < 10⁹`; the error
     /// names the field. Fields other than those of the layout are ignored.
     pub fn from_json(text: &str) -> Result<Self, FormatError> {
@@ -227,12 +222,7 @@ impl JointTrajectory {
         }
         let robot = string(member(top, "robot", "robot")?, "robot")?;
         let names = array(member(top, "joint_names", "joint_names")?, "joint_names")?;
-        if names.len() != DOF {
-            return Err(field_error(
-                "joint_names",
-                format!("has {} entries, expected {DOF}", names.len()),
-            ));
-        }
+        let joints = joint_count(names.len())?;
         let joint_names = names
             .iter()
             .enumerate()
@@ -250,10 +240,10 @@ impl JointTrajectory {
             ("max_acceleration", &limits.max_acceleration),
             ("max_jerk", &limits.max_jerk),
         ] {
-            if values.len() != DOF || !values.iter().all(|v| v.is_finite() && *v > 0.0) {
+            if values.len() != joints || !values.iter().all(|v| v.is_finite() && *v > 0.0) {
                 return Err(field_error(
                     format!("limits.{name}"),
-                    format!("is {values:?}, expected {DOF} positive numbers"),
+                    format!("is {values:?}, expected {joints} positive numbers (one per joint)"),
                 ));
             }
         }
@@ -262,7 +252,7 @@ impl JointTrajectory {
         let points = array(member(top, "points", "points")?, "points")?
             .iter()
             .enumerate()
-            .map(|(k, point)| read_point(point, &format!("points[{k}]")))
+            .map(|(k, point)| read_point(point, joints, &format!("points[{k}]")))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             format,
@@ -279,7 +269,7 @@ impl JointTrajectory {
     /// The points as [`JointSamples`]: times from `time_from_start`, positions, and the declared
     /// velocities and accelerations.
     pub fn samples(&self) -> JointSamples {
-        let vector = |values: &[f64]| JointVector::from_column_slice(values);
+        let vector = padded;
         JointSamples {
             time_s: self
                 .points
@@ -330,14 +320,31 @@ fn array<'a>(value: &'a Value, path: &str) -> Result<&'a Vec<Value>, FormatError
         .ok_or_else(|| field_error(path, format!("is {}, expected an array", describe(value))))
 }
 
-/// Exactly [`DOF`] finite numbers.
-fn joint_values(value: &Value, path: &str) -> Result<Vec<f64>, FormatError> {
+/// The number of joints `count` names, checked to be an arm's (6 or 7).
+fn joint_count(count: usize) -> Result<usize, FormatError> {
+    if (MIN_DOF..=MAX_DOF).contains(&count) {
+        Ok(count)
+    } else {
+        Err(field_error(
+            "joint_names",
+            format!("has {count} entries, expected {MIN_DOF} or {MAX_DOF} (one per joint)"),
+        ))
+    }
+}
+
+/// The joint vector of an arm's joint values (zero past them).
+fn padded(values: &[f64]) -> JointVector {
+    JointVector::from_fn(|i, _| values.get(i).copied().unwrap_or(0.0))
+}
+
+/// Exactly `joints` finite numbers.
+fn joint_values(value: &Value, joints: usize, path: &str) -> Result<Vec<f64>, FormatError> {
     let values = array(value, path)?;
-    if values.len() != DOF {
+    if values.len() != joints {
         return Err(field_error(
             path,
             format!(
-                "has {} values, expected {DOF} (one per joint)",
+                "has {} values, expected {joints} (one per joint)",
                 values.len()
             ),
         ));
@@ -355,21 +362,28 @@ fn joint_values(value: &Value, path: &str) -> Result<Vec<f64>, FormatError> {
         .collect()
 }
 
-fn read_point(value: &Value, path: &str) -> Result<JointTrajectoryPoint, FormatError> {
+fn read_point(
+    value: &Value,
+    joints: usize,
+    path: &str,
+) -> Result<JointTrajectoryPoint, FormatError> {
     let object = value
         .as_object()
         .ok_or_else(|| field_error(path, format!("is {}, expected an object", describe(value))))?;
     let at = |name: &str| format!("{path}.{name}");
     let positions = joint_values(
         member(object, "positions", &at("positions"))?,
+        joints,
         &at("positions"),
     )?;
     let velocities = joint_values(
         member(object, "velocities", &at("velocities"))?,
+        joints,
         &at("velocities"),
     )?;
     let accelerations = joint_values(
         member(object, "accelerations", &at("accelerations"))?,
+        joints,
         &at("accelerations"),
     )?;
     let time_path = at("time_from_start");

@@ -75,7 +75,7 @@ mod task_file;
 
 pub use atomic::{JournalError, open_journal, write_atomically};
 pub use contents::{Carried, ReadError, TrajectoryContents, VerifyFailure, task_file_beside};
-pub use csv::{CSV_HEADER, read_csv, samples_from_steps, trajectory_csv};
+pub use csv::{csv_header, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;
 pub use joint_trajectory::{
     JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint, TimeFromStart, TimingLimits,

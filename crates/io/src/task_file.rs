@@ -2,15 +2,15 @@
 //!
 //! Binary layout (little endian): the 8-byte magic `EMGTASKS`, `u32` format version (1), `u32`
 //! values per task (16), `u64` task count, then per task `p0` (3), `d` (3), `n` (3), `q0_seed` (7)
-//! as `f64` (`q0_seed` all NaN when unknown).
+//! as `f64` (`q0_seed` all NaN when unknown; an arm of six joints has a zero seventh value).
 //!
-//! JSON layout: an array of objects `{"p0": [x, y, z], "d": [..], "n": [..], "q0_seed": [7 values]}`
-//! (`q0_seed` optional), or one such object.
+//! JSON layout: an array of objects `{"p0": [x, y, z], "d": [..], "n": [..], "q0_seed": [n values]}`
+//! (`q0_seed` optional, one value per joint of the arm), or one such object.
 
 use std::path::Path;
 
 use emg_control::{Task, TaskError};
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::atomic::write_atomically;
@@ -62,31 +62,43 @@ pub struct TaskSpec {
     pub d: [f64; 3],
     /// Task-plane normal (normalised on reading).
     pub n: [f64; 3],
-    /// Generating configuration, if known (rad).
+    /// Generating configuration, if known (rad): one value per joint of the arm.
     #[serde(default)]
-    pub q0_seed: Option<[f64; 7]>,
+    pub q0_seed: Option<Vec<f64>>,
 }
 
 impl TaskSpec {
     /// Validates the spec into a task for `robot`.
     pub fn to_task(&self, robot: &Robot) -> Result<Task, TaskError> {
+        let seed = match &self.q0_seed {
+            Some(values) if values.len() != robot.dof() => {
+                return Err(TaskError::BadSeed {
+                    problem: format!(
+                        "has {} values; the robot has {} joints",
+                        values.len(),
+                        robot.dof()
+                    ),
+                });
+            }
+            Some(values) => Some(robot.joint_vector(values)),
+            None => None,
+        };
         Task::new(
             robot,
             Vec3::from(self.p0),
             Vec3::from(self.d),
             Vec3::from(self.n),
-            self.q0_seed.map(JointVector::from),
+            seed,
         )
     }
-}
 
-impl From<&Task> for TaskSpec {
-    fn from(task: &Task) -> Self {
+    /// The spec of `task` on `robot` (its seed's `n` joint values).
+    pub fn of(task: &Task, robot: &Robot) -> Self {
         Self {
             p0: task.p0.into(),
             d: task.d.into(),
             n: task.n.into(),
-            q0_seed: task.q0_seed.map(Into::into),
+            q0_seed: task.q0_seed.map(|q| robot.joints_of(&q).to_vec()),
         }
     }
 }
@@ -130,7 +142,7 @@ pub fn parse_tasks(origin: &str, bytes: &[u8], robot: &Robot) -> Result<Vec<Task
     let name = origin.to_string();
     let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
     let specs = if bytes.starts_with(MAGIC) {
-        parse_binary(&name, bytes)?
+        parse_binary(&name, bytes, robot.dof())?
     } else if matches!(first, Some(b'{' | b'[')) {
         parse_json(&name, bytes)?
     } else if bytes.starts_with(&MAGIC[..bytes.len().min(MAGIC.len())]) && !bytes.is_empty() {
@@ -177,7 +189,8 @@ fn parse_json(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> 
     }
 }
 
-fn parse_binary(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {
+/// The task specs of a binary task set read for an arm of `joints` joints.
+fn parse_binary(path: &str, bytes: &[u8], joints: usize) -> Result<Vec<TaskSpec>, TaskFileError> {
     let format = |problem: String| TaskFileError::Format {
         path: path.into(),
         problem,
@@ -223,12 +236,18 @@ fn parse_binary(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError
                 .chunks_exact(8)
                 .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")))
                 .collect();
-            let seed: [f64; 7] = v[9..16].try_into().expect("7 values");
+            let seed = &v[9..9 + MAX_DOF];
+            // An arm of fewer joints pads its seed with zeros; the padding is dropped.
+            let joints = if seed[joints..].iter().all(|x| *x == 0.0) {
+                joints
+            } else {
+                MAX_DOF
+            };
             TaskSpec {
                 p0: [v[0], v[1], v[2]],
                 d: [v[3], v[4], v[5]],
                 n: [v[6], v[7], v[8]],
-                q0_seed: (!seed.iter().all(|x| x.is_nan())).then_some(seed),
+                q0_seed: (!seed.iter().all(|x| x.is_nan())).then(|| seed[..joints].to_vec()),
             }
         })
         .collect())

@@ -7,7 +7,7 @@ use emg_control::{
 use emg_io::{
     CSV_HEADER, FormatError, JointTrajectory, TimeFromStart, TimingLimits, read_csv, trajectory_csv,
 };
-use emg_kinematics::{DOF, JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use emg_timing::{DynamicLimits, TimingRequest, time_motion};
 use emg_verify::{JointSamples, ReferenceModel, check_joint_names, check_replay, point_velocities};
 use serde_json::Value;
@@ -181,7 +181,7 @@ fn csv_round_trip_keeps_times_and_positions_bit_for_bit() {
     assert_eq!(samples.len(), trajectory.steps.len());
     for (k, step) in trajectory.steps.iter().enumerate() {
         assert_eq!(samples.time_s[k].to_bits(), step.time_s.to_bits());
-        for i in 0..DOF {
+        for i in 0..MAX_DOF {
             assert_eq!(samples.q[k][i].to_bits(), step.q[i].to_bits());
         }
     }

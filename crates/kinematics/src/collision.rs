@@ -5,7 +5,7 @@ use arrayvec::ArrayVec;
 use crate::clearance_floor::{ClearanceFloor, clearance_floor};
 use crate::fk::Kinematics;
 use crate::robot::Robot;
-use crate::{DOF, Vec3};
+use crate::{MAX_DOF, Vec3};
 
 /// A capsule: the segment `start`–`end` (in its segment's frame) swept by `radius`.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,9 +83,9 @@ pub(crate) struct BroadPhase {
     capsule_radii: Vec<f64>,
     /// Centre, in its segment's frame, of each segment's sphere (unused for segments without
     /// capsules).
-    segment_centres: [Vec3; DOF + 1],
+    segment_centres: [Vec3; MAX_DOF + 1],
     /// Radius of each segment's sphere (0 for segments without capsules).
-    segment_radii: [f64; DOF + 1],
+    segment_radii: [f64; MAX_DOF + 1],
     /// The checked pairs grouped by segment pair.
     groups: Vec<PairGroup>,
 }
@@ -98,9 +98,9 @@ impl BroadPhase {
             .iter()
             .map(|c| 0.5 * (c.end - c.start).norm() + c.radius)
             .collect();
-        let mut segment_centres = [Vec3::zeros(); DOF + 1];
-        let mut segment_radii = [0.0; DOF + 1];
-        for segment in 0..=DOF {
+        let mut segment_centres = [Vec3::zeros(); MAX_DOF + 1];
+        let mut segment_radii = [0.0; MAX_DOF + 1];
+        for segment in 0..=MAX_DOF {
             let members = || capsules.iter().filter(move |c| c.segment == segment);
             let Some(first) = members().next() else {
                 continue;
@@ -141,7 +141,7 @@ impl BroadPhase {
 
     /// The centre of each segment's sphere at `kin` (segments without capsules included: no
     /// group refers to them).
-    fn segment_centres(&self, kin: &Kinematics) -> [Vec3; DOF + 1] {
+    fn segment_centres(&self, kin: &Kinematics) -> [Vec3; MAX_DOF + 1] {
         std::array::from_fn(|s| kin.segment_point(s, &self.segment_centres[s]))
     }
 }

@@ -3,10 +3,11 @@
 use nalgebra::{Isometry3, Matrix3, SMatrix, Translation3, UnitQuaternion};
 
 use crate::robot::Robot;
-use crate::{DOF, JointVector, Vec3};
+use crate::{JointVector, MAX_DOF, Vec3};
 
-/// The 3×7 position Jacobian `J = ∂p/∂q` of the TCP.
-pub type PositionJacobian = SMatrix<f64, 3, DOF>;
+/// The 3×n position Jacobian `J = ∂p/∂q` of the TCP, zero-padded to 3×[`MAX_DOF`] (columns
+/// past the arm's joints are exactly zero).
+pub type PositionJacobian = SMatrix<f64, 3, MAX_DOF>;
 
 /// Everything forward kinematics yields for one configuration; computed on the stack.
 ///
@@ -15,8 +16,9 @@ pub type PositionJacobian = SMatrix<f64, 3, DOF>;
 #[derive(Clone, Debug)]
 pub struct Kinematics {
     configuration: JointVector,
-    rotations: [Matrix3<f64>; DOF + 1],
-    positions: [Vec3; DOF + 1],
+    dof: usize,
+    rotations: [Matrix3<f64>; MAX_DOF + 1],
+    positions: [Vec3; MAX_DOF + 1],
     tcp: Vec3,
     tcp_rotation: Matrix3<f64>,
     jacobian: PositionJacobian,
@@ -27,8 +29,9 @@ impl Robot {
     pub fn forward(&self, q: &JointVector) -> Kinematics {
         let mut kinematics = Kinematics {
             configuration: *q,
-            rotations: [Matrix3::identity(); DOF + 1],
-            positions: [Vec3::zeros(); DOF + 1],
+            dof: self.dof,
+            rotations: [Matrix3::identity(); MAX_DOF + 1],
+            positions: [Vec3::zeros(); MAX_DOF + 1],
             tcp: Vec3::zeros(),
             tcp_rotation: Matrix3::identity(),
             jacobian: PositionJacobian::zeros(),
@@ -42,6 +45,7 @@ impl Robot {
     pub fn forward_into(&self, q: &JointVector, kinematics: &mut Kinematics) {
         let Kinematics {
             configuration,
+            dof: _,
             rotations,
             positions,
             tcp,
@@ -51,7 +55,7 @@ impl Robot {
         *configuration = *q;
         // Every sine and cosine first: a library call clobbers every floating-point register,
         // so calls inside the loop would spill the chain of rotations around each of them.
-        let turns: [(f64, f64); DOF] = std::array::from_fn(|i| libm::sincos(q[i]));
+        let turns: [(f64, f64); MAX_DOF] = std::array::from_fn(|i| libm::sincos(q[i]));
         for (i, (joint, &(sin, cos))) in self.joints.iter().zip(&turns).enumerate() {
             let (parent_rotation, parent_position) = (rotations[i], positions[i]);
             let fixed: Matrix3<f64> = parent_rotation * joint.rotation;
@@ -62,10 +66,12 @@ impl Robot {
             rotations[i + 1] = rotation;
             positions[i + 1] = parent_position + parent_rotation * joint.translation;
         }
-        let last = rotations[DOF];
-        *tcp = positions[DOF] + last * self.tcp_offset.translation;
+        // The TCP hangs off the last joint's segment; an absent joint's slot (zero axis) after
+        // it turns nothing that is read.
+        let last = rotations[self.dof];
+        *tcp = positions[self.dof] + last * self.tcp_offset.translation;
         *tcp_rotation = last * self.tcp_offset.rotation;
-        for i in 0..DOF {
+        for i in 0..MAX_DOF {
             let axis = rotations[i + 1].column(2).into_owned();
             jacobian.set_column(i, &axis.cross(&(*tcp - positions[i + 1])));
         }
@@ -103,7 +109,12 @@ impl Kinematics {
         self.jacobian * self.jacobian.transpose()
     }
 
-    /// Unit rotation axis `ω_i` of joint `i` (0-based) in the base frame.
+    /// The arm's number of joints `n` ([`Robot::dof`]).
+    pub fn dof(&self) -> usize {
+        self.dof
+    }
+
+    /// Unit rotation axis `ω_i` of joint `i` (0-based) in the base frame; zero for `i ≥ n`.
     pub fn joint_axis(&self, i: usize) -> Vec3 {
         self.rotations[i + 1].column(2).into_owned()
     }

@@ -1,4 +1,5 @@
-//! Kinematics of a 7-DoF serial arm holding a tool, as used by extreme straight-line motion.
+//! Kinematics of a serial arm of six or seven revolute joints holding a tool, as used by extreme
+//! straight-line motion.
 //!
 //! A [`Robot`] is read once from a URDF file (the chain between two named links, its joint
 //! limits, velocity limits and capsule collision geometry) and then shared freely across
@@ -6,7 +7,7 @@
 //! the stack with fixed-size `nalgebra` types so the control step allocates nothing:
 //!
 //! * [`Robot::forward`]: every joint frame, the TCP position `p(q)` and the tool axis `z(q)`;
-//!   from it the 3×7 position Jacobian and the tool-axis Jacobian ([`Kinematics`]).
+//!   from it the 3×n position Jacobian and the tool-axis Jacobian ([`Kinematics`]).
 //! * [`directional_manipulability`]: `w_d` and its Hessian-based analytic gradient.
 //! * [`tool_alignment_gradient`]: the gradient of `z(q)·n`.
 //! * [`damped_pseudo_inverse`]: `J⁺` with variable damping (Eq. 2 of the paper).
@@ -61,11 +62,18 @@ pub use scene::{
 };
 pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
 
-/// Number of actuated joints of every supported arm.
-pub const DOF: usize = 7;
+/// Most revolute joints a supported arm may have: the length of every [`JointVector`].
+pub const MAX_DOF: usize = 7;
 
-/// A joint-space vector (configuration, velocity or gradient), radians.
-pub type JointVector = nalgebra::SVector<f64, DOF>;
+/// Fewest revolute joints a supported arm may have: three fix the TCP's position and at least
+/// three more move it in the null space (the pen's free roll and its tilt inside the cone), as
+/// the null-space step needs.
+pub const MIN_DOF: usize = 6;
+
+/// A joint-space vector (configuration, velocity or gradient), radians. An arm of
+/// [`Robot::dof`] `< MAX_DOF` joints uses the leading entries; the others are zero and stay
+/// zero (its Jacobian's trailing columns are zero, so no step moves them).
+pub type JointVector = nalgebra::SVector<f64, MAX_DOF>;
 
 /// A Cartesian 3-vector, metres or unit direction.
 pub type Vec3 = nalgebra::Vector3<f64>;

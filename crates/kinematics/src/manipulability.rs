@@ -3,7 +3,7 @@
 use nalgebra::Matrix3;
 
 use crate::fk::Kinematics;
-use crate::{DOF, JointVector, Vec3};
+use crate::{JointVector, MAX_DOF, Vec3};
 
 /// Directional manipulability `w_d = (dᵀ(JJᵀ + λ_μ²I)⁻¹d)^(−1/2)` (SPEC §4, the `k_μ` term of
 /// Eq. 3) and its analytic gradient.
@@ -34,19 +34,19 @@ pub fn directional_manipulability(
     }
     let value = 1.0 / s.sqrt();
     let u = jacobian.transpose() * w;
-    let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
-    let columns: [Vec3; DOF] = std::array::from_fn(|k| jacobian.column(k).into_owned());
+    let axes: [Vec3; MAX_DOF] = std::array::from_fn(|i| kin.joint_axis(i));
+    let columns: [Vec3; MAX_DOF] = std::array::from_fn(|k| jacobian.column(k).into_owned());
     let scale = value * value * value;
     // wᵀH_i u = Σ_{k≥i} u_k w·(ω_i × J_k) + Σ_{k<i} u_k w·(ω_k × J_i)
     //         = ω_i·Σ_{k≥i} u_k (J_k × w) + J_i·Σ_{k<i} u_k (w × ω_k):
     // suffix and prefix sums turn the 49 triple products into 14 cross products.
-    let mut suffix = [Vec3::zeros(); DOF + 1];
-    for k in (0..DOF).rev() {
+    let mut suffix = [Vec3::zeros(); MAX_DOF + 1];
+    for k in (0..MAX_DOF).rev() {
         suffix[k] = suffix[k + 1] + columns[k].cross(&w) * u[k];
     }
     let mut prefix = Vec3::zeros();
     let mut gradient = JointVector::zeros();
-    for i in 0..DOF {
+    for i in 0..MAX_DOF {
         gradient[i] = (axes[i].dot(&suffix[i]) + columns[i].dot(&prefix)) * scale;
         prefix += w.cross(&axes[i]) * u[i];
     }

@@ -3,14 +3,16 @@
 use nalgebra::{Matrix3, Matrix4, SMatrix, Vector4};
 use serde::{Deserialize, Serialize};
 
-use crate::fk::PositionJacobian;
-use crate::{DOF, JointVector};
+use crate::fk::{Kinematics, PositionJacobian};
+use crate::{JointVector, MAX_DOF};
 
-/// Dimension of the null space of a full-rank 3×7 position Jacobian.
-const NULL_DIM: usize = DOF - 3;
+/// Dimension of the null space of a full-rank 3×7 position Jacobian: the most columns a basis
+/// holds.
+const NULL_DIM: usize = MAX_DOF - 3;
 
-/// An orthonormal basis of the null space of `J` (7×4, columns are basis vectors).
-pub type NullSpaceBasis = SMatrix<f64, DOF, NULL_DIM>;
+/// An orthonormal basis of the null space of `J` (columns are basis vectors): n × (n − 3) for
+/// an arm of `n` joints, zero-padded to 7×4 (the rows and columns past them are zero).
+pub type NullSpaceBasis = SMatrix<f64, MAX_DOF, NULL_DIM>;
 
 /// Thresholds of the Gram–Schmidt construction of `B(q)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -31,35 +33,49 @@ impl Default for BasisConfig {
     }
 }
 
-/// The task-aligned null-space basis `B(q)` (7×4) of the RL action space (Sec. 4.2).
+/// The task-aligned null-space basis `B(q)` (n × (n − 3), zero-padded to 7×4) of the RL action
+/// space (Sec. 4.2).
 #[derive(Clone, Debug)]
 pub struct TaskBasis {
-    /// Columns: the orthonormalised projections of `∇w_d`, `∇(z·n)`, `∇(−mean q̄²)`, then the
-    /// remaining orthogonal complement.
+    /// Columns: the orthonormalised projections of `∇w_d`, `∇(z·n)`, `∇(−mean q̄²)`, then (seven
+    /// joints) the remaining orthogonal complement or (six joints) zero.
     pub columns: NullSpaceBasis,
     /// Which of the first three columns fell back to a column of `N` (gradient ≈ 0 in the null space).
     pub fallback: [bool; 3],
 }
 
-/// Orthonormal basis `N` of the null space of `J`: the last four columns of the orthogonal
-/// factor of a Householder QR of `Jᵀ` (no allocation). Spans the same space as the right
-/// singular vectors of `J`'s zero singular values.
-pub fn null_space_basis(jacobian: &PositionJacobian) -> NullSpaceBasis {
-    householder_null_space(jacobian).0
+/// Orthonormal basis `N` of the null space of `J` at `kin`: the last `n − 3` columns of the
+/// orthogonal factor of a Householder QR of `Jᵀ` (no allocation). Spans the same space as the
+/// right singular vectors of `J`'s zero singular values.
+pub fn null_space_basis(kin: &Kinematics) -> NullSpaceBasis {
+    let mut null = householder_null_space(kin.jacobian()).0;
+    absent_columns_zeroed(&mut null, kin.dof());
+    null
 }
 
-/// The task-aligned basis `B(q) = N C`: modified Gram–Schmidt (applied twice) of the null-space
-/// projections `N Nᵀ g` of the three `gradients` in order, carried out in the coordinates of `N`;
-/// a residual below `max(floor, relative·‖g‖)` is replaced by the unused column of `N` with the
-/// largest residual (sign aligned with `g`); the fourth column is the remaining orthogonal
-/// complement, oriented so that `det[J; Bᵀ] > 0` (so it varies continuously with `q`).
-/// Allocation-free.
+/// `basis` with its columns past the `n − 3` of an arm of `n = dof` joints set to zero. The
+/// Householder factor of a Jacobian whose trailing columns are zero ends with the unit vectors
+/// of those absent joints, exactly: its reflectors are zero in their rows.
+fn absent_columns_zeroed(basis: &mut NullSpaceBasis, dof: usize) {
+    for column in dof - 3..NULL_DIM {
+        basis.column_mut(column).fill(0.0);
+    }
+}
+
+/// The task-aligned basis `B(q) = N C` at `kin`: modified Gram–Schmidt (applied twice) of the
+/// null-space projections `N Nᵀ g` of the three `gradients` in order, carried out in the
+/// coordinates of `N`; a residual below `max(floor, relative·‖g‖)` is replaced by the unused
+/// column of `N` with the largest residual (sign aligned with `g`). With seven joints the fourth
+/// column is the remaining orthogonal complement, oriented so that `det[J; Bᵀ] > 0` (so it
+/// varies continuously with `q`); with six the three columns span the null space and the fourth
+/// is zero. The gradients are zero past the arm's joints. Allocation-free.
 pub fn task_aligned_basis(
-    jacobian: &PositionJacobian,
+    kin: &Kinematics,
     gradients: [&JointVector; 3],
     cfg: &BasisConfig,
 ) -> TaskBasis {
-    let (null, orientation) = householder_null_space(jacobian);
+    let (null, orientation) = householder_null_space(kin.jacobian());
+    let null_dim = kin.dof() - 3;
     let mut coords = [Vector4::zeros(); NULL_DIM];
     let mut fallback = [false; 3];
     for (k, gradient) in gradients.into_iter().enumerate() {
@@ -73,7 +89,7 @@ pub fn task_aligned_basis(
             residual / norm
         } else {
             fallback[k] = true;
-            let unit = (0..NULL_DIM)
+            let unit = (0..null_dim)
                 .map(|axis| orthogonalise(Vector4::ith(axis, 1.0), &coords[..k]))
                 .max_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
                 .expect("null space is not empty");
@@ -85,7 +101,9 @@ pub fn task_aligned_basis(
             }
         };
     }
-    coords[3] = complement(&coords[0], &coords[1], &coords[2]) * orientation;
+    if null_dim == NULL_DIM {
+        coords[3] = complement(&coords[0], &coords[1], &coords[2]) * orientation;
+    }
     TaskBasis {
         columns: null * Matrix4::from_columns(&coords),
         fallback,
@@ -102,12 +120,12 @@ pub fn task_aligned_basis(
 /// reaches them).
 fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) {
     // Column c of Jᵀ is row c of J.
-    let mut columns: [[f64; DOF]; 3] =
+    let mut columns: [[f64; MAX_DOF]; 3] =
         std::array::from_fn(|c| std::array::from_fn(|r| jacobian[(c, r)]));
-    let mut reflectors = [[0.0; DOF]; 3];
+    let mut reflectors = [[0.0; MAX_DOF]; 3];
     let mut sign = 1.0;
     for k in 0..3 {
-        let mut v = [0.0; DOF];
+        let mut v = [0.0; MAX_DOF];
         v[k..].copy_from_slice(&columns[k][k..]);
         let norm = dot_from(k, &v, &v).sqrt();
         let alpha = if v[k] > 0.0 { -norm } else { norm };
@@ -123,8 +141,8 @@ fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) 
         }
         reflectors[k] = v;
     }
-    let mut null: [[f64; DOF]; NULL_DIM] = std::array::from_fn(|c| {
-        let mut column = [0.0; DOF];
+    let mut null: [[f64; MAX_DOF]; NULL_DIM] = std::array::from_fn(|c| {
+        let mut column = [0.0; MAX_DOF];
         column[3 + c] = 1.0;
         column
     });
@@ -136,13 +154,13 @@ fn householder_null_space(jacobian: &PositionJacobian) -> (NullSpaceBasis, f64) 
 
 /// `x ← x − 2 v (v·x)` for every column `x`, over the rows from `first` on (`v` is zero above
 /// it).
-fn reflect(first: usize, v: &[f64; DOF], columns: &mut [[f64; DOF]]) {
+fn reflect(first: usize, v: &[f64; MAX_DOF], columns: &mut [[f64; MAX_DOF]]) {
     let mut projections = [0.0; NULL_DIM];
     for (projection, column) in projections.iter_mut().zip(columns.iter()) {
         *projection = dot_from(first, v, column);
     }
     for (projection, column) in projections.iter().zip(columns.iter_mut()) {
-        for r in first..DOF {
+        for r in first..MAX_DOF {
             column[r] -= v[r] * (2.0 * projection);
         }
     }
@@ -150,9 +168,9 @@ fn reflect(first: usize, v: &[f64; DOF], columns: &mut [[f64; DOF]]) {
 
 /// `a·b` over the rows from `first` on, summed in index order from zero.
 #[inline]
-fn dot_from(first: usize, a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
+fn dot_from(first: usize, a: &[f64; MAX_DOF], b: &[f64; MAX_DOF]) -> f64 {
     let mut sum = 0.0;
-    for r in first..DOF {
+    for r in first..MAX_DOF {
         sum += a[r] * b[r];
     }
     sum

@@ -4,7 +4,7 @@ use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
 use crate::robot::Robot;
-use crate::{DOF, JointVector, Vec3};
+use crate::{JointVector, MAX_DOF, Vec3};
 
 /// The pose a configuration is projected onto.
 #[derive(Clone, Debug, PartialEq)]
@@ -132,7 +132,7 @@ pub fn project_to_pose(
         // Freeze joints on a bound that the step would push further out, and solve again.
         let mut frozen = rows;
         let mut any_frozen = false;
-        for i in 0..DOF {
+        for i in 0..MAX_DOF {
             let outward =
                 (q[i] <= lower[i] && step[i] < 0.0) || (q[i] >= upper[i] && step[i] > 0.0);
             if outward {
@@ -178,7 +178,7 @@ fn split_norms(error: &SVector<f64, 6>) -> (f64, f64) {
 
 /// The Levenberg–Marquardt step `Mᵀ(MMᵀ + μI)⁻¹e`.
 fn damped_step(
-    rows: &SMatrix<f64, 6, DOF>,
+    rows: &SMatrix<f64, 6, MAX_DOF>,
     error: &SVector<f64, 6>,
     damping: f64,
 ) -> Option<JointVector> {
@@ -218,15 +218,15 @@ fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
 pub fn pose_residual(
     kin: &crate::Kinematics,
     target: &PoseTarget,
-) -> (SMatrix<f64, 6, DOF>, SVector<f64, 6>) {
-    let mut rows = SMatrix::<f64, 6, DOF>::zeros();
+) -> (SMatrix<f64, 6, MAX_DOF>, SVector<f64, 6>) {
+    let mut rows = SMatrix::<f64, 6, MAX_DOF>::zeros();
     rows.fixed_rows_mut::<3>(0).copy_from(kin.jacobian());
     let mut error = SVector::<f64, 6>::zeros();
     error
         .fixed_rows_mut::<3>(0)
         .copy_from(&(target.position - kin.tcp()));
     let current = kin.tcp_rotation();
-    let axes: [Vec3; DOF] = std::array::from_fn(|i| kin.joint_axis(i));
+    let axes: [Vec3; MAX_DOF] = std::array::from_fn(|i| kin.joint_axis(i));
     match &target.roll_axis {
         Some(x) => {
             let goal = Matrix3::from_columns(&[*x, target.tool_axis.cross(x), target.tool_axis]);

@@ -3,7 +3,7 @@
 use nalgebra::{Matrix3, SMatrix};
 use serde::{Deserialize, Serialize};
 
-use crate::DOF;
+use crate::MAX_DOF;
 use crate::fk::PositionJacobian;
 
 /// Variable-damping schedule: `λ = λ_max·√(1 − (σ_min/σ_0)²)` when `σ_min < σ_0`, else 0.
@@ -33,7 +33,7 @@ const WELL_CONDITIONED_MARGIN: f64 = 1e-6;
 #[derive(Clone, Debug)]
 pub struct DampedPseudoInverse {
     /// `J⁺` (7×3).
-    pub matrix: SMatrix<f64, DOF, 3>,
+    pub matrix: SMatrix<f64, MAX_DOF, 3>,
     /// Damping `λ` that was applied.
     pub lambda: f64,
     /// `JJᵀ`, kept for [`DampedPseudoInverse::sigma_min`] and [`DampedPseudoInverse::gram`].

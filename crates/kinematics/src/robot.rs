@@ -1,4 +1,4 @@
-//! The robot model: a serial chain of seven revolute joints read from a URDF file.
+//! The robot model: a serial chain of six or seven revolute joints read from a URDF file.
 
 use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 use std::collections::HashMap;
@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::collision::{BroadPhase, Capsule, CollisionPair, MAX_CAPSULES};
 use crate::rotation::{rotation_from_rpy, rotation_onto};
 use crate::srdf::PairRule;
-use crate::{DOF, JointVector, Vec3};
+use crate::{JointVector, MAX_DOF, MIN_DOF, Vec3};
 
 /// Why a robot file could not be turned into a [`Robot`].
 #[derive(Debug, thiserror::Error)]
@@ -71,9 +71,10 @@ pub enum RobotError {
         /// Links that are no joint's parent.
         leaves: String,
     },
-    /// The chain does not have exactly [`DOF`] revolute joints.
+    /// The chain has fewer than [`MIN_DOF`] or more than [`MAX_DOF`] revolute joints.
     #[error(
-        "the chain from '{base}' to '{tip}' has {found} revolute joints; exactly {DOF} are required"
+        "the chain from '{base}' to '{tip}' has {found} revolute joints; arms of {MIN_DOF} or \
+         {MAX_DOF} are supported ({reason})"
     )]
     WrongDof {
         /// Base link name.
@@ -82,6 +83,8 @@ pub enum RobotError {
         tip: String,
         /// Revolute joints found.
         found: usize,
+        /// Why that count cannot be planned.
+        reason: &'static str,
     },
     /// A joint has an unusable axis, limit or velocity limit.
     #[error("joint '{joint}': {field} {problem}")]
@@ -139,7 +142,8 @@ pub enum RobotError {
     },
 }
 
-/// Lower, upper and velocity limits of the seven joints.
+/// Lower, upper and velocity limits of the joints; entries past the arm's joints (an arm of six)
+/// hold the range ±π and speed 1 rad/s, which no step uses (those joints never move).
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointLimits {
     /// Lower position limits `q_min` (rad).
@@ -173,7 +177,7 @@ impl JointLimits {
 
     /// Index of the first joint outside `[q_min + margin, q_max − margin]`, if any.
     pub fn first_violation(&self, q: &JointVector, margin: f64) -> Option<usize> {
-        (0..DOF).find(|&i| !(q[i] >= self.lower[i] + margin && q[i] <= self.upper[i] - margin))
+        (0..MAX_DOF).find(|&i| !(q[i] >= self.lower[i] + margin && q[i] <= self.upper[i] - margin))
     }
 
     /// `q` clamped into the limits.
@@ -189,7 +193,23 @@ pub(crate) struct JointFrame {
     pub(crate) translation: Vec3,
 }
 
-/// A 7-DoF serial arm with a tool: the immutable model every algorithm reads.
+impl JointFrame {
+    /// The slot of a joint the arm does not have (an arm of six fills the seventh slot with
+    /// it): no offset, and a "rotation" without a z column, so its axis, its Jacobian columns
+    /// and every gradient entry it gets are exactly zero. The frame after it is never read.
+    fn absent() -> Self {
+        Self {
+            rotation: Matrix3::from_diagonal(&Vec3::new(1.0, 1.0, 0.0)),
+            translation: Vec3::zeros(),
+        }
+    }
+}
+
+/// Position range (rad) and velocity limit (rad/s) held by a joint slot the arm does not have.
+const ABSENT_JOINT_LIMITS: (f64, f64, f64) = (-std::f64::consts::PI, std::f64::consts::PI, 1.0);
+
+/// A serial arm of six or seven revolute joints with a tool: the immutable model every
+/// algorithm reads.
 ///
 /// Built once from a URDF file; cheap to share between threads (`&Robot` is all any
 /// algorithm needs). Joint frames are normalised at load time so that every joint turns about
@@ -200,7 +220,9 @@ pub struct Robot {
     pub(crate) base_link: String,
     pub(crate) tip_link: String,
     pub(crate) joint_names: Vec<String>,
-    pub(crate) joints: [JointFrame; DOF],
+    /// Revolute joints of the chain (6 or 7); the slots past them hold [`JointFrame::absent`].
+    pub(crate) dof: usize,
+    pub(crate) joints: [JointFrame; MAX_DOF],
     pub(crate) tcp_offset: JointFrame,
     pub(crate) limits: JointLimits,
     pub(crate) capsules: Vec<Capsule>,
@@ -293,8 +315,8 @@ impl Robot {
         let links: HashMap<&str, &urdf_rs::Link> =
             urdf.links.iter().map(|l| (l.name.as_str(), l)).collect();
 
-        let mut joints = Vec::with_capacity(DOF);
-        let mut joint_names = Vec::with_capacity(DOF);
+        let mut joints = Vec::with_capacity(MAX_DOF);
+        let mut joint_names = Vec::with_capacity(MAX_DOF);
         let (mut lower, mut upper, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
         let mut chain = vec![ChainLink {
             link: links[base_link],
@@ -340,14 +362,26 @@ impl Robot {
                 offset,
             });
         }
-        if joints.len() != DOF {
+        let dof = joints.len();
+        if !(MIN_DOF..=MAX_DOF).contains(&dof) {
             return Err(RobotError::WrongDof {
                 base: base_link.into(),
                 tip: tip_link.into(),
-                found: joints.len(),
+                found: dof,
+                reason: if dof < MIN_DOF {
+                    "with fewer, the tool cannot keep its position and still move in the null space"
+                } else {
+                    "joint vectors hold at most seven entries"
+                },
             });
         }
+        let (absent_lower, absent_upper, absent_velocity) = ABSENT_JOINT_LIMITS;
+        joints.resize_with(MAX_DOF, JointFrame::absent);
+        lower.resize(MAX_DOF, absent_lower);
+        upper.resize(MAX_DOF, absent_upper);
+        velocity.resize(MAX_DOF, absent_velocity);
         let capsules = chain_capsules(&chain)?;
+        let first_tool_capsule = first_tool_capsule(&capsules, dof);
         if capsules.len() > MAX_CAPSULES {
             return Err(RobotError::TooManyCapsules {
                 found: capsules.len(),
@@ -355,10 +389,9 @@ impl Robot {
         }
         let pairs = collision_pairs(&capsules, &pair_rule);
         let broad_phase = BroadPhase::new(&capsules, &pairs);
-        let first_tool_capsule = first_tool_capsule(&capsules);
-        let joints: [JointFrame; DOF] = joints.try_into().expect("length checked above");
+        let joints: [JointFrame; MAX_DOF] = joints.try_into().expect("length checked above");
         let reach_centre = joints[0].translation;
-        let reach_radius = joints[1..]
+        let reach_radius = joints[1..dof]
             .iter()
             .map(|j| j.translation.norm())
             .sum::<f64>()
@@ -368,6 +401,7 @@ impl Robot {
             base_link: base_link.into(),
             tip_link: tip_link.into(),
             joint_names,
+            dof,
             joints,
             tcp_offset: JointFrame {
                 rotation: offset.rotation.to_rotation_matrix().into_inner(),
@@ -396,18 +430,20 @@ impl Robot {
     pub fn fingerprint(&self) -> String {
         use sha2::{Digest, Sha256};
         let mut hash = Sha256::new();
-        let frames = self.joints.iter().chain(std::iter::once(&self.tcp_offset));
+        let frames = self.joints[..self.dof]
+            .iter()
+            .chain(std::iter::once(&self.tcp_offset));
         for frame in frames {
             for value in frame.rotation.iter().chain(frame.translation.iter()) {
                 hash.update(value.to_le_bytes());
             }
         }
         let limits = &self.limits;
-        for value in limits
-            .lower
+        let joints = ..self.dof;
+        for value in limits.lower.as_slice()[joints]
             .iter()
-            .chain(&limits.upper)
-            .chain(&limits.velocity)
+            .chain(&limits.upper.as_slice()[joints])
+            .chain(&limits.velocity.as_slice()[joints])
         {
             hash.update(value.to_le_bytes());
         }
@@ -429,7 +465,31 @@ impl Robot {
         &self.tip_link
     }
 
-    /// Names of the seven revolute joints, base to tip.
+    /// Number of revolute joints `n` (6 or 7): the leading entries of every [`JointVector`] of
+    /// this arm.
+    pub fn dof(&self) -> usize {
+        self.dof
+    }
+
+    /// The configuration whose joint `i < n` is `joint(i)`, called in joint order (a sampler's
+    /// draws stay in that order), and whose entries past the arm's joints are zero.
+    pub fn configuration_from_fn(&self, mut joint: impl FnMut(usize) -> f64) -> JointVector {
+        JointVector::from_fn(|i, _| if i < self.dof { joint(i) } else { 0.0 })
+    }
+
+    /// The first `n` entries of `q`: the arm's joints.
+    pub fn joints_of<'q>(&self, q: &'q JointVector) -> &'q [f64] {
+        &q.as_slice()[..self.dof]
+    }
+
+    /// The joint vector of the arm's `n` joint values (`values.len()` must be `n`), zero past
+    /// them.
+    pub fn joint_vector(&self, values: &[f64]) -> JointVector {
+        assert_eq!(values.len(), self.dof, "one value per joint of the arm");
+        self.configuration_from_fn(|i| values[i])
+    }
+
+    /// Names of the `n` revolute joints, base to tip.
     pub fn joint_names(&self) -> &[String] {
         &self.joint_names
     }
@@ -654,9 +714,9 @@ struct CollisionShape {
 
 /// Index of the first capsule of the tool (see [`Robot::tool_capsules`]); capsules come in chain
 /// order, so the tool's close the list.
-fn first_tool_capsule(capsules: &[Capsule]) -> usize {
+fn first_tool_capsule(capsules: &[Capsule], dof: usize) -> usize {
     match capsules.last() {
-        Some(last) if last.segment == DOF => capsules
+        Some(last) if last.segment == dof => capsules
             .iter()
             .position(|c| c.chain_index == last.chain_index)
             .expect("the last capsule is in the list"),

@@ -29,9 +29,9 @@ fn gradients(robot: &Robot, q: &JointVector, d: &Vec3, n: &Vec3) -> [JointVector
 
 fn basis_at(robot: &Robot, q: &JointVector, d: &Vec3, n: &Vec3) -> (NullSpaceBasis, TaskBasis) {
     let kin = robot.forward(q);
-    let null = null_space_basis(kin.jacobian());
+    let null = null_space_basis(&kin);
     let [g0, g1, g2] = gradients(robot, q, d, n);
-    let basis = task_aligned_basis(kin.jacobian(), [&g0, &g1, &g2], &BasisConfig::default());
+    let basis = task_aligned_basis(&kin, [&g0, &g1, &g2], &BasisConfig::default());
     (null, basis)
 }
 
@@ -44,7 +44,7 @@ fn null_space_basis_is_orthonormal_and_annihilated_by_the_jacobian() {
         let q = random_q(&mut rng, &robot);
         let kin = robot.forward(&q);
         let j = kin.jacobian();
-        let null = null_space_basis(j);
+        let null = null_space_basis(&kin);
         worst_orth = worst_orth.max((null.transpose() * null - Identity4::identity()).amax());
         worst_null = worst_null.max((j * null).amax());
         // Same space as the right singular vectors of the zero singular values: the projector
@@ -163,7 +163,7 @@ fn task_aligned_basis_is_continuous_in_q() {
         // Where every projected gradient keeps ≥ 10 % of its norm in the null space, the
         // Gram–Schmidt sequence is well conditioned and every column moves less than 1e-3.
         let kin = robot.forward(&q);
-        let null = null_space_basis(kin.jacobian());
+        let null = null_space_basis(&kin);
         let conditioned = gradients(&robot, &q, &d, &n)
             .iter()
             .all(|g| (null * (null.transpose() * g)).norm() >= 0.1 * g.norm());
@@ -236,10 +236,10 @@ fn zero_gradient_falls_back_to_a_null_space_column() {
         let d = random_unit(&mut rng);
         let n = random_unit(&mut rng);
         let kin = robot.forward(&q);
-        let null = null_space_basis(kin.jacobian());
+        let null = null_space_basis(&kin);
         let [_, g1, g2] = gradients(&robot, &q, &d, &n);
         let zero = JointVector::zeros();
-        let basis = task_aligned_basis(kin.jacobian(), [&zero, &g1, &g2], &BasisConfig::default());
+        let basis = task_aligned_basis(&kin, [&zero, &g1, &g2], &BasisConfig::default());
         assert!(basis.fallback[0], "a zero gradient must fall back");
         let b = basis.columns;
         assert!((b.transpose() * b - Identity4::identity()).amax() < 1e-10);
@@ -247,11 +247,7 @@ fn zero_gradient_falls_back_to_a_null_space_column() {
         assert!((b * b.transpose() - null * null.transpose()).amax() < 1e-9);
         // A gradient lying entirely in J's row space projects to zero in the null space too.
         let row_gradient: JointVector = kin.jacobian().transpose() * random_unit(&mut rng);
-        let basis = task_aligned_basis(
-            kin.jacobian(),
-            [&g1, &row_gradient, &g2],
-            &BasisConfig::default(),
-        );
+        let basis = task_aligned_basis(&kin, [&g1, &row_gradient, &g2], &BasisConfig::default());
         assert!(
             basis.fallback[1],
             "a gradient in the row space of J must fall back"

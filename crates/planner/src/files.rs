@@ -102,7 +102,7 @@ impl PlanFiles {
         joint_trajectory.push('\n');
         Ok(Self {
             json: file.to_json(),
-            csv: trajectory_csv(&trajectory.steps),
+            csv: trajectory_csv(&trajectory.steps, robot.dof()),
             timing: joint.timing.clone(),
             joint_trajectory,
         })

@@ -350,7 +350,7 @@ impl Scan<'_> {
             let limits = robot.limits();
             let starts: Vec<JointVector> = (0..config.restarts)
                 .map(|_| {
-                    JointVector::from_fn(|i, _| {
+                    robot.configuration_from_fn(|i| {
                         let u: f64 = rng.random();
                         limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
                     })

@@ -6,7 +6,7 @@ use std::str::FromStr;
 use emg_control::{ConstraintConfig, SEED_POSITION_TOLERANCE_M, Task, tool_angle_deg};
 use emg_diffusion::{DpSeedError, DpSeeder, SeedOrigin, SeedWorkspace};
 use emg_kinematics::{
-    DOF, JointVector, PoseTarget, ProjectionConfig, ProjectionError, Robot, project_to_pose,
+    JointVector, MAX_DOF, PoseTarget, ProjectionConfig, ProjectionError, Robot, project_to_pose,
 };
 use emg_seeding::{HeuristicConfig, HeuristicObjective, heuristic_seed};
 
@@ -70,7 +70,7 @@ impl FromStr for SeedSource {
             "q_jl" => Ok(Self::QJl),
             _ => match s.strip_prefix("q=") {
                 Some(values) => {
-                    let q: [f64; DOF] = crate::parse::numbers(values)?;
+                    let q: [f64; MAX_DOF] = crate::parse::numbers(values)?;
                     Ok(Self::Given(JointVector::from(q)))
                 }
                 None => Err(ParseError::Seed(s.to_string())),

@@ -37,6 +37,8 @@ pub enum TimingSetupError {
 pub struct MotionTiming {
     limits_file: String,
     assumed: bool,
+    /// The arm's joints (the entries of the limits a file records).
+    joints: usize,
     scaling: Scaling,
     request: TimingRequest,
 }
@@ -133,6 +135,7 @@ impl MotionTiming {
         Ok(Self {
             limits_file: origin.display().to_string(),
             assumed: false,
+            joints: robot.dof(),
             scaling,
             request,
         })
@@ -163,14 +166,15 @@ impl MotionTiming {
     /// The limits as a joint-trajectory file records them.
     pub fn record(&self) -> TimingLimits {
         let limits = &self.request.limits;
+        let joints = |values: &JointVector| values.as_slice()[..self.joints].to_vec();
         TimingLimits {
             joint_limits_file: self.limits_file.clone(),
             velocity_scaling: self.scaling.velocity,
             acceleration_scaling: self.scaling.acceleration,
             tool_speed_m_per_s: self.request.tool_speed_m_per_s,
-            max_velocity: limits.velocity.as_slice().to_vec(),
-            max_acceleration: limits.acceleration.as_slice().to_vec(),
-            max_jerk: limits.jerk.as_slice().to_vec(),
+            max_velocity: joints(&limits.velocity),
+            max_acceleration: joints(&limits.acceleration),
+            max_jerk: joints(&limits.jerk),
         }
     }
 }

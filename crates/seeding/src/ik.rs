@@ -40,7 +40,7 @@ fn restart_configuration(
     rng: &mut ChaCha8Rng,
 ) -> JointVector {
     let limits = robot.limits();
-    JointVector::from_fn(|i, _| {
+    robot.configuration_from_fn(|i| {
         let lower = limits.lower[i] + cfg.joint_margin_rad;
         let upper = limits.upper[i] - cfg.joint_margin_rad;
         let u: f64 = rng.random();

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use emg_kinematics::{DOF, JointVector};
+use emg_kinematics::{JointVector, MAX_DOF};
 use sha2::{Digest, Sha256};
 
 const MAGIC: &[u8; 8] = b"EMGLABEL";
@@ -18,7 +18,7 @@ const MAGIC: &[u8; 8] = b"EMGLABEL";
 pub const LABEL_FORMAT_VERSION: u32 = 1;
 const HEADER_BYTES: usize = 8 + 4 + 4 + 32 + 8 + 8;
 const RECORD_HEADER_BYTES: usize = 4 + 1;
-const LABEL_BYTES: usize = DOF * 8 + 4 + 4 + 4;
+const LABEL_BYTES: usize = MAX_DOF * 8 + 4 + 4 + 4;
 
 /// One labelled initial configuration of a task.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,6 +1,6 @@
 //! The tangent space of the self-motion family: motions that keep the pose `(p0, tool axis)`.
 
-use emg_kinematics::{DOF, JointVector, PoseTarget, Robot, pose_residual};
+use emg_kinematics::{JointVector, MAX_DOF, PoseTarget, Robot, pose_residual};
 use nalgebra::SMatrix;
 
 /// The orthogonal projector `P = I − Mᵀ(MMᵀ + εI)⁻¹M` onto the null space of the pose rows `M`
@@ -11,10 +11,10 @@ pub fn self_motion_projector(
     q: &JointVector,
     target: &PoseTarget,
     damping: f64,
-) -> SMatrix<f64, DOF, DOF> {
+) -> SMatrix<f64, MAX_DOF, MAX_DOF> {
     let (rows, _) = pose_residual(&robot.forward(q), target);
     let gram = rows * rows.transpose() + SMatrix::<f64, 6, 6>::identity() * damping;
-    let identity = SMatrix::<f64, DOF, DOF>::identity();
+    let identity = SMatrix::<f64, MAX_DOF, MAX_DOF>::identity();
     match gram.cholesky() {
         Some(c) => identity - rows.transpose() * c.solve(&rows),
         None => SMatrix::zeros(),

@@ -3,7 +3,7 @@
 //! at rest before the first and after the last sample, and the declared velocities and
 //! accelerations themselves.
 
-use emg_kinematics::{DOF, JointVector};
+use emg_kinematics::{JointVector, MAX_DOF};
 
 use crate::limits::DynamicLimits;
 
@@ -87,7 +87,7 @@ fn scan(
     }
     let mut check =
         |sample: usize, quantity: &'static str, value: &JointVector, limit: &JointVector| {
-            for j in 0..DOF {
+            for j in 0..MAX_DOF {
                 if value[j].abs() > limit[j]
                     && !visit(LimitBreach {
                         sample,

@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use emg_kinematics::{DOF, JointVector, Robot};
+use emg_kinematics::{JointVector, MAX_DOF, Robot};
 use serde::Deserialize;
 
 /// Acceleration limit (rad/s²) assumed for every joint of a robot whose vendor publishes none:
@@ -144,7 +144,7 @@ impl DynamicLimits {
             "default_velocity_scaling_factor: 1.0\ndefault_acceleration_scaling_factor: 1.0\n\
              joint_limits:\n",
         );
-        for (i, name) in robot.joint_names().iter().enumerate().take(DOF) {
+        for (i, name) in robot.joint_names().iter().enumerate().take(MAX_DOF) {
             text.push_str(&format!(
                 "  {name}:\n    has_velocity_limits: true\n    max_velocity: {:?}\n    \
                  has_acceleration_limits: true\n    max_acceleration: {:?}\n    \
@@ -180,12 +180,10 @@ impl DynamicLimits {
             field,
             problem,
         };
-        let mut limits = Self {
-            velocity: robot.limits().velocity,
-            acceleration: JointVector::zeros(),
-            jerk: JointVector::zeros(),
-        };
-        for (i, name) in robot.joint_names().iter().enumerate().take(DOF) {
+        // Every joint of the robot is read below; the assumed values stay only in the slots
+        // past an arm's joints, which never move.
+        let mut limits = Self::assumed(robot);
+        for (i, name) in robot.joint_names().iter().enumerate().take(MAX_DOF) {
             let entry = file.joint_limits.get(name).ok_or_else(|| {
                 field_error(
                     format!("joint_limits.{name}"),

@@ -11,7 +11,7 @@
 //! solved exactly: for fixed `x` the admissible `u` is an interval whose ends are linear in `x`,
 //! and the largest `x` is the smallest crossing of a lower end above an upper end.
 
-use emg_kinematics::{DOF, JointVector};
+use emg_kinematics::{JointVector, MAX_DOF};
 
 /// `|q'_j|` below this counts as zero: the acceleration constraint of joint `j` then bounds `x`
 /// alone (`|q''_j| x ≤ a_j`).
@@ -41,8 +41,8 @@ struct Bound {
 /// `(u, x)` and, as toppra's interpolation scheme does, at `s_{i+1}` on `(u, x + 2Δu)` (so the
 /// acceleration at both ends of the interval holds), each lower and upper bound a line in `x`.
 struct AccelerationBounds {
-    lower: [Bound; 2 * DOF],
-    upper: [Bound; 2 * DOF],
+    lower: [Bound; 2 * MAX_DOF],
+    upper: [Bound; 2 * MAX_DOF],
     count: usize,
     /// The largest `x` the constraints whose `u` coefficient is negligible allow.
     x_max: f64,
@@ -55,17 +55,17 @@ impl AccelerationBounds {
             lower: [Bound {
                 alpha: 0.0,
                 beta: 0.0,
-            }; 2 * DOF],
+            }; 2 * MAX_DOF],
             upper: [Bound {
                 alpha: 0.0,
                 beta: 0.0,
-            }; 2 * DOF],
+            }; 2 * MAX_DOF],
             count: 0,
             x_max: f64::INFINITY,
         };
         let delta = grid[i + 1].s - grid[i].s;
         let (here, next) = (&grid[i], &grid[i + 1]);
-        for j in 0..DOF {
+        for j in 0..MAX_DOF {
             // −a ≤ c_u u + c_x x ≤ a.
             bounds.push(here.dq[j], here.ddq[j], acceleration[j] * factor[i]);
             bounds.push(

@@ -3,18 +3,19 @@
 //! positions (the arm held at rest before the first and after the last sample), the declared
 //! velocities and accelerations, and their agreement with the positions.
 
-use crate::record::{JOINTS, Joints};
+use crate::record::Joints;
 use crate::replay::JointSamples;
 
-/// Joint velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits, base to tip.
+/// Joint velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits, one per joint of the
+/// arm, base to tip.
 #[derive(Clone, Debug, PartialEq)]
 pub struct JointDynamics {
     /// Largest joint speed.
-    pub velocity: Joints,
+    pub velocity: Vec<f64>,
     /// Largest joint acceleration.
-    pub acceleration: Joints,
+    pub acceleration: Vec<f64>,
     /// Largest joint jerk.
-    pub jerk: Joints,
+    pub jerk: Vec<f64>,
 }
 
 /// Relative slack on every velocity, acceleration and jerk limit (float rounding).
@@ -102,8 +103,9 @@ pub fn check_dynamics(
         ));
     };
     let n = samples.len();
+    let joints = limits.velocity.len();
     for (k, name) in [(0, "first"), (n - 1, "last")] {
-        for i in 0..JOINTS {
+        for i in 0..joints {
             if qd[k][i].abs() > REST_TOLERANCE || qdd[k][i].abs() > REST_TOLERANCE {
                 return Err(fail(
                     k,
@@ -119,11 +121,11 @@ pub fn check_dynamics(
             }
         }
     }
-    let mut peaks = [vec![0.0_f64; JOINTS], vec![0.0; JOINTS], vec![0.0; JOINTS]];
+    let mut peaks = [vec![0.0_f64; joints], vec![0.0; joints], vec![0.0; joints]];
     let names = ["velocity", "acceleration", "jerk"];
     let bounds = [&limits.velocity, &limits.acceleration, &limits.jerk];
     let mut limit = |k: usize, order: usize, what: &str, value: &Joints, rounding: f64| {
-        for i in 0..JOINTS {
+        for i in 0..joints {
             let fraction = value[i].abs() / bounds[order][i];
             peaks[order][i] = peaks[order][i].max(fraction);
             if value[i].abs() > bounds[order][i] * (1.0 + DYNAMICS_LIMIT_SLACK) + rounding {
@@ -170,7 +172,7 @@ pub fn check_dynamics(
     }
     for k in 1..n {
         let h = samples.time_s[k] - samples.time_s[k - 1];
-        for i in 0..JOINTS {
+        for i in 0..joints {
             let checks = [
                 (
                     samples.q[k][i] - samples.q[k - 1][i],
@@ -251,6 +253,7 @@ fn divided_difference(points: &[(f64, Joints)]) -> Joints {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::record::MAX_JOINTS;
 
     /// Every joint moving by `q(t) = c (1 − cos(ω t))²` over one period (ω = 2π): at rest, with
     /// zero acceleration, at both ends; sampled every `h` seconds with exact derivatives.
@@ -290,9 +293,9 @@ mod tests {
 
     fn limits(peaks: [f64; 3], factor: f64) -> JointDynamics {
         JointDynamics {
-            velocity: Joints::from_element(peaks[0] * factor),
-            acceleration: Joints::from_element(peaks[1] * factor),
-            jerk: Joints::from_element(peaks[2] * factor),
+            velocity: vec![peaks[0] * factor; MAX_JOINTS],
+            acceleration: vec![peaks[1] * factor; MAX_JOINTS],
+            jerk: vec![peaks[2] * factor; MAX_JOINTS],
         }
     }
 

@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Matrix4, Rotation3, Unit, Vector3, Vector4};
 
-use crate::record::{Bounds, JOINTS, Joints, Line, Solid};
+use crate::record::{Bounds, Joints, Line, MAX_JOINTS, MIN_JOINTS, Solid};
 
 /// The position range (rad) the planners give a `continuous` joint, as documented: a full turn
 /// each way of zero.
@@ -97,7 +97,7 @@ pub enum ModelError {
         problem: String,
     },
     /// The chain does not have the supported number of revolute joints.
-    #[error("the chain has {0} revolute joints, expected {JOINTS}")]
+    #[error("the chain has {0} revolute joints, expected {MIN_JOINTS} or {MAX_JOINTS}")]
     JointCount(usize),
 }
 
@@ -211,7 +211,7 @@ impl ReferenceModel {
             capsules.extend(merge_sphere_caps(name, elements)?);
         }
         let revolute = joints.iter().filter(|j| j.axis.is_some()).count();
-        if revolute != JOINTS {
+        if !(MIN_JOINTS..=MAX_JOINTS).contains(&revolute) {
             return Err(ModelError::JointCount(revolute));
         }
         // Link i + 1 is the child of joint i: the links from the last revolute joint's child on

@@ -3,11 +3,15 @@
 
 use nalgebra::{Matrix3, SVector, Vector3};
 
-/// Number of revolute joints of every arm the checker verifies.
-pub const JOINTS: usize = 7;
+/// Most revolute joints of an arm the checker verifies.
+pub const MAX_JOINTS: usize = 7;
 
-/// A joint configuration or joint velocity, one value per revolute joint, base to tip.
-pub type Joints = SVector<f64, JOINTS>;
+/// Fewest revolute joints of an arm the checker verifies.
+pub const MIN_JOINTS: usize = 6;
+
+/// A joint configuration or joint velocity, one value per revolute joint, base to tip; an arm of
+/// six joints leaves the last entry zero.
+pub type Joints = SVector<f64, MAX_JOINTS>;
 
 /// The task line: start `p0`, unit direction `d`, unit normal `n` (the tool axis must stay near
 /// it); on a path task, also the path's pieces from `p0` (`d` then is its tangent at the start).

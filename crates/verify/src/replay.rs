@@ -4,7 +4,7 @@
 use crate::check::FailedCheck;
 use crate::dynamics::{DynamicsCheck, DynamicsReport, JointDynamics, check_dynamics};
 use crate::model::{ReferenceModel, angle_deg, within};
-use crate::record::{Bounds, Ending, JOINTS, Joints, Line, RecordedStep, Recording};
+use crate::record::{Bounds, Ending, Joints, Line, RecordedStep, Recording};
 
 /// Relative slack when comparing a declared velocity with its limit (float rounding).
 pub const VELOCITY_LIMIT_SLACK: f64 = 1e-9;
@@ -94,8 +94,8 @@ pub fn point_velocities(time_s: &[f64], q: &[Joints]) -> Vec<Joints> {
 
 /// Per joint, `max_k |q̇_{k+1,i} − q̇_{k,i}| / (t_{k+1} − t_k)` over consecutive timed points
 /// (zeros for a single point).
-fn peak_accelerations(time_s: &[f64], velocities: &[Joints]) -> Vec<f64> {
-    let mut peak = vec![0.0_f64; JOINTS];
+fn peak_accelerations(time_s: &[f64], velocities: &[Joints], joints: usize) -> Vec<f64> {
+    let mut peak = vec![0.0_f64; joints];
     for k in 1..velocities.len() {
         let gap = time_s[k] - time_s[k - 1];
         for (i, peak) in peak.iter_mut().enumerate() {
@@ -284,7 +284,7 @@ pub fn check_replay(
         let rule = point_velocities(&samples.time_s, &samples.q);
         let mut worst = 0.0_f64;
         for (k, (qd, expected)) in declared.iter().zip(&rule).enumerate() {
-            for i in 0..JOINTS {
+            for i in 0..v_max.len() {
                 if let Some(f) = bounds.velocity_limit_fraction
                     && !within(qd[i].abs(), f * v_max[i] * (1.0 + VELOCITY_LIMIT_SLACK))
                 {
@@ -342,7 +342,7 @@ pub fn check_replay(
         None => None,
     };
 
-    let mut peak_speed_fraction = vec![0.0_f64; JOINTS];
+    let mut peak_speed_fraction = vec![0.0_f64; v_max.len()];
     for k in 1..samples.len() {
         let gap = samples.time_s[k] - samples.time_s[k - 1];
         for (i, peak) in peak_speed_fraction.iter_mut().enumerate() {
@@ -354,9 +354,9 @@ pub fn check_replay(
         Some(declared) => declared.clone(),
         None => point_velocities(&samples.time_s, &samples.q),
     };
-    let peak_acceleration_rad_s2 = peak_accelerations(&samples.time_s, &velocities);
+    let peak_acceleration_rad_s2 = peak_accelerations(&samples.time_s, &velocities, v_max.len());
     let fastest_joint = |qd: &Joints| {
-        (0..JOINTS)
+        (0..v_max.len())
             .map(|i| qd[i].abs() / v_max[i])
             .fold(0.0, f64::max)
     };
@@ -427,13 +427,14 @@ mod tests {
         let peaks = peak_accelerations(
             &[0.0, 1.0, 3.0],
             &[velocity(1.0), velocity(2.0 / 3.0), velocity(0.5)],
+            7,
         );
         for peak in peaks {
             assert!((peak - 1.0 / 3.0).abs() < 1e-15, "{peak}");
         }
         assert_eq!(
-            peak_accelerations(&[0.0], &[velocity(1.0)]),
-            vec![0.0; JOINTS]
+            peak_accelerations(&[0.0], &[velocity(1.0)], 6),
+            vec![0.0; 6]
         );
     }
 }

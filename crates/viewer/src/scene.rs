@@ -1,7 +1,7 @@
 //! The data blob a page animates: world-frame geometry of every recorded step.
 
 use emg_control::{ActingController, StepRecord};
-use emg_kinematics::{DOF, Shape, Vec3, WorkSurface};
+use emg_kinematics::{MAX_DOF, Shape, Vec3, WorkSurface};
 use serde::Serialize;
 
 use crate::ViewerInput;
@@ -250,9 +250,9 @@ fn scene_step(input: &ViewerInput<'_>, step: &StepRecord, s_m: &mut f64) -> Scen
     let tcp = kin.tcp();
     let along = input.task.along(&tcp, *s_m);
     *s_m = along.s_m;
-    let mut joints = Vec::with_capacity(DOF + 2);
+    let mut joints = Vec::with_capacity(MAX_DOF + 2);
     joints.push(point(&kin.segment_point(0, &Vec3::zeros())));
-    joints.extend((0..DOF).map(|i| point(&kin.joint_origin(i))));
+    joints.extend((0..MAX_DOF).map(|i| point(&kin.joint_origin(i))));
     joints.push(point(&tcp));
     let capsules = input
         .robot
