@@ -231,7 +231,7 @@ fn dp_sweep(
     for &value in values {
         let mut dp = DpSeedConfig::default();
         apply(&mut dp, value);
-        let seeder = DpSeeder::new(&weights, dp.clone())?;
+        let seeder = DpSeeder::new(robot, &weights, dp.clone())?;
         let bar = progress::bar(tasks.len() as u64, "dp seeds");
         let seeds = pool.install(|| {
             tasks

@@ -57,7 +57,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let weights = DenoiserWeights::read(&args.weights)
         .with_context(|| format!("reading {}", args.weights.display()))?;
     let config = DpSeedConfig::default();
-    let seeder = DpSeeder::new(&weights, config.clone())?;
+    let seeder = DpSeeder::new(&robot, &weights, config.clone())?;
     let candidates =
         seeder.candidates(&robot, task, args.candidates, &mut SeedWorkspace::default())?;
     let rollout_config = RolloutConfig::default();

@@ -95,9 +95,11 @@ struct ModelCard<'a> {
 
 /// Runs `train-diffusion`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let run_config: RunConfig =
+    let mut run_config: RunConfig =
         workspace::read_config(args.config.as_deref(), "run configuration")?;
     let robot = workspace::load_robot(&args.robot)?;
+    // The denoiser's samples are the arm's joint configurations.
+    run_config.network.data_dim = robot.dof();
     let tasks = read_tasks(&args.tasks, &robot)
         .with_context(|| format!("reading {}", args.tasks.display()))?;
     let labels = LabelSet::read(&args.labels).with_context(|| {

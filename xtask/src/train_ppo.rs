@@ -91,9 +91,11 @@ struct ModelCard<'a> {
 
 /// Runs `train-ppo`.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let run_config: RunConfig =
+    let mut run_config: RunConfig =
         workspace::read_config(args.config.as_deref(), "run configuration")?;
     let robot = workspace::load_robot(&args.robot)?;
+    // The observation and action follow the arm's joints.
+    run_config.network.joints = robot.dof();
     let tasks = read_tasks(&args.tasks, &robot).with_context(|| {
         format!(
             "reading {} (create it with `cargo xtask make-tasks`)",

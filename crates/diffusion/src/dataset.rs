@@ -70,15 +70,16 @@ pub fn training_set(
         let condition = condition_of(task);
         for label in &entry.labels {
             conditions.extend_from_slice(&condition);
-            samples.extend(robot.limits().normalise(&label.q).iter().map(|v| *v as f32));
+            let normalised = robot.limits().normalise(&label.q);
+            samples.extend(robot.joints_of(&normalised).iter().map(|v| *v as f32));
         }
     }
-    let set = TrainingSet::new(conditions, samples, CONDITION_DIM, MAX_DOF, name)?;
+    let set = TrainingSet::new(conditions, samples, CONDITION_DIM, robot.dof(), name)?;
     if !has_mirror_symmetry(robot) {
         return Ok(set);
     }
     set.with_mirror(Mirror {
         condition_signs: MIRROR_CONDITION_SIGNS.to_vec(),
-        sample_signs: MIRROR_JOINT_SIGNS.to_vec(),
+        sample_signs: MIRROR_JOINT_SIGNS[..robot.dof()].to_vec(),
     })
 }

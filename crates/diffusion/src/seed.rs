@@ -4,7 +4,7 @@
 use std::time::{Duration, Instant};
 
 use emg_control::{ConstraintConfig, Task, first_violation};
-use emg_kinematics::{JointVector, MAX_DOF, PoseTarget, ProjectionConfig, Robot, project_to_pose};
+use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
 use emg_learning::StandardNormal;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -124,12 +124,20 @@ pub struct SeedWorkspace {
 pub struct DpSeeder {
     sampler: DdimSampler,
     config: DpSeedConfig,
+    /// Joints of the arm the weights were trained for (the sample dimension).
+    joints: usize,
 }
 
 impl DpSeeder {
-    /// A seeder over `weights` (which must map a 9-D task condition to a 7-D configuration).
-    pub fn new(weights: &DenoiserWeights, config: DpSeedConfig) -> Result<Self, DpSeedError> {
-        weights.require_dimensions(MAX_DOF, CONDITION_DIM)?;
+    /// A seeder for `robot` over `weights` (which must map a 9-D task condition to an
+    /// `n`-D configuration of its `n` joints).
+    pub fn new(
+        robot: &Robot,
+        weights: &DenoiserWeights,
+        config: DpSeedConfig,
+    ) -> Result<Self, DpSeedError> {
+        let joints = robot.dof();
+        weights.require_dimensions(joints, CONDITION_DIM)?;
         if config.max_tries == 0 {
             return Err(DpSeedError::Config {
                 field: "max_tries",
@@ -144,7 +152,11 @@ impl DpSeeder {
         }
         let sampler = DdimSampler::new(weights);
         sampler.validate(&config.sample)?;
-        Ok(Self { sampler, config })
+        Ok(Self {
+            sampler,
+            config,
+            joints,
+        })
     }
 
     /// The settings.
@@ -165,7 +177,7 @@ impl DpSeeder {
         self.sample_batch(task, count, &mut rng, workspace)?;
         Ok(workspace
             .candidates
-            .chunks_exact(MAX_DOF)
+            .chunks_exact(self.joints)
             .map(|x| denormalise(robot, x))
             .collect())
     }
@@ -200,7 +212,7 @@ impl DpSeeder {
             };
             let batch = wanted.min(self.config.max_tries - tries);
             self.sample_batch(task, batch, &mut rng, workspace)?;
-            for x in workspace.candidates.chunks_exact(MAX_DOF) {
+            for x in workspace.candidates.chunks_exact(self.joints) {
                 tries += 1;
                 let start = denormalise(robot, x);
                 let Ok((q, _)) = project_to_pose(robot, &start, &target, &self.config.projection)
@@ -247,7 +259,7 @@ impl DpSeeder {
         workspace.candidates.clear();
         workspace
             .candidates
-            .extend((0..count * MAX_DOF).map(|_| rng.sample::<f32, _>(StandardNormal)));
+            .extend((0..count * self.joints).map(|_| rng.sample::<f32, _>(StandardNormal)));
         let condition = condition_of(task);
         self.sampler.sample(
             &condition,

@@ -52,7 +52,7 @@ fn weights() -> DenoiserWeights {
 
 /// A seeder over `weights`; both seeders of a comparison share one set of weights, since Burn's
 /// random generator is process-wide and tests training in parallel would make two trainings differ.
-fn seeder(weights: &DenoiserWeights, first_batch: usize) -> DpSeeder {
+fn seeder(robot: &Robot, weights: &DenoiserWeights, first_batch: usize) -> DpSeeder {
     let config = DpSeedConfig {
         sample: SampleConfig {
             steps: 5,
@@ -61,7 +61,7 @@ fn seeder(weights: &DenoiserWeights, first_batch: usize) -> DpSeeder {
         first_batch,
         ..DpSeedConfig::default()
     };
-    DpSeeder::new(weights, config).unwrap()
+    DpSeeder::new(robot, weights, config).unwrap()
 }
 
 #[test]
@@ -69,7 +69,7 @@ fn seeds_are_valid_or_the_fallback_and_independent_of_batching() {
     let robot = robot();
     let constraints = RolloutConfig::default().constraints;
     let weights = weights();
-    let (one, all) = (seeder(&weights, 1), seeder(&weights, 32));
+    let (one, all) = (seeder(&robot, &weights, 1), seeder(&robot, &weights, 32));
     let mut workspace = SeedWorkspace::default();
     for task in tasks(&robot) {
         let seed = one
@@ -113,7 +113,7 @@ fn a_task_without_fallback_and_no_valid_candidate_is_a_clear_error() {
         },
         ..DpSeedConfig::default()
     };
-    let seeder = DpSeeder::new(&weights(), config).unwrap();
+    let seeder = DpSeeder::new(&robot, &weights(), config).unwrap();
     let error = seeder
         .seed(&robot, &task, &constraints, &mut SeedWorkspace::default())
         .unwrap_err();

@@ -5,7 +5,7 @@ use emg_control::{
     ClassicalController, RolloutConfig, Task, Trajectory, VelocityLimitFraction, rollout,
 };
 use emg_io::{
-    CSV_HEADER, FormatError, JointTrajectory, TimeFromStart, TimingLimits, read_csv, trajectory_csv,
+    FormatError, csv_header, JointTrajectory, TimeFromStart, TimingLimits, read_csv, trajectory_csv,
 };
 use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use emg_timing::{DynamicLimits, TimingRequest, time_motion};
@@ -175,8 +175,9 @@ fn time_from_start_splits_whole_seconds() {
 #[test]
 fn csv_round_trip_keeps_times_and_positions_bit_for_bit() {
     let (_, _, _, trajectory) = planned();
-    let text = trajectory_csv(&trajectory.steps);
-    assert!(text.starts_with(CSV_HEADER));
+    let text = trajectory_csv(&trajectory.steps, 7);
+    assert!(text.starts_with(&csv_header(7)));
+    assert!(text.starts_with("time_s,q1,q2,q3,q4,q5,q6,q7,qd1,"));
     let samples = read_csv(&text).unwrap();
     assert_eq!(samples.len(), trajectory.steps.len());
     for (k, step) in trajectory.steps.iter().enumerate() {
@@ -188,7 +189,7 @@ fn csv_round_trip_keeps_times_and_positions_bit_for_bit() {
     let rule = point_velocities(&samples.time_s, &samples.q);
     assert_eq!(samples.qd.as_ref().unwrap(), &rule);
     let row = text.lines().nth(1).unwrap();
-    assert_eq!(row.split(',').count(), CSV_HEADER.split(',').count());
+    assert_eq!(row.split(',').count(), csv_header(7).split(',').count());
     assert!(row.ends_with(",classical"));
 }
 
@@ -255,7 +256,7 @@ fn malformed_json_names_the_field() {
 #[test]
 fn malformed_csv_names_line_and_column() {
     let (_, _, _, trajectory) = planned();
-    let text = trajectory_csv(&trajectory.steps);
+    let text = trajectory_csv(&trajectory.steps, 7);
     let bad = text.replacen("0.0,", "zero,", 1);
     let e = read_csv(&bad).unwrap_err().to_string();
     assert_eq!(
@@ -339,7 +340,7 @@ fn files_are_told_apart_by_content_and_json_errors_give_their_position() {
     );
     // The CSV is recognised by its header.
     let (_, _, _, trajectory) = planned();
-    let csv = trajectory_csv(&trajectory.steps);
+    let csv = trajectory_csv(&trajectory.steps, 7);
     assert!(matches!(
         TrajectoryContents::parse(&csv),
         Ok(TrajectoryContents::Csv(_))

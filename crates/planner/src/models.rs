@@ -113,7 +113,7 @@ pub fn load_seeder(robot: &Robot, path: &Path) -> Result<DpSeeder, ModelsError> 
     })?;
     let file = path.display().to_string();
     check_stamp(weights.header().robot.as_ref(), &robot_stamp(robot), &file)?;
-    DpSeeder::new(&weights, DpSeedConfig::default()).map_err(|source| ModelsError::Seeder {
+    DpSeeder::new(robot, &weights, DpSeedConfig::default()).map_err(|source| ModelsError::Seeder {
         path: path.to_path_buf(),
         source,
     })

@@ -470,7 +470,7 @@ fn trajectory_files(robot: &Robot) -> Vec<Vec<u8>> {
     vec![
         file.to_json().into_bytes(),
         joint.to_json().into_bytes(),
-        trajectory_csv(&trajectory.steps).into_bytes(),
+        trajectory_csv(&trajectory.steps, 7).into_bytes(),
     ]
 }
 
@@ -578,7 +578,11 @@ fn diffusion_weights_are_read_or_refused() {
             };
             let stamp = weights.header().robot.as_ref();
             let _ = emg_learning::check_stamp(stamp, &robot_stamp(fr3()), "fuzzed");
-            let _ = emg_diffusion::DpSeeder::new(&weights, emg_diffusion::DpSeedConfig::default());
+            let _ = emg_diffusion::DpSeeder::new(
+                fr3(),
+                &weights,
+                emg_diffusion::DpSeedConfig::default(),
+            );
             true
         },
     );

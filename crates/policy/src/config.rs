@@ -10,12 +10,16 @@ pub struct NetworkConfig {
     /// Width of each hidden layer, input side first (the authors: three of 512; here two of 128,
     /// sized for two CPU cores).
     pub hidden: Vec<usize>,
+    /// Joints `n` of the arm (6 or 7), which size the observation and the action
+    /// ([`crate::PolicyDims`]); `cargo xtask train-ppo` sets it from the robot.
+    pub joints: usize,
 }
 
 impl Default for NetworkConfig {
     fn default() -> Self {
         Self {
             hidden: vec![128, 128],
+            joints: emg_kinematics::MAX_DOF,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! An allocation-free plain-Rust forward of the exported actor and critic: the batch-1 path
 //! used inside rollouts (training environments and the evaluated controller).
 
-use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
+use crate::observation::{ACTION_DIM, OBSERVATION_DIM, PolicyDims};
 use crate::weights::{PolicyWeights, layer_shapes};
 
 /// One dense layer `y = x W + b` with `W` stored `[in, out]` row-major.
@@ -65,9 +65,9 @@ pub struct PolicyScratch {
 /// What the actor outputs for one observation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ActorOutput {
-    /// Gaussian mean `μ` (before the tanh squash).
+    /// Gaussian mean `μ` (before the tanh squash); zero past the action's length.
     pub mean: [f32; ACTION_DIM],
-    /// Clamped log standard deviation.
+    /// Clamped log standard deviation; zero past the action's length.
     pub log_std: [f32; ACTION_DIM],
 }
 
@@ -81,6 +81,7 @@ impl ActorOutput {
 /// The actor and critic of exported [`PolicyWeights`] as plain `f32` loops (ReLU hidden layers).
 #[derive(Clone, Debug)]
 pub struct PlainPolicy {
+    dims: PolicyDims,
     actor: Vec<Layer>,
     mean: Layer,
     log_std: Layer,
@@ -125,6 +126,7 @@ impl PlainPolicy {
             .max()
             .unwrap_or(OBSERVATION_DIM);
         Self {
+            dims: PolicyDims::for_joints(header.network.joints),
             actor: layers,
             mean,
             log_std,
@@ -142,6 +144,11 @@ impl PlainPolicy {
         }
     }
 
+    /// The observation and action lengths the network reads and writes.
+    pub fn dims(&self) -> PolicyDims {
+        self.dims
+    }
+
     /// Working memory for this network.
     pub fn scratch(&self) -> PolicyScratch {
         PolicyScratch {
@@ -150,7 +157,8 @@ impl PlainPolicy {
         }
     }
 
-    /// The Gaussian of `observation` (allocation-free).
+    /// The Gaussian of `observation` (allocation-free): its first [`PlainPolicy::dims`]
+    /// entries are read, and the output's entries past the action's are zero.
     pub fn actor(
         &self,
         observation: &[f32; OBSERVATION_DIM],
@@ -161,7 +169,7 @@ impl PlainPolicy {
         self.mean.forward(hidden, &mut output.mean);
         self.log_std.forward(hidden, &mut output.log_std);
         let (low, high) = self.log_std_range;
-        for s in &mut output.log_std {
+        for s in &mut output.log_std[..self.dims.action] {
             *s = s.clamp(low, high);
         }
         output

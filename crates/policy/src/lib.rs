@@ -19,7 +19,7 @@
 //! use emg_policy::{Backend, NetworkConfig, PpoConfig, RlController, Trainer};
 //! let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
 //! let robot = Robot::from_urdf_file(path, "link0", "pen_tip")?;
-//! let network = NetworkConfig { hidden: vec![8] };
+//! let network = NetworkConfig { hidden: vec![8], ..NetworkConfig::default() };
 //! let trainer = Trainer::new(network, PpoConfig::default(), Backend::Flex)?;
 //! let mut controller = RlController::new(&trainer.weights());
 //! let seed = robot.mid_range();
@@ -53,7 +53,7 @@ pub use env::{ArmEnvironment, TrainingPool};
 pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
 #[cfg(feature = "train")]
 pub use network::{ActorCritic, PolicyOutput, Trunk};
-pub use observation::{ACTION_DIM, OBSERVATION_DIM, observe};
+pub use observation::{ACTION_DIM, OBSERVATION_DIM, PolicyDims, observe};
 #[cfg(feature = "train")]
 pub use ppo::{IterationLog, IterationTiming, Trainer};
 pub use vec_env::{Environment, EpisodeEnd, MAX_ENVS, Rollout, Transition, VecEnv, VecEnvSnapshot};

@@ -10,7 +10,7 @@ use burn::tensor::activation::relu;
 use burn::tensor::{Device, Tensor};
 
 use crate::config::NetworkConfig;
-use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
+use crate::observation::PolicyDims;
 
 /// A ReLU MLP trunk: `input → hidden[0] → … → hidden[last]`, ReLU after every layer.
 #[derive(Module, Debug)]
@@ -67,12 +67,13 @@ impl ActorCritic {
     /// 0.01 in the actor heads, 1 in the value head; zero biases except the log-std head's
     /// `log_std_bias`). Seed the device first for reproducible weights.
     pub fn new(config: &NetworkConfig, log_std_bias: f64, device: &Device) -> Self {
-        let last = config.hidden.last().copied().unwrap_or(OBSERVATION_DIM);
+        let dims = PolicyDims::for_joints(config.joints);
+        let last = config.hidden.last().copied().unwrap_or(dims.observation);
         Self {
-            actor: Trunk::new(OBSERVATION_DIM, &config.hidden, device),
-            mean: orthogonal_linear(last, ACTION_DIM, 0.01, 0.0, device),
-            log_std: orthogonal_linear(last, ACTION_DIM, 0.01, log_std_bias, device),
-            critic: Trunk::new(OBSERVATION_DIM, &config.hidden, device),
+            actor: Trunk::new(dims.observation, &config.hidden, device),
+            mean: orthogonal_linear(last, dims.action, 0.01, 0.0, device),
+            log_std: orthogonal_linear(last, dims.action, 0.01, log_std_bias, device),
+            critic: Trunk::new(dims.observation, &config.hidden, device),
             value: orthogonal_linear(last, 1, 1.0, 0.0, device),
         }
     }

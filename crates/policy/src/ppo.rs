@@ -24,7 +24,7 @@ use crate::advantage::{ReturnScaler, generalised_advantages};
 use crate::config::{Backend, NetworkConfig, PpoConfig};
 use crate::inference::PlainPolicy;
 use crate::network::ActorCritic;
-use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
+
 use crate::vec_env::{Environment, HALF_LN_TWO_PI, MAX_ENVS, Rollout, VecEnv, VecEnvSnapshot};
 use crate::weights::PolicyWeights;
 
@@ -361,12 +361,13 @@ impl Trainer {
         };
         let vector =
             |values: Vec<f32>| Tensor::from_data(TensorData::new(values, [b]), &self.device);
+        let dims = rollout.dims.expect("a collected rollout");
         Minibatch {
             observations: matrix(
-                rows(&rollout.observations, OBSERVATION_DIM),
-                OBSERVATION_DIM,
+                rows(&rollout.observations, dims.observation),
+                dims.observation,
             ),
-            samples: matrix(rows(&rollout.samples, ACTION_DIM), ACTION_DIM),
+            samples: matrix(rows(&rollout.samples, dims.action), dims.action),
             old_log_probs: vector(rows(&rollout.log_probs, 1)),
             old_values: vector(rows(&rollout.values, 1)),
             advantages: vector(advantages),

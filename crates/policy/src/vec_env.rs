@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::PolicyError;
 use crate::inference::PlainPolicy;
-use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
+use crate::observation::{ACTION_DIM, OBSERVATION_DIM, PolicyDims};
 
 /// How an episode ended at a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,7 +40,7 @@ pub trait Environment: Send {
     /// The current observation (after a truncation: the final state's).
     fn observe(&self, out: &mut [f32; OBSERVATION_DIM]);
 
-    /// Applies `action ∈ (−1, 1)⁴`.
+    /// Applies `action ∈ (−1, 1)ⁿ⁻³` (the entries past the action's length are zero).
     fn step(&mut self, action: &[f32; ACTION_DIM]) -> Transition;
 
     /// The environment's measure of the current episode so far (for the arm: path length, m).
@@ -55,9 +55,11 @@ pub(crate) const HALF_LN_TWO_PI: f32 = 0.918_938_5;
 pub struct Rollout {
     /// Steps per environment.
     pub steps: usize,
-    /// Observations, `[N·T, 31]`.
+    /// The policy's observation and action lengths (the rows below).
+    pub dims: Option<PolicyDims>,
+    /// Observations, `[N·T, observation length]`.
     pub observations: Vec<f32>,
-    /// Pre-squash Gaussian samples `u` (the action is `tanh(u)`), `[N·T, 4]`.
+    /// Pre-squash Gaussian samples `u` (the action is `tanh(u)`), `[N·T, action length]`.
     pub samples: Vec<f32>,
     /// Gaussian log-density of `u` under the sampling policy, `[N·T]`.
     pub log_probs: Vec<f32>,
@@ -76,11 +78,12 @@ pub struct Rollout {
 }
 
 impl Rollout {
-    fn resize(&mut self, envs: usize, steps: usize) {
+    fn resize(&mut self, envs: usize, steps: usize, dims: PolicyDims) {
         let n = envs * steps;
         self.steps = steps;
-        self.observations.resize(n * OBSERVATION_DIM, 0.0);
-        self.samples.resize(n * ACTION_DIM, 0.0);
+        self.dims = Some(dims);
+        self.observations.resize(n * dims.observation, 0.0);
+        self.samples.resize(n * dims.action, 0.0);
         self.log_probs.resize(n, 0.0);
         self.values.resize(n, 0.0);
         self.rewards.resize(n, 0.0);
@@ -225,12 +228,13 @@ impl<E: Environment> VecEnv<E> {
         steps: usize,
         rollout: &mut Rollout,
     ) {
-        rollout.resize(self.slots.len(), steps);
+        let dims = policy.dims();
+        rollout.resize(self.slots.len(), steps, dims);
         let finished: Vec<Vec<(f64, f64)>> = self
             .slots
             .par_iter_mut()
-            .zip(rollout.observations.par_chunks_mut(steps * OBSERVATION_DIM))
-            .zip(rollout.samples.par_chunks_mut(steps * ACTION_DIM))
+            .zip(rollout.observations.par_chunks_mut(steps * dims.observation))
+            .zip(rollout.samples.par_chunks_mut(steps * dims.action))
             .zip(rollout.log_probs.par_chunks_mut(steps))
             .zip(rollout.values.par_chunks_mut(steps))
             .zip(rollout.rewards.par_chunks_mut(steps))
@@ -254,19 +258,18 @@ impl<E: Environment> VecEnv<E> {
                     let mut rng = stream(seed, iteration + 1, i);
                     let mut finished = Vec::new();
                     for t in 0..steps {
-                        let observation: &mut [f32; OBSERVATION_DIM] = (&mut obs
-                            [t * OBSERVATION_DIM..(t + 1) * OBSERVATION_DIM])
-                            .try_into()
-                            .expect("observation row");
-                        slot.env.observe(observation);
-                        let output = policy.actor(observation, scratch);
-                        values[t] = policy.value(observation, scratch);
+                        let mut observation = [0.0; OBSERVATION_DIM];
+                        slot.env.observe(&mut observation);
+                        obs[t * dims.observation..(t + 1) * dims.observation]
+                            .copy_from_slice(&observation[..dims.observation]);
+                        let output = policy.actor(&observation, scratch);
+                        values[t] = policy.value(&observation, scratch);
                         let mut action = [0.0f32; ACTION_DIM];
                         let mut log_prob = 0.0;
-                        for k in 0..ACTION_DIM {
+                        for k in 0..dims.action {
                             let noise: f32 = rng.sample(StandardNormal);
                             let u = output.mean[k] + libm::expf(output.log_std[k]) * noise;
-                            samples[t * ACTION_DIM + k] = u;
+                            samples[t * dims.action + k] = u;
                             action[k] = libm::tanhf(u);
                             log_prob += -0.5 * noise * noise - output.log_std[k] - HALF_LN_TWO_PI;
                         }

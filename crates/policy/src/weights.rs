@@ -19,7 +19,8 @@ use serde::{Deserialize, Serialize};
 use crate::config::NetworkConfig;
 #[cfg(feature = "train")]
 use crate::network::ActorCritic;
-use crate::observation::{ACTION_DIM, OBSERVATION_DIM};
+use crate::observation::PolicyDims;
+use emg_kinematics::{MAX_DOF, MIN_DOF};
 
 const MAGIC: &[u8; 8] = b"EMGPPOWT";
 
@@ -32,9 +33,9 @@ pub const WEIGHTS_FORMAT_VERSION: u32 = 1;
 pub struct WeightsHeader {
     /// Hidden layer widths of the actor and the critic.
     pub network: NetworkConfig,
-    /// Observation length the network reads (31).
+    /// Observation length the network reads (`3n + 10`: 31 for seven joints).
     pub observation_dim: usize,
-    /// Action length the network writes (4).
+    /// Action length the network writes (`n − 3`: 4 for seven joints).
     pub action_dim: usize,
     /// Clamp range of the log standard deviation, `[min, max]`.
     pub log_std_range: [f64; 2],
@@ -79,17 +80,18 @@ pub enum WeightsError {
 /// `(inputs, outputs)` of every linear layer in file order: actor hidden layers, mean head,
 /// log-std head, critic hidden layers, value head.
 pub fn layer_shapes(network: &NetworkConfig) -> Vec<(usize, usize)> {
+    let dims = PolicyDims::for_joints(network.joints);
     let trunk = || {
-        let mut width = OBSERVATION_DIM;
+        let mut width = dims.observation;
         network.hidden.iter().map(move |&next| {
             let shape = (width, next);
             width = next;
             shape
         })
     };
-    let last = network.hidden.last().copied().unwrap_or(OBSERVATION_DIM);
+    let last = network.hidden.last().copied().unwrap_or(dims.observation);
     trunk()
-        .chain([(last, ACTION_DIM), (last, ACTION_DIM)])
+        .chain([(last, dims.action), (last, dims.action)])
         .chain(trunk())
         .chain([(last, 1)])
         .collect()
@@ -109,9 +111,16 @@ pub struct PolicyWeights {
 impl PolicyWeights {
     /// Weights from a header and values, checked for shape and finiteness.
     pub fn new(header: WeightsHeader, values: Vec<f32>) -> Result<Self, WeightsError> {
+        let joints = header.network.joints;
+        if !(MIN_DOF..=MAX_DOF).contains(&joints) {
+            return Err(WeightsError::Format(ContainerError::BadHeader(format!(
+                "network.joints is {joints}; arms of {MIN_DOF} or {MAX_DOF} joints are supported"
+            ))));
+        }
+        let dims = PolicyDims::for_joints(joints);
         for (field, expected, found) in [
-            ("observation_dim", OBSERVATION_DIM, header.observation_dim),
-            ("action_dim", ACTION_DIM, header.action_dim),
+            ("observation_dim", dims.observation, header.observation_dim),
+            ("action_dim", dims.action, header.action_dim),
         ] {
             if expected != found {
                 return Err(WeightsError::ShapeMismatch {
@@ -164,8 +173,8 @@ impl PolicyWeights {
         Self {
             header: WeightsHeader {
                 network: network.clone(),
-                observation_dim: OBSERVATION_DIM,
-                action_dim: ACTION_DIM,
+                observation_dim: PolicyDims::for_joints(network.joints).observation,
+                action_dim: PolicyDims::for_joints(network.joints).action,
                 log_std_range: [log_std_range.0, log_std_range.1],
                 env_steps,
 

@@ -62,6 +62,7 @@ fn a_short_run_raises_the_mean_return_above_the_untrained_policy() {
     let tasks = common::tasks(&robot, 8);
     let network = NetworkConfig {
         hidden: vec![32, 32],
+        ..NetworkConfig::default()
     };
     let mut trainer = Trainer::new(network, small_ppo(40), Backend::Flex).unwrap();
     let untrained = mean_return(&robot, &tasks, &trainer.weights());
@@ -82,7 +83,10 @@ fn a_short_run_raises_the_mean_return_above_the_untrained_policy() {
 fn a_resumed_run_continues_the_same_curve() {
     let robot = common::robot();
     let pool = pool(&robot, 6);
-    let network = NetworkConfig { hidden: vec![16] };
+    let network = NetworkConfig {
+        hidden: vec![16],
+        ..NetworkConfig::default()
+    };
     let ppo = small_ppo(4);
 
     let mut straight = Trainer::new(network.clone(), ppo.clone(), Backend::Flex).unwrap();

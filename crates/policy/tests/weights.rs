@@ -16,6 +16,7 @@ fn trained_weights(backend: Backend) -> PolicyWeights {
     Trainer::new(
         NetworkConfig {
             hidden: vec![24, 16],
+            ..NetworkConfig::default()
         },
         ppo,
         backend,

@@ -328,11 +328,12 @@ mod tests {
         let (motion, peaks) = samples(1e-3, 0.1);
         for (order, name) in ["velocity", "acceleration", "jerk"].iter().enumerate() {
             let mut tight = limits(peaks, 1.0);
-            match order {
-                0 => tight.velocity *= 0.9,
-                1 => tight.acceleration *= 0.7,
-                _ => tight.jerk *= 0.2,
-            }
+            let (limit, factor) = match order {
+                0 => (&mut tight.velocity, 0.9),
+                1 => (&mut tight.acceleration, 0.7),
+                _ => (&mut tight.jerk, 0.2),
+            };
+            limit.iter_mut().for_each(|value| *value *= factor);
             let failure = check_dynamics(&motion, &tight).unwrap_err();
             assert!(
                 matches!(failure.check, DynamicsCheck::Limit { joint: 1 }),
