@@ -14,7 +14,8 @@ __version__: str
 
 PathLike = Union[str, "os.PathLike[str]"]
 Vector3 = Sequence[float]
-Vector7 = Sequence[float]
+# One angle (rad) per joint of the arm.
+JointAngles = Sequence[float]
 FloatArray = npt.NDArray[np.float64]
 
 class Error(Exception):
@@ -30,7 +31,8 @@ class CheckFailed(Error):
     """A trajectory file that does not hold up under the independent checker."""
 
 class Robot:
-    """A 7-DoF serial arm from a robot file: ``Robot("fr3")``, ``Robot("iiwa14")`` or ``Robot(path)``."""
+    """An arm of six or seven revolute joints from a robot file: ``Robot("fr3")``,
+    ``Robot("iiwa14")``, ``Robot("ur5e")`` or ``Robot(path)``."""
 
     def __init__(self, robot: PathLike = "fr3") -> None: ...
     @property
@@ -41,20 +43,23 @@ class Robot:
         """The robot's name in its file."""
     @property
     def joint_names(self) -> list[str]:
-        """Names of the seven joints, base to tip (the order of every ``q``)."""
+        """Names of the arm's n joints (6 or 7), base to tip (the order of every ``q``)."""
+    @property
+    def dof(self) -> int:
+        """Number of joints n (6 or 7)."""
     @property
     def lower_limits(self) -> FloatArray:
-        """Lower joint limits (rad), shape (7,)."""
+        """Lower joint limits (rad), shape (n,)."""
     @property
     def upper_limits(self) -> FloatArray:
-        """Upper joint limits (rad), shape (7,)."""
+        """Upper joint limits (rad), shape (n,)."""
     @property
     def velocity_limits(self) -> FloatArray:
-        """Joint velocity limits (rad/s), shape (7,)."""
-    def fk(self, q: Vector7) -> FloatArray:
+        """Joint velocity limits (rad/s), shape (n,)."""
+    def fk(self, q: JointAngles) -> FloatArray:
         """The tool-centre-point pose at ``q`` as a 4x4 homogeneous transform (base frame)."""
-    def jacobian(self, q: Vector7) -> FloatArray:
-        """The position Jacobian d(tcp)/dq at ``q``, shape (3, 7)."""
+    def jacobian(self, q: JointAngles) -> FloatArray:
+        """The position Jacobian d(tcp)/dq at ``q``, shape (3, n)."""
 
 class Task:
     """A task: move the tool from ``p0`` along ``d`` on the surface with normal ``n``."""
@@ -73,14 +78,14 @@ class Task:
         """The length of the task's path (m), or None for a line."""
     @property
     def q0_seed(self) -> Optional[FloatArray]:
-        """The configuration the task was generated from (rad), shape (7,), or None."""
+        """The configuration the task was generated from (rad), shape (n,), or None."""
 
 class Plan:
     """A planned task; arrays have one row per step, the seed first."""
 
     @property
     def q(self) -> FloatArray:
-        """Joint configurations (rad), shape (T, 7)."""
+        """Joint configurations (rad), shape (T, n)."""
     @property
     def t(self) -> FloatArray:
         """Times since the start (s), shape (T,)."""
@@ -104,7 +109,7 @@ class Plan:
         """Why the motion ended."""
     @property
     def seed(self) -> FloatArray:
-        """The seed configuration (rad), shape (7,)."""
+        """The seed configuration (rad), shape (n,)."""
     @property
     def seed_source(self) -> str:
         """Where the seed came from (dp, generating, home, given, q_mu, q_jl)."""
@@ -144,13 +149,13 @@ class Motion:
         """Sample times (s), shape (N,)."""
     @property
     def q(self) -> FloatArray:
-        """Joint positions (rad), shape (N, 7)."""
+        """Joint positions (rad), shape (N, n)."""
     @property
     def qd(self) -> FloatArray:
-        """Joint velocities (rad/s), shape (N, 7)."""
+        """Joint velocities (rad/s), shape (N, n)."""
     @property
     def qdd(self) -> FloatArray:
-        """Joint accelerations (rad/s²), shape (N, 7)."""
+        """Joint accelerations (rad/s²), shape (N, n)."""
     @property
     def duration_s(self) -> float:
         """Time from rest to rest (s)."""
@@ -165,7 +170,7 @@ class Motion:
         """The path parameter (m of TCP travel) at each waypoint, shape (K,)."""
     @property
     def waypoints(self) -> FloatArray:
-        """The waypoints of the path (rad), shape (K, 7): a natural cubic spline between rests."""
+        """The waypoints of the path (rad), shape (K, n): a natural cubic spline between rests."""
     @property
     def rest_knots(self) -> npt.NDArray[np.uint64]:
         """Indices of the knots where the motion rests inside the path (unblended corners), shape (R,)."""
@@ -174,12 +179,12 @@ class Motion:
         """The TOPP-RA grid along the path, shape (M,)."""
     @property
     def limits(self) -> dict[str, FloatArray]:
-        """The limits the samples hold: velocity, acceleration, jerk, shape (7,) each."""
+        """The limits the samples hold: velocity, acceleration, jerk, shape (n,) each."""
     @property
     def tool_speed(self) -> float:
         """The largest tool speed asked for (m/s)."""
 
-SeedArg = Union[Literal["dp", "generating", "home", "q_mu", "q_jl"], Vector7, None]
+SeedArg = Union[Literal["dp", "generating", "home", "q_mu", "q_jl"], JointAngles, None]
 ControllerArg = Literal["hybrid", "rl", "classical"]
 PlannerArg = Optional[Literal["controller", "search"]]
 TaskArg = Union[Task, Tuple[Vector3, Vector3, Vector3]]

@@ -190,7 +190,7 @@ fn draw(args: &Args, robot: &emg_kinematics::Robot, branches: &[Branch]) -> anyh
             .x_desc("joint-space arc length (rad)")
             .y_desc("q (rad)")
             .draw()?;
-        for joint in 0..7 {
+        for joint in 0..robot.dof() {
             let color = Palette99::pick(joint).to_rgba();
             chart
                 .draw_series(LineSeries::new(

@@ -84,7 +84,7 @@ struct TaskLimit {
     /// Where the limit's start came from.
     limit_seed: String,
     /// The limit's joint configurations, one per step (rad).
-    limit_q: Vec<[f64; 7]>,
+    limit_q: Vec<Vec<f64>>,
     /// The reachability bound (m): the scan's, raised to ℓ* where the limit went beyond it.
     bound_m: f64,
     /// Hybrid + DP, the paper's pipeline (m).
@@ -173,7 +173,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 index,
                 limit_m: limit.trajectory.path_length_m,
                 limit_seed: limit.seed.source.to_string(),
-                limit_q: limit.trajectory.steps.iter().map(|s| s.q.into()).collect(),
+                limit_q: limit
+                    .trajectory
+                    .steps
+                    .iter()
+                    .map(|s| planner.robot().joints_of(&s.q).to_vec())
+                    .collect(),
                 bound_m: planner.reach_of(task, &limit).reachable_m,
                 pipeline_m,
                 search_m,

@@ -59,6 +59,15 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "tasks-ur5e",
+        args: &["make-tasks", "--robot", "ur5e", "--train-count", "20000"],
+        writes: &[
+            "data/ur5e/tasks/eval-v1.tasks",
+            "data/ur5e/tasks/train-v1.tasks",
+            "data/ur5e/tasks/tasks-v1.manifest.json",
+        ],
+    },
+    Stage {
         name: "labels",
         args: &["label-seeds"],
         writes: &[
@@ -79,6 +88,16 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "labels-ur5e",
+        args: &["label-seeds", "--robot", "ur5e"],
+        writes: &[
+            "data/ur5e/labels/eval-v1.labels",
+            "data/ur5e/labels/eval-v1.manifest.json",
+            "data/ur5e/labels/train-v1.labels",
+            "data/ur5e/labels/train-v1.manifest.json",
+        ],
+    },
+    Stage {
         name: "diffusion",
         args: &["train-diffusion"],
         writes: &[
@@ -96,6 +115,16 @@ const STAGES: &[Stage] = &[
             "data/iiwa14/models/diffusion-v1.json",
             "docs/results/iiwa14/diffusion-training.csv",
             "docs/results/iiwa14/diffusion-training.svg",
+        ],
+    },
+    Stage {
+        name: "diffusion-ur5e",
+        args: &["train-diffusion", "--robot", "ur5e"],
+        writes: &[
+            "data/ur5e/models/diffusion-v1.weights",
+            "data/ur5e/models/diffusion-v1.json",
+            "docs/results/ur5e/diffusion-training.csv",
+            "docs/results/ur5e/diffusion-training.svg",
         ],
     },
     Stage {
@@ -121,6 +150,17 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "ppo-ur5e",
+        args: &["train-ppo", "--robot", "ur5e"],
+        writes: &[
+            "data/ur5e/models/ppo-v1.weights",
+            "data/ur5e/models/ppo-v1.json",
+            "docs/results/ur5e/ppo-training.md",
+            "docs/results/ur5e/ppo-learning-curve.csv",
+            "docs/results/ur5e/ppo-learning-curve.svg",
+        ],
+    },
+    Stage {
         name: "search-eval",
         args: &["search-eval"],
         writes: &[
@@ -139,6 +179,15 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "search-eval-ur5e",
+        args: &["search-eval", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/search.json",
+            "docs/results/ur5e/search.md",
+            "docs/figures/ur5e/search-budget.svg",
+        ],
+    },
+    Stage {
         name: "cartesian-eval",
         args: &["cartesian-eval"],
         writes: &["docs/results/cartesian.json", "docs/results/cartesian.md"],
@@ -149,6 +198,14 @@ const STAGES: &[Stage] = &[
         writes: &[
             "docs/results/iiwa14/cartesian.json",
             "docs/results/iiwa14/cartesian.md",
+        ],
+    },
+    Stage {
+        name: "cartesian-eval-ur5e",
+        args: &["cartesian-eval", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/cartesian.json",
+            "docs/results/ur5e/cartesian.md",
         ],
     },
     Stage {
@@ -165,6 +222,11 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "path-eval-ur5e",
+        args: &["path-eval", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/paths.json", "docs/results/ur5e/paths.md"],
+    },
+    Stage {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],
@@ -175,6 +237,14 @@ const STAGES: &[Stage] = &[
         writes: &[
             "docs/results/iiwa14/labels.json",
             "docs/results/iiwa14/labels.md",
+        ],
+    },
+    Stage {
+        name: "labels-report-ur5e",
+        args: &["label-seeds", "--report", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/labels.json",
+            "docs/results/ur5e/labels.md",
         ],
     },
     Stage {
@@ -189,6 +259,11 @@ const STAGES: &[Stage] = &[
             "docs/results/iiwa14/eval.json",
             "docs/results/iiwa14/eval.md",
         ],
+    },
+    Stage {
+        name: "eval-ur5e",
+        args: &["eval", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/eval.json", "docs/results/ur5e/eval.md"],
     },
     Stage {
         name: "eval-classical",
@@ -235,6 +310,14 @@ const STAGES: &[Stage] = &[
         writes: &[
             "docs/results/iiwa14/velocity-limits.json",
             "docs/results/iiwa14/velocity-limits.md",
+        ],
+    },
+    Stage {
+        name: "velocity-limits-ur5e",
+        args: &["eval", "--compare-velocity-limits", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/velocity-limits.json",
+            "docs/results/ur5e/velocity-limits.md",
         ],
     },
     Stage {
@@ -338,6 +421,15 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "timing-ur5e",
+        args: &["timing", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/timing.json",
+            "docs/results/ur5e/timing.md",
+            "docs/figures/ur5e/timing-durations.svg",
+        ],
+    },
+    Stage {
         name: "limit",
         args: &["limit"],
         writes: &[],
@@ -353,12 +445,22 @@ const STAGES: &[Stage] = &[
         writes: &[],
     },
     Stage {
+        name: "limit-ur5e",
+        args: &["limit", "--robot", "ur5e"],
+        writes: &[],
+    },
+    Stage {
         name: "limit-merge-iiwa14",
         args: &["limit", "--merge", "--robot", "iiwa14"],
         writes: &[
             "docs/results/iiwa14/limit.json",
             "docs/results/iiwa14/limit.md",
         ],
+    },
+    Stage {
+        name: "limit-merge-ur5e",
+        args: &["limit", "--merge", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/limit.json", "docs/results/ur5e/limit.md"],
     },
     Stage {
         name: "figure-dp-seeds",

@@ -394,7 +394,8 @@ fn json_task_files() {
         let m = format_error(read_tasks(&file.path, &robot));
         assert!(m.contains("speed"), "unknown key not named: {m}");
     }
-    // A missing field and a wrong length are reported as format errors naming the field.
+    // A missing field is reported as a format error naming the field; a seed of another
+    // length than the arm's joints as an error of its task naming the field and both counts.
     let mut missing = spec(p0, d, None);
     missing.as_object_mut().unwrap().remove("n");
     std::fs::write(&file.path, serde_json::json!([missing]).to_string()).unwrap();
@@ -402,7 +403,12 @@ fn json_task_files() {
     let mut short = spec(p0, d, None);
     short["q0_seed"] = serde_json::json!([0.0, 1.0]);
     std::fs::write(&file.path, serde_json::json!([short]).to_string()).unwrap();
-    format_error(read_tasks(&file.path, &robot));
+    let message = read_tasks(&file.path, &robot).unwrap_err().to_string();
+    assert!(
+        message.contains("task 0")
+            && message.contains("'q0_seed' has 2 values; the robot has 7 joints"),
+        "{message}"
+    );
     std::fs::write(&file.path, "not json").unwrap();
     format_error(read_tasks(&file.path, &robot));
 }

@@ -5,7 +5,7 @@ use emg_control::{
     ClassicalController, RolloutConfig, Task, Trajectory, VelocityLimitFraction, rollout,
 };
 use emg_io::{
-    FormatError, csv_header, JointTrajectory, TimeFromStart, TimingLimits, read_csv, trajectory_csv,
+    FormatError, JointTrajectory, TimeFromStart, TimingLimits, csv_header, read_csv, trajectory_csv,
 };
 use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use emg_timing::{DynamicLimits, TimingRequest, time_motion};
@@ -226,7 +226,17 @@ fn malformed_json_names_the_field() {
     let e = error(&|d| {
         d["joint_names"].as_array_mut().unwrap().pop();
     });
-    assert!(e.contains("'joint_names' has 6 entries, expected 7"), "{e}");
+    assert!(
+        e.contains("'limits.max_velocity'") && e.contains("expected 6 positive numbers"),
+        "{e}"
+    );
+    let e = error(&|d| {
+        d["joint_names"].as_array_mut().unwrap().truncate(5);
+    });
+    assert!(
+        e.contains("'joint_names' has 5 entries, expected 6 or 7"),
+        "{e}"
+    );
     let e = error(&|d| {
         d["points"][1]["positions"].as_array_mut().unwrap().pop();
     });

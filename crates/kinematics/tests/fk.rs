@@ -2,7 +2,8 @@
 //! home), and agreement with an independent modified (Craig) DH computation, written here from
 //! the SPEC's DH table, on 1,000 random configurations (TCP position, full TCP orientation and
 //! every joint axis line); `forward_into` over another configuration's kinematics gives exactly
-//! what `forward` gives.
+//! what `forward` gives. The six-joint UR5e file against Universal Robots' published standard DH
+//! parameters, written here independently.
 
 mod common;
 
@@ -174,4 +175,48 @@ fn segment_frames_are_consistent_with_joint_axes_and_points() {
             assert!((frame.rotation * Vec3::z() - kin.joint_axis(s - 1)).norm() < 1e-12);
         }
     }
+}
+
+/// Universal Robots' published standard DH parameters of the UR5e (m, rad).
+const UR5E_D: [f64; 6] = [0.1625, 0.0, 0.0, 0.1333, 0.0997, 0.0996];
+const UR5E_A: [f64; 6] = [0.0, -0.425, -0.3922, 0.0, 0.0, 0.0];
+const UR5E_ALPHA: [f64; 6] = [FRAC_PI_2, 0.0, 0.0, FRAC_PI_2, -FRAC_PI_2, 0.0];
+
+/// The flange pose of the UR5e at `q` by standard DH: `Rz(θ) Tz(d) Tx(a) Rx(α)` per joint.
+fn ur5e_dh_flange(q: &JointVector) -> Matrix4<f64> {
+    let mut pose = Matrix4::identity();
+    for i in 0..6 {
+        let (st, ct) = q[i].sin_cos();
+        let (sa, ca) = UR5E_ALPHA[i].sin_cos();
+        #[rustfmt::skip]
+        let link = Matrix4::new(
+            ct, -st * ca, st * sa, UR5E_A[i] * ct,
+            st, ct * ca, -ct * sa, UR5E_A[i] * st,
+            0.0, sa, ca, UR5E_D[i],
+            0.0, 0.0, 0.0, 1.0,
+        );
+        pose *= link;
+    }
+    pose
+}
+
+#[test]
+fn ur5e_matches_universal_robots_dh_parameters() {
+    let robot = common::ur5e();
+    assert_eq!(robot.dof(), 6);
+    let mut rng = rng(66);
+    let mut worst = 0.0f64;
+    for _ in 0..1000 {
+        let q = random_q(&mut rng, &robot);
+        assert_eq!(q[6], 0.0, "the absent seventh joint stays zero");
+        let flange = ur5e_dh_flange(&q);
+        let rotation: Matrix3<f64> = flange.fixed_view::<3, 3>(0, 0).into_owned();
+        let axis = rotation.column(2).into_owned();
+        let tip = flange.fixed_view::<3, 1>(0, 3).into_owned() + axis * PEN_FROM_FLANGE;
+        let kin = robot.forward(&q);
+        worst = worst
+            .max((kin.tcp() - tip).norm())
+            .max((kin.tool_axis() - axis).norm());
+    }
+    assert!(worst < 1e-12, "worst deviation from the DH model {worst:e}");
 }

@@ -2,7 +2,8 @@
 //! configurations: `N` orthonormal with `J·N ≈ 0` and spanning the SVD null space; `B`
 //! orthonormal, in the null space, spanning the same space as `N`, with its first three columns
 //! the Gram–Schmidt sequence of the projected gradients `[∇w_d, ∇(z·n), ∇(−mean q̄²)]`, a 4th
-//! column continuous under small perturbations of q, and the fallback path for a zero gradient.
+//! column continuous under small perturbations of q, and the fallback path for a zero gradient;
+//! on an arm of six joints (UR5e), three columns of each over its six joints, the rest zero.
 
 mod common;
 
@@ -23,7 +24,8 @@ fn gradients(robot: &Robot, q: &JointVector, d: &Vec3, n: &Vec3) -> [JointVector
     let (_, grad_wd) = directional_manipulability(&kin, &kin.jacobian_gram(), d, 1e-3);
     let grad_align = tool_alignment_gradient(&kin, n);
     let limits = robot.limits();
-    let grad_centre = -(2.0 / 7.0) * limits.normalise(q).component_div(&limits.half_range());
+    let grad_centre =
+        -(2.0 / robot.dof() as f64) * limits.normalise(q).component_div(&limits.half_range());
     [grad_wd, grad_align, grad_centre]
 }
 
@@ -256,5 +258,51 @@ fn zero_gradient_falls_back_to_a_null_space_column() {
         let b = basis.columns;
         assert!((b.transpose() * b - Identity4::identity()).amax() < 1e-10);
         assert!((kin.jacobian() * b).amax() < 1e-10);
+    }
+}
+
+#[test]
+fn a_six_joint_arm_has_three_basis_columns_over_its_own_joints() {
+    let robot = common::ur5e();
+    let mut rng = rng(60);
+    let identity3 = SMatrix::<f64, 3, 3>::identity();
+    for _ in 0..CONFIGS {
+        let q = random_q(&mut rng, &robot);
+        let (d, n) = (random_unit(&mut rng), random_unit(&mut rng));
+        let kin = robot.forward(&q);
+        let (null, basis) = basis_at(&robot, &q, &d, &n);
+        for b in [&null, &basis.columns] {
+            assert!(b.column(3).iter().all(|v| *v == 0.0), "fourth column {b}");
+            assert!(
+                b.row(6).iter().all(|v| *v == 0.0),
+                "seventh joint moves: {b}"
+            );
+            let active = b.fixed_view::<7, 3>(0, 0);
+            assert!((active.transpose() * active - identity3).amax() < 1e-12);
+            assert!((kin.jacobian() * active).amax() < 1e-12);
+        }
+        // Both span the null space of the 3×6 Jacobian (its SVD's last three right singular
+        // vectors): equal orthogonal projectors.
+        let jacobian6 = kin.jacobian().fixed_view::<3, 6>(0, 0).into_owned();
+        let gram = jacobian6.transpose() * jacobian6;
+        let eigen = gram.symmetric_eigen();
+        let mut order: Vec<usize> = (0..6).collect();
+        order.sort_by(|&a, &b| eigen.eigenvalues[a].total_cmp(&eigen.eigenvalues[b]));
+        let mut svd_projector = SMatrix::<f64, 6, 6>::zeros();
+        for &k in &order[..3] {
+            let v = eigen.eigenvectors.column(k);
+            svd_projector += v * v.transpose();
+        }
+        for b in [&null, &basis.columns] {
+            let active = b.fixed_view::<6, 3>(0, 0);
+            let projector = active * active.transpose();
+            assert!((projector - svd_projector).amax() < 1e-8);
+        }
+        // The first column follows the projected manipulability gradient unless it fell back.
+        if !basis.fallback[0] {
+            let [g0, _, _] = gradients(&robot, &q, &d, &n);
+            let projected = null * (null.transpose() * g0);
+            assert!((basis.columns.column(0) - projected.normalize()).norm() < 1e-9);
+        }
     }
 }

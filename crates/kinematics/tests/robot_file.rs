@@ -1,6 +1,6 @@
 //! Loading robot files: the shipped FR3 file's structure (joint names, limits), every load error
 //! (unreadable file, malformed XML, missing base/tip link, tip not below base, a branching
-//! chain, a loop of joints, a prismatic joint, six revolute joints, lower > upper, zero axis, bad
+//! chain, a loop of joints, a prismatic joint, five or eight revolute joints, lower > upper, zero axis, bad
 //! velocity, non-finite origins or capsules, unsupported geometry, a cylinder without its sphere
 //! caps) with a message naming the offending field or link; a capsule written as a cylinder plus
 //! two sphere caps reads back exactly as the `<capsule>` element it stands for; and the load-time axis alignment: joints given with a non-z axis and
@@ -175,26 +175,46 @@ fn continuous_joints_are_revolute_with_a_full_turn_each_way() {
 }
 
 #[test]
-fn six_revolute_joints_are_rejected() {
+fn five_or_eight_revolute_joints_are_rejected_six_accepted() {
     let text = edited(
         "<joint name=\"fr3_joint7\" type=\"revolute\">",
         "<joint name=\"fr3_joint7\" type=\"fixed\">",
     );
-    let (error, message) = error_message(load(&text));
+    let six = load(&text).expect("an arm of six joints loads");
+    assert_eq!(six.dof(), 6);
+    let five = text.replace(
+        "<joint name=\"fr3_joint6\" type=\"revolute\">",
+        "<joint name=\"fr3_joint6\" type=\"fixed\">",
+    );
+    let (error, message) = error_message(load(&five));
     assert!(
-        matches!(error, RobotError::WrongDof { found: 6, .. }),
+        matches!(error, RobotError::WrongDof { found: 5, .. }),
         "{error:?}"
     );
     assert!(
-        message.contains("6 revolute joints") && message.contains("pen_tip"),
+        message.contains("5 revolute joints")
+            && message.contains("arms of 6 or 7 are supported")
+            && message.contains("pen_tip")
+            && message.contains("null space"),
         "{message}"
     );
     // The same with a shorter chain of the shipped file.
-    let (error, _) = error_message(Robot::from_urdf_str(&robot_text(), "link0", "link6"));
+    let (error, _) = error_message(Robot::from_urdf_str(&robot_text(), "link0", "link5"));
     assert!(
-        matches!(error, RobotError::WrongDof { found: 6, .. }),
+        matches!(error, RobotError::WrongDof { found: 5, .. }),
         "{error:?}"
     );
+    let eight = edited(
+        "<joint name=\"fr3_flange\" type=\"fixed\">",
+        "<joint name=\"fr3_flange\" type=\"revolute\">\n    <axis xyz=\"0 0 1\"/>\n    \
+         <limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>",
+    );
+    let (error, message) = error_message(load(&eight));
+    assert!(
+        matches!(error, RobotError::WrongDof { found: 8, .. }),
+        "{error:?}"
+    );
+    assert!(message.contains("at most seven"), "{message}");
 }
 
 #[test]

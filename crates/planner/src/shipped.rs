@@ -34,7 +34,7 @@ impl DataDir {
         &self.0
     }
 
-    /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`) gives its file
+    /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) gives its file
     /// here, anything else is a path to a robot file.
     pub fn robot_file(&self, value: &str) -> PathBuf {
         ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(self))
@@ -58,8 +58,9 @@ pub struct ShippedRobot {
 }
 
 /// The shipped robots: the paper's Franka FR3 (whose data keep the top level of the data
-/// directory) and the KUKA LBR iiwa 14 R820 (`iiwa14/`), both holding the same pen.
-pub const SHIPPED_ROBOTS: [ShippedRobot; 2] = [
+/// directory), the KUKA LBR iiwa 14 R820 (`iiwa14/`) and the six-joint Universal Robots UR5e
+/// (`ur5e/`), all holding the same pen.
+pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
     ShippedRobot {
         name: "fr3",
         file: "fr3_pen.urdf",
@@ -69,6 +70,11 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 2] = [
         name: "iiwa14",
         file: "iiwa14_pen.urdf",
         data_subdir: "iiwa14",
+    },
+    ShippedRobot {
+        name: "ur5e",
+        file: "ur5e_pen.urdf",
+        data_subdir: "ur5e",
     },
 ];
 

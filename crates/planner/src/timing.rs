@@ -141,6 +141,11 @@ impl MotionTiming {
         })
     }
 
+    /// The arm's number of joints (the entries of every limit and sample that are its).
+    pub fn joints(&self) -> usize {
+        self.joints
+    }
+
     /// Whether the acceleration and jerk limits were assumed, no limits file being found.
     pub fn assumed(&self) -> bool {
         self.assumed

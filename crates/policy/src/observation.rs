@@ -52,7 +52,11 @@ pub fn observe(context: &StepContext<'_>, out: &mut [f32; OBSERVATION_DIM]) {
         .chain(z.iter().copied())
         .chain(std::iter::once(z.dot(&task.n)))
         .chain(cross.iter().copied())
-        .chain(context.previous_action.as_slice()[..joints - 3].iter().copied())
+        .chain(
+            context.previous_action.as_slice()[..joints - 3]
+                .iter()
+                .copied(),
+        )
         .chain(std::iter::repeat(0.0));
     for (slot, value) in out.iter_mut().zip(values) {
         *slot = value as f32;

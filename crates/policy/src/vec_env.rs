@@ -233,7 +233,11 @@ impl<E: Environment> VecEnv<E> {
         let finished: Vec<Vec<(f64, f64)>> = self
             .slots
             .par_iter_mut()
-            .zip(rollout.observations.par_chunks_mut(steps * dims.observation))
+            .zip(
+                rollout
+                    .observations
+                    .par_chunks_mut(steps * dims.observation),
+            )
             .zip(rollout.samples.par_chunks_mut(steps * dims.action))
             .zip(rollout.log_probs.par_chunks_mut(steps))
             .zip(rollout.values.par_chunks_mut(steps))

@@ -60,10 +60,15 @@ fn ppo_finds_the_optimum_of_a_bandit() {
         entropy_coefficient: 0.0,
         ..PpoConfig::default()
     };
-    let mut trainer = Trainer::new(NetworkConfig {
+    let mut trainer = Trainer::new(
+        NetworkConfig {
             hidden: vec![16],
             ..NetworkConfig::default()
-        }, ppo, Backend::Flex).unwrap();
+        },
+        ppo,
+        Backend::Flex,
+    )
+    .unwrap();
     let start = greedy_action(&trainer);
     assert!(
         start.iter().zip(OPTIMUM).any(|(a, b)| (a - b).abs() > 0.3),

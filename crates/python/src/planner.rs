@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use crate::robot::{Robot, joint_vector};
+use crate::robot::{Robot, joint_array, joint_rows, joint_vector};
 use crate::timing::{Motion, motion_timing};
 use crate::{InputError, PlanningError, data_dir, input_error, message};
 use emg_timing::Scaling;
@@ -43,6 +43,8 @@ pub struct Planner {
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct Task {
     inner: emg_control::Task,
+    /// Joints of the arm the task was validated for (the length of its `q0_seed`).
+    joints: usize,
 }
 
 /// A planned task: the seed it started from and the motion, every step holding every
@@ -65,6 +67,7 @@ struct Request {
 
 impl Request {
     fn parse(
+        robot: &emg_kinematics::Robot,
         models: &Models,
         seed: Option<&Bound<'_, PyAny>>,
         controller: Option<&str>,
@@ -77,13 +80,16 @@ impl Request {
                 Ok(name) => name
                     .parse::<SeedSource>()
                     .map_err(|e| input_error("seed", &e))?,
-                Err(_) => SeedSource::Given(joint_vector(value.extract::<[f64; 7]>().map_err(
-                    |_| {
-                        InputError::new_err(
-                            "seed: give a seed name (dp, generating, home, q_mu, q_jl) or 7 joint angles (rad)",
-                        )
-                    },
-                )?)),
+                Err(_) => {
+                    let angles = value.extract::<Vec<f64>>().map_err(|_| {
+                        InputError::new_err(format!(
+                            "seed: give a seed name (dp, generating, home, q_mu, q_jl) or {} \
+                             joint angles (rad)",
+                            robot.dof()
+                        ))
+                    })?;
+                    SeedSource::Given(joint_vector(robot, &angles, "seed")?)
+                }
             }),
         };
         let controller = match controller {
@@ -115,16 +121,14 @@ impl Planner {
         p0: [f64; 3],
         d: [f64; 3],
         n: [f64; 3],
-        q0_seed: Option<[f64; 7]>,
+        q0_seed: Option<Vec<f64>>,
     ) -> PyResult<emg_control::Task> {
-        emg_control::Task::new(
-            self.inner.robot(),
-            Vec3::from(p0),
-            Vec3::from(d),
-            Vec3::from(n),
-            q0_seed.map(joint_vector),
-        )
-        .map_err(|e| input_error("task", &e))
+        let robot = self.inner.robot();
+        let q0_seed = q0_seed
+            .map(|q| joint_vector(robot, &q, "q0_seed"))
+            .transpose()?;
+        emg_control::Task::new(robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), q0_seed)
+            .map_err(|e| input_error("task", &e))
     }
 
     /// One plan (and its reachability bound when asked), made without the GIL.
@@ -288,7 +292,7 @@ impl Planner {
 
     /// Plans the task `(p0, d, n)` (3 floats each, base frame).
     ///
-    /// `seed`: `"dp"`, `"generating"`, `"home"`, `"q_mu"`, `"q_jl"` or 7 joint angles (rad);
+    /// `seed`: `"dp"`, `"generating"`, `"home"`, `"q_mu"`, `"q_jl"` or n joint angles (rad);
     /// `None` picks `"dp"` when the seeder is loaded, else `"home"`. `controller`: `"hybrid"`,
     /// `"rl"` or `"classical"`; `None` picks `"hybrid"` when the policy is loaded, else
     /// `"classical"`. `planner`: `"search"` (the default, as `emg plan`: many starts within a
@@ -308,7 +312,14 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Plan> {
-        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
+        let request = Request::parse(
+            self.inner.robot(),
+            self.inner.models(),
+            seed,
+            controller,
+            planner,
+            reach,
+        )?;
         let task = self.task(p0, d, n, None)?;
         self.plan_task(py, task, &request)
     }
@@ -328,7 +339,14 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Plan> {
-        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
+        let request = Request::parse(
+            self.inner.robot(),
+            self.inner.models(),
+            seed,
+            controller,
+            planner,
+            reach,
+        )?;
         let path = if path.is_instance_of::<PyDict>() {
             let text: String = py
                 .import("json")?
@@ -359,14 +377,22 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Vec<Plan>> {
-        let request = Request::parse(self.inner.models(), seed, controller, planner, reach)?;
+        let request = Request::parse(
+            self.inner.robot(),
+            self.inner.models(),
+            seed,
+            controller,
+            planner,
+            reach,
+        )?;
         let mut parsed = Vec::new();
         for (index, item) in tasks.try_iter()?.enumerate() {
             let item = item?;
             let task = match item.cast::<Task>() {
                 Ok(task) => {
                     let task = &task.get().inner;
-                    let q0 = task.q0_seed.map(|q| std::array::from_fn(|i| q[i]));
+                    let robot = self.inner.robot();
+                    let q0 = task.q0_seed.map(|q| robot.joints_of(&q).to_vec());
                     self.task(task.p0.into(), task.d.into(), task.n.into(), q0)
                 }
                 Err(_) => match item.extract::<([f64; 3], [f64; 3], [f64; 3])>() {
@@ -420,16 +446,11 @@ fn trajectory(plan: &Plan) -> &Trajectory {
 
 #[pymethods]
 impl Plan {
-    /// Joint configurations (rad), shape (T, 7).
+    /// Joint configurations (rad), shape (T, n).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let steps = &trajectory(self).steps;
-        array2(
-            py,
-            steps
-                .iter()
-                .map(|s| std::array::from_fn::<f64, 7, _>(|i| s.q[i])),
-        )
+        joint_rows(py, self.planner.robot().dof(), steps.iter().map(|s| &s.q))
     }
 
     /// Times since the start (s), shape (T,).
@@ -480,10 +501,10 @@ impl Plan {
         trajectory(self).termination.to_string()
     }
 
-    /// The seed configuration the motion started from (rad), shape (7,).
+    /// The seed configuration the motion started from (rad), shape (n,).
     #[getter]
     fn seed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array1(py, self.plan.seed.q.iter().copied())
+        joint_array(py, self.planner.robot(), &self.plan.seed.q)
     }
 
     /// Where the seed came from (`dp`, `generating`, `home`, `given`, `q_mu`, `q_jl`).
@@ -503,6 +524,7 @@ impl Plan {
     fn task(&self) -> Task {
         Task {
             inner: self.task.clone(),
+            joints: self.planner.robot().dof(),
         }
     }
 
@@ -625,10 +647,12 @@ impl Task {
         self.inner.length_m()
     }
 
-    /// The configuration the task was generated from (rad), shape (7,), or `None`.
+    /// The configuration the task was generated from (rad), shape (n,), or `None`.
     #[getter]
     fn q0_seed<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        self.inner.q0_seed.map(|q| array1(py, q.iter().copied()))
+        self.inner
+            .q0_seed
+            .map(|q| array1(py, q.as_slice()[..self.joints].iter().copied()))
     }
 
     fn __repr__(&self) -> String {
@@ -650,5 +674,9 @@ pub fn load_tasks(path: PathBuf, robot: PathBuf) -> PyResult<Vec<Task>> {
     let robot = Robot::load(&robot)?;
     let tasks = emg_io::read_tasks(&path, &robot.inner)
         .map_err(|e| input_error(format!("task file {}", path.display()), &e))?;
-    Ok(tasks.into_iter().map(|inner| Task { inner }).collect())
+    let joints = robot.inner.dof();
+    Ok(tasks
+        .into_iter()
+        .map(|inner| Task { inner, joints })
+        .collect())
 }

@@ -10,8 +10,9 @@ use pyo3::prelude::*;
 
 use crate::{input_error, robot_file};
 
-/// A 7-DoF serial arm from a robot file: `Robot("fr3")`, `Robot("iiwa14")` or `Robot(path)`
-/// (the chain from the file's root link to its only leaf link).
+/// A serial arm of six or seven revolute joints from a robot file: `Robot("fr3")`,
+/// `Robot("iiwa14")`, `Robot("ur5e")` or `Robot(path)` (the chain from the file's root link to
+/// its only leaf link).
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct Robot {
     pub(crate) inner: Arc<emg_kinematics::Robot>,
@@ -31,9 +32,43 @@ impl Robot {
     }
 }
 
-/// A joint configuration from a sequence of 7 floats (rad).
-pub(crate) fn joint_vector(q: [f64; 7]) -> JointVector {
-    JointVector::from(q)
+/// The configuration of `robot` from `q`, one angle (rad) per joint; `field` names the argument
+/// in the error when the count is not the arm's.
+pub(crate) fn joint_vector(
+    robot: &emg_kinematics::Robot,
+    q: &[f64],
+    field: &str,
+) -> PyResult<JointVector> {
+    if q.len() != robot.dof() {
+        return Err(crate::InputError::new_err(format!(
+            "{field}: give {} joint angles (rad), one per joint of the arm; got {}",
+            robot.dof(),
+            q.len()
+        )));
+    }
+    Ok(robot.joint_vector(q))
+}
+
+/// The arm's `n` entries of `q` as an array, shape (n,).
+pub(crate) fn joint_array<'py>(
+    py: Python<'py>,
+    robot: &emg_kinematics::Robot,
+    q: &JointVector,
+) -> Bound<'py, PyArray1<f64>> {
+    vector(py, robot.joints_of(q).iter().copied())
+}
+
+/// Rows of the arm's `joints` entries of each vector, shape (len, joints).
+pub(crate) fn joint_rows<'py, 'q>(
+    py: Python<'py>,
+    joints: usize,
+    rows: impl ExactSizeIterator<Item = &'q JointVector>,
+) -> Bound<'py, PyArray2<f64>> {
+    let count = rows.len();
+    let flat: Vec<f64> = rows.flat_map(|q| q.as_slice()[..joints].to_vec()).collect();
+    Array2::from_shape_vec((count, joints), flat)
+        .expect("rows of the arm's joints")
+        .into_pyarray(py)
 }
 
 fn vector<'py>(
@@ -63,34 +98,40 @@ impl Robot {
         self.inner.name()
     }
 
-    /// Names of the seven joints, base to tip (the order of every `q`).
+    /// Names of the arm's `n` joints (6 or 7), base to tip (the order of every `q`).
     #[getter]
     fn joint_names(&self) -> Vec<String> {
         self.inner.joint_names().to_vec()
     }
 
-    /// Lower joint limits (rad), shape (7,).
+    /// Number of joints `n` (6 or 7).
+    #[getter]
+    fn dof(&self) -> usize {
+        self.inner.dof()
+    }
+
+    /// Lower joint limits (rad), shape (n,).
     #[getter]
     fn lower_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vector(py, self.inner.limits().lower.iter().copied())
+        joint_array(py, &self.inner, &self.inner.limits().lower)
     }
 
-    /// Upper joint limits (rad), shape (7,).
+    /// Upper joint limits (rad), shape (n,).
     #[getter]
     fn upper_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vector(py, self.inner.limits().upper.iter().copied())
+        joint_array(py, &self.inner, &self.inner.limits().upper)
     }
 
-    /// Joint velocity limits (rad/s), shape (7,).
+    /// Joint velocity limits (rad/s), shape (n,).
     #[getter]
     fn velocity_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vector(py, self.inner.limits().velocity.iter().copied())
+        joint_array(py, &self.inner, &self.inner.limits().velocity)
     }
 
-    /// The tool-centre-point pose at `q` (7 joint angles, rad) as a 4×4 homogeneous transform in
+    /// The tool-centre-point pose at `q` (n joint angles, rad) as a 4×4 homogeneous transform in
     /// the base frame (rotation columns: the TCP frame's axes; the tool axis is the third).
-    fn fk<'py>(&self, py: Python<'py>, q: [f64; 7]) -> Bound<'py, PyArray2<f64>> {
-        let kinematics = self.inner.forward(&joint_vector(q));
+    fn fk<'py>(&self, py: Python<'py>, q: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let kinematics = self.inner.forward(&joint_vector(&self.inner, &q, "q")?);
         let (rotation, tcp) = (kinematics.tcp_rotation(), kinematics.tcp());
         let mut pose = Array2::<f64>::eye(4);
         for row in 0..3 {
@@ -99,14 +140,19 @@ impl Robot {
             }
             pose[[row, 3]] = tcp[row];
         }
-        pose.into_pyarray(py)
+        Ok(pose.into_pyarray(py))
     }
 
-    /// The position Jacobian `∂tcp/∂q` at `q` (7 joint angles, rad), shape (3, 7).
-    fn jacobian<'py>(&self, py: Python<'py>, q: [f64; 7]) -> Bound<'py, PyArray2<f64>> {
-        let kinematics = self.inner.forward(&joint_vector(q));
+    /// The position Jacobian `∂tcp/∂q` at `q` (n joint angles, rad), shape (3, n).
+    fn jacobian<'py>(&self, py: Python<'py>, q: Vec<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let kinematics = self.inner.forward(&joint_vector(&self.inner, &q, "q")?);
         let jacobian = kinematics.jacobian();
-        Array2::from_shape_fn((3, 7), |(row, column)| jacobian[(row, column)]).into_pyarray(py)
+        Ok(
+            Array2::from_shape_fn((3, self.inner.dof()), |(row, column)| {
+                jacobian[(row, column)]
+            })
+            .into_pyarray(py),
+        )
     }
 
     fn __repr__(&self) -> String {

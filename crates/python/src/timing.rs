@@ -9,7 +9,8 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::input_error;
-use crate::planner::{array1, array2};
+use crate::planner::array1;
+use crate::robot::joint_rows;
 
 /// The timing the keyword arguments of `Plan.timed` and `Plan.save` ask for, for `planner`'s
 /// robot read from `robot_file`: `limits` a MoveIt joint_limits.yaml (default: the one beside
@@ -84,22 +85,34 @@ impl Motion {
         array1(py, self.motion.samples.iter().map(|s| s.time_s()))
     }
 
-    /// Joint positions (rad), shape (N, 7).
+    /// Joint positions (rad), shape (N, n).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array2(py, self.motion.samples.iter().map(|s| s.q.into()))
+        joint_rows(
+            py,
+            self.timing.joints(),
+            self.motion.samples.iter().map(|s| &s.q),
+        )
     }
 
-    /// Joint velocities (rad/s), shape (N, 7).
+    /// Joint velocities (rad/s), shape (N, n).
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array2(py, self.motion.samples.iter().map(|s| s.qd.into()))
+        joint_rows(
+            py,
+            self.timing.joints(),
+            self.motion.samples.iter().map(|s| &s.qd),
+        )
     }
 
-    /// Joint accelerations (rad/s²), shape (N, 7).
+    /// Joint accelerations (rad/s²), shape (N, n).
     #[getter]
     fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array2(py, self.motion.samples.iter().map(|s| s.qdd.into()))
+        joint_rows(
+            py,
+            self.timing.joints(),
+            self.motion.samples.iter().map(|s| &s.qdd),
+        )
     }
 
     /// Time from rest to rest (s).
@@ -128,12 +141,13 @@ impl Motion {
         array1(py, self.joined().0.into_iter().map(|(s, _)| s))
     }
 
-    /// The waypoints the path passes through at its knots (rad), shape (K, 7): between two
+    /// The waypoints the path passes through at its knots (rad), shape (K, n): between two
     /// rests (`rest_knots`, and the ends) the path is the natural cubic spline through them
     /// (`scipy.interpolate.CubicSpline(knots[a:b+1], waypoints[a:b+1], bc_type="natural")`).
     #[getter]
     fn waypoints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array2(py, self.joined().0.into_iter().map(|(_, q)| q.into()))
+        let waypoints: Vec<JointVector> = self.joined().0.into_iter().map(|(_, q)| q).collect();
+        joint_rows(py, self.timing.joints(), waypoints.iter())
     }
 
     /// Indices of the knots at which the motion rests inside the path (the corners a path task
@@ -150,20 +164,23 @@ impl Motion {
     }
 
     /// The joint limits the samples hold (after scaling, at most the robot file's velocity
-    /// limits): `{"velocity": (7,), "acceleration": (7,), "jerk": (7,)}`.
+    /// limits): `{"velocity": (n,), "acceleration": (n,), "jerk": (n,)}`.
     #[getter]
     fn limits<'py>(
         &self,
         py: Python<'py>,
     ) -> std::collections::BTreeMap<&'static str, Bound<'py, PyArray1<f64>>> {
         let limits = &self.timing.request().limits;
+        let joints = |values: &JointVector| {
+            array1(
+                py,
+                values.as_slice()[..self.timing.joints()].iter().copied(),
+            )
+        };
         [
-            ("velocity", array1(py, limits.velocity.iter().copied())),
-            (
-                "acceleration",
-                array1(py, limits.acceleration.iter().copied()),
-            ),
-            ("jerk", array1(py, limits.jerk.iter().copied())),
+            ("velocity", joints(&limits.velocity)),
+            ("acceleration", joints(&limits.acceleration)),
+            ("jerk", joints(&limits.jerk)),
         ]
         .into()
     }

@@ -252,7 +252,7 @@ fn scene_step(input: &ViewerInput<'_>, step: &StepRecord, s_m: &mut f64) -> Scen
     *s_m = along.s_m;
     let mut joints = Vec::with_capacity(MAX_DOF + 2);
     joints.push(point(&kin.segment_point(0, &Vec3::zeros())));
-    joints.extend((0..MAX_DOF).map(|i| point(&kin.joint_origin(i))));
+    joints.extend((0..input.robot.dof()).map(|i| point(&kin.joint_origin(i))));
     joints.push(point(&tcp));
     let capsules = input
         .robot

@@ -41,7 +41,22 @@ pub fn home() -> JointVector {
 /// A configuration drawn uniformly within the robot's joint limits.
 pub fn random_q(rng: &mut ChaCha8Rng, robot: &Robot) -> JointVector {
     let limits = robot.limits();
-    JointVector::from_fn(|i, _| rng.random_range(limits.lower[i]..limits.upper[i]))
+    robot.configuration_from_fn(|i| rng.random_range(limits.lower[i]..limits.upper[i]))
+}
+
+/// The six-joint UR5e-with-pen chain of the shipped robot file.
+pub fn ur5e() -> Robot {
+    Robot::from_urdf_file(
+        data_dir().join("robots/ur5e_pen.urdf"),
+        "base_link",
+        "pen_tip",
+    )
+    .expect("shipped UR5e file loads")
+}
+
+/// An arm of each supported joint count: the FR3 (seven) and the UR5e (six).
+pub fn arms() -> [Robot; 2] {
+    [robot(), ur5e()]
 }
 
 /// A direction drawn uniformly on the unit sphere.
