@@ -3,7 +3,9 @@
 //!   STL collision meshes behind `package://` paths (and its COLLADA visual meshes read in their
 //!   place fit about the same capsules);
 //! - the Franka Emika Panda of PyPI's `pybullet` (`pybullet_data`), OBJ collision meshes behind
-//!   `package://meshes/...` read beside the file as pybullet does, fingers on prismatic joints.
+//!   `package://meshes/...` read beside the file as pybullet does, fingers on prismatic joints;
+//! - the six-joint UFactory xArm 6 of the same package, OBJ collision meshes behind
+//!   `package://xarm_description/...`, under a fixed `world` link.
 //!
 //! Imported, each is read whole by urdfdom's `check_urdf`, comes with the SRDF of its
 //! self-collision rule and a joint_limits.yaml, plans more than 10 cm with the default command
@@ -246,6 +248,40 @@ fn collada_collisions(text: &str) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+#[test]
+fn pybullets_six_joint_xarm6_with_obj_meshes_plans_end_to_end() {
+    let Some(data) = package("EMG_PYBULLET_DATA", "xarm/xarm6_robot.urdf") else {
+        return;
+    };
+    let tmp = temp_dir("import-xarm6");
+    let dir = tmp.path();
+    end_to_end(
+        &data.join("xarm/xarm6_robot.urdf"),
+        &["--tool-link", "link6", "--pen-length", "0.2"],
+        "world",
+        dir,
+    );
+    // Every file names the arm's six joints and holds six values per joint vector.
+    let joint = read_json(&dir.join("x.joint_trajectory.json"));
+    let names: Vec<&str> = joint["joint_names"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        ["joint1", "joint2", "joint3", "joint4", "joint5", "joint6"]
+    );
+    assert_eq!(joint["points"][0]["positions"].as_array().unwrap().len(), 6);
+    let csv = read(&dir.join("x.csv"));
+    assert!(
+        csv.starts_with("time_s,q1,q2,q3,q4,q5,q6,qd1,qd2,qd3,qd4,qd5,qd6,tcp_x"),
+        "{}",
+        csv.lines().next().unwrap_or_default()
+    );
 }
 
 #[test]
