@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand};
 use emg_kinematics::WorkSurface;
 use emg_planner::{ControllerKind, PlannerKind, SeedSource};
 
-/// Extreme straight-line motion on a 7-DoF arm holding a pen.
+/// Extreme straight-line motion on an arm of six or seven joints holding a pen.
 #[derive(Debug, Parser)]
 #[command(name = "emg", version, about)]
 pub struct Cli {
@@ -78,7 +78,7 @@ pub struct CheckArgs {
     /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json` or `<stem>.csv`.
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// Robot: a shipped robot's name (`fr3`, `iiwa14`) or a robot file (URDF). Default: the
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) or a robot file (URDF). Default: the
     /// file's `robot` field (a JSON file, or the --task-from file for a CSV), else `fr3`.
     #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot)]
     pub robot: Option<PathBuf>,
@@ -146,8 +146,8 @@ pub struct TaskLineArgs {
 /// Options of `emg plan`.
 #[derive(Debug, Args)]
 pub struct PlanArgs {
-    /// Robot: a shipped robot's name (`fr3`, the default, or `iiwa14`) or a robot file (URDF)
-    /// of any 7-DoF serial arm.
+    /// Robot: a shipped robot's name (`fr3`, the default, `iiwa14` or `ur5e`) or a robot file
+    /// (URDF) of any serial arm of six or seven revolute joints.
     #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot,
           default_value = "fr3")]
     pub robot: PathBuf,

@@ -1,4 +1,4 @@
-//! `emg`: plan extreme straight-line motions for a 7-DoF arm holding a pen.
+//! `emg`: plan extreme straight-line motions for an arm of six or seven joints holding a pen.
 //!
 //! ```text
 //! emg plan                                   # built-in demo task → trajectory.json, trajectory.csv
@@ -7,9 +7,9 @@
 //! emg check runs/line.joint_trajectory.json  # verify a file with the independent checker
 //! ```
 //!
-//! * Robot: `--robot fr3` (the default), `--robot iiwa14`, or `--robot <urdf>` for any 7-DoF
-//!   serial arm; the chain runs from the file's root link to its only leaf unless `--base-link`
-//!   and `--tip-link` name its ends. A shipped robot brings its own trained models.
+//! * Robot: `--robot fr3` (the default), `--robot iiwa14`, `--robot ur5e`, or `--robot <urdf>`
+//!   for any serial arm of six or seven revolute joints; the chain runs from the file's root link
+//!   to its only leaf unless `--base-link` and `--tip-link` name its ends. A shipped robot brings its own trained models.
 //! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON or the binary
 //!   `EMGTASKS` set, told apart by the content), or nothing for the demo task: from the
 //!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n` (the

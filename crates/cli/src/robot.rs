@@ -1,4 +1,4 @@
-//! `--robot`: a shipped robot by name or any 7-DoF robot file, its chain ends, and the models
+//! `--robot`: a shipped robot by name or any robot file of six or seven joints, its chain ends, and the models
 //! shipped for it.
 
 use std::path::{Path, PathBuf};
@@ -19,7 +19,7 @@ pub fn default_robot() -> PathBuf {
     SHIPPED_ROBOTS[0].path(&data_dir())
 }
 
-/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`) gives its file, anything else is a
+/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) gives its file, anything else is a
 /// path to an existing robot file.
 pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
     let names: Vec<_> = SHIPPED_ROBOTS.iter().map(|r| r.name).collect();
