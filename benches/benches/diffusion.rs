@@ -14,7 +14,8 @@ fn benches(c: &mut Criterion) {
         .join("../data/models/diffusion-v1.weights");
     let weights =
         DenoiserWeights::read(&path).expect("shipped weights load (cargo xtask train-diffusion)");
-    let seeder = DpSeeder::new(&weights, DpSeedConfig::default()).expect("weights fit the seeder");
+    let seeder = DpSeeder::new(&fixture.robot, &weights, DpSeedConfig::default())
+        .expect("weights fit the seeder");
     let constraints = RolloutConfig::default().constraints;
     let mut workspace = SeedWorkspace::default();
     let mut next = 0;

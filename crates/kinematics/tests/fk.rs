@@ -186,8 +186,8 @@ const UR5E_ALPHA: [f64; 6] = [FRAC_PI_2, 0.0, 0.0, FRAC_PI_2, -FRAC_PI_2, 0.0];
 fn ur5e_dh_flange(q: &JointVector) -> Matrix4<f64> {
     let mut pose = Matrix4::identity();
     for i in 0..6 {
-        let (st, ct) = q[i].sin_cos();
-        let (sa, ca) = UR5E_ALPHA[i].sin_cos();
+        let (st, ct) = libm::sincos(q[i]);
+        let (sa, ca) = libm::sincos(UR5E_ALPHA[i]);
         #[rustfmt::skip]
         let link = Matrix4::new(
             ct, -st * ca, st * sa, UR5E_A[i] * ct,

@@ -375,7 +375,7 @@ fn task_files(robot: &Robot) -> Vec<Vec<u8>> {
     let dir = tempfile::tempdir().expect("temporary directory");
     let binary = dir.path().join("set.tasks");
     write_task_set(&binary, tasks).expect("task set written");
-    let specs: Vec<TaskSpec> = tasks.iter().map(|t| TaskSpec::of(t, &robot)).collect();
+    let specs: Vec<TaskSpec> = tasks.iter().map(|t| TaskSpec::of(t, robot)).collect();
     vec![
         read(&binary),
         serde_json::to_vec_pretty(&specs).expect("JSON"),
