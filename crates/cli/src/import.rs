@@ -8,8 +8,8 @@ use emg_kinematics::{PairRule, Robot, srdf_beside};
 use crate::args::ImportArgs;
 use crate::output::write_text;
 
-/// Imports, checks that the planners read the result as a chain of six or seven joints ending in the pen, writes
-/// it and prints the fit report.
+/// Imports, checks that the planners read the result as a chain of six or seven joints ending in
+/// the pen, writes it and prints the fit report.
 pub fn run_import(args: &ImportArgs) -> Result<()> {
     let options = ImportOptions {
         package_paths: args.package_path.clone(),

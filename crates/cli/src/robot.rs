@@ -1,5 +1,5 @@
-//! `--robot`: a shipped robot by name or any robot file of six or seven joints, its chain ends, and the models
-//! shipped for it.
+//! `--robot`: a shipped robot by name or any robot file of six or seven joints, its chain ends,
+//! and the models shipped for it.
 
 use std::path::{Path, PathBuf};
 

@@ -257,8 +257,29 @@ fn pybullets_six_joint_xarm6_with_obj_meshes_plans_end_to_end() {
     };
     let tmp = temp_dir("import-xarm6");
     let dir = tmp.path();
+    let vendor = data.join("xarm/xarm6_robot.urdf");
+    // The chain to the fifth link has five revolute joints: refused, naming the count and why.
+    let five = dir.join("five.urdf");
+    let output = emg(&[
+        "import-robot",
+        vendor.to_str().unwrap(),
+        "--out",
+        five.to_str().unwrap(),
+        "--tool-link",
+        "link5",
+        "--pen-length",
+        "0.2",
+    ]);
+    assert!(!output.status.success());
+    let error = text(&output.stderr);
+    assert!(
+        error.contains("has 5 revolute joints; arms of 6 or 7 are supported")
+            && error.contains("null space"),
+        "{error}"
+    );
+    assert!(!five.exists());
     end_to_end(
-        &data.join("xarm/xarm6_robot.urdf"),
+        &vendor,
         &["--tool-link", "link6", "--pen-length", "0.2"],
         "world",
         dir,
@@ -306,6 +327,21 @@ fn pybullets_panda_with_obj_meshes_and_fingers_plans_end_to_end() {
     let error = text(&output.stderr);
     assert!(
         error.contains("mesh is not supported") && error.contains("emg import-robot"),
+        "{error}"
+    );
+    // A chain through a finger holds a prismatic joint: refused, naming it.
+    let output = emg(&[
+        "import-robot",
+        vendor.to_str().unwrap(),
+        "--out",
+        dir.join("finger.urdf").to_str().unwrap(),
+        "--tool-link",
+        "panda_leftfinger",
+    ]);
+    assert!(!output.status.success());
+    let error = text(&output.stderr);
+    assert!(
+        error.contains("joint 'panda_finger_joint1' is prismatic"),
         "{error}"
     );
     end_to_end(

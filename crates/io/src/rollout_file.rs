@@ -20,7 +20,8 @@ pub struct TrajectoryFile<'a> {
     pub format: &'static str,
     /// Robot: a shipped robot's file or the path as given to the planner.
     pub robot: String,
-    /// Names of the seven joints, base to tip (the order of every `q`).
+    /// Names of the arm's `n` joints (6 or 7), base to tip (the order of every `q`; the file's
+    /// joint vectors hold seven entries, zero past the arm's joints).
     pub joint_names: &'a [String],
     /// The validated task.
     pub task: &'a Task,

@@ -9,7 +9,7 @@ use emg_io::{TrajectoryContents, read_tasks};
 use emg_kinematics::Robot;
 use emg_planner::{
     DataDir, Models, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig,
-    SearchConfig, ShippedRobot, limits_file_beside,
+    SHIPPED_ROBOTS, SearchConfig, ShippedRobot, limits_file_beside,
 };
 use emg_timing::Scaling;
 use emg_verify::ReferenceModel;
@@ -30,9 +30,9 @@ fn population(arm: ShippedRobot, planner: &Planner) -> Vec<(PathShape, Task)> {
 }
 
 #[test]
-fn rectangles_circles_and_s_curves_plan_time_and_check_on_both_arms() {
-    for name in ["fr3", "iiwa14"] {
-        let arm = ShippedRobot::by_name(name).expect("a shipped arm");
+fn rectangles_circles_and_s_curves_plan_time_and_check_on_every_shipped_arm() {
+    for arm in SHIPPED_ROBOTS {
+        let name = arm.name;
         let file = arm.path(&data());
         let robot = Robot::from_chain_file(&file).expect("robot loads");
         let models = Models::shipped(&robot, &arm.data_dir(&data())).expect("shipped models");

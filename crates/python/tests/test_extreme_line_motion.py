@@ -225,6 +225,31 @@ def test_a_robot_file_without_models_plans_classically_and_refuses_learned_contr
         planner.plan(p0, d, n, seed="dp", controller="classical")
 
 
+def test_a_six_joint_arm_takes_and_gives_one_value_per_joint(tmp_path):
+    planner = elm.Planner("ur5e")
+    robot = planner.robot
+    assert robot.dof == 6 and len(robot.joint_names) == 6
+    assert robot.lower_limits.shape == robot.velocity_limits.shape == (6,)
+    task = elm.load_tasks(ROOT / "data" / "ur5e" / "tasks" / "eval-v1.tasks", "ur5e")[0]
+    assert task.q0_seed.shape == (6,)
+    plan = planner.plan(
+        task.p0, task.d, task.n, seed=list(task.q0_seed), controller="classical", planner="controller"
+    )
+    assert plan.q.shape == (len(plan.t), 6) and plan.seed.shape == (6,)
+    np.testing.assert_array_equal(plan.seed, task.q0_seed)
+    np.testing.assert_allclose(robot.fk(plan.q[-1])[:3, 3], plan.tcp[-1], atol=1e-12)
+    assert robot.jacobian(plan.q[0]).shape == (3, 6)
+    motion = plan.timed()
+    assert motion.q.shape[1] == motion.qd.shape[1] == 6
+    assert motion.limits["jerk"].shape == (6,)
+    plan.save(tmp_path / "six")
+    assert elm.check(tmp_path / "six.joint_trajectory.json").points == motion.q.shape[0]
+    with pytest.raises(elm.InputError, match="give 6 joint angles"):
+        robot.fk([0.0] * 7)
+    with pytest.raises(elm.InputError, match="seed: give 6 joint angles"):
+        planner.plan(task.p0, task.d, task.n, seed=[0.0] * 7)
+
+
 def test_plan_many_releases_the_gil_and_matches_plan(planner, tasks):
     chosen = tasks[:1000]
     result = {}
