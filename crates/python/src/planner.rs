@@ -66,9 +66,9 @@ struct Request {
 }
 
 impl Request {
+    /// The request of the arguments, for `planning` (its robot's joints, its models).
     fn parse(
-        robot: &emg_kinematics::Robot,
-        models: &Models,
+        planning: &emg_planner::Planner,
         seed: Option<&Bound<'_, PyAny>>,
         controller: Option<&str>,
         planner: Option<&str>,
@@ -85,10 +85,10 @@ impl Request {
                         InputError::new_err(format!(
                             "seed: give a seed name (dp, generating, home, q_mu, q_jl) or {} \
                              joint angles (rad)",
-                            robot.dof()
+                            planning.robot().dof()
                         ))
                     })?;
-                    SeedSource::Given(joint_vector(robot, &angles, "seed")?)
+                    SeedSource::Given(joint_vector(planning.robot(), &angles, "seed")?)
                 }
             }),
         };
@@ -96,7 +96,7 @@ impl Request {
             Some(name) => name
                 .parse::<ControllerKind>()
                 .map_err(|e| input_error("controller", &e))?,
-            None => models.best_controller(),
+            None => planning.models().best_controller(),
         };
         let planner = match planner {
             Some(name) => name
@@ -312,14 +312,7 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Plan> {
-        let request = Request::parse(
-            self.inner.robot(),
-            self.inner.models(),
-            seed,
-            controller,
-            planner,
-            reach,
-        )?;
+        let request = Request::parse(&self.inner, seed, controller, planner, reach)?;
         let task = self.task(p0, d, n, None)?;
         self.plan_task(py, task, &request)
     }
@@ -339,14 +332,7 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Plan> {
-        let request = Request::parse(
-            self.inner.robot(),
-            self.inner.models(),
-            seed,
-            controller,
-            planner,
-            reach,
-        )?;
+        let request = Request::parse(&self.inner, seed, controller, planner, reach)?;
         let path = if path.is_instance_of::<PyDict>() {
             let text: String = py
                 .import("json")?
@@ -377,14 +363,7 @@ impl Planner {
         planner: Option<&str>,
         reach: bool,
     ) -> PyResult<Vec<Plan>> {
-        let request = Request::parse(
-            self.inner.robot(),
-            self.inner.models(),
-            seed,
-            controller,
-            planner,
-            reach,
-        )?;
+        let request = Request::parse(&self.inner, seed, controller, planner, reach)?;
         let mut parsed = Vec::new();
         for (index, item) in tasks.try_iter()?.enumerate() {
             let item = item?;
