@@ -22,6 +22,13 @@ pub const MAX_REFINEMENTS: usize = 64;
 /// this are a step apart by this much, so the knots increase strictly.
 pub const MIN_KNOT_STEP_M: f64 = 1e-6;
 
+/// Smallest path-parameter step per radian of the fastest joint between two waypoints (m/rad):
+/// where the arm turns through a singularity while its TCP barely moves (a six-joint arm's
+/// wrist), the parameter still advances with the joints, so the spline's joint derivatives per
+/// metre of parameter stay bounded and the timing finite. A step of the line speed moves the
+/// joints far less than the TCP distance over this, so ordinary steps keep the TCP distance.
+pub const KNOT_STEP_M_PER_RAD: f64 = 0.05;
+
 /// A joint path `q(s)` that holds the task's constraints at every checked point.
 #[derive(Clone, Debug)]
 pub struct SmoothPath {
@@ -40,7 +47,8 @@ pub struct SmoothPath {
 impl SmoothPath {
     /// The smooth path through `waypoints` (each holding the constraints, as a rollout's steps
     /// do). The parameter of waypoint `k` is the TCP distance travelled along the polyline of
-    /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`] per step); the spline passes through
+    /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
+    /// largest joint change, per step); the spline passes through
     /// the first, every [`KNOT_STRIDE`]-th and the last waypoint. It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment; a segment that breaks a constraint
     /// gets back the middle waypoint it skipped, or, between consecutive waypoints, their chord
@@ -62,15 +70,16 @@ impl SmoothPath {
             first_violation(robot, task, &robot.forward(q), constraints).is_none()
         };
         let mut params = Vec::with_capacity(waypoints.len());
-        let mut previous = robot.forward(&waypoints[0]).tcp();
+        let mut previous = (waypoints[0], robot.forward(&waypoints[0]).tcp());
         let mut s = 0.0;
         for q in waypoints {
             let tcp = robot.forward(q).tcp();
             if !params.is_empty() {
-                s += (tcp - previous).norm().max(MIN_KNOT_STEP_M);
+                let joints_m = KNOT_STEP_M_PER_RAD * (q - previous.0).amax();
+                s += (tcp - previous.1).norm().max(MIN_KNOT_STEP_M).max(joints_m);
             }
             params.push(s);
-            previous = tcp;
+            previous = (*q, tcp);
         }
         let last = waypoints.len() - 1;
         // The knots: which given waypoint each is (None for a chord midpoint), parameter, value.

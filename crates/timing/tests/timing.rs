@@ -102,6 +102,39 @@ fn a_rollout_becomes_a_rest_to_rest_motion_within_every_limit() {
 }
 
 #[test]
+fn turning_the_pen_about_its_axis_while_the_tcp_stands_still_is_timed() {
+    // The FR3's pen lies on its last joint's axis: turning that joint moves no TCP. Ten
+    // waypoints of such a turn in the middle of a line stand for a wrist turning through a
+    // singularity while the tool barely moves; the path parameter advances with the joints.
+    let (robot, _) = fr3();
+    let (task, waypoints, config) = planned(&robot);
+    let middle = waypoints.len() / 2;
+    let turn = |q: &JointVector, angle: f64| {
+        let mut turned = *q;
+        turned[6] += angle;
+        turned
+    };
+    let mut turning: Vec<JointVector> = waypoints[..=middle].to_vec();
+    turning.extend((1..=10).map(|i| turn(&waypoints[middle], 0.02 * f64::from(i))));
+    turning.extend(waypoints[middle + 1..].iter().map(|q| turn(q, 0.2)));
+    let tcp = |q: &JointVector| robot.forward(q).tcp();
+    assert!((tcp(&turning[middle + 10]) - tcp(&waypoints[middle])).norm() < 1e-12);
+    let request = TimingRequest {
+        limits: shipped_limits(&robot),
+        tool_speed_m_per_s: 0.2,
+        rate_hz: 1000.0,
+    };
+    let plain = time_motion(&robot, &task, &config.constraints, &waypoints, &request).unwrap();
+    let motion = time_motion(&robot, &task, &config.constraints, &turning, &request).unwrap();
+    assert_eq!(first_breach(&motion.samples, &request.limits), None);
+    assert!(motion.report.cut.is_none(), "{:?}", motion.report);
+    // The turn of 0.2 rad costs a fraction of a second, not the hours a parameter of TCP
+    // distance alone would give it.
+    let extra = motion.report.duration_s - plain.report.duration_s;
+    assert!((0.0..2.0).contains(&extra), "{extra} s");
+}
+
+#[test]
 fn scaling_slows_the_motion_down() {
     let (robot, _) = fr3();
     let (task, waypoints, config) = planned(&robot);
