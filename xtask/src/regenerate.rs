@@ -422,7 +422,7 @@ const STAGES: &[Stage] = &[
     },
     Stage {
         name: "timing-ur5e",
-        args: &["timing", "--robot", "ur5e"],
+        args: &["timing", "--robot", "ur5e", "--tasks", "1000"],
         writes: &[
             "docs/results/ur5e/timing.json",
             "docs/results/ur5e/timing.md",
