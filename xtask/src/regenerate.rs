@@ -445,22 +445,12 @@ const STAGES: &[Stage] = &[
         writes: &[],
     },
     Stage {
-        name: "limit-ur5e",
-        args: &["limit", "--robot", "ur5e"],
-        writes: &[],
-    },
-    Stage {
         name: "limit-merge-iiwa14",
         args: &["limit", "--merge", "--robot", "iiwa14"],
         writes: &[
             "docs/results/iiwa14/limit.json",
             "docs/results/iiwa14/limit.md",
         ],
-    },
-    Stage {
-        name: "limit-merge-ur5e",
-        args: &["limit", "--merge", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/limit.json", "docs/results/ur5e/limit.md"],
     },
     Stage {
         name: "figure-dp-seeds",
