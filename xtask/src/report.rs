@@ -472,7 +472,7 @@ fn other_arms(results: &Path, figures: &Path) -> anyhow::Result<String> {
             .set("unseen")
             .with_context(|| format!("docs/results/{} lacks the unseen set", file.display()))?;
         md += &format!(
-            "## Second arm: `{}`, Table 1\n\nThe whole pipeline on the second shipped arm (its own task sets, labels, \
+            "## Shipped arm `{}`, Table 1\n\nThe whole pipeline on this shipped arm (its own task sets, labels, \
              diffusion seeder and policy; `docs/results/{}`), {} unseen tasks; the search rows are the \
              search planner of `emg plan` at its default budget (`cargo xtask search-eval --robot {}`):\n\n\
              | tasks | π | path length (m) | ratio to ℓ_ref (%) |\n|---|---|---|---|\n",
