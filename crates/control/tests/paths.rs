@@ -126,15 +126,7 @@ fn blends_round_the_corners_tangentially_and_shorten_the_path() {
     );
     assert_eq!(path.corners_m().count(), 0);
     assert_eq!(path.pieces().len(), 7);
-    for pair in path.pieces().windows(2) {
-        let s = pair[1].start_s;
-        assert_close(
-            path.tangent_at(s - 1e-9),
-            path.tangent_at(s),
-            1e-6,
-            "tangent continuity",
-        );
-    }
+    assert_tangent_continuous(&path, "blended path");
     assert_parameterised(&path);
 }
 
@@ -188,15 +180,7 @@ fn corners_with_arcs_blend_tangentially_on_either_side() {
             path.length_m() < plain.length_m(),
             "case {index}: a blend cuts the corner"
         );
-        for pair in path.pieces().windows(2) {
-            let s = pair[1].start_s;
-            assert_close(
-                path.tangent_at(s - 1e-9),
-                path.tangent_at(s),
-                1e-6,
-                &format!("case {index}: tangent continuity"),
-            );
-        }
+        assert_tangent_continuous(&path, &format!("case {index}"));
         assert_parameterised(&path);
         // The blend stays within its radius's reach of the corner it rounds.
         let blend = &path.pieces()[1];
@@ -631,4 +615,17 @@ fn a_point_just_before_a_full_circles_start_is_located_at_its_start_and_checked_
     };
     assert!(line.reached([before]) < 1e-6);
     assert!(line.distance(&before) < 1e-8);
+}
+
+/// The tangent of `path` is continuous where each piece meets the next.
+fn assert_tangent_continuous(path: &Path, what: &str) {
+    for pair in path.pieces().windows(2) {
+        let s = pair[1].start_s;
+        assert_close(
+            path.tangent_at(s - 1e-9),
+            path.tangent_at(s),
+            1e-6,
+            &format!("{what}: tangent continuity"),
+        );
+    }
 }

@@ -3,10 +3,11 @@
 //! The layout is documented in `docs/trajectory-format.md`.
 
 use emg_control::StepRecord;
-use emg_kinematics::{JointVector, MAX_DOF, MIN_DOF};
+use emg_kinematics::{MAX_DOF, MIN_DOF};
 use emg_verify::{JointSamples, point_velocities};
 
 use crate::error::FormatError;
+use crate::joint_trajectory::padded;
 
 /// The CSV header [`trajectory_csv`] writes for an arm of `joints` joints; [`read_csv`] needs its
 /// first `1 + 2·joints` columns.
@@ -137,12 +138,9 @@ pub fn read_csv(text: &str) -> Result<JointSamples, FormatError> {
                 }
             };
         }
-        let joint_vector = |first: usize| {
-            JointVector::from_fn(|i, _| if i < joints { values[first + i] } else { 0.0 })
-        };
         time_s.push(values[0]);
-        q.push(joint_vector(1));
-        qd.push(joint_vector(1 + joints));
+        q.push(padded(&values[1..=joints]));
+        qd.push(padded(&values[1 + joints..]));
     }
     Ok(JointSamples {
         time_s,

@@ -333,7 +333,7 @@ fn joint_count(count: usize) -> Result<usize, FormatError> {
 }
 
 /// The joint vector of an arm's joint values (zero past them).
-fn padded(values: &[f64]) -> JointVector {
+pub(crate) fn padded(values: &[f64]) -> JointVector {
     JointVector::from_fn(|i, _| values.get(i).copied().unwrap_or(0.0))
 }
 

@@ -156,6 +156,7 @@ impl PolicyWeights {
         log_std_range: (f64, f64),
         env_steps: u64,
     ) -> Self {
+        let dims = PolicyDims::for_joints(network.joints);
         let mut values = Vec::with_capacity(value_count(network));
         for linear in layers(model) {
             for tensor in [
@@ -173,8 +174,8 @@ impl PolicyWeights {
         Self {
             header: WeightsHeader {
                 network: network.clone(),
-                observation_dim: PolicyDims::for_joints(network.joints).observation,
-                action_dim: PolicyDims::for_joints(network.joints).action,
+                observation_dim: dims.observation,
+                action_dim: dims.action,
                 log_std_range: [log_std_range.0, log_std_range.1],
                 env_steps,
 
