@@ -422,7 +422,7 @@ const STAGES: &[Stage] = &[
     },
     Stage {
         name: "timing-ur5e",
-        args: &["timing", "--robot", "ur5e", "--tasks", "1000"],
+        args: &["timing", "--robot", "ur5e"],
         writes: &[
             "docs/results/ur5e/timing.json",
             "docs/results/ur5e/timing.md",
@@ -451,6 +451,16 @@ const STAGES: &[Stage] = &[
             "docs/results/iiwa14/limit.json",
             "docs/results/iiwa14/limit.md",
         ],
+    },
+    Stage {
+        name: "limit-ur5e",
+        args: &["limit", "--robot", "ur5e"],
+        writes: &[],
+    },
+    Stage {
+        name: "limit-merge-ur5e",
+        args: &["limit", "--merge", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/limit.json", "docs/results/ur5e/limit.md"],
     },
     Stage {
         name: "figure-dp-seeds",
