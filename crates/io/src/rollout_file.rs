@@ -5,6 +5,7 @@
 use emg_control::{
     ClassicalGains, ConstraintConfig, RolloutConfig, StepRecord, Task, Termination, Trajectory,
 };
+use emg_kinematics::{MAX_DOF, MIN_DOF};
 use serde::Serialize;
 use serde_json::Value;
 
@@ -20,8 +21,8 @@ pub struct TrajectoryFile<'a> {
     pub format: &'static str,
     /// Robot: a shipped robot's file or the path as given to the planner.
     pub robot: String,
-    /// Names of the arm's `n` joints (6 or 7), base to tip (the order of every `q`; the file's
-    /// joint vectors hold seven entries, zero past the arm's joints).
+    /// Names of the arm's `n` joints (6 or 7), base to tip (the order of every `q`; every joint
+    /// vector of the file holds `n` entries).
     pub joint_names: &'a [String],
     /// The validated task.
     pub task: &'a Task,
@@ -51,9 +52,17 @@ pub struct TrajectoryFile<'a> {
 
 impl TrajectoryFile<'_> {
     /// The file's text: compact JSON on one line, numbers in their shortest round-trip form,
-    /// then a newline.
+    /// then a newline. Joint vectors hold the arm's `n` joints (the in-memory vectors' entries
+    /// past `n` are the absent joint's zeros).
     pub fn to_json(&self) -> String {
-        let mut json = serde_json::to_string(self).expect("a trajectory file serialises");
+        let mut doc = serde_json::to_value(self).expect("a trajectory file serialises");
+        let joints = self.joint_names.len();
+        for (_, vector) in joint_vector_fields(&mut doc) {
+            if let Value::Array(values) = vector {
+                values.truncate(joints);
+            }
+        }
+        let mut json = doc.to_string();
         json.push('\n');
         json
     }
@@ -90,16 +99,22 @@ impl RolloutRecord {
             .as_str()
             .ok_or_else(|| field_error("robot", "is not a string"))?
             .to_string();
-        let joint_names = serde_json::from_value(field("joint_names")?.clone())
+        let joint_names: Vec<String> = serde_json::from_value(field("joint_names")?.clone())
             .map_err(|e| field_error("joint_names", format!("is not an array of strings: {e}")))?;
-        let task = serde_json::from_value(field("task")?.clone())
-            .map_err(|e| field_error("task", format!("is not a task: {e}")))?;
+        field("task")?;
         let config: RolloutConfig = serde_json::from_value(field("config")?.clone())
             .map_err(|e| field_error("config", format!("is not a rollout config: {e}")))?;
         for name in ["steps", "termination", "path_length_m"] {
             field(name)?;
         }
-        let trajectory = serde_json::from_value(doc.clone()).map_err(|e| {
+        let joints = joint_names_count(&joint_names)?;
+        let mut doc = doc.clone();
+        for (name, vector) in joint_vector_fields(&mut doc) {
+            pad_joint_vector(&name, vector, joints)?;
+        }
+        let task = serde_json::from_value(doc["task"].clone())
+            .map_err(|e| field_error("task", format!("is not a task: {e}")))?;
+        let trajectory = serde_json::from_value(doc).map_err(|e| {
             field_error(
                 "steps/termination/path_length_m",
                 format!("do not form a trajectory: {e}"),
@@ -113,4 +128,67 @@ impl RolloutRecord {
             trajectory,
         })
     }
+}
+
+/// The number of joints `joint_names` names, refused unless 6 or 7.
+fn joint_names_count(joint_names: &[String]) -> Result<usize, FormatError> {
+    let joints = joint_names.len();
+    if !(MIN_DOF..=MAX_DOF).contains(&joints) {
+        return Err(field_error(
+            "joint_names",
+            format!("names {joints} joints; arms of {MIN_DOF} or {MAX_DOF} are supported"),
+        ));
+    }
+    Ok(joints)
+}
+
+/// The joint vectors of an `emg-trajectory/1` document, each with the field path an error
+/// names: every step's `q`, the task's `q0_seed` and the termination's `rejected_q`, where present.
+fn joint_vector_fields(doc: &mut Value) -> impl Iterator<Item = (String, &mut Value)> {
+    let Value::Object(members) = doc else {
+        return Vec::new().into_iter();
+    };
+    let mut vectors = Vec::new();
+    for (name, member) in members.iter_mut() {
+        match (name.as_str(), member) {
+            ("steps", Value::Array(steps)) => {
+                for (i, step) in steps.iter_mut().enumerate() {
+                    if let Some(q) = step.get_mut("q") {
+                        vectors.push((format!("steps[{i}].q"), q));
+                    }
+                }
+            }
+            ("task", task) => {
+                if let Some(seed) = task.get_mut("q0_seed").filter(|seed| !seed.is_null()) {
+                    vectors.push(("task.q0_seed".to_string(), seed));
+                }
+            }
+            ("termination", termination) => {
+                if let Some(rejected) = termination.get_mut("rejected_q") {
+                    vectors.push(("termination.rejected_q".to_string(), rejected));
+                }
+            }
+            _ => {}
+        }
+    }
+    vectors.into_iter()
+}
+
+/// Pads the joint vector `field` of `joints` values to the in-memory [`MAX_DOF`] with the
+/// absent joint's zeros; refuses a vector of another length.
+fn pad_joint_vector(field: &str, vector: &mut Value, joints: usize) -> Result<(), FormatError> {
+    let Value::Array(values) = vector else {
+        return Err(field_error(field, "is not an array of joint angles"));
+    };
+    if values.len() != joints {
+        return Err(field_error(
+            field,
+            format!(
+                "holds {} values; `joint_names` names {joints} joints",
+                values.len()
+            ),
+        ));
+    }
+    values.resize(MAX_DOF, Value::from(0.0));
+    Ok(())
 }

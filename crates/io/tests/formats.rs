@@ -2,10 +2,12 @@
 //! hold.
 
 use emg_control::{
-    ClassicalController, RolloutConfig, Task, Trajectory, VelocityLimitFraction, rollout,
+    ClassicalController, ClassicalGains, RolloutConfig, Task, Trajectory, VelocityLimitFraction,
+    rollout,
 };
 use emg_io::{
-    FormatError, JointTrajectory, TimeFromStart, TimingLimits, csv_header, read_csv, trajectory_csv,
+    FormatError, JointTrajectory, RolloutRecord, TRAJECTORY_FORMAT, TimeFromStart, TimingLimits,
+    TrajectoryFile, csv_header, read_csv, trajectory_csv,
 };
 use emg_kinematics::{JointVector, MAX_DOF, Robot, Vec3};
 use emg_timing::{DynamicLimits, TimingRequest, time_motion};
@@ -355,4 +357,70 @@ fn files_are_told_apart_by_content_and_json_errors_give_their_position() {
         TrajectoryContents::parse(&csv),
         Ok(TrajectoryContents::Csv(_))
     ));
+}
+
+/// A short classical rollout of the six-joint UR5e from the middle of its joint ranges.
+fn planned_on_six_joints() -> (Robot, Task, RolloutConfig, Trajectory) {
+    let path = robot_path().with_file_name("ur5e_pen.urdf");
+    let robot = Robot::from_urdf_file(path, "base_link", "pen_tip").unwrap();
+    let seed = robot.mid_range();
+    let kin = robot.forward(&seed);
+    let n = kin.tool_axis();
+    let d = (Vec3::y() - n * n.y).normalize();
+    let task = Task::new(&robot, kin.tcp(), d, n, Some(seed)).unwrap();
+    let config = RolloutConfig {
+        max_steps: 20,
+        ..RolloutConfig::default()
+    };
+    let trajectory = rollout(
+        &robot,
+        &task,
+        &seed,
+        &mut ClassicalController::default(),
+        &config,
+    );
+    (robot, task, config, trajectory)
+}
+
+#[test]
+fn rollout_json_of_a_six_joint_arm_holds_six_values_per_joint_vector_and_reads_back() {
+    let (robot, task, config, trajectory) = planned_on_six_joints();
+    let file = TrajectoryFile {
+        format: TRAJECTORY_FORMAT,
+        robot: "ur5e_pen.urdf".into(),
+        joint_names: robot.joint_names(),
+        task: &task,
+        seed_source: "given",
+        planner: "controller",
+        controller: "classical",
+        config: &config,
+        gains: &ClassicalGains::default(),
+        steps: &trajectory.steps,
+        termination: &trajectory.termination,
+        path_length_m: trajectory.path_length_m,
+        reachable_m: None,
+        below_bound: None,
+    };
+    let doc: Value = serde_json::from_str(&file.to_json()).unwrap();
+    let steps = doc["steps"].as_array().unwrap();
+    assert!(steps.len() > 1);
+    for step in steps {
+        assert_eq!(step["q"].as_array().unwrap().len(), 6);
+    }
+    assert_eq!(doc["task"]["q0_seed"].as_array().unwrap().len(), 6);
+    let back = RolloutRecord::from_value(&doc).unwrap();
+    assert_eq!(back.trajectory, trajectory);
+    assert_eq!(back.task, task);
+
+    // A step with the seventh (absent) value, or one value short, is refused by its field.
+    for length in [7, 5] {
+        let mut wrong = doc.clone();
+        let q = wrong["steps"][1]["q"].as_array_mut().unwrap();
+        q.resize(length, Value::from(0.0));
+        let message = RolloutRecord::from_value(&wrong).unwrap_err().to_string();
+        assert!(
+            message.contains("steps[1].q") && message.contains(&format!("holds {length} values")),
+            "{message}"
+        );
+    }
 }
