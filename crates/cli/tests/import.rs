@@ -297,6 +297,10 @@ fn pybullets_six_joint_xarm6_with_obj_meshes_plans_end_to_end() {
         ["joint1", "joint2", "joint3", "joint4", "joint5", "joint6"]
     );
     assert_eq!(joint["points"][0]["positions"].as_array().unwrap().len(), 6);
+    let rollout = read_json(&dir.join("x.json"));
+    for step in rollout["steps"].as_array().unwrap() {
+        assert_eq!(step["q"].as_array().unwrap().len(), 6);
+    }
     let csv = read(&dir.join("x.csv"));
     assert!(
         csv.starts_with("time_s,q1,q2,q3,q4,q5,q6,qd1,qd2,qd3,qd4,qd5,qd6,tcp_x"),
