@@ -61,6 +61,7 @@ mod check;
 mod import;
 mod interrupt;
 mod output;
+mod report;
 mod robot;
 mod tasks;
 
@@ -79,6 +80,7 @@ use emg_planner::{
 use crate::args::{Cli, Command, OnOff, PlanArgs};
 use crate::interrupt::{Interrupt, Interrupted};
 use crate::output::write_text;
+use crate::report::error_text;
 
 fn main() -> ExitCode {
     let result = match Cli::parse().command {
@@ -89,13 +91,13 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) if error.is::<Interrupted>() => {
-            eprintln!("{error:#}");
+            eprintln!("{}", error_text(&error));
             error
                 .downcast_ref::<Interrupted>()
                 .map_or(ExitCode::FAILURE, |stop| ExitCode::from(stop.exit_code()))
         }
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", error_text(&error));
             ExitCode::FAILURE
         }
     }
@@ -176,8 +178,9 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
             Err(error) if !many => return Err(plan_error(error, &request)),
             Err(error) => {
                 let error = plan_error(error, &request);
-                eprintln!("{label}error: {error:#}");
-                failures.push((index, format!("{error:#}")));
+                let text = error_text(&error);
+                eprintln!("{label}error: {text}");
+                failures.push((index, text));
                 continue;
             }
         };
@@ -195,8 +198,9 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
             Ok(report) => println!("{label}{report}"),
             Err(error) if !many => return Err(error),
             Err(error) => {
-                eprintln!("{label}error: {error:#}");
-                failures.push((index, format!("{error:#}")));
+                let text = error_text(&error);
+                eprintln!("{label}error: {text}");
+                failures.push((index, text));
             }
         }
     }
