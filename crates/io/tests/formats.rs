@@ -41,17 +41,23 @@ const FRACTION: f64 = 0.03;
 /// limits, so that most steps are slowed and the times are not uniform.
 fn planned() -> (Robot, Task, RolloutConfig, Trajectory) {
     let robot = Robot::from_urdf_file(robot_path(), "link0", "pen_tip").unwrap();
-    let seed = robot.mid_range();
-    let kin = robot.forward(&seed);
-    let n = kin.tool_axis();
-    let d = (Vec3::y() - n * n.y).normalize();
-    let task = Task::new(&robot, kin.tcp(), d, n, Some(seed)).unwrap();
     let mut config = RolloutConfig {
         max_steps: 30,
         ..RolloutConfig::default()
     };
     config.constraints.velocity_limit_fraction =
         Some(VelocityLimitFraction::new(FRACTION).unwrap());
+    from_mid_range(robot, config)
+}
+
+/// A classical rollout of `robot` under `config` from the middle of its joint ranges, along
+/// the line through its TCP there that runs across `y`, with the tool axis as `n`.
+fn from_mid_range(robot: Robot, config: RolloutConfig) -> (Robot, Task, RolloutConfig, Trajectory) {
+    let seed = robot.mid_range();
+    let kin = robot.forward(&seed);
+    let n = kin.tool_axis();
+    let d = (Vec3::y() - n * n.y).normalize();
+    let task = Task::new(&robot, kin.tcp(), d, n, Some(seed)).unwrap();
     let trajectory = rollout(
         &robot,
         &task,
@@ -363,23 +369,11 @@ fn files_are_told_apart_by_content_and_json_errors_give_their_position() {
 fn planned_on_six_joints() -> (Robot, Task, RolloutConfig, Trajectory) {
     let path = robot_path().with_file_name("ur5e_pen.urdf");
     let robot = Robot::from_urdf_file(path, "base_link", "pen_tip").unwrap();
-    let seed = robot.mid_range();
-    let kin = robot.forward(&seed);
-    let n = kin.tool_axis();
-    let d = (Vec3::y() - n * n.y).normalize();
-    let task = Task::new(&robot, kin.tcp(), d, n, Some(seed)).unwrap();
     let config = RolloutConfig {
         max_steps: 20,
         ..RolloutConfig::default()
     };
-    let trajectory = rollout(
-        &robot,
-        &task,
-        &seed,
-        &mut ClassicalController::default(),
-        &config,
-    );
-    (robot, task, config, trajectory)
+    from_mid_range(robot, config)
 }
 
 #[test]
