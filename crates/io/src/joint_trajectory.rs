@@ -321,7 +321,7 @@ fn array<'a>(value: &'a Value, path: &str) -> Result<&'a Vec<Value>, FormatError
 }
 
 /// The number of joints `count` names, checked to be an arm's (6 or 7).
-fn joint_count(count: usize) -> Result<usize, FormatError> {
+pub(crate) fn joint_count(count: usize) -> Result<usize, FormatError> {
     if (MIN_DOF..=MAX_DOF).contains(&count) {
         Ok(count)
     } else {
@@ -338,7 +338,11 @@ pub(crate) fn padded(values: &[f64]) -> JointVector {
 }
 
 /// Exactly `joints` finite numbers.
-fn joint_values(value: &Value, joints: usize, path: &str) -> Result<Vec<f64>, FormatError> {
+pub(crate) fn joint_values(
+    value: &Value,
+    joints: usize,
+    path: &str,
+) -> Result<Vec<f64>, FormatError> {
     let values = array(value, path)?;
     if values.len() != joints {
         return Err(field_error(

@@ -5,11 +5,11 @@
 use emg_control::{
     ClassicalGains, ConstraintConfig, RolloutConfig, StepRecord, Task, Termination, Trajectory,
 };
-use emg_kinematics::{MAX_DOF, MIN_DOF};
 use serde::Serialize;
 use serde_json::Value;
 
 use crate::error::{FormatError, field_error};
+use crate::joint_trajectory::{joint_count, joint_values, padded};
 
 /// Value of the `format` field of every `emg-trajectory/1` file.
 pub const TRAJECTORY_FORMAT: &str = "emg-trajectory/1";
@@ -107,7 +107,7 @@ impl RolloutRecord {
         for name in ["steps", "termination", "path_length_m"] {
             field(name)?;
         }
-        let joints = joint_names_count(&joint_names)?;
+        let joints = joint_count(joint_names.len())?;
         let mut doc = doc.clone();
         for (name, vector) in joint_vector_fields(&mut doc) {
             pad_joint_vector(&name, vector, joints)?;
@@ -128,18 +128,6 @@ impl RolloutRecord {
             trajectory,
         })
     }
-}
-
-/// The number of joints `joint_names` names, refused unless 6 or 7.
-fn joint_names_count(joint_names: &[String]) -> Result<usize, FormatError> {
-    let joints = joint_names.len();
-    if !(MIN_DOF..=MAX_DOF).contains(&joints) {
-        return Err(field_error(
-            "joint_names",
-            format!("names {joints} joints; arms of {MIN_DOF} or {MAX_DOF} are supported"),
-        ));
-    }
-    Ok(joints)
 }
 
 /// The joint vectors of an `emg-trajectory/1` document, each with the field path an error
@@ -174,21 +162,10 @@ fn joint_vector_fields(doc: &mut Value) -> impl Iterator<Item = (String, &mut Va
     vectors.into_iter()
 }
 
-/// Pads the joint vector `field` of `joints` values to the in-memory [`MAX_DOF`] with the
+/// Pads the joint vector `field` of `joints` values to the in-memory `JointVector` with the
 /// absent joint's zeros; refuses a vector of another length.
 fn pad_joint_vector(field: &str, vector: &mut Value, joints: usize) -> Result<(), FormatError> {
-    let Value::Array(values) = vector else {
-        return Err(field_error(field, "is not an array of joint angles"));
-    };
-    if values.len() != joints {
-        return Err(field_error(
-            field,
-            format!(
-                "holds {} values; `joint_names` names {joints} joints",
-                values.len()
-            ),
-        ));
-    }
-    values.resize(MAX_DOF, Value::from(0.0));
+    let values = joint_values(vector, joints, field)?;
+    *vector = Value::from(padded(&values).as_slice().to_vec());
     Ok(())
 }

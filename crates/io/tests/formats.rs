@@ -413,7 +413,7 @@ fn rollout_json_of_a_six_joint_arm_holds_six_values_per_joint_vector_and_reads_b
         q.resize(length, Value::from(0.0));
         let message = RolloutRecord::from_value(&wrong).unwrap_err().to_string();
         assert!(
-            message.contains("steps[1].q") && message.contains(&format!("holds {length} values")),
+            message.contains("steps[1].q") && message.contains(&format!("has {length} values")),
             "{message}"
         );
     }
