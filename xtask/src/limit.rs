@@ -14,9 +14,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use emg_control::CheckRollout;
-use emg_eval::{BoundShare, BucketConfig, Difficulty, Summary, bound_shares, four};
+use emg_eval::{
+    BOUND_BUCKET_EDGES_M, BoundShare, BucketConfig, Difficulty, Summary, bound_bucket,
+    bound_shares, four,
+};
 
-use emg_planner::{PlanRequest, Planner, PlannerConfig, PlannerKind, SearchConfig};
+use emg_planner::{
+    FAR_END_SHARE, PlanRequest, Planner, PlannerConfig, PlannerKind, SHORTFALL_SHARE, SearchConfig,
+    far_end_chains,
+};
 use emg_seeding::Shard;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -73,6 +79,8 @@ struct Identity {
     task_count: usize,
     limit: SearchConfig,
     search: SearchConfig,
+    /// Restarts of the continuity test ([`FAR_END_RESTARTS`]).
+    far_end_restarts: usize,
 }
 
 /// One task's results, the file the journal holds for it.
@@ -91,7 +99,14 @@ struct TaskLimit {
     pipeline_m: f64,
     /// The default search (m).
     search_m: f64,
+    /// Whether a chain of valid configurations joins `p0` to [`FAR_END_SHARE`] of the scan
+    /// ([`far_end_chains`] from [`FAR_END_RESTARTS`] restarts).
+    joined: bool,
 }
+
+/// Random IK restarts at the far end of the scan whose configurations [`far_end_chains`]
+/// extends back to `p0`.
+const FAR_END_RESTARTS: usize = 64;
 
 /// Runs this shard's pending tasks, or merges the journal.
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -105,6 +120,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         task_count: tasks.len(),
         limit: limit_search(),
         search: SearchConfig::default(),
+        far_end_restarts: FAR_END_RESTARTS,
     };
     open_journal(&args.journal, &identity)?;
     if args.merge {
@@ -169,6 +185,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 .map_err(|failure| {
                     anyhow::anyhow!("task {index}: the limit fails the checker: {failure:?}")
                 })?;
+            let reach = planner.reach_of(task, &limit);
+            let config = planner.config();
+            let joined = !far_end_chains(
+                planner.robot(),
+                task,
+                &config.rollout.constraints,
+                &config.reach,
+                &reach,
+                config.search.chain_jump_rad,
+                FAR_END_RESTARTS,
+            )
+            .is_empty();
             let record = TaskLimit {
                 index,
                 limit_m: limit.trajectory.path_length_m,
@@ -179,9 +207,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .iter()
                     .map(|s| planner.robot().joints_of(&s.q).to_vec())
                     .collect(),
-                bound_m: planner.reach_of(task, &limit).reachable_m,
+                bound_m: reach.reachable_m,
                 pipeline_m,
                 search_m,
+                joined,
             };
             let text = serde_json::to_string(&record)? + "\n";
             emg_io::write_atomically(task_path(&args.journal, index), text.as_bytes())?;
@@ -232,12 +261,29 @@ struct BoundBucket {
     search_of_limit: BoundShare,
 }
 
+/// Where ℓ* ends short of the bound, whether the bound's points join into one motion: over
+/// one bucket of the bound, the tasks whose ℓ* ends below [`SHORTFALL_SHARE`] of their bound.
+#[derive(Serialize)]
+struct ContinuityBucket {
+    bucket: String,
+    /// Tasks whose ℓ* ends short.
+    short: usize,
+    /// Of them, the tasks a chain joins `p0` to [`FAR_END_SHARE`] of the scan on.
+    joined: usize,
+    /// Σ (bound − ℓ*) over the short tasks (m).
+    missing_m: f64,
+    /// Σ (bound − ℓ*) over the short tasks a chain joins (m).
+    missing_joined_m: f64,
+}
+
 #[derive(Serialize)]
 struct Record {
     robot: String,
     identity: Identity,
     /// Per bucket of the bound, then all tasks.
     by_bound: Vec<BoundBucket>,
+    /// Per bucket of the bound, then all tasks.
+    continuity: Vec<ContinuityBucket>,
     buckets_by_limit: BucketConfig,
     rows: Vec<Bucket>,
 }
@@ -306,10 +352,44 @@ fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
         robot: workspace::relative(&args.robot),
         identity: identity.clone(),
         by_bound,
+        continuity: continuity(&records),
         buckets_by_limit: buckets,
         rows,
     };
     workspace::write_results(&args.out_dir, "limit", &record, &markdown(&record))
+}
+
+/// The continuity of the short tasks per bucket of the bound, then over all tasks.
+fn continuity(records: &[TaskLimit]) -> Vec<ContinuityBucket> {
+    let short: Vec<&TaskLimit> = records
+        .iter()
+        .filter(|r| r.limit_m < SHORTFALL_SHARE * r.bound_m)
+        .collect();
+    let bucket = |name: &str, members: Vec<&&TaskLimit>| {
+        let missing = |r: &&&TaskLimit| r.bound_m - r.limit_m;
+        ContinuityBucket {
+            bucket: name.to_string(),
+            short: members.len(),
+            joined: members.iter().filter(|r| r.joined).count(),
+            missing_m: members.iter().map(missing).sum(),
+            missing_joined_m: members.iter().filter(|r| r.joined).map(missing).sum(),
+        }
+    };
+    let mut buckets: Vec<ContinuityBucket> = std::iter::once(0.0)
+        .chain(BOUND_BUCKET_EDGES_M)
+        .map(|lower| {
+            let name = bound_bucket(lower);
+            bucket(
+                name,
+                short
+                    .iter()
+                    .filter(|r| bound_bucket(r.bound_m) == name)
+                    .collect(),
+            )
+        })
+        .collect();
+    buckets.push(bucket("all", short.iter().collect()));
+    buckets
 }
 
 fn markdown(record: &Record) -> String {
@@ -363,6 +443,31 @@ fn markdown(record: &Record) -> String {
         );
     }
     md += &format!(
+        "\n## Where ℓ* ends short: do the bound's points join into one motion?\n\nThe bound \
+         only says that every point up to it has a valid configuration. For each task, valid \
+         configurations at {:.0} % of the scan (the scan's own, then the cone IK from {} seeded \
+         random restarts) are extended backwards to `p0`, at every 1 cm grid point the valid \
+         configuration nearest the one after it, while no joint moves more than {} rad between \
+         neighbours (`emg_planner::far_end_chains`). Over the tasks whose ℓ* ends below {} × \
+         their bound: how many such a chain joins, and the length ℓ* misses (Σ bound − ℓ*) on \
+         all of them and on the joined ones. Where no chain joins, the points found need not \
+         join into one motion: the shortfall there is more likely the bound's looseness than a \
+         motion the search missed.\n\n\
+         | bound | tasks ℓ* < {} × bound | joined by a chain | missing (m) | missing on joined (m) \
+         |\n|---|---|---|---|---|\n",
+        100.0 * FAR_END_SHARE,
+        FAR_END_RESTARTS,
+        record.identity.search.chain_jump_rad,
+        SHORTFALL_SHARE,
+        SHORTFALL_SHARE,
+    );
+    for row in &record.continuity {
+        md += &format!(
+            "| {} | {} | {} | {:.2} | {:.2} |\n",
+            row.bucket, row.short, row.joined, row.missing_m, row.missing_joined_m
+        );
+    }
+    md += &format!(
         "\n## By bucket of ℓ*\n\nBuckets by ℓ* (Easy ≥ {} m, Difficult < {} m); shares are task \
          means of the ratio.\n\n\
          | bucket | tasks | ℓ* (m, mean / std / min / max) | bound (m) | ℓ* / bound | Hybrid + DP / ℓ* | \
@@ -396,6 +501,7 @@ mod tests {
             task_count,
             limit: limit_search(),
             search: SearchConfig::default(),
+            far_end_restarts: FAR_END_RESTARTS,
         }
     }
 

@@ -293,6 +293,100 @@ pub fn witness_chains(
     chains
 }
 
+/// Share of the scan's reach at which [`far_end_chains`] start.
+pub const FAR_END_SHARE: f64 = 0.95;
+
+/// Chains of valid configurations joined from near the far end of the scan back to `p0`: a
+/// test of whether the scan's points join into one motion, which the bound alone does not say.
+/// Valid configurations at the grid point at [`FAR_END_SHARE`] of the scan (the scan's own
+/// there, then cone-IK solutions from `restarts` seeded random starts) are each extended
+/// backwards, at every grid point before it in turn, by the valid configuration nearest the one
+/// after it (the cone IK from it or the projection onto the pose from it, whichever moves the
+/// joints less), while the largest joint change stays within `max_jump_rad`. A chain that comes
+/// within the IK's distinctness of an earlier chain's configuration at the same grid point would
+/// follow that chain from there and is dropped. Returns the chains that reach `p0`, in the order
+/// found, each with one configuration per grid point from `p0`.
+pub fn far_end_chains(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    config: &ReachConfig,
+    reach: &Reach,
+    max_jump_rad: f64,
+    restarts: usize,
+) -> Vec<Vec<JointVector>> {
+    if reach.witnesses.is_empty() {
+        return Vec::new();
+    }
+    let far = ((reach.witnesses.len() - 1) as f64 * FAR_END_SHARE) as usize;
+    let scan = Scan::new(robot, task, constraints, config);
+    let point = |k: usize| task.point_at(k as f64 * reach.grid_m);
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    rng.set_stream(FAR_END_STREAM);
+    let limits = robot.limits();
+    let mut ends = vec![reach.witnesses[far]];
+    for _ in 0..restarts {
+        let start = robot.configuration_from_fn(|i| {
+            let u: f64 = rng.random();
+            limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
+        });
+        if let Some(q) = scan.continuation(&point(far), &start)
+            && ends.iter().all(|e| (e - q).amax() >= scan.ik.dedup_rad)
+        {
+            ends.push(q);
+        }
+    }
+    // The configurations the chains so far held at each grid point.
+    let mut visited: Vec<Vec<JointVector>> = vec![Vec::new(); far + 1];
+    let joins = |visited: &[Vec<JointVector>], k: usize, q: &JointVector| {
+        visited[k]
+            .iter()
+            .any(|v| (v - q).amax() < scan.ik.dedup_rad)
+    };
+    let mut chains = Vec::new();
+    for end in ends {
+        if joins(&visited, far, &end) {
+            continue;
+        }
+        let mut chain = vec![end];
+        for k in (0..far).rev() {
+            let after = chain[chain.len() - 1];
+            match scan.nearest(&point(k), &after) {
+                Some(q) if (q - after).amax() <= max_jump_rad && !joins(&visited, k, &q) => {
+                    chain.push(q)
+                }
+                _ => break,
+            }
+        }
+        for (i, q) in chain.iter().enumerate() {
+            visited[far - i].push(*q);
+        }
+        if chain.len() == far + 1 {
+            chain.reverse();
+            chains.push(chain);
+        }
+    }
+    chains
+}
+
+/// The random stream of [`far_end_chains`]' restarts (the scan's grid points take the streams
+/// from 0 up).
+const FAR_END_STREAM: u64 = u64::MAX;
+
+impl Scan<'_> {
+    /// Of the valid configurations at `target` the cone IK reaches from `start` and on the
+    /// pose nearest `start`, the one with the smaller largest joint change.
+    fn nearest(&self, target: &Vec3, start: &JointVector) -> Option<JointVector> {
+        [
+            self.continuation(target, start),
+            self.nearest_on_pose(target, start),
+        ]
+        .into_iter()
+        .flatten()
+        .min_by(|a, b| (a - start).amax().total_cmp(&(b - start).amax()))
+    }
+}
+
 impl Scan<'_> {
     /// The valid configuration at `target` with the tool axis along `n` nearest `start` (the
     /// Newton projection from it), if any.

@@ -8,8 +8,8 @@ use emg_control::Task;
 use emg_io::read_tasks;
 use emg_kinematics::{Robot, Vec3};
 use emg_planner::{
-    ControllerKind, DataDir, Models, PlanRequest, Planner, PlannerConfig, Reach, SeedSource,
-    ShippedRobot, witness_chains,
+    ControllerKind, DataDir, FAR_END_SHARE, Models, PlanRequest, Planner, PlannerConfig, Reach,
+    SeedSource, ShippedRobot, far_end_chains, witness_chains,
 };
 use emg_verify::ReferenceModel;
 
@@ -122,6 +122,7 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
         ..PlanRequest::pipeline()
     };
     let constraints = &planner.config().rollout.constraints;
+    let mut joined_tasks = 0;
     for task in &tasks[..6] {
         let plan = planner.plan(task, &request).expect("searches");
         let reach = plan.reach.clone().expect("the search scans the bound");
@@ -148,7 +149,23 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
             jump,
         );
         assert!(!chains.is_empty(), "the scan's first chain starts at p0");
-        for chain in &chains {
+        // The chains joined back from near the far end likewise, each ending at its grid
+        // point at FAR_END_SHARE of the scan.
+        let far = ((reach.witnesses.len() - 1) as f64 * FAR_END_SHARE) as usize;
+        let joined = far_end_chains(
+            robot,
+            task,
+            constraints,
+            &planner.config().reach,
+            &reach,
+            jump,
+            16,
+        );
+        joined_tasks += usize::from(!joined.is_empty());
+        for chain in &joined {
+            assert_eq!(chain.len(), far + 1);
+        }
+        for chain in chains.iter().chain(&joined) {
             let grid: Vec<_> = chain.to_vec();
             let as_scan = Reach {
                 reachable_m: (grid.len() - 1) as f64 * reach.grid_m,
@@ -162,6 +179,7 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
             }
         }
     }
+    assert!(joined_tasks > 0, "no chain joined back to p0 on any task");
 }
 
 #[test]
