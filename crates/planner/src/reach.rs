@@ -17,7 +17,9 @@
 //! plan reports never reads below the plan.
 //!
 //! The scan's configurations also guide the search: joined into chains on one self-motion
-//! branch ([`witness_chains`]), they show a motion along the line that the search follows.
+//! branch ([`witness_chains`]), they show a motion along the line that the search follows. And
+//! [`far_end_chains`] tests what the bound cannot say: whether configurations near its end
+//! join `p0` through valid configurations at every grid point between.
 
 use emg_control::{ConstraintConfig, OutOfRange, Task, Trajectory, first_contact, first_violation};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, Vec3, project_to_pose};
