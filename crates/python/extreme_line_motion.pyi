@@ -117,6 +117,10 @@ class Plan:
     def reachable_m(self) -> Optional[float]:
         """The task's reachability bound (m) when reach=True was asked."""
     @property
+    def below_bound(self) -> Optional[str]:
+        """Why the plan ends below 0.9 x the bound, when reach=True was asked and it does
+        (as `emg plan` prints it and the trajectory file records it)."""
+    @property
     def task(self) -> Task:
         """The task."""
     def timed(

@@ -226,12 +226,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 }
                 let started = Instant::now();
                 let plan = planner.plan(task, &search)?;
-                let reach = planner.reach_of(task, &plan);
                 let plan_ms = started.elapsed().as_secs_f64() * 1e3;
+                let bound = planner.bound_note(task, &plan);
                 let record = PlanRecord {
                     robot: &robot_name,
                     request: &search,
-                    reachable_m: Some(reach.reachable_m),
+                    bound: Some(&bound),
                     timing: &timing,
                 };
                 let files = PlanFiles::new(&planner, task, &plan, &record).with_context(|| {
@@ -278,7 +278,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         pipeline_m: learned.trajectory.path_length_m,
                         search_classical_m: classical_search.trajectory.path_length_m,
                         search_m: plan.trajectory.path_length_m,
-                        bound_m: reach.reachable_m,
+                        bound_m: bound.reachable_m,
                         search_completed: plan.trajectory.termination == Termination::Completed,
                         lines,
                         duration_s: files.timing.duration_s,

@@ -150,7 +150,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let record = PlanRecord {
                     robot: &robot_name,
                     request: &request,
-                    reachable_m: None,
+                    bound: None,
                     timing: &timing,
                 };
                 let files = PlanFiles::new(&planner, task, &plan, &record)?;

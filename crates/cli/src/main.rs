@@ -350,7 +350,7 @@ fn write_plan(
     index: Option<usize>,
 ) -> Result<String> {
     let trajectory = &plan.trajectory;
-    let reach = (args.reach == OnOff::On).then(|| planner.reach_of(task, plan));
+    let bound = (args.reach == OnOff::On).then(|| planner.bound_note(task, plan));
     let paths = PlanPaths::new(&args.out, index);
     let robot = args.robot.display().to_string();
     let files = PlanFiles::new(
@@ -360,7 +360,7 @@ fn write_plan(
         &PlanRecord {
             robot: &robot,
             request: record.request,
-            reachable_m: reach.as_ref().map(|r| r.reachable_m),
+            bound: bound.as_ref(),
             timing: record.timing,
         },
     )?;
@@ -393,16 +393,18 @@ fn write_plan(
         Some(n) => format!(", projected onto (p0, n) in {n} Newton iterations"),
         None => String::new(),
     };
-    let bound = match &reach {
-        Some(reach) => format!(" of at most {:.2} m reachable", reach.reachable_m),
-        None => String::new(),
-    };
-    let short = match reach.as_ref().and_then(|r| r.shortfall(trajectory)) {
-        Some(note) => format!("\n  note: {note}"),
-        None => String::new(),
+    let (reachable, short) = match &bound {
+        Some(bound) => (
+            format!(" of at most {:.2} m reachable", bound.reachable_m),
+            bound
+                .shortfall
+                .as_ref()
+                .map_or(String::new(), |note| format!("\n  note: {note}")),
+        ),
+        None => (String::new(), String::new()),
     };
     Ok(format!(
-        "path length {:.4} m{bound}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
+        "path length {:.4} m{reachable}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
          seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
          requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}\n  \

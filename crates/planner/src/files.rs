@@ -10,7 +10,7 @@ use emg_io::{
 use emg_timing::TimingError;
 
 use crate::planner::{Plan, PlanRequest, Planner};
-use crate::reach::shortfall;
+use crate::reach::BoundNote;
 use crate::timing::MotionTiming;
 
 /// How a plan was asked for, as its files record it.
@@ -20,8 +20,9 @@ pub struct PlanRecord<'a> {
     pub robot: &'a str,
     /// The request the plan answered (its planner and controller are recorded).
     pub request: &'a PlanRequest,
-    /// The task's reachability bound (m), when it was computed.
-    pub reachable_m: Option<f64>,
+    /// What the files say of the task's reachability bound, when it was computed
+    /// ([`Planner::bound_note`]).
+    pub bound: Option<&'a BoundNote>,
     /// How the joint trajectory is timed.
     pub timing: &'a MotionTiming,
 }
@@ -82,10 +83,8 @@ impl PlanFiles {
             steps: &trajectory.steps,
             termination: &trajectory.termination,
             path_length_m: trajectory.path_length_m,
-            reachable_m: record.reachable_m,
-            below_bound: record
-                .reachable_m
-                .and_then(|bound| shortfall(trajectory, bound)),
+            reachable_m: record.bound.map(|bound| bound.reachable_m),
+            below_bound: record.bound.and_then(|bound| bound.shortfall.clone()),
         };
         let constraints = &config.rollout.constraints;
         let motion = record.timing.time(robot, task, constraints, trajectory)?;

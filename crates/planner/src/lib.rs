@@ -54,10 +54,10 @@ pub use models::{
     robot_stamp,
 };
 pub use parse::ParseError;
-pub use planner::{Plan, PlanError, PlanRequest, Planner, PlannerKind};
+pub use planner::{CONTINUITY_RESTARTS, Plan, PlanError, PlanRequest, Planner, PlannerKind};
 pub use reach::{
-    FAR_END_SHARE, MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE, far_end_chains, reach,
-    shortfall, witness_chains,
+    BoundNote, FAR_END_SHARE, MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE,
+    far_end_chains, reach, shortfall, witness_chains,
 };
 pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig, search_classical_gains};
 pub use seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed, seed_source_meaning};

@@ -9,7 +9,7 @@ use crate::config::{ConfigError, PlannerConfig};
 use crate::controller::{ControllerKind, Executor, ExecutorError};
 use crate::models::Models;
 use crate::parse::ParseError;
-use crate::reach::{Reach, reach};
+use crate::reach::{BoundNote, Reach, SHORTFALL_SHARE, far_end_chains, reach, shortfall};
 use crate::search::{SearchContext, search};
 use crate::seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed};
 
@@ -89,6 +89,10 @@ impl std::str::FromStr for PlannerKind {
             .ok_or_else(|| ParseError::Planner(value.to_string()))
     }
 }
+
+/// Random IK restarts of the continuity test a short plan's note reports
+/// ([`Planner::bound_note`]).
+pub const CONTINUITY_RESTARTS: usize = 32;
 
 /// A planned task: the seed it started from and the rollout.
 #[derive(Clone, Debug, PartialEq)]
@@ -243,6 +247,31 @@ impl Planner {
             &self.config.reach,
             &starts,
         )
+    }
+
+    /// What `plan`'s output says of `task`'s bound: [`Planner::reach_of`], and when the plan
+    /// ends below [`SHORTFALL_SHARE`] of it, why ([`shortfall`], with the bound's continuity
+    /// test [`far_end_chains`] from [`CONTINUITY_RESTARTS`] restarts).
+    pub fn bound_note(&self, task: &Task, plan: &Plan) -> BoundNote {
+        let reach = self.reach_of(task, plan);
+        let trajectory = &plan.trajectory;
+        let shortfall =
+            (trajectory.path_length_m < SHORTFALL_SHARE * reach.reachable_m).then(|| {
+                let chains = far_end_chains(
+                    &self.robot,
+                    task,
+                    &self.config.rollout.constraints,
+                    &self.config.reach,
+                    &reach,
+                    self.config.search.chain_jump_rad,
+                    CONTINUITY_RESTARTS,
+                );
+                shortfall(trajectory, reach.reachable_m, !chains.is_empty())
+            });
+        BoundNote {
+            reachable_m: reach.reachable_m,
+            shortfall,
+        }
     }
 
     /// [`Planner::plan`] of every task, in parallel on the current rayon pool; the results come

@@ -106,12 +106,6 @@ impl Reach {
     pub fn witness(&mut self, trajectory: &Trajectory) {
         self.reachable_m = self.reachable_m.max(trajectory.path_length_m);
     }
-
-    /// Why `trajectory` ends well short of the bound, when it ends below
-    /// [`SHORTFALL_SHARE`] of it: how far it got, what ended it, and that the bound may be loose.
-    pub fn shortfall(&self, trajectory: &Trajectory) -> Option<String> {
-        shortfall(trajectory, self.reachable_m)
-    }
 }
 
 /// The reachability bound of `task` under `constraints` (module documentation); `hints` are
@@ -192,18 +186,40 @@ fn grid_point(task: &Task, k: u64, grid_m: f64) -> Option<f64> {
 /// Share of the reachability bound below which a plan's output says that it ends short.
 pub const SHORTFALL_SHARE: f64 = 0.9;
 
-/// Why `trajectory` ends well short of the bound `reachable_m`, when it ends below
-/// [`SHORTFALL_SHARE`] of it.
-pub fn shortfall(trajectory: &Trajectory, reachable_m: f64) -> Option<String> {
+/// What a plan's output says of its task's reachability bound (`Planner::bound_note`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundNote {
+    /// The bound (m), raised to the plan's length where the plan went beyond the scan.
+    pub reachable_m: f64,
+    /// Why the plan ends below [`SHORTFALL_SHARE`] of the bound, when it does ([`shortfall`]).
+    pub shortfall: Option<String>,
+}
+
+/// Why `trajectory` ends below [`SHORTFALL_SHARE`] of the bound `reachable_m`: how far it got,
+/// what ended it, and what the bound's continuity test ([`far_end_chains`]) says: where a chain
+/// of valid configurations joins `p0` to near the bound's end (`joined`), a longer motion may
+/// exist; where none does, the bound is likely loose there.
+pub fn shortfall(trajectory: &Trajectory, reachable_m: f64, joined: bool) -> String {
     let length = trajectory.path_length_m;
-    (length < SHORTFALL_SHARE * reachable_m).then(|| {
+    let continuity = if joined {
         format!(
-            "the plan ends at {length:.2} m, below {SHORTFALL_SHARE} × the bound of \
-             {reachable_m:.2} m, because {}; the bound only says that every point up to it has \
-             a valid configuration, not that they join into one motion, so it may be loose",
-            trajectory.termination
+            "a chain of valid configurations joins `p0` to {:.0} % of the bound, so a longer \
+             motion may exist (a larger search budget, `search.budget_steps`, may find it)",
+            100.0 * FAR_END_SHARE
         )
-    })
+    } else {
+        format!(
+            "the bound only says that every point up to it has a valid configuration, and no \
+             chain of them was found that joins `p0` to {:.0} % of it, so the bound is likely \
+             loose here",
+            100.0 * FAR_END_SHARE
+        )
+    };
+    format!(
+        "the plan ends at {length:.2} m, below {SHORTFALL_SHARE} × the bound of {reachable_m:.2} \
+         m, because {}; {continuity}",
+        trajectory.termination
+    )
 }
 
 /// The scan's IK gives a restart up once its residual has not fallen by a tenth in this many

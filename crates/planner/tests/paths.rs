@@ -86,7 +86,7 @@ fn rectangles_circles_and_s_curves_plan_time_and_check_on_every_shipped_arm() {
             let record = PlanRecord {
                 robot: name,
                 request: &request,
-                reachable_m: None,
+                bound: None,
                 timing: &timing,
             };
             let files = PlanFiles::new(&planner, &task, &plan, &record).expect("timed");

@@ -8,8 +8,9 @@ use emg_control::Task;
 use emg_io::read_tasks;
 use emg_kinematics::{Robot, Vec3};
 use emg_planner::{
-    ControllerKind, DataDir, FAR_END_SHARE, Models, PlanRequest, Planner, PlannerConfig, Reach,
-    SeedSource, ShippedRobot, far_end_chains, witness_chains,
+    CONTINUITY_RESTARTS, ControllerKind, DataDir, FAR_END_SHARE, Models, PlanRequest, Planner,
+    PlannerConfig, Reach, SHORTFALL_SHARE, SeedSource, ShippedRobot, far_end_chains,
+    witness_chains,
 };
 use emg_verify::ReferenceModel;
 
@@ -180,6 +181,56 @@ fn the_bound_of_a_search_never_reads_below_its_plan_and_its_chains_hold() {
         }
     }
     assert!(joined_tasks > 0, "no chain joined back to p0 on any task");
+}
+
+#[test]
+fn a_plan_short_of_its_bound_says_whether_the_bound_joins_p0() {
+    let planner = planner();
+    let robot = planner.robot();
+    let tasks = eval_tasks(robot);
+    // The classical controller from the generating configuration stops short on many tasks.
+    let request = PlanRequest {
+        seed: Some(SeedSource::Generating),
+        controller: ControllerKind::Classical,
+        ..PlanRequest::pipeline()
+    };
+    let config = planner.config();
+    let mut short = 0;
+    for task in &tasks[..12] {
+        let plan = planner.plan(task, &request).expect("plans");
+        let note = planner.bound_note(task, &plan);
+        let reach = planner.reach_of(task, &plan);
+        assert_eq!(note.reachable_m, reach.reachable_m);
+        let length = plan.trajectory.path_length_m;
+        if length >= SHORTFALL_SHARE * reach.reachable_m {
+            assert_eq!(note.shortfall, None, "{length} m of {}", reach.reachable_m);
+            continue;
+        }
+        short += 1;
+        let joined = !far_end_chains(
+            robot,
+            task,
+            &config.rollout.constraints,
+            &config.reach,
+            &reach,
+            config.search.chain_jump_rad,
+            CONTINUITY_RESTARTS,
+        )
+        .is_empty();
+        let text = note.shortfall.expect("a short plan says so");
+        assert!(text.contains(&format!("ends at {length:.2} m")), "{text}");
+        assert!(
+            text.contains(&plan.trajectory.termination.to_string()),
+            "{text}"
+        );
+        let says = if joined {
+            "a longer motion may exist"
+        } else {
+            "the bound is likely loose here"
+        };
+        assert!(text.contains(says), "{text}");
+    }
+    assert!(short > 0, "no plan ended short of its bound");
 }
 
 #[test]

@@ -7,8 +7,8 @@ use emg_control::Trajectory;
 use emg_io::PlanPaths;
 use emg_kinematics::{Vec3, WorkSurface};
 use emg_planner::{
-    ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, POLICY_WEIGHTS_FILE, PlanError, PlanFiles,
-    PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
+    BoundNote, ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, POLICY_WEIGHTS_FILE, PlanError,
+    PlanFiles, PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -56,7 +56,7 @@ pub struct Plan {
     request: PlanRequest,
     task: emg_control::Task,
     plan: emg_planner::Plan,
-    reachable_m: Option<f64>,
+    bound: Option<BoundNote>,
 }
 
 /// What `plan` and `plan_many` are asked for, parsed from their arguments.
@@ -134,10 +134,8 @@ impl Planner {
     /// One plan (and its reachability bound when asked), made without the GIL.
     fn plan_one(&self, task: &emg_control::Task, request: &Request) -> Result<Planned, PlanError> {
         let plan = self.inner.plan(task, &request.request)?;
-        let reachable_m = request
-            .reach
-            .then(|| self.inner.reach_of(task, &plan).reachable_m);
-        Ok((plan, reachable_m))
+        let bound = request.reach.then(|| self.inner.bound_note(task, &plan));
+        Ok((plan, bound))
     }
 
     /// The plan of one validated `task`, made without the GIL, as its Python object.
@@ -155,20 +153,20 @@ impl Planner {
 
     /// The Python object of a plan of `task`.
     fn wrap(&self, task: emg_control::Task, request: &Request, planned: Planned) -> Plan {
-        let (plan, reachable_m) = planned;
+        let (plan, bound) = planned;
         Plan {
             planner: Arc::clone(&self.inner),
             robot: self.robot.get().file.display().to_string(),
             request: request.request.clone(),
             task,
             plan,
-            reachable_m,
+            bound,
         }
     }
 }
 
-/// A plan and, when asked, its task's reachability bound (m).
-type Planned = (emg_planner::Plan, Option<f64>);
+/// A plan and, when asked, what its output says of its task's reachability bound.
+type Planned = (emg_planner::Plan, Option<BoundNote>);
 
 /// A [`PlanError`] as the Python exception it raises (its message prefixed by `tasks[i]: ` for
 /// task `i` of a batch): a controller that cannot be built is bad input (a learned controller
@@ -495,7 +493,16 @@ impl Plan {
     /// The task's reachability bound (m) when `reach=True` was asked, else `None`.
     #[getter]
     fn reachable_m(&self) -> Option<f64> {
-        self.reachable_m
+        self.bound.as_ref().map(|bound| bound.reachable_m)
+    }
+
+    /// Why the plan ends below 0.9 × the bound, when `reach=True` was asked and it does (as
+    /// `emg plan` prints it and the trajectory file records it), else `None`.
+    #[getter]
+    fn below_bound(&self) -> Option<String> {
+        self.bound
+            .as_ref()
+            .and_then(|bound| bound.shortfall.clone())
     }
 
     /// The task.
@@ -578,7 +585,7 @@ impl Plan {
         let record = PlanRecord {
             robot: &self.robot,
             request: &self.request,
-            reachable_m: self.reachable_m,
+            bound: self.bound.as_ref(),
             timing: &timing,
         };
         let files = PlanFiles::new(&self.planner, &self.task, &self.plan, &record)

@@ -118,6 +118,7 @@ def test_plan_arrays_describe_the_motion(planner, tasks):
     assert np.all(np.diff(plan.t) > 0)
     assert plan.path_length_m == pytest.approx(float((plan.tcp[-1] - task.p0) @ task.d), abs=1e-9)
     assert 0 < plan.path_length_m <= plan.reachable_m + 0.02
+    assert (plan.below_bound is None) == (plan.path_length_m >= 0.9 * plan.reachable_m)
     np.testing.assert_array_equal(plan.q[0], plan.seed)
     # The search starts from whichever of its candidates goes furthest, never less far than
     # the paper's pipeline (one DP seed, one rollout).
