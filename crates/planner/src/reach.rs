@@ -341,13 +341,9 @@ pub fn far_end_chains(
     let point = |k: usize| task.point_at(k as f64 * reach.grid_m);
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     rng.set_stream(FAR_END_STREAM);
-    let limits = robot.limits();
     let mut ends = vec![reach.witnesses[far]];
     for _ in 0..restarts {
-        let start = robot.configuration_from_fn(|i| {
-            let u: f64 = rng.random();
-            limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
-        });
+        let start = random_configuration(robot, &mut rng);
         if let Some(q) = scan.continuation(&point(far), &start)
             && ends.iter().all(|e| (e - q).amax() >= scan.ik.dedup_rad)
         {
@@ -459,19 +455,22 @@ impl Scan<'_> {
             // one by one, whatever the thread count (the stream is read on only after all of
             // them failed, and then all of them were drawn either way). The restarts of a point
             // that has no valid configuration, the last of every scan, are most of its work.
-            let limits = robot.limits();
             let starts: Vec<JointVector> = (0..config.restarts)
-                .map(|_| {
-                    robot.configuration_from_fn(|i| {
-                        let u: f64 = rng.random();
-                        limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
-                    })
-                })
+                .map(|_| random_configuration(robot, rng))
                 .collect();
             found.extend(starts.par_iter().find_map_first(valid));
         }
         found
     }
+}
+
+/// A configuration drawn uniformly within the joint limits, joint by joint in order.
+fn random_configuration(robot: &Robot, rng: &mut ChaCha8Rng) -> JointVector {
+    let limits = robot.limits();
+    robot.configuration_from_fn(|i| {
+        let u: f64 = rng.random();
+        limits.lower[i] + u * (limits.upper[i] - limits.lower[i])
+    })
 }
 
 /// `count` unit directions ⟂ `d` (across the line, where the line tolerance allows the TCP to

@@ -38,6 +38,15 @@ fn eval_tasks(robot: &Robot) -> Vec<Task> {
     read_tasks(&fr3().data_dir(&data()).join("tasks/eval-v1.tasks"), robot).expect("shipped tasks")
 }
 
+/// The classical controller from the task's generating configuration (no models needed).
+fn classical_from_generating() -> PlanRequest {
+    PlanRequest {
+        seed: Some(SeedSource::Generating),
+        controller: ControllerKind::Classical,
+        ..PlanRequest::pipeline()
+    }
+}
+
 /// Checks every witness of `reach` for `task` with the independent checker.
 fn check_witnesses(planner: &Planner, checker: &ReferenceModel, task: &Task, reach: &Reach) {
     let constraints = &planner.config().rollout.constraints;
@@ -85,11 +94,7 @@ fn no_plan_goes_beyond_the_bound_and_every_witness_holds() {
     let robot = planner.robot();
     let checker = checker(robot);
     let tasks = eval_tasks(robot);
-    let request = PlanRequest {
-        seed: Some(SeedSource::Generating),
-        controller: ControllerKind::Classical,
-        ..PlanRequest::pipeline()
-    };
+    let request = classical_from_generating();
     let mut beyond_plan = 0;
     for task in &tasks[..8] {
         let plan = planner.plan(task, &request).expect("plans");
@@ -189,11 +194,7 @@ fn a_plan_short_of_its_bound_says_whether_the_bound_joins_p0() {
     let robot = planner.robot();
     let tasks = eval_tasks(robot);
     // The classical controller from the generating configuration stops short on many tasks.
-    let request = PlanRequest {
-        seed: Some(SeedSource::Generating),
-        controller: ControllerKind::Classical,
-        ..PlanRequest::pipeline()
-    };
+    let request = classical_from_generating();
     let config = planner.config();
     let mut short = 0;
     for task in &tasks[..12] {
