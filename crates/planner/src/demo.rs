@@ -16,7 +16,7 @@ const DEMO_MAX_CANDIDATES: u64 = 4096;
 /// axis, `d` = +y made perpendicular to `n`; `q0_seed` = the mid-range configuration. When the
 /// mid-range configuration is near a singularity, the first task of the robot's task population
 /// (`emg_control::TaskSampler` with its default settings) instead (or, should none of its
-/// first [`DEMO_MAX_CANDIDATES`] candidates be accepted, the mid-range task all the same).
+/// first `DEMO_MAX_CANDIDATES` candidates be accepted, the mid-range task all the same).
 pub fn demo_task(robot: &Robot) -> Result<Task, TaskError> {
     let seed = robot.mid_range();
     let kinematics = robot.forward(&seed);
