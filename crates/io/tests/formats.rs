@@ -395,7 +395,13 @@ fn rollout_json_of_a_six_joint_arm_holds_six_values_per_joint_vector_and_reads_b
         reachable_m: None,
         below_bound: None,
     };
-    let doc: Value = serde_json::from_str(&file.to_json()).unwrap();
+    let text = file.to_json();
+    // The fields keep the layout's order, the format first.
+    assert!(
+        text.starts_with(r#"{"format":"emg-trajectory/1","robot":"#),
+        "{text}"
+    );
+    let doc: Value = serde_json::from_str(&text).unwrap();
     let steps = doc["steps"].as_array().unwrap();
     assert!(steps.len() > 1);
     for step in steps {
