@@ -49,7 +49,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::controller::Executor;
-use crate::reach::{Reach, ReachConfig, witness_chains};
+use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
 use crate::seed::Seed;
 use crate::track::{Reference, progress_per_step, tracking_action};
 
@@ -88,6 +88,15 @@ pub struct SearchConfig {
     pub classical_gains: ClassicalGains,
     /// Seed of the IK restarts.
     pub seed: u64,
+    /// Control steps added to the budget when the search has ended below
+    /// [`SHORTFALL_SHARE`] × the task's bound (0: never). The search then goes on from where it
+    /// stopped, wider: [`SearchConfig::widened_breadth`] times as many diffusion samples, IK
+    /// restarts and chains, the starts it has not rolled out yet ranked and repaired like the
+    /// first ones, the leaders it had not finished repairing repaired further.
+    pub widened_budget_steps: u64,
+    /// How many times as many diffusion samples, IK restarts and chains the widened search
+    /// draws ([`SearchConfig::widened_budget_steps`]).
+    pub widened_breadth: usize,
 }
 
 /// The search's classical gains ([`SearchConfig::classical_gains`]): the paper's `k_μ` and
@@ -123,6 +132,8 @@ impl Default for SearchConfig {
             chains: 4,
             classical_gains: search_classical_gains(),
             seed: 20_261_123,
+            widened_budget_steps: 0,
+            widened_breadth: 4,
         }
     }
 }
@@ -153,6 +164,18 @@ impl SearchConfig {
         ] {
             OutOfRange::require(field, count(value), "[1, 64]", within(1.0, 64.0))?;
         }
+        OutOfRange::require(
+            "search.widened_budget_steps",
+            self.widened_budget_steps as f64,
+            "[0, 10000000]",
+            within(0.0, MAX_SEARCH_BUDGET_STEPS as f64),
+        )?;
+        OutOfRange::require(
+            "search.widened_breadth",
+            count(self.widened_breadth),
+            "[1, 16]",
+            within(1.0, 16.0),
+        )?;
         OutOfRange::require(
             "search.detour_steps",
             count(self.detour_steps),
@@ -192,6 +215,25 @@ fn search_gain_field(field: &'static str) -> &'static str {
         "gains.k_lead" => "search.classical_gains.k_lead",
         "gains.lead_deg" => "search.classical_gains.lead_deg",
         other => other,
+    }
+}
+
+/// How many candidate starts and chains one pass of the search draws.
+#[derive(Clone, Copy, Debug)]
+struct Breadth {
+    dp_samples: usize,
+    ik_restarts: usize,
+    chains: usize,
+}
+
+impl Breadth {
+    /// The configured counts, each times `factor`.
+    fn of(config: &SearchConfig, factor: usize) -> Self {
+        Self {
+            dp_samples: config.dp_samples * factor,
+            ik_restarts: config.ik_restarts * factor,
+            chains: config.chains * factor,
+        }
     }
 }
 
@@ -286,6 +328,11 @@ struct Search<'a> {
     enough_m: f64,
     spent: u64,
     leaders: Vec<Best>,
+    /// The starts rolled out from the start pose so far (the pipeline's seed and the
+    /// candidates; not the chains' starts).
+    tried: Vec<JointVector>,
+    /// The starts whose repair rounds have ended without going further.
+    settled: Vec<JointVector>,
 }
 
 impl<'a> Search<'a> {
@@ -298,6 +345,8 @@ impl<'a> Search<'a> {
             enough_m,
             spent: 0,
             leaders: Vec::new(),
+            tried: Vec::new(),
+            settled: Vec::new(),
         }
     }
 }
@@ -305,7 +354,12 @@ impl<'a> Search<'a> {
 impl Search<'_> {
     /// Whether the search is over: its budget spent, or its longest rollout long enough.
     fn done(&self) -> bool {
-        self.spent >= self.budget || self.longest_m() >= self.enough_m
+        self.spent >= self.budget || self.arrived()
+    }
+
+    /// Whether the longest rollout has got far enough that nothing is left to find.
+    fn arrived(&self) -> bool {
+        self.longest_m() >= self.enough_m
     }
 
     /// The length of the longest rollout so far (m; −∞ before the first).
@@ -319,6 +373,7 @@ impl Search<'_> {
     /// is among the longest so far.
     fn try_start(&mut self, seed: &Seed, tail: &mut Executor) -> f64 {
         let context = self.context;
+        self.tried.push(seed.q);
         let episode = Episode::start(context.robot, self.task, &seed.q, context.rollout);
         self.try_branch(seed, episode, &[], None, tail)
     }
@@ -379,13 +434,20 @@ impl Search<'_> {
     /// Repairs the leaders in turn, longest first: rounds of detours near the end of the
     /// longest rollout from the leader's start (from a few steps before where it stopped, each
     /// basis direction held for [`SearchConfig::detour_steps`] steps, then each tail); a round
-    /// that goes further starts the next round from the new rollout.
+    /// that goes further starts the next round from the new rollout. A start whose rounds
+    /// have ended without going further is settled and not repaired again.
     fn repair(&mut self, tails: &mut [Executor]) {
-        let starts: Vec<Seed> = self.leaders.iter().map(|b| b.seed.clone()).collect();
+        let starts: Vec<Seed> = self
+            .leaders
+            .iter()
+            .filter(|b| !self.settled.contains(&b.seed.q))
+            .map(|b| b.seed.clone())
+            .collect();
         for seed in &starts {
             if !self.repair_from(seed, tails) {
                 return;
             }
+            self.settled.push(seed.q);
         }
     }
 
@@ -468,11 +530,11 @@ const BACKTRACK_STEPS: [usize; 6] = [1, 2, 4, 8, 16, 32];
 
 /// The searched plan of `task`: its start and its rollout. The pipeline's own plan (`seed`
 /// rolled out by `finalist`, the requested controller) is always evaluated first, so the
-/// search never returns less; then the scan's chains of configurations (`reach`) are followed
-/// from `p0`, the other candidates are ranked by rollouts of the search's classical controller, the
-/// best [`SearchConfig::finalists`] rolled out by `finalist`, and the longest rollouts of the best
-/// starts repaired by detours near their ends, while budget is left and no rollout has come within
-/// [`SearchConfig::stop_within_m`] of the first grid point the scan missed.
+/// search never returns less; then a pass at the configured breadth ([`Search::pass`]) while
+/// budget is left and no rollout has come within [`SearchConfig::stop_within_m`] of the first
+/// grid point the scan missed. Where the longest rollout then ends below [`SHORTFALL_SHARE`] ×
+/// the bound, the budget grows by [`SearchConfig::widened_budget_steps`] and a wider pass
+/// ([`SearchConfig::widened_breadth`]) goes on from there.
 pub(crate) fn search(
     context: &SearchContext<'_>,
     task: &Task,
@@ -491,58 +553,77 @@ pub(crate) fn search(
     let enough_m = past_scan_m - config.stop_within_m;
     let mut search = Search::new(context, task, config.budget_steps, enough_m);
     search.try_start(&seed, &mut tails[0]);
-    search.track_chains(reach, &mut tails);
-    let candidates = if search.done() {
+    let chains = if search.done() {
         Vec::new()
     } else {
-        candidates(context, task, &[seed.q])
+        witness_chains(
+            context.robot,
+            task,
+            &context.rollout.constraints,
+            context.reach,
+            reach,
+            config.chain_jump_rad,
+        )
     };
-    let mut ranked: Vec<(usize, f64)> = Vec::new();
-    for (index, candidate) in candidates.iter().enumerate() {
-        if search.done() {
-            break;
-        }
-        let length = search.try_start(&candidate.seed(), &mut tails[1]);
-        ranked.push((index, length));
+    let first = Breadth::of(config, 1);
+    search.pass(reach, &chains, 0, first, &mut tails);
+    let short = search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
+    if config.widened_budget_steps > 0 && short && !search.arrived() {
+        search.budget += config.widened_budget_steps;
+        let wide = Breadth::of(config, config.widened_breadth);
+        search.pass(reach, &chains, first.chains, wide, &mut tails);
     }
-    // Longest first; equal lengths keep the candidates' order.
-    ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
-    for &(index, _) in ranked.iter().take(config.finalists) {
-        if search.done() {
-            break;
-        }
-        search.try_start(&candidates[index].seed(), &mut tails[0]);
-    }
-    search.repair(&mut tails);
     let best = search.leaders.swap_remove(0);
     (best.seed, best.trajectory)
 }
 
 impl Search<'_> {
-    /// The long-horizon stage (`crate::track`): each of the scan's chains of configurations
-    /// from `p0` ([`witness_chains`], farthest-reaching first, at most
-    /// [`SearchConfig::chains`]) is followed from its configuration at `p0` by each tail in
-    /// turn, the tail taking over where the chain ends.
-    fn track_chains(&mut self, reach: &Reach, tails: &mut [Executor]) {
+    /// One pass of the search at `breadth`: the scan's `chains` from `first_chain` up to
+    /// `breadth.chains` followed from `p0` ([`Search::track`]); then the candidate starts not
+    /// rolled out yet ranked by rollouts of the search's classical controller, the best
+    /// [`SearchConfig::finalists`] rolled out by the requested controller, and the longest
+    /// rollouts of the best starts repaired by detours near their ends; each stage only while
+    /// the search is not done.
+    fn pass(
+        &mut self,
+        reach: &Reach,
+        chains: &[Vec<JointVector>],
+        first_chain: usize,
+        breadth: Breadth,
+        tails: &mut [Executor; 2],
+    ) {
         let context = self.context;
-        if self.done() {
-            return;
-        }
-        let chains = witness_chains(
-            context.robot,
-            self.task,
-            &context.rollout.constraints,
-            context.reach,
-            reach,
-            context.config.chain_jump_rad,
-        );
-        for chain in chains.iter().take(context.config.chains) {
+        for chain in chains.iter().take(breadth.chains).skip(first_chain) {
             if let Some(reference) = Reference::along_grid(chain, reach.grid_m) {
                 self.track(&reference, tails);
             }
         }
+        let candidates = if self.done() {
+            Vec::new()
+        } else {
+            candidates(context, self.task, &self.tried, breadth)
+        };
+        let mut ranked: Vec<(usize, f64)> = Vec::new();
+        for (index, candidate) in candidates.iter().enumerate() {
+            if self.done() {
+                break;
+            }
+            let length = self.try_start(&candidate.seed(), &mut tails[1]);
+            ranked.push((index, length));
+        }
+        // Longest first; equal lengths keep the candidates' order.
+        ranked.sort_by(|a, b| b.1.total_cmp(&a.1));
+        for &(index, _) in ranked.iter().take(context.config.finalists) {
+            if self.done() {
+                break;
+            }
+            self.try_start(&candidates[index].seed(), &mut tails[0]);
+        }
+        self.repair(tails);
     }
+}
 
+impl Search<'_> {
     /// Follows `reference` from its configuration at `p0`, with each tail taking over where it
     /// ends.
     fn track(&mut self, reference: &Reference, tails: &mut [Executor]) {
@@ -610,8 +691,13 @@ fn steps_evaluated(trajectory: &Trajectory) -> u64 {
 }
 
 /// The distinct valid starts on the start pose other than `tried` (the seeds already rolled
-/// out), in the fixed order of the module documentation.
-fn candidates(context: &SearchContext<'_>, task: &Task, tried: &[JointVector]) -> Vec<Candidate> {
+/// out), drawn at `breadth`, in the fixed order of the module documentation.
+fn candidates(
+    context: &SearchContext<'_>,
+    task: &Task,
+    tried: &[JointVector],
+    breadth: Breadth,
+) -> Vec<Candidate> {
     let robot = context.robot;
     let constraints = &context.rollout.constraints;
     let distinct_rad = context.config.distinct_rad;
@@ -645,11 +731,11 @@ fn candidates(context: &SearchContext<'_>, task: &Task, tried: &[JointVector]) -
         }
     }
     if let Some(seeder) = context.seeder
-        && context.config.dp_samples > 0
+        && breadth.dp_samples > 0
         && let Ok(samples) = seeder.candidates(
             robot,
             task,
-            context.config.dp_samples,
+            breadth.dp_samples,
             &mut SeedWorkspace::default(),
         )
     {
@@ -660,7 +746,7 @@ fn candidates(context: &SearchContext<'_>, task: &Task, tried: &[JointVector]) -
         }
     }
     let ik = IkConfig {
-        restarts: context.config.ik_restarts,
+        restarts: breadth.ik_restarts,
         ..IkConfig::default()
     };
     let mut rng = ChaCha8Rng::seed_from_u64(context.config.seed);
