@@ -68,6 +68,8 @@ pub fn limit_search() -> SearchConfig {
         finalists: 16,
         repaired_starts: 16,
         chains: 16,
+        // Its own budget and breadth are already far wider than the widened pass's.
+        widened_budget_steps: 0,
         ..SearchConfig::default()
     }
 }

@@ -9,7 +9,9 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{BoundShare, Summary, bound_shares, four};
-use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SHIPPED_ROBOTS, SearchConfig};
+use emg_planner::{
+    PlanRequest, PlannerConfig, PlannerKind, SHIPPED_ROBOTS, SHORTFALL_SHARE, SearchConfig,
+};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -369,7 +371,8 @@ fn markdown(record: &Record) -> String {
          failed (each null-space basis direction held for {} steps from 1 to 32 steps before \
          the end, then the hybrid or the search's classical controller). It stops \
          when its budget of control steps is spent or a plan comes within {} m of the first \
-         grid point the scan missed. Every plan is re-checked by the independent \
+         grid point the scan missed; where its plan then ends below {} × the bound, it goes on \
+         with {} more steps, {} times as many chains, diffusion samples and IK restarts. Every plan is re-checked by the independent \
          checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
          plan beyond the scan's bound on {} tasks); it ignores continuity, so it may be loose. \
          Bound (m, mean / std / min / max): {}. Times are on {} ({} threads) and depend on the \
@@ -392,6 +395,9 @@ fn markdown(record: &Record) -> String {
         record.search.repaired_starts,
         record.search.detour_steps,
         record.search.stop_within_m,
+        SHORTFALL_SHARE,
+        record.search.widened_budget_steps,
+        record.search.widened_breadth,
         record.scan_missed,
         four(&record.reachability_bound_m, 3),
         record.machine,

@@ -38,7 +38,8 @@ pub struct PlannerConfig {
     pub reach: ReachConfig,
     /// The search planner ([`SearchConfig`]: `budget_steps` 10,000, `dp_samples` 32,
     /// `ik_restarts` 64, `finalists` 8, `repaired_starts` 8, `detour_steps` 10, its own
-    /// `classical_gains`).
+    /// `classical_gains`; 25,000 more steps at breadth 4 where a plan ends short of its
+    /// bound, `widened_budget_steps` and `widened_breadth`).
     pub search: SearchConfig,
 }
 

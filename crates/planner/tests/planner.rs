@@ -263,6 +263,14 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
             "search.classical_gains.k_lead must be in [0, ∞), got -5",
         ),
         (
+            r#"{"search": {"widened_breadth": 0}}"#,
+            "search.widened_breadth must be in [1, 16], got 0",
+        ),
+        (
+            r#"{"search": {"widened_budget_steps": 20000000}}"#,
+            "search.widened_budget_steps must be in [0, 10000000], got 20000000",
+        ),
+        (
             r#"{"measure": {"kind": "all_constraints", "clearance_scale_m": 0}}"#,
             "measure.clearance_scale_m must be in (0, ∞), got 0",
         ),
