@@ -302,7 +302,7 @@ pub fn shares_table(results: &Path) -> anyhow::Result<String> {
         for row in pipeline.into_iter().chain(record.default_budget_row()) {
             md += &share_row(
                 shipped.name,
-                &row_name(row),
+                &row_name(row, &record.search),
                 &row.bound_shares,
                 record.task_count,
                 row.plan_ms.mean,
@@ -329,11 +329,13 @@ fn share_row(
     row + &format!(" {below} of {tasks} | {mean_ms:.1} |\n")
 }
 
-/// A row's planner for tables: the pipeline, or the search with its budget.
-fn row_name(row: &Row) -> String {
-    match row.budget_steps {
-        None => "Hybrid + DP (the paper's pipeline)".into(),
-        Some(budget) => format!("search ({budget} steps)"),
+/// A row's planner for tables: the pipeline, or the search (`config`) with its budget and the
+/// steps its widened pass adds where a plan ends short of its bound.
+fn row_name(row: &Row, config: &SearchConfig) -> String {
+    match (row.budget_steps, config.widened_budget_steps) {
+        (None, _) => "Hybrid + DP (the paper's pipeline)".into(),
+        (Some(budget), 0) => format!("search ({budget} steps)"),
+        (Some(budget), widened) => format!("search ({budget} steps, + {widened} where short)"),
     }
 }
 

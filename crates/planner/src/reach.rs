@@ -204,7 +204,8 @@ pub fn shortfall(trajectory: &Trajectory, reachable_m: f64, joined: bool) -> Str
     let continuity = if joined {
         format!(
             "a chain of valid configurations joins `p0` to {:.0} % of the bound, so a longer \
-             motion may exist (a larger search budget, `search.budget_steps`, may find it)",
+             motion may exist (a larger search budget, `search.budget_steps` or \
+             `search.widened_budget_steps`, may find it)",
             100.0 * FAR_END_SHARE
         )
     } else {

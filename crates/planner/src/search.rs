@@ -561,7 +561,8 @@ pub(crate) fn search(
     let enough_m = past_scan_m - config.stop_within_m;
     let mut search = Search::new(context, task, config.budget_steps, enough_m);
     search.try_start(&seed, &mut tails[0]);
-    let chains = if search.done() {
+    // Computed once for both passes (none needed once a rollout has arrived).
+    let chains = if search.arrived() {
         Vec::new()
     } else {
         witness_chains(
@@ -629,9 +630,7 @@ impl Search<'_> {
         }
         self.repair(tails);
     }
-}
 
-impl Search<'_> {
     /// Follows `reference` from its configuration at `p0`, with each tail taking over where it
     /// ends.
     fn track(&mut self, reference: &Reference, tails: &mut [Executor]) {
