@@ -51,6 +51,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::beam::{BeamLimits, beam_search, null_actions};
 use crate::controller::Executor;
 use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
 use crate::seed::Seed;
@@ -105,6 +106,12 @@ pub struct SearchConfig {
     /// How many times as many diffusion samples, IK restarts and chains the widened search
     /// draws ([`SearchConfig::widened_budget_steps`]).
     pub widened_breadth: usize,
+    /// Members of the beam stage (`crate::beam`), run last where the longest rollout still
+    /// ends below [`SHORTFALL_SHARE`] × the bound (0: never): a search over action sequences
+    /// from every start the search rolled out, diverse across joint-space cells.
+    pub beam_width: usize,
+    /// Control steps the beam stage may evaluate.
+    pub beam_budget_steps: u64,
 }
 
 /// The search's classical gains ([`SearchConfig::classical_gains`]): the paper's `k_μ` and
@@ -142,6 +149,8 @@ impl Default for SearchConfig {
             seed: 20_261_123,
             widened_budget_steps: 25_000,
             widened_breadth: 4,
+            beam_width: 0,
+            beam_budget_steps: 0,
         }
     }
 }
@@ -177,6 +186,18 @@ impl SearchConfig {
             self.widened_budget_steps as f64,
             "[0, 10000000]",
             within(0.0, MAX_SEARCH_BUDGET_STEPS as f64),
+        )?;
+        OutOfRange::require(
+            "search.beam_budget_steps",
+            self.beam_budget_steps as f64,
+            "[0, 10000000]",
+            within(0.0, MAX_SEARCH_BUDGET_STEPS as f64),
+        )?;
+        OutOfRange::require(
+            "search.beam_width",
+            count(self.beam_width),
+            "[0, 4096]",
+            within(0.0, 4096.0),
         )?;
         OutOfRange::require(
             "search.widened_breadth",
@@ -338,7 +359,7 @@ struct Search<'a> {
     leaders: Vec<Best>,
     /// The starts rolled out from the start pose so far (the pipeline's seed and the
     /// candidates; not the chains' starts).
-    tried: Vec<JointVector>,
+    tried: Vec<Seed>,
     /// The starts whose repair rounds have ended without going further.
     settled: Vec<JointVector>,
 }
@@ -381,7 +402,7 @@ impl Search<'_> {
     /// is among the longest so far.
     fn try_start(&mut self, seed: &Seed, tail: &mut Executor) -> f64 {
         let context = self.context;
-        self.tried.push(seed.q);
+        self.tried.push(seed.clone());
         let episode = Episode::start(context.robot, self.task, &seed.q, context.rollout);
         self.try_branch(seed, episode, &[], None, tail)
     }
@@ -461,15 +482,7 @@ impl Search<'_> {
 
     /// Rounds of detours from `seed`'s leader; false once the budget is spent.
     fn repair_from(&mut self, seed: &Seed, tails: &mut [Executor]) -> bool {
-        let directions: Vec<NullAction> = (0..4)
-            .flat_map(|axis| {
-                [1.0, -1.0].map(|sign| {
-                    let mut action = NullAction::zeros();
-                    action[axis] = sign;
-                    action
-                })
-            })
-            .collect();
+        let directions = null_actions(4);
         loop {
             // A start that has fallen out of the leaders is not repaired further.
             let Some(base) = self.leader_of(seed).cloned() else {
@@ -582,6 +595,10 @@ pub(crate) fn search(
         let wide = Breadth::of(config, config.widened_breadth);
         search.pass(reach, &chains, first.chains, wide, &mut tails);
     }
+    let still_short = search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
+    if config.beam_width > 0 && still_short && !search.arrived() {
+        search.beam();
+    }
     let best = search.leaders.swap_remove(0);
     (best.seed, best.trajectory)
 }
@@ -629,6 +646,42 @@ impl Search<'_> {
             self.try_start(&candidates[index].seed(), &mut tails[0]);
         }
         self.repair(tails);
+    }
+
+    /// The beam stage (`crate::beam`) from the leaders' starts and every start rolled out,
+    /// its motion offered like any rollout. It runs last: its motion keeps no actions to
+    /// replay, so no repair may follow it.
+    fn beam(&mut self) {
+        let context = self.context;
+        let mut starts: Vec<Seed> = self.leaders.iter().map(|b| b.seed.clone()).collect();
+        for seed in &self.tried {
+            if starts.iter().all(|s| s.q != seed.q) {
+                starts.push(seed.clone());
+            }
+        }
+        let configurations: Vec<JointVector> = starts.iter().map(|s| s.q).collect();
+        let mut controller = ClassicalController::new(context.config.classical_gains.clone());
+        let limits = BeamLimits {
+            width: context.config.beam_width,
+            budget_steps: context.config.beam_budget_steps,
+            enough_m: self.enough_m,
+        };
+        let (plan, spent) = beam_search(
+            context.robot,
+            self.task,
+            context.rollout,
+            &configurations,
+            &mut controller,
+            limits,
+        );
+        self.spent += spent;
+        if let Some(plan) = plan {
+            self.offer(Best {
+                seed: starts[plan.start].clone(),
+                trajectory: plan.trajectory,
+                issued: Vec::new(),
+            });
+        }
     }
 
     /// Follows `reference` from its configuration at `p0`, with each tail taking over where it
@@ -688,7 +741,7 @@ impl Candidate {
 }
 
 /// Steps a rollout evaluated: every accepted step, and the rejected one that ended it.
-fn steps_evaluated(trajectory: &Trajectory) -> u64 {
+pub(crate) fn steps_evaluated(trajectory: &Trajectory) -> u64 {
     let accepted = trajectory.steps.len().saturating_sub(1) as u64;
     accepted
         + u64::from(matches!(
@@ -702,7 +755,7 @@ fn steps_evaluated(trajectory: &Trajectory) -> u64 {
 fn candidates(
     context: &SearchContext<'_>,
     task: &Task,
-    tried: &[JointVector],
+    tried: &[Seed],
     breadth: Breadth,
 ) -> Vec<Candidate> {
     let robot = context.robot;
@@ -712,7 +765,7 @@ fn candidates(
     let mut offer = |q: JointVector, source: &'static str| {
         let kinematics = robot.forward(&q);
         let valid = first_violation(robot, task, &kinematics, constraints).is_none();
-        let distinct = tried.iter().all(|t| (t - q).amax() >= distinct_rad)
+        let distinct = tried.iter().all(|t| (t.q - q).amax() >= distinct_rad)
             && found.iter().all(|c| (c.q - q).amax() >= distinct_rad);
         if valid && distinct {
             found.push(Candidate { q, source });

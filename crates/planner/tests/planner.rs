@@ -271,6 +271,14 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
             "search.widened_budget_steps must be in [0, 10000000], got 20000000",
         ),
         (
+            r#"{"search": {"beam_width": 5000}}"#,
+            "search.beam_width must be in [0, 4096], got 5000",
+        ),
+        (
+            r#"{"search": {"beam_budget_steps": 20000000}}"#,
+            "search.beam_budget_steps must be in [0, 10000000], got 20000000",
+        ),
+        (
             r#"{"measure": {"kind": "all_constraints", "clearance_scale_m": 0}}"#,
             "measure.clearance_scale_m must be in (0, ∞), got 0",
         ),

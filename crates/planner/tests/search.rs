@@ -3,7 +3,8 @@
 //! stage's detours (recorded as such); every plan passes the independent checker; results do not depend on the thread count; a budget spent by the
 //! pipeline's rollout gives exactly the pipeline's plan; with the work surface and an obstacle on
 //! the way, every plan still passes the checker told of them; a plan short of its bound is
-//! searched wider and goes further, one near its bound is left as it is.
+//! searched wider and goes further, one near its bound is left as it is; the beam stage goes on
+//! where the widened search still ends short.
 
 use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
@@ -193,6 +194,59 @@ fn search_holds_the_work_surface_and_the_scene() {
         scene_ends > 0 && moved > 3,
         "{scene_ends} plans end on the scene, {moved} move"
     );
+}
+
+#[test]
+fn the_beam_stage_goes_on_where_the_search_ends_short() {
+    // Evaluation task 593: a line whose bound is 1.28 m, where the default search (its widened
+    // pass included) ends at 0.47 m; and task 0, which it plans to its bound.
+    let without = PlannerConfig::default();
+    let mut with = without.clone();
+    with.search.beam_width = 64;
+    with.search.beam_budget_steps = 100_000;
+    let (without, with) = (planner(without), planner(with));
+    let robot = with.robot();
+    let checker = checker(robot);
+    let constraints = &with.config().rollout.constraints;
+    let tasks = tasks(robot, 1000);
+    for index in [0, 593] {
+        let task = &tasks[index];
+        let first = without.plan(task, &search_request()).expect("searches");
+        let second = with.plan(task, &search_request()).expect("searches");
+        checker
+            .check(task, &second.trajectory, constraints)
+            .expect("the beam's plan holds every constraint");
+        let bound = first.reach.as_ref().expect("the search scans").reachable_m;
+        let (a, b) = (
+            first.trajectory.path_length_m,
+            second.trajectory.path_length_m,
+        );
+        eprintln!("task {index}: {a:.3} m → {b:.3} m of {bound:.3} m");
+        if index == 0 {
+            assert!(
+                a >= SHORTFALL_SHARE * bound,
+                "task 0 is planned near its bound"
+            );
+            assert_eq!(first, second, "a plan near its bound runs no beam");
+        } else {
+            assert!(
+                a < SHORTFALL_SHARE * bound,
+                "task {index}: the search ends short"
+            );
+            assert!(
+                b >= SHORTFALL_SHARE * bound,
+                "task {index}: the beam reaches only {b} m of {bound} m"
+            );
+            assert!(
+                second
+                    .trajectory
+                    .steps
+                    .iter()
+                    .any(|s| s.controller == Some(ActingController::Search)),
+                "the beam's steps are recorded as the search's"
+            );
+        }
+    }
 }
 
 #[test]
