@@ -376,8 +376,10 @@ fn continuity(records: &[TaskLimit]) -> Vec<ContinuityBucket> {
             bucket: name.to_string(),
             short: members.len(),
             joined: members.iter().filter(|r| r.joined).count(),
-            missing_m: members.iter().map(missing).sum(),
-            missing_joined_m: members.iter().filter(|r| r.joined).map(missing).sum(),
+            // A fold from +0: an empty sum of floats is −0, which would print as "-0.00".
+            missing_m: members.iter().map(missing).fold(0.0, |a, m| a + m),
+            missing_joined_m: (members.iter().filter(|r| r.joined).map(missing))
+                .fold(0.0, |a, m| a + m),
         }
     };
     let mut buckets: Vec<ContinuityBucket> = std::iter::once(0.0)

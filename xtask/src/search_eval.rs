@@ -329,14 +329,42 @@ fn share_row(
     row + &format!(" {below} of {tasks} | {mean_ms:.1} |\n")
 }
 
-/// A row's planner for tables: the pipeline, or the search (`config`) with its budget and the
-/// steps its widened pass adds where a plan ends short of its bound.
+/// A row's planner for tables: the pipeline, or the search (`config`) with its budget, the
+/// steps its widened pass adds where a plan ends short of its bound, and its beam stage.
 fn row_name(row: &Row, config: &SearchConfig) -> String {
-    match (row.budget_steps, config.widened_budget_steps) {
-        (None, _) => "Hybrid + DP (the paper's pipeline)".into(),
-        (Some(budget), 0) => format!("search ({budget} steps)"),
-        (Some(budget), widened) => format!("search ({budget} steps, + {widened} where short)"),
+    let Some(budget) = row.budget_steps else {
+        return "Hybrid + DP (the paper's pipeline)".into();
+    };
+    let mut name = format!("search ({budget} steps");
+    if config.widened_budget_steps > 0 {
+        name += &format!(", + {} where short", config.widened_budget_steps);
     }
+    if config.beam_width > 0 {
+        name += &format!(", then a beam of {}", config.beam_width);
+    }
+    name + ")"
+}
+
+/// What the search (`config`) does where its plan ends short of its bound, as a clause of
+/// search.md's description: its widened pass and its beam stage, each when it has one.
+fn shortfall_clause(config: &SearchConfig) -> String {
+    let mut clause = String::new();
+    if config.widened_budget_steps > 0 {
+        clause += &format!(
+            "; where its plan then ends below {SHORTFALL_SHARE} × the bound, it goes on with {} \
+             more steps, {} times as many chains, diffusion samples and IK restarts",
+            config.widened_budget_steps, config.widened_breadth
+        );
+    }
+    if config.beam_width > 0 {
+        let when = if clause.is_empty() { "then" } else { "still" };
+        clause += &format!(
+            "; where its plan {when} ends below {SHORTFALL_SHARE} × the bound, a beam search over \
+             action sequences of {} members goes on for up to {} more steps",
+            config.beam_width, config.beam_budget_steps
+        );
+    }
+    clause
 }
 
 /// The `fraction` quantile of `values` (nearest rank).
@@ -373,9 +401,7 @@ fn markdown(record: &Record) -> String {
          failed (each null-space basis direction held for {} steps from 1 to 32 steps before \
          the end, then the hybrid or the search's classical controller). It stops \
          when its budget of control steps is spent or a plan comes within {} m of the first \
-         grid point the scan missed; where its plan then ends below {} × the bound, it goes on \
-         with {} more steps, {} times as many chains, diffusion samples and IK restarts. Every plan is re-checked by the independent \
-         checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
+         grid point the scan missed{}. Every plan is re-checked by the independent checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
          plan beyond the scan's bound on {} tasks); it ignores continuity, so it may be loose. \
          Bound (m, mean / std / min / max): {}. Times are on {} ({} threads) and depend on the \
          machine; the lengths do not.\n\n\
@@ -397,9 +423,7 @@ fn markdown(record: &Record) -> String {
         record.search.repaired_starts,
         record.search.detour_steps,
         record.search.stop_within_m,
-        SHORTFALL_SHARE,
-        record.search.widened_budget_steps,
-        record.search.widened_breadth,
+        shortfall_clause(&record.search),
         record.scan_missed,
         four(&record.reachability_bound_m, 3),
         record.machine,

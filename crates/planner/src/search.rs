@@ -25,7 +25,10 @@
 //! that the bound can tell. Where the budget is spent and the longest rollout ends below
 //! [`SHORTFALL_SHARE`] × the bound, the budget grows ([`SearchConfig::widened_budget_steps`])
 //! and the search goes on wider: more chains, diffusion samples and IK restarts, the starts not
-//! rolled out yet ranked and re-rolled, the leaders not yet settled repaired.
+//! rolled out yet ranked and re-rolled, the leaders not yet settled repaired. Where it still
+//! ends short and [`SearchConfig::beam_width`] is set (off by default; `cargo xtask limit`
+//! sets it), a beam search over action sequences from every start rolled out goes last
+//! (`crate::beam`).
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
@@ -108,7 +111,12 @@ pub struct SearchConfig {
     pub widened_breadth: usize,
     /// Members of the beam stage (`crate::beam`), run last where the longest rollout still
     /// ends below [`SHORTFALL_SHARE`] × the bound (0: never): a search over action sequences
-    /// from every start the search rolled out, diverse across joint-space cells.
+    /// from every start the search rolled out, diverse across joint-space cells. Measured on
+    /// the first 1,000 evaluation tasks of each shipped arm at the default budget, Σ length /
+    /// Σ bound over the lines whose bound is 1 m or more, without and with a beam of 512
+    /// (1,000,000 steps), and the mean time per plan: FR3 0.886 → 0.907 (43.1 → 46.2 ms), iiwa
+    /// 0.940 → 0.948 (44.3 → 46.1 ms), UR5e 0.860 → 0.866 (49.3 → 52.5 ms); a beam of 1,024
+    /// gave the same lengths.
     pub beam_width: usize,
     /// Control steps the beam stage may evaluate.
     pub beam_budget_steps: u64,
