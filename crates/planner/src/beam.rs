@@ -336,18 +336,13 @@ fn score_of(state: &StepContext<'_>, progress_m: f64, rho: f64, angle_deg: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn fr3() -> Robot {
-        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-        Robot::from_chain_file(data.join("robots/fr3_pen.urdf")).expect("the FR3 loads")
-    }
+    use crate::test_support::{demo, fr3};
 
     #[test]
     fn a_proposal_predicts_the_configuration_its_step_reaches() {
         let robot = fr3();
-        let task = crate::demo_task(&robot).expect("the demo task");
+        let (task, q) = demo(&robot);
         let config = RolloutConfig::default();
-        let q = task.q0_seed.expect("the demo task has its configuration");
         let mut controller = ClassicalController::default();
         for action in [
             NullAction::new(1.0, 0.0, 0.0, 0.0),

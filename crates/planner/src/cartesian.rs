@@ -165,17 +165,14 @@ pub fn cartesian_path(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::demo_task;
+    use crate::test_support::{demo, fr3};
 
     #[test]
     fn the_demo_line_is_followed_with_the_pose_held_and_every_waypoint_valid() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
-        let robot = Robot::from_chain_file(path).unwrap();
-        let task = demo_task(&robot).unwrap();
+        let robot = fr3();
+        let (task, start) = demo(&robot);
         let constraints = ConstraintConfig::default();
         let config = CartesianConfig::default();
-        let start = task.q0_seed.unwrap();
         let line = cartesian_path(&robot, &task, &constraints, &start, &config);
         assert!(line.length_m > 0.05, "{}: {}", line.length_m, line.ended);
         let first = robot.forward(&line.waypoints[0]);

@@ -42,6 +42,8 @@ mod reach;
 mod search;
 mod seed;
 mod shipped;
+#[cfg(test)]
+mod test_support;
 mod timing;
 mod track;
 

@@ -61,13 +61,8 @@ pub(crate) fn progress_per_step(step: &StepContext<'_>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::{demo, fr3};
     use emg_control::RolloutConfig;
-    use emg_kinematics::Robot;
-
-    fn fr3() -> Robot {
-        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
-        Robot::from_chain_file(data.join("robots/fr3_pen.urdf")).expect("the FR3 loads")
-    }
 
     #[test]
     fn a_reference_interpolates_between_its_grid_points_and_nowhere_else() {
@@ -86,9 +81,8 @@ mod tests {
     #[test]
     fn the_tracking_action_recovers_the_action_that_reaches_the_target() {
         let robot = fr3();
-        let task = crate::demo_task(&robot).expect("the demo task");
+        let (task, q) = demo(&robot);
         let config = RolloutConfig::default();
-        let q = task.q0_seed.expect("the demo task has its configuration");
         let step = StepContext::new(
             &robot,
             &task,

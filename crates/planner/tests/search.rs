@@ -10,7 +10,7 @@ use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
-    CHAIN_SOURCE, DataDir, Models, PlanRequest, Planner, PlannerConfig, PlannerKind,
+    CHAIN_SOURCE, DataDir, Models, Plan, PlanRequest, Planner, PlannerConfig, PlannerKind,
     SHORTFALL_SHARE, SearchConfig, ShippedRobot,
 };
 use emg_verify::ReferenceModel;
@@ -196,6 +196,37 @@ fn search_holds_the_work_surface_and_the_scene() {
     );
 }
 
+/// The first 1,000 shipped FR3 tasks' `indices`, each planned by the search of `first` and then
+/// of `second` (whose plan the checker must pass): both plans and the task's bound.
+fn planned_twice(
+    first: PlannerConfig,
+    second: PlannerConfig,
+    indices: &[usize],
+) -> Vec<(usize, Plan, Plan, f64)> {
+    let (first, second) = (planner(first), planner(second));
+    let robot = second.robot();
+    let checker = checker(robot);
+    let constraints = &second.config().rollout.constraints;
+    let tasks = tasks(robot, 1000);
+    indices
+        .iter()
+        .map(|&index| {
+            let task = &tasks[index];
+            let a = first.plan(task, &search_request()).expect("searches");
+            let b = second.plan(task, &search_request()).expect("searches");
+            checker
+                .check(task, &b.trajectory, constraints)
+                .expect("every plan holds every constraint");
+            let bound = a.reach.as_ref().expect("the search scans").reachable_m;
+            eprintln!(
+                "task {index}: {:.3} m → {:.3} m of {bound:.3} m",
+                a.trajectory.path_length_m, b.trajectory.path_length_m
+            );
+            (index, a, b, bound)
+        })
+        .collect()
+}
+
 #[test]
 fn the_beam_stage_goes_on_where_the_search_ends_short() {
     // Evaluation task 593: a line whose bound is 1.28 m, where the default search (its widened
@@ -204,24 +235,11 @@ fn the_beam_stage_goes_on_where_the_search_ends_short() {
     let mut with = without.clone();
     with.search.beam_width = 64;
     with.search.beam_budget_steps = 100_000;
-    let (without, with) = (planner(without), planner(with));
-    let robot = with.robot();
-    let checker = checker(robot);
-    let constraints = &with.config().rollout.constraints;
-    let tasks = tasks(robot, 1000);
-    for index in [0, 593] {
-        let task = &tasks[index];
-        let first = without.plan(task, &search_request()).expect("searches");
-        let second = with.plan(task, &search_request()).expect("searches");
-        checker
-            .check(task, &second.trajectory, constraints)
-            .expect("the beam's plan holds every constraint");
-        let bound = first.reach.as_ref().expect("the search scans").reachable_m;
+    for (index, first, second, bound) in planned_twice(without, with, &[0, 593]) {
         let (a, b) = (
             first.trajectory.path_length_m,
             second.trajectory.path_length_m,
         );
-        eprintln!("task {index}: {a:.3} m → {b:.3} m of {bound:.3} m");
         if index == 0 {
             assert!(
                 a >= SHORTFALL_SHARE * bound,
@@ -262,25 +280,12 @@ fn a_plan_short_of_its_bound_is_searched_wider() {
     };
     let mut narrow = wide.clone();
     narrow.search.widened_budget_steps = 0;
-    let (wide, narrow) = (planner(wide), planner(narrow));
-    let robot = wide.robot();
-    let checker = checker(robot);
-    let constraints = &wide.config().rollout.constraints;
-    let tasks = tasks(robot, 1000);
     let mut widened = 0;
-    for index in [0, 137, 868] {
-        let task = &tasks[index];
-        let first = narrow.plan(task, &search_request()).expect("searches");
-        let second = wide.plan(task, &search_request()).expect("searches");
-        checker
-            .check(task, &second.trajectory, constraints)
-            .expect("every widened plan holds every constraint");
-        let bound = first.reach.as_ref().expect("the search scans").reachable_m;
+    for (index, first, second, bound) in planned_twice(narrow, wide, &[0, 137, 868]) {
         let (a, b) = (
             first.trajectory.path_length_m,
             second.trajectory.path_length_m,
         );
-        eprintln!("task {index}: {a:.3} m → {b:.3} m of {bound:.3} m");
         if a >= SHORTFALL_SHARE * bound {
             assert_eq!(
                 first, second,
