@@ -1,7 +1,7 @@
 //! `cargo xtask limit`: the best-known length ℓ* of each task of a fixed evaluation subset (the
-//! search planner with a large budget and its beam stage, every trajectory re-checked by the independent checker),
-//! its trajectory, and its reachability bound, beside what the paper's pipeline and the default
-//! search reach.
+//! search planner with a large budget and its beam stage, every trajectory re-checked by the
+//! independent checker), its trajectory, and its reachability bound, beside what the paper's
+//! pipeline and the default search reach.
 //!
 //! Resumable and shardable: each finished task is written atomically as its own file in the
 //! journal directory (`target/limit/` by default) and a run skips the tasks already there;
@@ -407,9 +407,10 @@ fn markdown(record: &Record) -> String {
          ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
          {} restarts, {} finalists, the best {} starts repaired, up to {} of the scan's chains \
          followed from `p0`, then, where the plan still ends below 0.9 × the bound, a beam \
-         search over action sequences of {} members and {} more steps), every trajectory re-checked by the independent checker; the bound is \
-         the reachability scan (a necessary condition, so an upper bound as good as its IK \
-         sampling), raised to ℓ* where a plan went beyond it.\n\n\
+         search over action sequences: {} members, up to {} more steps), every trajectory \
+         re-checked by the independent checker; the bound is the reachability scan (a necessary \
+         condition, so an upper bound as good as its IK sampling), raised to ℓ* where a plan \
+         went beyond it.\n\n\
          ## By bucket of the bound\n\nΣ length / Σ reference over the tasks whose bound lies in \
          the bucket (the task mean of the ratio in brackets); below ½: the tasks that end below \
          half of the reference.\n\n\

@@ -399,10 +399,11 @@ fn markdown(record: &Record) -> String {
          led {}° ahead of its drift with k_lead {}) and re-rolls the best {} with the hybrid \
          controller; then it repairs the longest rollouts of the best {} starts where they \
          failed (each null-space basis direction held for {} steps from 1 to 32 steps before \
-         the end, then the hybrid or the search's classical controller). It stops \
-         when its budget of control steps is spent or a plan comes within {} m of the first \
-         grid point the scan missed{}. Every plan is re-checked by the independent checker. The bound of a task is the scan's, raised to the longest plan of any row (a \
-         plan beyond the scan's bound on {} tasks); it ignores continuity, so it may be loose. \
+         the end, then the hybrid or the search's classical controller). It stops when its \
+         budget of control steps is spent or a plan comes within {} m of the first grid point \
+         the scan missed{}. Every plan is re-checked by the independent checker. The bound of a \
+         task is the scan's, raised to the longest plan of any row (a plan beyond the scan's \
+         bound on {} tasks); it ignores continuity, so it may be loose. \
          Bound (m, mean / std / min / max): {}. Times are on {} ({} threads) and depend on the \
          machine; the lengths do not.\n\n\
          | planner | budget (steps) | path length (m, mean / std / min / max) | mean / pipeline \
