@@ -196,15 +196,14 @@ impl Beam {
         }
         going_on
     }
-}
 
-impl Beam {
     /// The members after an expansion: each member's classical action and every basis
-    /// direction, judged before the step by the configuration it would reach
-    /// ([`predict`]); taken best first, a child per diversity cell, until `width` children go
-    /// on. A child whose step breaks a constraint leaves its cell to the next best. Judging
-    /// before stepping saves the steps, and the copies of the episodes, that the selection
-    /// would discard.
+    /// direction, judged before the step by the configuration it would reach ([`predict`]);
+    /// taken best first, the first [`STEPPED_PER_CELL`] children of each diversity cell whose
+    /// steps hold every constraint are stepped (a child whose step breaks one leaves its place
+    /// to the next best), then [`select`] keeps the best of each cell by its real state and
+    /// the `width` best of those. Judging before stepping saves the steps, and the copies of
+    /// the episodes, that the selection would discard.
     fn expand<'a>(
         &mut self,
         members: &[Member<'a>],
