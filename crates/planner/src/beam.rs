@@ -184,17 +184,23 @@ impl Beam {
     /// constraint, the line's end or the step cap) leaves the beam, its motion kept if it is
     /// the longest.
     fn advance<'a>(&mut self, stepped: Vec<(StepOutcome, Member<'a>)>) -> Vec<Member<'a>> {
-        let mut going_on = Vec::with_capacity(stepped.len());
-        for (outcome, member) in stepped {
-            self.spent += 1;
-            match outcome {
-                StepOutcome::Continued { .. } => going_on.push(member),
-                StepOutcome::Truncated { .. } | StepOutcome::Terminated => {
-                    self.keep(member.start, member.episode.finish());
-                }
+        stepped
+            .into_iter()
+            .filter_map(|(outcome, member)| self.settle(outcome, member))
+            .collect()
+    }
+
+    /// `member` after a step with `outcome`: still in the beam, or (its episode over) its
+    /// motion kept if it is the longest.
+    fn settle<'a>(&mut self, outcome: StepOutcome, member: Member<'a>) -> Option<Member<'a>> {
+        self.spent += 1;
+        match outcome {
+            StepOutcome::Continued { .. } => Some(member),
+            StepOutcome::Truncated { .. } | StepOutcome::Terminated => {
+                self.keep(member.start, member.episode.finish());
+                None
             }
         }
-        going_on
     }
 
     /// The members after an expansion: each member's classical action and every basis
@@ -241,7 +247,7 @@ impl Beam {
             let outcome = child
                 .episode
                 .apply(&proposal.action, ActingController::Search);
-            if let Some(going_on) = self.advance(vec![(outcome, child)]).pop() {
+            if let Some(going_on) = self.settle(outcome, child) {
                 *filled.entry(proposal.cell).or_insert(0) += 1;
                 children.push(going_on);
             }
