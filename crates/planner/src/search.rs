@@ -26,9 +26,8 @@
 //! [`SHORTFALL_SHARE`] × the bound, the budget grows ([`SearchConfig::widened_budget_steps`])
 //! and the search goes on wider: more chains, diffusion samples and IK restarts, the starts not
 //! rolled out yet ranked and re-rolled, the leaders not yet settled repaired. Where it still
-//! ends short and [`SearchConfig::beam_width`] is set (off by default; `cargo xtask limit`
-//! sets it), a beam search over action sequences from every start rolled out goes last
-//! (`crate::beam`).
+//! ends short, a beam search over action sequences from every start rolled out goes last
+//! ([`SearchConfig::beam_width`], `crate::beam`).
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
@@ -157,8 +156,8 @@ impl Default for SearchConfig {
             seed: 20_261_123,
             widened_budget_steps: 25_000,
             widened_breadth: 4,
-            beam_width: 0,
-            beam_budget_steps: 0,
+            beam_width: 512,
+            beam_budget_steps: 300_000,
         }
     }
 }

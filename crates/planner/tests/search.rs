@@ -133,6 +133,7 @@ fn a_spent_budget_gives_the_pipeline_plan() {
     let mut config = small_search();
     config.search.budget_steps = 1;
     config.search.widened_budget_steps = 0;
+    config.search.beam_width = 0;
     let planner = planner(config);
     for task in tasks(planner.robot(), 4) {
         let searched = planner.plan(&task, &search_request()).expect("searches");
@@ -231,7 +232,8 @@ fn planned_twice(
 fn the_beam_stage_goes_on_where_the_search_ends_short() {
     // Evaluation task 593: a line whose bound is 1.28 m, where the default search (its widened
     // pass included) ends at 0.47 m; and task 0, which it plans to its bound.
-    let without = PlannerConfig::default();
+    let mut without = PlannerConfig::default();
+    without.search.beam_width = 0;
     let mut with = without.clone();
     with.search.beam_width = 64;
     with.search.beam_budget_steps = 100_000;
@@ -274,6 +276,7 @@ fn a_plan_short_of_its_bound_is_searched_wider() {
     let wide = PlannerConfig {
         search: SearchConfig {
             dp_samples: 8,
+            beam_width: 0,
             ..SearchConfig::default()
         },
         ..PlannerConfig::default()
