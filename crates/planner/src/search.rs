@@ -113,11 +113,12 @@ pub struct SearchConfig {
     /// from every start the search rolled out, diverse across joint-space cells. Measured on
     /// the first 1,000 evaluation tasks of each shipped arm at the default budget, Σ length /
     /// Σ bound over the lines whose bound is 1 m or more, without and with a beam of 512
-    /// (1,000,000 steps), and the mean time per plan: FR3 0.886 → 0.907 (43.1 → 46.2 ms), iiwa
-    /// 0.940 → 0.948 (44.3 → 46.1 ms), UR5e 0.860 → 0.866 (49.3 → 52.5 ms); a beam of 1,024
+    /// (300,000 steps), and the mean time per plan: FR3 0.886 → 0.907 (42.1 → 46.8 ms), iiwa
+    /// 0.940 → 0.948 (44.0 → 46.3 ms), UR5e 0.860 → 0.866 (49.8 → 53.2 ms); a beam of 1,024
     /// gave the same lengths.
     pub beam_width: usize,
-    /// Control steps the beam stage may evaluate.
+    /// Control steps the beam stage may evaluate: 1,000,000 gave the same lengths as 300,000
+    /// (the default) on the same tasks; the budget bounds the slowest plan.
     pub beam_budget_steps: u64,
 }
 
