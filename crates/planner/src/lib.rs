@@ -34,6 +34,7 @@ mod cartesian;
 mod config;
 mod controller;
 mod demo;
+mod far_end;
 mod files;
 mod models;
 pub mod parse;
@@ -62,7 +63,10 @@ pub use reach::{
     BoundNote, FAR_END_SHARE, MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE,
     far_end_chains, reach, shortfall, witness_chains,
 };
-pub use search::{CHAIN_SOURCE, MAX_SEARCH_BUDGET_STEPS, SearchConfig, search_classical_gains};
+pub use search::{
+    CHAIN_SOURCE, FAR_END_SOURCE, MAX_FAR_END_SHARES, MAX_SEARCH_BUDGET_STEPS, SearchConfig,
+    search_classical_gains,
+};
 pub use seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed, seed_source_meaning};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 pub use timing::{

@@ -55,6 +55,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::beam::{BeamLimits, beam_search, null_actions};
 use crate::controller::Executor;
+use crate::far_end::{forward_reference, reversed_reach, reversed_surface, reversed_task};
 use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
 use crate::seed::Seed;
 use crate::track::{Reference, progress_per_step, tracking_action};
@@ -120,6 +121,13 @@ pub struct SearchConfig {
     /// Control steps the beam stage may evaluate: 1,000,000 gave the same lengths as 300,000
     /// (the default) on the same tasks; the budget bounds the slowest plan.
     pub beam_budget_steps: u64,
+    /// Shares of the scan's reach from which the far-end stage plans back to `p0` (empty, the
+    /// default: never), run before the beam where the longest rollout still ends below
+    /// [`SHORTFALL_SHARE`] × the bound: for each share beyond the longest rollout, a search
+    /// with these settings (this stage left out) of the motion from that grid point back to
+    /// `p0` (`crate::far_end`), and where that motion gets back to `p0`, rollouts from `p0`
+    /// that follow it forwards, each tail taking over where it ends.
+    pub far_end_shares: Vec<f64>,
 }
 
 /// The search's classical gains ([`SearchConfig::classical_gains`]): the paper's `k_μ` and
@@ -159,9 +167,13 @@ impl Default for SearchConfig {
             widened_breadth: 4,
             beam_width: 512,
             beam_budget_steps: 300_000,
+            far_end_shares: Vec::new(),
         }
     }
 }
+
+/// Most shares [`SearchConfig::far_end_shares`] may hold.
+pub const MAX_FAR_END_SHARES: usize = 8;
 
 /// Most steps a search budget may hold (keeps a plan to seconds).
 pub const MAX_SEARCH_BUDGET_STEPS: u64 = 10_000_000;
@@ -234,6 +246,17 @@ impl SearchConfig {
         OutOfRange::require("search.chains", count(self.chains), "[0, 64]", |n| {
             n <= 64.0
         })?;
+        OutOfRange::require(
+            "search.far_end_shares (how many)",
+            count(self.far_end_shares.len()),
+            "[0, 8]",
+            within(0.0, MAX_FAR_END_SHARES as f64),
+        )?;
+        for &share in &self.far_end_shares {
+            OutOfRange::require("search.far_end_shares", share, "(0, 1]", |s| {
+                s > 0.0 && s <= 1.0
+            })?;
+        }
         self.classical_gains.validate().map_err(|error| OutOfRange {
             field: search_gain_field(error.field),
             ..error
@@ -603,8 +626,12 @@ pub(crate) fn search(
         let wide = Breadth::of(config, config.widened_breadth);
         search.pass(reach, &chains, first.chains, wide, &mut tails);
     }
-    let still_short = search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
-    if config.beam_width > 0 && still_short && !search.arrived() {
+    let still_short =
+        |search: &Search| search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
+    if !config.far_end_shares.is_empty() && still_short(&search) && !search.arrived() {
+        search.far_end(reach, &mut tails);
+    }
+    if config.beam_width > 0 && still_short(&search) && !search.arrived() {
         search.beam();
     }
     let best = search.leaders.swap_remove(0);
@@ -629,7 +656,7 @@ impl Search<'_> {
         let context = self.context;
         for chain in chains.iter().take(breadth.chains).skip(first_chain) {
             if let Some(reference) = Reference::along_grid(chain, reach.grid_m) {
-                self.track(&reference, tails);
+                self.track(chain[0], &reference, CHAIN_SOURCE, tails);
             }
         }
         let candidates = if self.done() {
@@ -692,13 +719,71 @@ impl Search<'_> {
         }
     }
 
-    /// Follows `reference` from its configuration at `p0`, with each tail taking over where it
-    /// ends.
-    fn track(&mut self, reference: &Reference, tails: &mut [Executor]) {
+    /// The far-end stage ([`SearchConfig::far_end_shares`]): from each share of the scan's
+    /// grid points beyond the longest rollout, a search of the reversed task back to `p0`
+    /// (`crate::far_end`; the requested controller its finalist), and where its motion gets
+    /// back to `p0`, that motion followed forwards from its configuration there, put on `p0`.
+    fn far_end(&mut self, reach: &Reach, tails: &mut [Executor; 2]) {
         let context = self.context;
-        let Some(q) = reference.at(0.0) else {
-            return;
+        let config = SearchConfig {
+            far_end_shares: Vec::new(),
+            ..context.config.clone()
         };
+        for &share in &context.config.far_end_shares {
+            let far = ((reach.witnesses.len().saturating_sub(1)) as f64 * share) as usize;
+            let s_far_m = far as f64 * reach.grid_m;
+            if s_far_m <= self.longest_m() {
+                continue;
+            }
+            let (Some(task), Some(scan)) = (
+                reversed_task(context.robot, self.task, s_far_m),
+                reversed_reach(reach, far),
+            ) else {
+                continue;
+            };
+            let mut rollout = context.rollout.clone();
+            rollout.constraints.work_surface =
+                reversed_surface(&rollout.constraints.work_surface, s_far_m);
+            let backward_context = SearchContext {
+                rollout: &rollout,
+                config: &config,
+                ..*context
+            };
+            let seed = Seed {
+                q: scan.witnesses[0],
+                source: FAR_END_SOURCE,
+                projection_iterations: None,
+            };
+            let (_, backward) = search(&backward_context, &task, seed, tails[0].clone(), &scan);
+            let Some(reference) = forward_reference(self.task, &backward, s_far_m) else {
+                continue;
+            };
+            let Some(at_p0) = reference.at(0.0) else {
+                continue;
+            };
+            let target = PoseTarget {
+                position: self.task.p0,
+                tool_axis: context.robot.forward(&at_p0).tool_axis(),
+                roll_axis: None,
+            };
+            if let Ok((start, _)) =
+                project_to_pose(context.robot, &at_p0, &target, &ProjectionConfig::default())
+            {
+                self.track(start, &reference, FAR_END_SOURCE, tails);
+            }
+        }
+    }
+
+    /// Follows `reference` from `q`, a configuration on `p0`, with each tail taking over where
+    /// it ends; the rollouts' start is named `source`.
+    fn track(
+        &mut self,
+        q: JointVector,
+        reference: &Reference,
+        source: &'static str,
+        tails: &mut [Executor],
+    ) {
+        let context = self.context;
         let kinematics = context.robot.forward(&q);
         if first_violation(
             context.robot,
@@ -712,7 +797,7 @@ impl Search<'_> {
         }
         let seed = Seed {
             q,
-            source: CHAIN_SOURCE,
+            source,
             projection_iterations: None,
         };
         for tail in tails.iter_mut() {
@@ -728,6 +813,10 @@ impl Search<'_> {
 /// The source name of a start the long-horizon stage found: the first configuration of a chain
 /// of the reachability scan.
 pub const CHAIN_SOURCE: &str = "scan-chain";
+
+/// The source name of a start the far-end stage found: where a motion planned back from far
+/// along the line reaches `p0`.
+pub const FAR_END_SOURCE: &str = "far-end";
 
 /// The task's start pose: the TCP on `p0`, the tool axis along `n`.
 fn start_pose(task: &Task) -> PoseTarget {

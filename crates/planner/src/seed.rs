@@ -85,7 +85,7 @@ pub const SCAN_SOURCE: &str = "scan";
 
 /// What a seed's source (its name in output and files) means: the sources of
 /// [`SeedSource::name`] and the search's own starts (`ik`, [`crate::CHAIN_SOURCE`],
-/// [`SCAN_SOURCE`]).
+/// [`crate::FAR_END_SOURCE`], [`SCAN_SOURCE`]).
 pub fn seed_source_meaning(name: &str) -> &'static str {
     match name {
         "dp" => "the diffusion seeder's start",
@@ -97,6 +97,10 @@ pub fn seed_source_meaning(name: &str) -> &'static str {
         "ik" => "a start the search found by inverse kinematics at p0 within the cone",
         crate::search::CHAIN_SOURCE => {
             "the reachability scan's chain of configurations from p0, followed by the search"
+        }
+        crate::search::FAR_END_SOURCE => {
+            "where a motion the search planned back from far along the line reaches p0, \
+             followed forwards"
         }
         SCAN_SOURCE => {
             "the reachability scan's configuration at p0 (the requested seed could not be put \

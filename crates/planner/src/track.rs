@@ -22,9 +22,18 @@ impl Reference {
     /// The configurations `chain`, one per point of a grid of spacing `grid_m` from `p0`.
     /// `None` when it holds fewer than two.
     pub(crate) fn along_grid(chain: &[JointVector], grid_m: f64) -> Option<Self> {
-        (chain.len() >= 2).then(|| Self {
-            progress_m: (0..chain.len()).map(|k| k as f64 * grid_m).collect(),
-            configurations: chain.to_vec(),
+        let progress_m = (0..chain.len()).map(|k| k as f64 * grid_m).collect();
+        Self::along(progress_m, chain.to_vec())
+    }
+
+    /// `configurations` at the progress `progress_m` (one each, strictly increasing). `None`
+    /// when they hold fewer than two.
+    pub(crate) fn along(progress_m: Vec<f64>, configurations: Vec<JointVector>) -> Option<Self> {
+        debug_assert_eq!(progress_m.len(), configurations.len());
+        debug_assert!(progress_m.windows(2).all(|pair| pair[0] < pair[1]));
+        (configurations.len() >= 2).then_some(Self {
+            progress_m,
+            configurations,
         })
     }
 
