@@ -27,6 +27,7 @@ use emg_seeding::Shard;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::search_eval::far_end_points;
 use crate::{progress, workspace};
 
 /// Options of `limit`.
@@ -59,8 +60,9 @@ pub struct Args {
 }
 
 /// The search settings of the limit: far more starts, finalists, repairs, chains and steps
-/// than the planner's default, and the beam stage (a search over action sequences) where the
-/// plan still ends short of the bound.
+/// than the planner's default, then, where the plan still ends short of the bound, the
+/// far-end stage (motions planned back to `p0` from far along the line, at this breadth) and
+/// the beam stage (a search over action sequences) with a larger budget.
 pub fn limit_search() -> SearchConfig {
     SearchConfig {
         budget_steps: 200_000,
@@ -406,7 +408,8 @@ fn markdown(record: &Record) -> String {
          `cargo xtask limit --merge`. Do not edit by hand. Robot `{}`, the first {} tasks of `{}`. \
          ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
          {} restarts, {} finalists, the best {} starts repaired, up to {} of the scan's chains \
-         followed from `p0`, then, where the plan still ends below 0.9 × the bound, a beam \
+         followed from `p0`, then, where the plan still ends below 0.9 × the bound, motions \
+         planned backwards to `p0` from {} followed forwards, then where it still does, a beam \
          search over action sequences: {} members, up to {} more steps), every trajectory \
          re-checked by the independent checker; the bound is the reachability scan (a necessary \
          condition, so an upper bound as good as its IK sampling), raised to ℓ* where a plan \
@@ -425,6 +428,7 @@ fn markdown(record: &Record) -> String {
         limit.finalists,
         limit.repaired_starts,
         limit.chains,
+        far_end_points(limit),
         limit.beam_width,
         limit.beam_budget_steps,
     );

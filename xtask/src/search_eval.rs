@@ -339,10 +339,28 @@ fn row_name(row: &Row, config: &SearchConfig) -> String {
     if config.widened_budget_steps > 0 {
         name += &format!(", + {} where short", config.widened_budget_steps);
     }
+    if !config.far_end_shares.is_empty() {
+        name += ", then from the far end";
+    }
     if config.beam_width > 0 {
         name += &format!(", then a beam of {}", config.beam_width);
     }
     name + ")"
+}
+
+/// The points the far-end stage of `config` plans back from, as words: "95 %, 80 % and 50 % of
+/// the scan".
+pub(crate) fn far_end_points(config: &SearchConfig) -> String {
+    let percents: Vec<String> = config
+        .far_end_shares
+        .iter()
+        .map(|share| format!("{:.0} %", 100.0 * share))
+        .collect();
+    let listed = match percents.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => percents.join(""),
+    };
+    format!("{listed} of the scan")
 }
 
 /// What the search (`config`) does where its plan ends short of its bound, as a clause of
@@ -354,6 +372,15 @@ fn shortfall_clause(config: &SearchConfig) -> String {
             "; where its plan then ends below {SHORTFALL_SHARE} × the bound, it goes on with {} \
              more steps, {} times as many chains, diffusion samples and IK restarts",
             config.widened_budget_steps, config.widened_breadth
+        );
+    }
+    if !config.far_end_shares.is_empty() {
+        let when = if clause.is_empty() { "then" } else { "still" };
+        clause += &format!(
+            "; where its plan {when} ends below {SHORTFALL_SHARE} × the bound, it plans the line \
+             backwards to `p0` from {} (the search's first pass on the reversed line) and \
+             follows each motion that gets there forwards from `p0`",
+            far_end_points(config)
         );
     }
     if config.beam_width > 0 {

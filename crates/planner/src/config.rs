@@ -39,8 +39,9 @@ pub struct PlannerConfig {
     /// The search planner ([`SearchConfig`]: `budget_steps` 10,000, `dp_samples` 32,
     /// `ik_restarts` 64, `finalists` 8, `repaired_starts` 8, `detour_steps` 10, its own
     /// `classical_gains`; 25,000 more steps at breadth 4 where a plan ends short of its
-    /// bound, `widened_budget_steps` and `widened_breadth`; then a beam of 512 members and
-    /// 300,000 steps where it still ends short, `beam_width` and `beam_budget_steps`).
+    /// bound, `widened_budget_steps` and `widened_breadth`; then, where it still ends short,
+    /// motions planned back to `p0` from 95, 80, 65 and 50 % of the scan, `far_end_shares`;
+    /// then a beam of 512 members and 300,000 steps, `beam_width` and `beam_budget_steps`).
     pub search: SearchConfig,
 }
 

@@ -148,7 +148,11 @@ mod tests {
         assert!((at_far - start).amax() < 1e-6, "{at_far} against {start}");
         // At p0 it puts the TCP on p0.
         let at_p0 = robot.forward(&reference.at(0.0).expect("covered")).tcp();
-        assert!((at_p0 - task.p0).norm() < 1e-3, "{at_p0} against {}", task.p0);
+        assert!(
+            (at_p0 - task.p0).norm() < 1e-3,
+            "{at_p0} against {}",
+            task.p0
+        );
         // A motion that stops short of p0 gives none.
         assert!(forward_reference(&task, &backward, backward.path_length_m + 0.01).is_none());
     }

@@ -26,8 +26,12 @@
 //! [`SHORTFALL_SHARE`] × the bound, the budget grows ([`SearchConfig::widened_budget_steps`])
 //! and the search goes on wider: more chains, diffusion samples and IK restarts, the starts not
 //! rolled out yet ranked and re-rolled, the leaders not yet settled repaired. Where it still
-//! ends short, a beam search over action sequences from every start rolled out goes last
-//! ([`SearchConfig::beam_width`], `crate::beam`).
+//! ends short, the far-end stage plans the line backwards, from points far along it back to
+//! `p0`, and follows each motion that gets there forwards from `p0`
+//! ([`SearchConfig::far_end_shares`], `crate::far_end`): planned from `p0`, the search must
+//! guess at the start the branch that survives far along the line; planned from there, it
+//! starts on one. Where it still ends short, a beam search over action sequences from every
+//! start rolled out goes last ([`SearchConfig::beam_width`], `crate::beam`).
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
@@ -126,7 +130,14 @@ pub struct SearchConfig {
     /// [`SHORTFALL_SHARE`] × the bound: for each share beyond the longest rollout, a search
     /// with these settings (this stage left out) of the motion from that grid point back to
     /// `p0` (`crate::far_end`), and where that motion gets back to `p0`, rollouts from `p0`
-    /// that follow it forwards, each tail taking over where it ends.
+    /// that follow it forwards, each tail taking over where it ends. Measured on the first
+    /// 1,000 evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over
+    /// the lines whose bound is 1 m or more, without and with the default shares (0.95, 0.8,
+    /// 0.65 and 0.5), and the mean time per plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa
+    /// 0.948 → 0.958 (45.7 → 45.9 ms), UR5e 0.866 → 0.886 (55.3 → 59.7 ms). On the 39 FR3
+    /// tasks of those whose best-known length ended below 0.9 × their bound, the backward
+    /// search's own widened pass and beam found no more than its first pass alone, at twice
+    /// the time; so it runs the first pass only.
     pub far_end_shares: Vec<f64>,
 }
 
@@ -167,7 +178,7 @@ impl Default for SearchConfig {
             widened_breadth: 4,
             beam_width: 512,
             beam_budget_steps: 300_000,
-            far_end_shares: Vec::new(),
+            far_end_shares: vec![0.95, 0.8, 0.65, 0.5],
         }
     }
 }
@@ -626,8 +637,7 @@ pub(crate) fn search(
         let wide = Breadth::of(config, config.widened_breadth);
         search.pass(reach, &chains, first.chains, wide, &mut tails);
     }
-    let still_short =
-        |search: &Search| search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
+    let still_short = |search: &Search| search.longest_m() < SHORTFALL_SHARE * reach.reachable_m;
     if !config.far_end_shares.is_empty() && still_short(&search) && !search.arrived() {
         search.far_end(reach, &mut tails);
     }
@@ -725,7 +735,10 @@ impl Search<'_> {
     /// back to `p0`, that motion followed forwards from its configuration there, put on `p0`.
     fn far_end(&mut self, reach: &Reach, tails: &mut [Executor; 2]) {
         let context = self.context;
+        // The backward search is the first pass alone: no widened pass, beam or far end.
         let config = SearchConfig {
+            widened_budget_steps: 0,
+            beam_width: 0,
             far_end_shares: Vec::new(),
             ..context.config.clone()
         };

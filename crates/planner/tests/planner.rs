@@ -279,6 +279,14 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
             "search.beam_budget_steps must be in [0, 10000000], got 20000000",
         ),
         (
+            r#"{"search": {"far_end_shares": [0.9, 1.5]}}"#,
+            "search.far_end_shares must be in (0, 1], got 1.5",
+        ),
+        (
+            r#"{"search": {"far_end_shares": [0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1]}}"#,
+            "search.far_end_shares (how many) must be in [0, 8], got 9",
+        ),
+        (
             r#"{"measure": {"kind": "all_constraints", "clearance_scale_m": 0}}"#,
             "measure.clearance_scale_m must be in (0, ∞), got 0",
         ),

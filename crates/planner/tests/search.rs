@@ -3,15 +3,16 @@
 //! stage's detours (recorded as such); every plan passes the independent checker; results do not depend on the thread count; a budget spent by the
 //! pipeline's rollout gives exactly the pipeline's plan; with the work surface and an obstacle on
 //! the way, every plan still passes the checker told of them; a plan short of its bound is
-//! searched wider and goes further, one near its bound is left as it is; the beam stage goes on
-//! where the widened search still ends short.
+//! searched wider and goes further, one near its bound is left as it is; the far-end stage finds
+//! a motion the search from `p0` misses; the beam stage goes on where the widened search still
+//! ends short.
 
 use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
-    CHAIN_SOURCE, DataDir, Models, Plan, PlanRequest, Planner, PlannerConfig, PlannerKind,
-    SHORTFALL_SHARE, SearchConfig, ShippedRobot,
+    CHAIN_SOURCE, DataDir, FAR_END_SOURCE, Models, Plan, PlanRequest, Planner, PlannerConfig,
+    PlannerKind, SHORTFALL_SHARE, SearchConfig, ShippedRobot,
 };
 use emg_verify::ReferenceModel;
 
@@ -133,6 +134,7 @@ fn a_spent_budget_gives_the_pipeline_plan() {
     let mut config = small_search();
     config.search.budget_steps = 1;
     config.search.widened_budget_steps = 0;
+    config.search.far_end_shares.clear();
     config.search.beam_width = 0;
     let planner = planner(config);
     for task in tasks(planner.robot(), 4) {
@@ -229,10 +231,49 @@ fn planned_twice(
 }
 
 #[test]
+fn the_far_end_stage_finds_the_motion_the_search_from_p0_misses() {
+    // Evaluation task 7: a line whose bound is 1.11 m, where the search from `p0` (its widened
+    // pass included) ends at 0.23 m; and task 0, which it plans to its bound. The beam is left
+    // out of both, so that the far-end stage alone makes the difference.
+    let mut without = PlannerConfig::default();
+    without.search.far_end_shares.clear();
+    without.search.beam_width = 0;
+    let mut with = PlannerConfig::default();
+    with.search.beam_width = 0;
+    for (index, first, second, bound) in planned_twice(without, with, &[0, 7]) {
+        let (a, b) = (
+            first.trajectory.path_length_m,
+            second.trajectory.path_length_m,
+        );
+        if index == 0 {
+            assert!(
+                a >= SHORTFALL_SHARE * bound,
+                "task 0 is planned near its bound"
+            );
+            assert_eq!(
+                first, second,
+                "a plan near its bound plans nothing backwards"
+            );
+        } else {
+            assert!(
+                a < 0.5 * bound,
+                "task {index}: the search from p0 ends short"
+            );
+            assert!(
+                b >= SHORTFALL_SHARE * bound,
+                "task {index}: the far end reaches only {b} m of {bound} m"
+            );
+            assert_eq!(second.seed.source, FAR_END_SOURCE);
+        }
+    }
+}
+
+#[test]
 fn the_beam_stage_goes_on_where_the_search_ends_short() {
     // Evaluation task 593: a line whose bound is 1.28 m, where the default search (its widened
-    // pass included) ends at 0.47 m; and task 0, which it plans to its bound.
+    // pass included, no far end) ends at 0.47 m; and task 0, which it plans to its bound.
     let mut without = PlannerConfig::default();
+    without.search.far_end_shares.clear();
     without.search.beam_width = 0;
     let mut with = without.clone();
     with.search.beam_width = 64;
@@ -276,6 +317,7 @@ fn a_plan_short_of_its_bound_is_searched_wider() {
     let wide = PlannerConfig {
         search: SearchConfig {
             dp_samples: 8,
+            far_end_shares: Vec::new(),
             beam_width: 0,
             ..SearchConfig::default()
         },
