@@ -230,84 +230,77 @@ fn planned_twice(
         .collect()
 }
 
+/// Plans evaluation task 0 and task `short` with `without` a stage of the search and `with`
+/// it: task 0 is planned near its bound by both, alike (a plan near its bound runs no stage
+/// for short plans); task `short` ends below [`SHORTFALL_SHARE`] × its bound without the stage
+/// and reaches that far with it. Returns task `short`'s plans without and with the stage, and
+/// its bound.
+fn a_stage_reaches_the_bound(
+    without: PlannerConfig,
+    with: PlannerConfig,
+    short: usize,
+) -> (Plan, Plan, f64) {
+    let mut planned = planned_twice(without, with, &[0, short]);
+    let (_, first, second, bound) = planned.swap_remove(1);
+    let (_, near_first, near_second, near_bound) = planned.swap_remove(0);
+    let near = near_first.trajectory.path_length_m;
+    assert!(
+        near >= SHORTFALL_SHARE * near_bound,
+        "task 0 is planned near its bound"
+    );
+    assert_eq!(
+        near_first, near_second,
+        "task 0: the stage runs only where a plan ends short"
+    );
+    let (a, b) = (
+        first.trajectory.path_length_m,
+        second.trajectory.path_length_m,
+    );
+    assert!(
+        a < SHORTFALL_SHARE * bound,
+        "task {short}: {a} m of {bound} m without the stage"
+    );
+    assert!(
+        b >= SHORTFALL_SHARE * bound,
+        "task {short}: {b} m of {bound} m with the stage"
+    );
+    (first, second, bound)
+}
+
 #[test]
 fn the_far_end_stage_finds_the_motion_the_search_from_p0_misses() {
     // Evaluation task 7: a line whose bound is 1.11 m, where the search from `p0` (its widened
-    // pass included) ends at 0.23 m; and task 0, which it plans to its bound. The beam is left
-    // out of both, so that the far-end stage alone makes the difference.
+    // pass included) ends at 0.23 m. The beam is left out of both, so that the far-end stage
+    // alone makes the difference.
     let mut without = PlannerConfig::default();
     without.search.far_end_shares.clear();
     without.search.beam_width = 0;
     let mut with = PlannerConfig::default();
     with.search.beam_width = 0;
-    for (index, first, second, bound) in planned_twice(without, with, &[0, 7]) {
-        let (a, b) = (
-            first.trajectory.path_length_m,
-            second.trajectory.path_length_m,
-        );
-        if index == 0 {
-            assert!(
-                a >= SHORTFALL_SHARE * bound,
-                "task 0 is planned near its bound"
-            );
-            assert_eq!(
-                first, second,
-                "a plan near its bound plans nothing backwards"
-            );
-        } else {
-            assert!(
-                a < 0.5 * bound,
-                "task {index}: the search from p0 ends short"
-            );
-            assert!(
-                b >= SHORTFALL_SHARE * bound,
-                "task {index}: the far end reaches only {b} m of {bound} m"
-            );
-            assert_eq!(second.seed.source, FAR_END_SOURCE);
-        }
-    }
+    let (first, second, bound) = a_stage_reaches_the_bound(without, with, 7);
+    assert!(first.trajectory.path_length_m < 0.5 * bound);
+    assert_eq!(second.seed.source, FAR_END_SOURCE);
 }
 
 #[test]
 fn the_beam_stage_goes_on_where_the_search_ends_short() {
     // Evaluation task 593: a line whose bound is 1.28 m, where the default search (its widened
-    // pass included, no far end) ends at 0.47 m; and task 0, which it plans to its bound.
+    // pass included, no far end) ends at 0.47 m.
     let mut without = PlannerConfig::default();
     without.search.far_end_shares.clear();
     without.search.beam_width = 0;
     let mut with = without.clone();
     with.search.beam_width = 64;
     with.search.beam_budget_steps = 100_000;
-    for (index, first, second, bound) in planned_twice(without, with, &[0, 593]) {
-        let (a, b) = (
-            first.trajectory.path_length_m,
-            second.trajectory.path_length_m,
-        );
-        if index == 0 {
-            assert!(
-                a >= SHORTFALL_SHARE * bound,
-                "task 0 is planned near its bound"
-            );
-            assert_eq!(first, second, "a plan near its bound runs no beam");
-        } else {
-            assert!(
-                a < SHORTFALL_SHARE * bound,
-                "task {index}: the search ends short"
-            );
-            assert!(
-                b >= SHORTFALL_SHARE * bound,
-                "task {index}: the beam reaches only {b} m of {bound} m"
-            );
-            assert!(
-                second
-                    .trajectory
-                    .steps
-                    .iter()
-                    .any(|s| s.controller == Some(ActingController::Search)),
-                "the beam's steps are recorded as the search's"
-            );
-        }
-    }
+    let (_, second, _) = a_stage_reaches_the_bound(without, with, 593);
+    assert!(
+        second
+            .trajectory
+            .steps
+            .iter()
+            .any(|s| s.controller == Some(ActingController::Search)),
+        "the beam's steps are recorded as the search's"
+    );
 }
 
 #[test]
