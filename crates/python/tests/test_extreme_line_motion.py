@@ -122,7 +122,8 @@ def test_plan_arrays_describe_the_motion(planner, tasks):
     np.testing.assert_array_equal(plan.q[0], plan.seed)
     # The search starts from whichever of its candidates goes furthest, never less far than
     # the paper's pipeline (one DP seed, one rollout).
-    assert plan.seed_source in ("dp", "generating", "q_mu", "q_jl", "ik", "scan-chain", "scan")
+    search_sources = ("dp", "generating", "q_mu", "q_jl", "ik", "scan-chain", "far-end", "scan")
+    assert plan.seed_source in search_sources
     pipeline = planner.plan(task.p0, task.d, task.n, planner="controller")
     assert pipeline.seed_source == "dp"
     assert plan.path_length_m >= pipeline.path_length_m
