@@ -129,8 +129,9 @@ pub struct SearchConfig {
     /// default: never), run before the beam where the longest rollout still ends below
     /// [`SHORTFALL_SHARE`] × the bound: for each share beyond the longest rollout, a search
     /// with these settings (this stage left out) of the motion from that grid point back to
-    /// `p0` (`crate::far_end`), and where that motion gets back to `p0`, rollouts from `p0`
-    /// that follow it forwards, each tail taking over where it ends. Measured on the first
+    /// `p0` (`crate::far_end`; its own budget of [`SearchConfig::budget_steps`]), and where
+    /// that motion gets back to `p0`, rollouts from `p0` that follow it forwards, each tail
+    /// taking over where it ends. Measured on the first
     /// 1,000 evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over
     /// the lines whose bound is 1 m or more, without and with the default shares (0.95, 0.8,
     /// 0.65 and 0.5), and the mean time per plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa
