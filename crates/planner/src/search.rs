@@ -125,20 +125,19 @@ pub struct SearchConfig {
     /// Control steps the beam stage may evaluate: 1,000,000 gave the same lengths as 300,000
     /// (the default) on the same tasks; the budget bounds the slowest plan.
     pub beam_budget_steps: u64,
-    /// Shares of the scan's reach from which the far-end stage plans back to `p0` (empty, the
-    /// default: never), run before the beam where the longest rollout still ends below
-    /// [`SHORTFALL_SHARE`] × the bound: for each share beyond the longest rollout, a search
-    /// with these settings (this stage left out) of the motion from that grid point back to
-    /// `p0` (`crate::far_end`; its own budget of [`SearchConfig::budget_steps`]), and where
-    /// that motion gets back to `p0`, rollouts from `p0` that follow it forwards, each tail
-    /// taking over where it ends. Measured on the first
+    /// Shares of the scan's reach from which the far-end stage plans back to `p0` (default
+    /// 0.95, 0.8, 0.65 and 0.5; empty: never), run before the beam where the longest rollout
+    /// still ends below [`SHORTFALL_SHARE`] × the bound: from the grid point at each share
+    /// beyond the longest rollout, the first pass of a search with these settings plans the
+    /// motion back to `p0` (`crate::far_end`; its own budget of
+    /// [`SearchConfig::budget_steps`]), and where that motion gets back to `p0`, rollouts from
+    /// `p0` follow it forwards, each tail taking over where it ends. Measured on the first
     /// 1,000 evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over
-    /// the lines whose bound is 1 m or more, without and with the default shares (0.95, 0.8,
-    /// 0.65 and 0.5), and the mean time per plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa
-    /// 0.948 → 0.958 (45.7 → 45.9 ms), UR5e 0.866 → 0.886 (55.3 → 59.7 ms). On the 39 FR3
-    /// tasks of those whose best-known length ended below 0.9 × their bound, the backward
-    /// search's own widened pass and beam found no more than its first pass alone, at twice
-    /// the time; so it runs the first pass only.
+    /// the lines whose bound is 1 m or more, without and with the default shares, and the mean
+    /// time per plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa 0.948 → 0.958 (45.7 → 45.9 ms),
+    /// UR5e 0.866 → 0.886 (55.3 → 59.7 ms). On the 39 FR3 tasks of those whose best-known
+    /// length ended below 0.9 × their bound, a backward search with its own widened pass and
+    /// beam found no more than its first pass alone, at twice the time.
     pub far_end_shares: Vec<f64>,
 }
 
