@@ -386,9 +386,9 @@ fn shortfall_clause(config: &SearchConfig) -> String {
     if config.beam_width > 0 {
         let when = if clause.is_empty() { "then" } else { "still" };
         clause += &format!(
-            "; where its plan {when} ends below {SHORTFALL_SHARE} × the bound, a beam search over \
-             action sequences of {} members goes on for up to {} more steps",
-            config.beam_width, config.beam_budget_steps
+            "; where its plan {when} ends below {} × the bound, a beam search over action \
+             sequences of {} members goes on for up to {} more steps",
+            config.beam_below_share, config.beam_width, config.beam_budget_steps
         );
     }
     clause

@@ -279,6 +279,10 @@ fn out_of_range_values_are_refused_naming_field_value_and_range() {
             "search.beam_budget_steps must be in [0, 10000000], got 20000000",
         ),
         (
+            r#"{"search": {"beam_below_share": 0}}"#,
+            "search.beam_below_share must be in (0, 1], got 0",
+        ),
+        (
             r#"{"search": {"far_end_shares": [0.9, 1.5]}}"#,
             "search.far_end_shares must be in (0, 1], got 1.5",
         ),
