@@ -750,13 +750,12 @@ impl Search<'_> {
     }
 
     /// The far-end stage ([`SearchConfig::far_end_shares`]): from each share of the scan's
-    /// grid points beyond the longest rollout, a search of the reversed task back to `p0`
-    /// (`crate::far_end`; the requested controller its finalist), and where its motion gets
-    /// back to `p0`, that motion followed forwards from its configuration there, put on `p0`.
+    /// grid points beyond the longest rollout, the motion planned back to `p0`
+    /// ([`Search::planned_back`]) followed forwards from its configuration there.
     fn far_end(&mut self, reach: &Reach, tails: &mut [Executor; 2]) {
         let context = self.context;
         // The backward search is the first pass alone: no widened pass, beam or far end.
-        let config = SearchConfig {
+        let backward = SearchConfig {
             widened_budget_steps: 0,
             beam_width: 0,
             far_end_shares: Vec::new(),
@@ -764,47 +763,54 @@ impl Search<'_> {
         };
         for &share in &context.config.far_end_shares {
             let far = ((reach.witnesses.len().saturating_sub(1)) as f64 * share) as usize;
-            let s_far_m = far as f64 * reach.grid_m;
-            if s_far_m <= self.longest_m() {
+            if far as f64 * reach.grid_m <= self.longest_m() {
                 continue;
             }
-            let (Some(task), Some(scan)) = (
-                reversed_task(context.robot, self.task, s_far_m),
-                reversed_reach(reach, far),
-            ) else {
-                continue;
-            };
-            let mut rollout = context.rollout.clone();
-            rollout.constraints.work_surface =
-                reversed_surface(&rollout.constraints.work_surface, s_far_m);
-            let backward_context = SearchContext {
-                rollout: &rollout,
-                config: &config,
-                ..*context
-            };
-            let seed = Seed {
-                q: scan.witnesses[0],
-                source: FAR_END_SOURCE,
-                projection_iterations: None,
-            };
-            let (_, backward) = search(&backward_context, &task, seed, tails[0].clone(), &scan);
-            let Some(reference) = forward_reference(self.task, &backward, s_far_m) else {
-                continue;
-            };
-            let Some(at_p0) = reference.at(0.0) else {
-                continue;
-            };
-            let target = PoseTarget {
-                position: self.task.p0,
-                tool_axis: context.robot.forward(&at_p0).tool_axis(),
-                roll_axis: None,
-            };
-            if let Ok((start, _)) =
-                project_to_pose(context.robot, &at_p0, &target, &ProjectionConfig::default())
-            {
+            if let Some((start, reference)) = self.planned_back(reach, far, &backward, &tails[0]) {
                 self.track(start, &reference, FAR_END_SOURCE, tails);
             }
         }
+    }
+
+    /// The motion a search with `config` (`finalist` its requested controller) plans on the
+    /// reversed task from the scan's grid point `far` back to `p0` (`crate::far_end`), read
+    /// forwards: its configuration at `p0`, put on `p0` with its own tool axis, and the
+    /// reference that follows it from there; `None` where it does not get back to `p0`.
+    fn planned_back(
+        &self,
+        reach: &Reach,
+        far: usize,
+        config: &SearchConfig,
+        finalist: &Executor,
+    ) -> Option<(JointVector, Reference)> {
+        let context = self.context;
+        let s_far_m = far as f64 * reach.grid_m;
+        let task = reversed_task(context.robot, self.task, s_far_m)?;
+        let scan = reversed_reach(reach, far)?;
+        let mut rollout = context.rollout.clone();
+        rollout.constraints.work_surface =
+            reversed_surface(&rollout.constraints.work_surface, s_far_m);
+        let backward_context = SearchContext {
+            rollout: &rollout,
+            config,
+            ..*context
+        };
+        let seed = Seed {
+            q: scan.witnesses[0],
+            source: FAR_END_SOURCE,
+            projection_iterations: None,
+        };
+        let (_, backward) = search(&backward_context, &task, seed, finalist.clone(), &scan);
+        let reference = forward_reference(self.task, &backward, s_far_m)?;
+        let at_p0 = reference.at(0.0)?;
+        let target = PoseTarget {
+            position: self.task.p0,
+            tool_axis: context.robot.forward(&at_p0).tool_axis(),
+            roll_axis: None,
+        };
+        let (start, _) =
+            project_to_pose(context.robot, &at_p0, &target, &ProjectionConfig::default()).ok()?;
+        Some((start, reference))
     }
 
     /// Follows `reference` from `q`, a configuration on `p0`, with each tail taking over where
