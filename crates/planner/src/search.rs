@@ -115,8 +115,9 @@ pub struct SearchConfig {
     /// draws ([`SearchConfig::widened_budget_steps`]).
     pub widened_breadth: usize,
     /// Members of the beam stage (`crate::beam`), run last where the longest rollout still
-    /// ends below [`SearchConfig::beam_below_share`] × the bound (0: never): a search over action sequences
-    /// from every start the search rolled out, diverse across joint-space cells. Measured on
+    /// ends below [`SearchConfig::beam_below_share`] × the bound (0: never): a search over
+    /// action sequences from every start the search rolled out, diverse across joint-space
+    /// cells. Measured on
     /// the first 1,000 evaluation tasks of each shipped arm at the default budget, Σ length /
     /// Σ bound over the lines whose bound is 1 m or more, without and with a beam of 512
     /// (300,000 steps), and the mean time per plan: FR3 0.886 → 0.907 (42.1 → 46.8 ms), iiwa
