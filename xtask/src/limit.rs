@@ -408,12 +408,12 @@ fn markdown(record: &Record) -> String {
          `cargo xtask limit --merge`. Do not edit by hand. Robot `{}`, the first {} tasks of `{}`. \
          ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
          {} restarts, {} finalists, the best {} starts repaired, up to {} of the scan's chains \
-         followed from `p0`, then, where the plan still ends below 0.9 × the bound, motions \
-         planned backwards to `p0` from {} followed forwards, then where it still does, a beam \
-         search over action sequences: {} members, up to {} more steps), every trajectory \
-         re-checked by the independent checker; the bound is the reachability scan (a necessary \
-         condition, so an upper bound as good as its IK sampling), raised to ℓ* where a plan \
-         went beyond it.\n\n\
+         followed from `p0`, then, where the plan still ends below {} × the bound, motions \
+         planned backwards to `p0` from {} followed forwards, then where it still ends below {} × \
+         the bound, a beam search over action sequences: {} members, up to {} more steps), \
+         every trajectory re-checked by the independent checker; the bound is the reachability \
+         scan (a necessary condition, so an upper bound as good as its IK sampling), raised to ℓ* \
+         where a plan went beyond it.\n\n\
          ## By bucket of the bound\n\nΣ length / Σ reference over the tasks whose bound lies in \
          the bucket (the task mean of the ratio in brackets); below ½: the tasks that end below \
          half of the reference.\n\n\
@@ -428,7 +428,9 @@ fn markdown(record: &Record) -> String {
         limit.finalists,
         limit.repaired_starts,
         limit.chains,
+        SHORTFALL_SHARE,
         far_end_points(limit),
+        limit.beam_below_share,
         limit.beam_width,
         limit.beam_budget_steps,
     );

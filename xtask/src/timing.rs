@@ -58,7 +58,8 @@ struct Outcome {
     points: usize,
     file_bytes: usize,
     refined: bool,
-    cut: bool,
+    /// Where the smooth path ends before the last planned point, and why.
+    cut: Option<String>,
     slowdowns: usize,
     /// Wall time of the timing alone (ms).
     timing_ms: f64,
@@ -91,8 +92,9 @@ struct Record {
     file_megabytes: Summary,
     /// Tasks whose smooth path needed extra knots to hold the task constraints.
     tasks_refined: usize,
-    /// Tasks whose smooth path ends before the last planned point.
+    /// Tasks whose smooth path ends before the last planned point, and the first few.
     tasks_cut: usize,
+    cut_examples: Vec<String>,
     /// Rounds of local slow-down per task.
     slowdowns: Summary,
     /// Wall time of the timing per trajectory (ms): median and 95th percentile.
@@ -137,7 +139,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let outcomes: Vec<Outcome> = pool.install(|| {
         tasks
             .par_iter()
-            .map(|task| {
+            .enumerate()
+            .map(|(index, task)| {
                 let plan = planner.plan(task, &request)?;
                 let started = Instant::now();
                 let motion = timing.time(
@@ -165,7 +168,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         None,
                     )
                     .err()
-                    .map(|failure| failure.to_string());
+                    .map(|failure| format!("task {index}: {failure}"));
                 let report = &motion.report;
                 bar.inc(1);
                 Ok(Outcome {
@@ -176,7 +179,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     points: motion.samples.len(),
                     file_bytes: files.joint_trajectory.len(),
                     refined: report.refined_knots > 0,
-                    cut: report.cut.is_some(),
+                    cut: report.cut.as_ref().map(|(point, violation)| {
+                        format!("task {index}: ends at planned point {point}: {violation}")
+                    }),
                     slowdowns: report.slowdowns,
                     timing_ms,
                     failure,
@@ -198,6 +203,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     timing_ms.sort_by(f64::total_cmp);
     let quantile = |q: f64| timing_ms[((timing_ms.len() - 1) as f64 * q).round() as usize];
     let failures: Vec<String> = outcomes.iter().filter_map(|o| o.failure.clone()).collect();
+    let cuts: Vec<String> = outcomes.iter().filter_map(|o| o.cut.clone()).collect();
     let record = Record {
         robot: planner.robot().name().to_string(),
         joint_limits: workspace::relative(&limits_file),
@@ -215,7 +221,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         points_per_trajectory: summary(|o| o.points as f64)?,
         file_megabytes: summary(|o| o.file_bytes as f64 / 1e6)?,
         tasks_refined: outcomes.iter().filter(|o| o.refined).count(),
-        tasks_cut: outcomes.iter().filter(|o| o.cut).count(),
+        tasks_cut: cuts.len(),
+        cut_examples: cuts.iter().take(5).cloned().collect(),
         slowdowns: summary(|o| o.slowdowns as f64)?,
         timing_ms_median: quantile(0.5),
         timing_ms_p95: quantile(0.95),
@@ -298,7 +305,7 @@ fn markdown(record: &Record) -> String {
         record.machine,
         record.threads,
     );
-    for example in &record.failure_examples {
+    for example in record.cut_examples.iter().chain(&record.failure_examples) {
         md += &format!("\n* {example}");
     }
     md

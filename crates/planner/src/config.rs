@@ -41,8 +41,8 @@ pub struct PlannerConfig {
     /// `classical_gains`; 25,000 more steps at breadth 4 where a plan ends short of its
     /// bound, `widened_budget_steps` and `widened_breadth`; then, where it still ends short,
     /// motions planned back to `p0` from 95, 80, 65 and 50 % of the scan, `far_end_shares`;
-    /// then, where it still ends below 0.9 × the bound (`beam_below_share`), a beam of 512
-    /// members and 300,000 steps, `beam_width` and `beam_budget_steps`).
+    /// then, where it still ends below 0.95 × the bound (`beam_below_share`), a beam of 512
+    /// members and 100,000 steps, `beam_width` and `beam_budget_steps`).
     pub search: SearchConfig,
 }
 

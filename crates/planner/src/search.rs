@@ -123,19 +123,19 @@ pub struct SearchConfig {
     /// 46.8 ms), iiwa 0.940 → 0.948 (44.0 → 46.3 ms), UR5e 0.860 → 0.866 (49.8 → 53.2 ms); a
     /// beam of 1,024 gave the same lengths.
     pub beam_width: usize,
-    /// Control steps the beam stage may evaluate: 1,000,000 gave the same lengths as 300,000
-    /// (the default) on the same tasks, and so did 100,000 on the first 1,000 evaluation tasks
-    /// of the FR3 and the iiwa 14; the budget bounds the slowest plan.
+    /// Control steps the beam stage may evaluate (default 100,000); the budget bounds the
+    /// slowest plan. On the first 1,000 evaluation tasks of the FR3 and the iiwa 14, 100,000
+    /// gave the same lengths as 300,000 and 1,000,000 (with the beam below 0.9 and below 0.95
+    /// × the bound); 50,000 gave less.
     pub beam_budget_steps: u64,
     /// The beam stage runs where the longest rollout still ends below this share of the bound
-    /// (default [`SHORTFALL_SHARE`], in (0, 1]). Above it, the beam also finds the last
-    /// centimetres of plans that end near the bound. Measured on 10,000 evaluation tasks at
-    /// the default budget with 0.95 and a 100,000-step beam, Σ length / Σ bound over the
-    /// lines whose bound is 1 m or more and over all lines: FR3 0.9196 → 0.9206 and 0.9596
-    /// → 0.9602, iiwa 0.9498 → 0.9503 and 0.9691 → 0.9694. But `cargo xtask timing` then
-    /// found, on each arm, one timed motion whose tool axis left the cone by under 0.001°
-    /// between the points at which `emg_timing`'s smooth path is checked, and one smooth path
-    /// cut short near its start, so the default stays at 0.9.
+    /// (default 0.95, in (0, 1]): above [`SHORTFALL_SHARE`], where the earlier stages stop,
+    /// since the beam also finds the last few centimetres of plans that end near the bound.
+    /// Measured on the 10,000 evaluation tasks of each seven-axis arm at the default budget,
+    /// Σ length / Σ bound over the lines whose bound is 1 m or more and over all lines, at 0.9
+    /// (with a 300,000-step beam) and at 0.95 (100,000): FR3 0.9196 → 0.9206 and 0.9596 →
+    /// 0.9602, iiwa 0.9498 → 0.9503 and 0.9691 → 0.9694, at about the same time per plan; on
+    /// the first 1,000, 0.99 gave FR3 ≥ 1 m 0.9177 (0.9169 at 0.95) at nearly twice the time.
     pub beam_below_share: f64,
     /// Shares of the scan's reach from which the far-end stage plans back to `p0` (default
     /// 0.95, 0.8, 0.65 and 0.5; empty: never), run before the beam where the longest rollout
@@ -189,8 +189,8 @@ impl Default for SearchConfig {
             widened_budget_steps: 25_000,
             widened_breadth: 4,
             beam_width: 512,
-            beam_budget_steps: 300_000,
-            beam_below_share: SHORTFALL_SHARE,
+            beam_budget_steps: 100_000,
+            beam_below_share: 0.95,
             far_end_shares: vec![0.95, 0.8, 0.65, 0.5],
         }
     }

@@ -2,7 +2,8 @@
 //! limits (libfranka stops a motion whose acceleration jumps):
 //!
 //! 1. [`SmoothPath`]: a natural cubic spline ([`JointSpline`], C²) through the planned
-//!    waypoints, checked against every task constraint on a dense sampling and refined where it
+//!    waypoints (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits and turned
+//!    [`CONE_INSET_DEG`] inside the tool cone where they ride them), checked against every task constraint on a dense sampling and refined where it
 //!    fails;
 //! 2. [`topp_ra`]: the time-optimal path speed under joint velocity and acceleration limits and
 //!    a tool-speed cap (Pham & Pham 2018), from rest to rest;
@@ -14,6 +15,7 @@
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
 mod dynamics;
+mod inset;
 mod limits;
 mod path;
 mod profile;
@@ -22,6 +24,7 @@ mod spline;
 mod topp;
 
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
+pub use inset::{CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };

@@ -1,12 +1,14 @@
 //! The smooth joint path of a planned motion: a natural cubic spline through every
 //! [`KNOT_STRIDE`]-th waypoint (the controller's step-to-step jitter left out, so the joints'
-//! accelerations along the path stay low), parametrised by the distance the TCP travels between
+//! accelerations along the path stay low), each inner one moved a hair inside the joint limits
+//! and the tool cone ([`crate::inset`]), parametrised by the distance the TCP travels between
 //! waypoints, checked against every task constraint on a dense sampling and refined where it
 //! fails.
 
 use emg_control::{ConstraintConfig, Task, Violation, first_violation};
 use emg_kinematics::{JointVector, Robot};
 
+use crate::inset::{inset, tool_angle_gradient};
 use crate::spline::JointSpline;
 
 /// The spline passes through every this many waypoints (and the last).
@@ -48,13 +50,16 @@ impl SmoothPath {
     /// The smooth path through `waypoints` (each holding the constraints, as a rollout's steps
     /// do). The parameter of waypoint `k` is the TCP distance travelled along the polyline of
     /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
-    /// largest joint change, per step); the spline passes through
-    /// the first, every [`KNOT_STRIDE`]-th and the last waypoint. It is checked at
-    /// [`CHECKS_PER_SEGMENT`] points inside each segment; a segment that breaks a constraint
-    /// gets back the middle waypoint it skipped, or, between consecutive waypoints, their chord
-    /// midpoint as a new knot (when that midpoint holds the constraints, up to
-    /// [`MAX_REFINEMENTS`] midpoints in all), else the path ends at the segment's first
-    /// waypoint.
+    /// largest joint change, per step); the spline passes through the first, every
+    /// [`KNOT_STRIDE`]-th and the last waypoint, each inner one moved
+    /// [`JOINT_INSET_RAD`](crate::JOINT_INSET_RAD) inside the joint limits and turned about its
+    /// TCP to [`CONE_INSET_DEG`](crate::CONE_INSET_DEG) inside the tool cone where it lies
+    /// closer to them (when the moved configuration holds every constraint). It is checked at
+    /// [`CHECKS_PER_SEGMENT`] points inside each segment, at the joints' turning points and at
+    /// the tool angle's peaks; a segment that breaks a constraint gets back the middle waypoint
+    /// it skipped, or, between consecutive waypoints, their chord midpoint moved likewise as a
+    /// new knot (when that holds the constraints, up to [`MAX_REFINEMENTS`] midpoints in all),
+    /// else the path ends at the segment's first waypoint.
     ///
     /// # Panics
     ///
@@ -87,9 +92,20 @@ impl SmoothPath {
             .filter(|k| k % KNOT_STRIDE == 0 || *k == last)
             .map(Some)
             .collect();
+        // A knot at an inner waypoint, moved inside the joint limits and the cone where that
+        // holds every constraint.
+        let knot = |k: usize| {
+            let q = waypoints[k];
+            if k == 0 || k == last {
+                return q;
+            }
+            inset(robot, task, constraints.theta_max_deg, &q)
+                .filter(|turned| *turned == q || valid(turned))
+                .unwrap_or(q)
+        };
         let mut values: Vec<JointVector> = origin
             .iter()
-            .map(|k| waypoints[k.expect("a waypoint")])
+            .map(|k| knot(k.expect("a waypoint")))
             .collect();
         let mut knots: Vec<f64> = origin
             .iter()
@@ -116,13 +132,16 @@ impl SmoothPath {
             {
                 let middle = (a + b) / 2;
                 origin.insert(segment + 1, Some(middle));
-                values.insert(segment + 1, waypoints[middle]);
+                values.insert(segment + 1, knot(middle));
                 knots.insert(segment + 1, params[middle]);
                 refined_knots += 1;
                 continue;
             }
-            let midpoint = (values[segment] + values[segment + 1]) / 2.0;
-            if midpoints < MAX_REFINEMENTS && valid(&midpoint) {
+            let midpoint = (midpoints < MAX_REFINEMENTS)
+                .then(|| (values[segment] + values[segment + 1]) / 2.0)
+                .and_then(|chord| inset(robot, task, constraints.theta_max_deg, &chord))
+                .filter(|q| valid(q));
+            if let Some(midpoint) = midpoint {
                 knots.insert(segment + 1, (knots[segment] + knots[segment + 1]) / 2.0);
                 values.insert(segment + 1, midpoint);
                 origin.insert(segment + 1, None);
@@ -159,10 +178,14 @@ impl SmoothPath {
     }
 }
 
+/// Bisection steps that place a peak of the tool angle inside a check interval (an interval of
+/// a few millimetres shrinks below a nanometre).
+const PEAK_BISECTIONS: usize = 24;
+
 /// The first segment of `spline` with a checked inside point that breaks a constraint.
-/// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points and every joint's turning points
-/// (where a joint's extreme values inside the segment lie, so the joint limits hold on the
-/// whole segment).
+/// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points, every joint's turning points (where
+/// a joint's extreme values inside the segment lie, so the joint limits hold on the whole
+/// segment) and the tool angle's peaks ([`tool_angle_peaks`]).
 fn first_failing_segment(
     robot: &Robot,
     task: &Task,
@@ -171,12 +194,60 @@ fn first_failing_segment(
 ) -> Option<(usize, Violation)> {
     let knots = spline.knots();
     (0..knots.len() - 1).find_map(|k| {
-        let even = (1..CHECKS_PER_SEGMENT + 1).map(|j| {
-            knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64
-        });
-        even.chain(spline.turning_points(k)).find_map(|s| {
-            let q = spline.eval(s).q;
-            first_violation(robot, task, &robot.forward(&q), constraints).map(|v| (k, v))
-        })
+        let even: Vec<f64> = (1..CHECKS_PER_SEGMENT + 1)
+            .map(|j| {
+                knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64
+            })
+            .collect();
+        let peaks = tool_angle_peaks(robot, task, spline, k, &even);
+        even.iter()
+            .copied()
+            .chain(spline.turning_points(k))
+            .chain(peaks)
+            .find_map(|s| {
+                let q = spline.eval(s).q;
+                first_violation(robot, task, &robot.forward(&q), constraints).map(|v| (k, v))
+            })
     })
+}
+
+/// Where the tool angle `θ(s) = ∠(z(q(s)), n)` peaks inside segment `k` of `spline`: in each
+/// interval between consecutive points of the segment's knots and `inner` (increasing) where
+/// the angle's rate `θ' = ∇θ · q'` turns from rising to falling, the root of `θ'` found by
+/// [`PEAK_BISECTIONS`] bisections. The largest angle on an interval lies at one of its ends or
+/// at such a peak, unless the rate changes sign more than once inside it; so a spline that
+/// holds the cone at its check points and peaks holds it between them, where the timed samples
+/// fall.
+fn tool_angle_peaks(
+    robot: &Robot,
+    task: &Task,
+    spline: &JointSpline,
+    k: usize,
+    inner: &[f64],
+) -> Vec<f64> {
+    let rate = |s: f64| {
+        let point = spline.eval(s);
+        tool_angle_gradient(&robot.forward(&point.q), &task.n).map_or(0.0, |g| g.dot(&point.dq))
+    };
+    let knots = spline.knots();
+    let points: Vec<f64> = std::iter::once(knots[k])
+        .chain(inner.iter().copied())
+        .chain(std::iter::once(knots[k + 1]))
+        .collect();
+    let rates: Vec<f64> = points.iter().map(|&s| rate(s)).collect();
+    (0..points.len() - 1)
+        .filter(|&i| rates[i] > 0.0 && rates[i + 1] <= 0.0)
+        .map(|i| {
+            let (mut rising, mut falling) = (points[i], points[i + 1]);
+            for _ in 0..PEAK_BISECTIONS {
+                let middle = 0.5 * (rising + falling);
+                if rate(middle) > 0.0 {
+                    rising = middle;
+                } else {
+                    falling = middle;
+                }
+            }
+            0.5 * (rising + falling)
+        })
+        .collect()
 }
