@@ -81,7 +81,7 @@ pub(crate) fn inset(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::{Rotation3, Unit};
+    use emg_kinematics::rotation_about;
 
     fn fr3() -> Robot {
         let path =
@@ -93,8 +93,8 @@ mod tests {
     fn task_at_angle(robot: &Robot, q: &JointVector, angle_deg: f64) -> Task {
         let kinematics = robot.forward(q);
         let z = kinematics.tool_axis();
-        let across = Unit::new_normalize(z.cross(&Vec3::x()));
-        let n = Rotation3::from_axis_angle(&across, angle_deg.to_radians()) * z;
+        let across = z.cross(&Vec3::x()).normalize();
+        let n = rotation_about(&across, angle_deg.to_radians()) * z;
         let d = n.cross(&across);
         Task::new(robot, kinematics.tcp(), d, n, Some(*q)).unwrap()
     }
