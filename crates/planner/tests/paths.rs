@@ -4,19 +4,14 @@
 //! verified as `emg check` verifies them; the search never returns less than the pipeline's plan
 //! and a plan that reaches the end says so.
 
-use emg_control::{PathShape, Task, Termination, path_tasks};
-use emg_io::{TrajectoryContents, read_tasks};
-use emg_kinematics::Robot;
-use emg_planner::{
-    DataDir, Models, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig,
-    SHIPPED_ROBOTS, SearchConfig, ShippedRobot, limits_file_beside,
-};
-use emg_timing::Scaling;
-use emg_verify::ReferenceModel;
+mod common;
 
-fn data() -> DataDir {
-    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
-}
+use common::{TimedArm, data};
+use emg_control::{PathShape, Task, Termination, path_tasks};
+use emg_io::read_tasks;
+use emg_planner::{
+    PlanRequest, Planner, PlannerConfig, SHIPPED_ROBOTS, SearchConfig, ShippedRobot,
+};
 
 /// The first eight paths of the population from `arm`'s evaluation tasks (two of each shape).
 fn population(arm: ShippedRobot, planner: &Planner) -> Vec<(PathShape, Task)> {
@@ -33,9 +28,6 @@ fn population(arm: ShippedRobot, planner: &Planner) -> Vec<(PathShape, Task)> {
 fn rectangles_circles_and_s_curves_plan_time_and_check_on_every_shipped_arm() {
     for arm in SHIPPED_ROBOTS {
         let name = arm.name;
-        let file = arm.path(&data());
-        let robot = Robot::from_chain_file(&file).expect("robot loads");
-        let models = Models::shipped(&robot, &arm.data_dir(&data())).expect("shipped models");
         let config = PlannerConfig {
             search: SearchConfig {
                 budget_steps: 2_000,
@@ -45,25 +37,10 @@ fn rectangles_circles_and_s_curves_plan_time_and_check_on_every_shipped_arm() {
             },
             ..PlannerConfig::default()
         };
-        let planner = Planner::new(robot, models, config).expect("valid config");
-        let checker = ReferenceModel::from_urdf_file(
-            &file,
-            planner.robot().base_link(),
-            planner.robot().tip_link(),
-        )
-        .expect("checker");
-        let constraints = &planner.config().rollout.constraints;
-        let timing = MotionTiming::new(
-            planner.robot(),
-            &limits_file_beside(&file),
-            Scaling::default(),
-            planner.config().rollout.speed_m_per_s,
-            1000.0,
-            constraints,
-        )
-        .expect("shipped joint limits");
+        let timed = TimedArm::new(arm, config);
+        let planner = &timed.planner;
         let mut completed = Vec::new();
-        for (shape, task) in population(arm, &planner) {
+        for (shape, task) in population(arm, planner) {
             if shape == PathShape::Arc {
                 continue;
             }
@@ -83,32 +60,13 @@ fn rectangles_circles_and_s_curves_plan_time_and_check_on_every_shipped_arm() {
             if done {
                 completed.push(shape);
             }
-            let record = PlanRecord {
-                robot: name,
-                request: &request,
-                bound: None,
-                timing: &timing,
-            };
-            let files = PlanFiles::new(&planner, &task, &plan, &record).expect("timed");
+            let files = timed.checked_files(&format!("{name} {shape:?}"), &task, &plan, &request);
             if shape == PathShape::Rectangle && done {
                 assert_eq!(
                     files.timing.rests_s.len(),
                     3,
                     "{name}: at rest at each corner"
                 );
-            }
-            for text in [&files.json, &files.joint_trajectory] {
-                TrajectoryContents::parse(text)
-                    .expect("a trajectory file")
-                    .verify(
-                        &checker,
-                        planner.robot().joint_names(),
-                        &task,
-                        constraints,
-                        true,
-                        None,
-                    )
-                    .unwrap_or_else(|e| panic!("{name} {shape:?}: {e}"));
             }
         }
         for shape in [PathShape::Rectangle, PathShape::Circle, PathShape::SCurve] {

@@ -2,19 +2,12 @@
 //! them: the smooth path keeps the whole planned motion (no cut), and every sample of the timed
 //! file holds every constraint, as `emg check` verifies it.
 
-use emg_control::{Task, tool_angle_deg};
-use emg_io::{TrajectoryContents, read_tasks};
-use emg_kinematics::Robot;
-use emg_planner::{
-    DataDir, Models, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerConfig,
-    PlannerKind, ShippedRobot, limits_file_beside,
-};
-use emg_timing::Scaling;
-use emg_verify::ReferenceModel;
+mod common;
 
-fn data() -> DataDir {
-    DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
-}
+use common::{TimedArm, data};
+use emg_control::tool_angle_deg;
+use emg_io::read_tasks;
+use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, ShippedRobot};
 
 /// A waypoint near the cone's edge has its tool axis within this of it (degrees).
 const EDGE_DEG: f64 = 0.01;
@@ -23,39 +16,21 @@ const EDGE_DEG: f64 = 0.01;
 /// the timed file; returns whether a planned waypoint rides a joint limit and whether one comes
 /// near the cone's edge.
 fn plan_time_and_check(arm: ShippedRobot, index: usize) -> (bool, bool) {
-    let file = arm.path(&data());
-    let robot = Robot::from_chain_file(&file).expect("robot loads");
-    let models = Models::shipped(&robot, &arm.data_dir(&data())).expect("shipped models");
-    let planner = Planner::new(robot, models, PlannerConfig::default()).expect("valid config");
-    let task: Task = read_tasks(
+    let timed = TimedArm::new(arm, PlannerConfig::default());
+    let planner = &timed.planner;
+    let task = read_tasks(
         &arm.data_dir(&data()).join("tasks/eval-v1.tasks"),
         planner.robot(),
     )
     .expect("shipped tasks")
     .swap_remove(index);
-    let constraints = &planner.config().rollout.constraints;
-    let timing = MotionTiming::new(
-        planner.robot(),
-        &limits_file_beside(&file),
-        Scaling::default(),
-        planner.config().rollout.speed_m_per_s,
-        1000.0,
-        constraints,
-    )
-    .expect("shipped joint limits");
     let request = PlanRequest {
         planner: PlannerKind::Search,
         ..PlanRequest::pipeline()
     };
     let plan = planner.plan(&task, &request).expect("a plan");
-    let record = PlanRecord {
-        robot: arm.name,
-        request: &request,
-        bound: None,
-        timing: &timing,
-    };
-    let files = PlanFiles::new(&planner, &task, &plan, &record).expect("timed");
     let name = format!("{} task {index}", arm.name);
+    let files = timed.checked_files(&name, &task, &plan, &request);
     let cut = &files.timing.cut_reason;
     assert!(files.timing.cut_at_point.is_none(), "{name}: cut, {cut:?}");
     let travel = files.timing.path_travel_m;
@@ -64,23 +39,7 @@ fn plan_time_and_check(arm: ShippedRobot, index: usize) -> (bool, bool) {
         travel > 0.95 * planned,
         "{name}: {travel} m timed of {planned} m planned"
     );
-    let checker = ReferenceModel::from_urdf_file(
-        &file,
-        planner.robot().base_link(),
-        planner.robot().tip_link(),
-    )
-    .expect("checker");
-    TrajectoryContents::parse(&files.joint_trajectory)
-        .expect("a trajectory file")
-        .verify(
-            &checker,
-            planner.robot().joint_names(),
-            &task,
-            constraints,
-            true,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let theta_max_deg = planner.config().rollout.constraints.theta_max_deg;
     let limits = planner.robot().limits();
     let steps = &plan.trajectory.steps;
     let at_limit = steps.iter().any(|s| {
@@ -88,7 +47,7 @@ fn plan_time_and_check(arm: ShippedRobot, index: usize) -> (bool, bool) {
     });
     let near_edge = steps.iter().any(|s| {
         let axis = planner.robot().forward(&s.q).tool_axis();
-        tool_angle_deg(&axis, &task.n) > constraints.theta_max_deg - EDGE_DEG
+        tool_angle_deg(&axis, &task.n) > theta_max_deg - EDGE_DEG
     });
     (at_limit, near_edge)
 }
@@ -103,8 +62,10 @@ fn a_plan_on_the_cone_edge_is_timed_inside_the_cone() {
 
 #[test]
 fn a_plan_on_a_joint_limit_is_timed_whole_within_the_limits() {
-    // FR3 evaluation task 9028: its smooth path, overshooting joint 7's limit, was once cut to
-    // its first waypoint.
-    let (at_limit, _) = plan_time_and_check(ShippedRobot::by_name("fr3").unwrap(), 9028);
-    assert!(at_limit, "the plan rides a joint limit");
+    // FR3 evaluation task 9028 and iiwa 14 task 7680: their smooth paths, overshooting joint
+    // 7's limit, were once cut to their first waypoint and to 0.010 m.
+    for (arm, index) in [("fr3", 9028), ("iiwa14", 7680)] {
+        let (at_limit, _) = plan_time_and_check(ShippedRobot::by_name(arm).unwrap(), index);
+        assert!(at_limit, "{arm} task {index}: the plan rides a joint limit");
+    }
 }
