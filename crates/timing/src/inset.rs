@@ -1,11 +1,13 @@
-//! Configurations moved a hair inside the joint limits and the tool cone, as knots of the
-//! smooth path. A plan that rides a joint limit or the cone's edge has waypoints on it; a spline
-//! through such knots overshoots a limit it follows, and, the cone not being convex in joint
-//! space, a spline (or a chord) between two waypoints on its edge bows out of it by a few
-//! ten-thousandths of a degree. Knots held [`JOINT_INSET_RAD`] inside the joint limits and
-//! turned [`CONE_INSET_DEG`] inside the cone leave the spline between them room to stay inside.
+//! Configurations moved a hair inside the joint limits, clear of the arm's own links and inside
+//! the tool cone, as knots of the smooth path. A plan that rides a joint limit, grazes its own
+//! links or rides the cone's edge has waypoints on that boundary; a spline through such knots
+//! overshoots a limit it follows, and, neither the links' clearance nor the cone being convex
+//! in joint space, a spline (or a chord) between two waypoints on their boundary bows out of it
+//! (by a few micrometres, a few ten-thousandths of a degree). Knots held [`JOINT_INSET_RAD`]
+//! inside the joint limits, [`CLEARANCE_INSET_M`] beyond the collision margin and turned
+//! [`CONE_INSET_DEG`] inside the cone leave the spline between them room to stay inside.
 
-use emg_control::{Task, tool_angle_deg};
+use emg_control::{ConstraintConfig, Task, tool_angle_deg};
 use emg_kinematics::{JointVector, Kinematics, Robot, Vec3};
 
 /// Distance (rad) inside its position limits to which each joint of the smooth path's inner
@@ -15,6 +17,16 @@ pub const JOINT_INSET_RAD: f64 = 1e-4;
 /// Depth (degrees) inside the tool cone to which the smooth path's inner knots are turned where
 /// they lie closer to its edge.
 pub const CONE_INSET_DEG: f64 = 0.005;
+
+/// Clearance (m) beyond the collision margin to which the smooth path's inner knots move the
+/// arm's checked link pairs where they come closer to each other.
+pub const CLEARANCE_INSET_M: f64 = 2e-5;
+
+/// Joint step (rad) of the central differences of the links' clearance ([`clearance_gradient`]).
+const CLEARANCE_STEP_RAD: f64 = 1e-7;
+
+/// How far (m) below its target an inset's clearance may end.
+const CLEARANCE_TOLERANCE_M: f64 = 1e-9;
 
 /// Newton steps at most of one inset.
 const INSET_STEPS: usize = 4;
@@ -32,12 +44,34 @@ pub(crate) fn tool_angle_gradient(kinematics: &Kinematics, n: &Vec3) -> Option<J
     (sin > 1e-12).then(|| -(kinematics.tool_axis_jacobian().transpose() * across) / sin)
 }
 
-/// The joint direction that turns the tool angle by one radian (to first order) and moves the
-/// TCP not at all: the gradient projected into the null space of the position Jacobian `J`,
-/// `N∇θ / (∇θᵀ N ∇θ)` with `N = I − Jᵀ(JJᵀ)⁻¹J`. `None` at a singular `J` or where the null
-/// space cannot turn the angle.
-fn angle_turn(kinematics: &Kinematics, n: &Vec3) -> Option<JointVector> {
-    let gradient = tool_angle_gradient(kinematics, n)?;
+/// The smallest clearance (m) between the arm's checked link pairs at `kinematics`
+/// ([`Robot::min_clearance`]), infinite for an arm without pairs.
+fn links_clearance(robot: &Robot, kinematics: &Kinematics) -> f64 {
+    robot
+        .min_clearance(kinematics)
+        .map_or(f64::INFINITY, |hit| hit.clearance)
+}
+
+/// The gradient `∂c/∂q` of the links' clearance `c` ([`links_clearance`]) at `q` by central
+/// differences of [`CLEARANCE_STEP_RAD`]: `c` is the distance between two capsules' axes less
+/// their radii, smooth wherever the nearest pair and its closest features stay the same.
+fn clearance_gradient(robot: &Robot, q: &JointVector) -> JointVector {
+    let clearance = |q: &JointVector| links_clearance(robot, &robot.forward(q));
+    JointVector::from_fn(|j, _| {
+        if j >= robot.dof() {
+            return 0.0;
+        }
+        let mut step = JointVector::zeros();
+        step[j] = CLEARANCE_STEP_RAD;
+        (clearance(&(q + step)) - clearance(&(q - step))) / (2.0 * CLEARANCE_STEP_RAD)
+    })
+}
+
+/// The joint direction that changes a function of the configuration with `gradient` by one
+/// unit (to first order) and moves the TCP not at all: the gradient projected into the null
+/// space of the position Jacobian `J`, `N∇f / (∇fᵀ N ∇f)` with `N = I − Jᵀ(JJᵀ)⁻¹J`. `None` at
+/// a singular `J` or where the null space cannot change the function.
+fn null_space_turn(kinematics: &Kinematics, gradient: &JointVector) -> Option<JointVector> {
     let jacobian = kinematics.jacobian();
     let inverse_gram = kinematics.jacobian_gram().try_inverse()?;
     let projected = gradient - jacobian.transpose() * (inverse_gram * (jacobian * gradient));
@@ -46,15 +80,18 @@ fn angle_turn(kinematics: &Kinematics, n: &Vec3) -> Option<JointVector> {
 }
 
 /// `q` with every joint at least [`JOINT_INSET_RAD`] inside its limits (where the range is
-/// wider than twice that), then, where its tool axis lies less than [`CONE_INSET_DEG`] inside
-/// the task's cone of half-angle `theta_max_deg`, turned about its TCP (Newton steps along
-/// [`angle_turn`]) until it lies that far inside; `None` when the turn fails. The turn moves
+/// wider than twice that); then, where two of its checked link pairs come closer than
+/// [`CLEARANCE_INSET_M`] beyond `constraints.collision_margin_m`, moved about its TCP (Newton
+/// steps along [`null_space_turn`] of [`clearance_gradient`]) until they are that far clear;
+/// then, where its tool axis lies less than [`CONE_INSET_DEG`] inside the task's cone of
+/// half-angle `constraints.theta_max_deg`, turned about its TCP (the same, along the tool
+/// angle's gradient) until it lies that far inside. `None` when a move fails. The moves shift
 /// the TCP only to second order (tens of nanometres for a hundredth of a degree); no
 /// constraint is checked here.
 pub(crate) fn inset(
     robot: &Robot,
     task: &Task,
-    theta_max_deg: f64,
+    constraints: &ConstraintConfig,
     q: &JointVector,
 ) -> Option<JointVector> {
     let limits = robot.limits();
@@ -66,14 +103,42 @@ pub(crate) fn inset(
             q[j]
         }
     });
-    let target_deg = theta_max_deg - CONE_INSET_DEG;
+    let target_m = constraints.collision_margin_m + CLEARANCE_INSET_M;
+    let kinematics = robot.forward(&q);
+    // The broad phase answers for all but the few configurations that graze.
+    if robot.first_collision(&kinematics, target_m).is_some() {
+        q = newton_inset(robot, q, |kinematics, q| {
+            let shortfall = target_m - links_clearance(robot, kinematics);
+            (shortfall > CLEARANCE_TOLERANCE_M).then(|| {
+                null_space_turn(kinematics, &clearance_gradient(robot, q))
+                    .map(|turn| turn * shortfall)
+            })
+        })?;
+    }
+    let target_deg = constraints.theta_max_deg - CONE_INSET_DEG;
+    newton_inset(robot, q, |kinematics, _| {
+        let excess_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n) - target_deg;
+        (excess_deg > INSET_TOLERANCE_DEG).then(|| {
+            let gradient = tool_angle_gradient(kinematics, &task.n)?;
+            null_space_turn(kinematics, &gradient).map(|turn| -turn * excess_deg.to_radians())
+        })
+    })
+}
+
+/// `q` moved by up to [`INSET_STEPS`] Newton steps: `step` says, from the kinematics and the
+/// configuration, `None` once the configuration is where it should be, else the step to add
+/// (itself `None` where no step can be made). `None` when no step can be made or the steps do
+/// not get there.
+fn newton_inset(
+    robot: &Robot,
+    mut q: JointVector,
+    step: impl Fn(&Kinematics, &JointVector) -> Option<Option<JointVector>>,
+) -> Option<JointVector> {
     for _ in 0..=INSET_STEPS {
-        let kinematics = robot.forward(&q);
-        let angle_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n);
-        if angle_deg <= target_deg + INSET_TOLERANCE_DEG {
-            return Some(q);
+        match step(&robot.forward(&q), &q) {
+            None => return Some(q),
+            Some(change) => q += change?,
         }
-        q -= angle_turn(&kinematics, &task.n)? * (angle_deg - target_deg).to_radians();
     }
     None
 }
@@ -97,6 +162,14 @@ mod tests {
         let n = rotation_about(&across, angle_deg.to_radians()) * z;
         let d = n.cross(&across);
         Task::new(robot, kinematics.tcp(), d, n, Some(*q)).unwrap()
+    }
+
+    /// The default constraints with the cone's half-angle `theta_max_deg`.
+    fn cone(theta_max_deg: f64) -> ConstraintConfig {
+        ConstraintConfig {
+            theta_max_deg,
+            ..ConstraintConfig::default()
+        }
     }
 
     fn angle_rad(robot: &Robot, task: &Task, q: &JointVector) -> f64 {
@@ -137,7 +210,7 @@ mod tests {
         let theta_max_deg = 30.0;
         for outside_deg in [0.0, 0.001, 0.01] {
             let task = task_at_angle(&robot, &q, theta_max_deg + outside_deg);
-            let turned = inset(&robot, &task, theta_max_deg, &q).unwrap();
+            let turned = inset(&robot, &task, &cone(theta_max_deg), &q).unwrap();
             let angle_deg = angle_rad(&robot, &task, &turned).to_degrees();
             assert!(
                 (angle_deg - (theta_max_deg - CONE_INSET_DEG)).abs() <= INSET_TOLERANCE_DEG,
@@ -148,7 +221,7 @@ mod tests {
         }
         // A configuration already that far inside stays as it is.
         let task = task_at_angle(&robot, &q, theta_max_deg - 2.0 * CONE_INSET_DEG);
-        assert_eq!(inset(&robot, &task, theta_max_deg, &q), Some(q));
+        assert_eq!(inset(&robot, &task, &cone(theta_max_deg), &q), Some(q));
     }
 
     #[test]
@@ -159,9 +232,56 @@ mod tests {
         q[6] = limits.upper[6];
         q[0] = limits.lower[0] + 0.5 * JOINT_INSET_RAD;
         let task = task_at_angle(&robot, &q, 10.0);
-        let moved = inset(&robot, &task, 30.0, &q).unwrap();
+        let moved = inset(&robot, &task, &cone(30.0), &q).unwrap();
         assert_eq!(moved[6], limits.upper[6] - JOINT_INSET_RAD);
         assert_eq!(moved[0], limits.lower[0] + JOINT_INSET_RAD);
         assert_eq!(moved.rows(1, 5), q.rows(1, 5));
+    }
+
+    #[test]
+    fn an_inset_moves_grazing_links_apart_and_keeps_its_tcp() {
+        let robot = fr3();
+        let q = robot.mid_range();
+        let task = task_at_angle(&robot, &q, 10.0);
+        let clearance = links_clearance(&robot, &robot.forward(&q));
+        // The links graze once the collision margin is their clearance, or a hair more.
+        for short_m in [0.0, 1e-6, 1e-5] {
+            let constraints = ConstraintConfig {
+                collision_margin_m: clearance + short_m,
+                ..cone(30.0)
+            };
+            let moved = inset(&robot, &task, &constraints, &q).unwrap();
+            let kinematics = robot.forward(&moved);
+            let beyond_m = links_clearance(&robot, &kinematics) - constraints.collision_margin_m;
+            assert!(
+                (CLEARANCE_INSET_M - CLEARANCE_TOLERANCE_M..1.01 * CLEARANCE_INSET_M)
+                    .contains(&beyond_m),
+                "{beyond_m} m beyond the margin"
+            );
+            let moved_m = (kinematics.tcp() - robot.forward(&q).tcp()).norm();
+            assert!(moved_m < 1e-6, "the TCP moved {moved_m} m");
+        }
+        // Links that far clear stay where they are.
+        let constraints = ConstraintConfig {
+            collision_margin_m: clearance - 2.0 * CLEARANCE_INSET_M,
+            ..cone(30.0)
+        };
+        assert_eq!(inset(&robot, &task, &constraints, &q), Some(q));
+    }
+
+    #[test]
+    fn the_clearance_gradient_predicts_a_small_move() {
+        let robot = fr3();
+        let q = robot.mid_range();
+        let gradient = clearance_gradient(&robot, &q);
+        let clearance = |q: &JointVector| links_clearance(&robot, &robot.forward(q));
+        let step = gradient.normalize() * 1e-4;
+        let predicted = gradient.dot(&step);
+        let actual = clearance(&(q + step)) - clearance(&q);
+        assert!(predicted > 1e-6, "{predicted}");
+        assert!(
+            (actual - predicted).abs() < 1e-3 * predicted,
+            "{actual} vs {predicted}"
+        );
     }
 }

@@ -2,9 +2,10 @@
 //! limits (libfranka stops a motion whose acceleration jumps):
 //!
 //! 1. [`SmoothPath`]: a natural cubic spline ([`JointSpline`], C²) through the planned
-//!    waypoints (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits and turned
-//!    [`CONE_INSET_DEG`] inside the tool cone where they ride them), checked against every task constraint on a dense sampling and refined where it
-//!    fails;
+//!    waypoints (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits,
+//!    [`CLEARANCE_INSET_M`] clear of the arm's own links and [`CONE_INSET_DEG`] inside the tool
+//!    cone where they ride them), checked against every task constraint on a dense sampling and
+//!    refined where it fails;
 //! 2. [`topp_ra`]: the time-optimal path speed under joint velocity and acceleration limits and
 //!    a tool-speed cap (Pham & Pham 2018), from rest to rest;
 //! 3. [`SmoothedProfile`]: jerk limiting by a moving average of the path position in time;
@@ -24,7 +25,7 @@ mod spline;
 mod topp;
 
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
-pub use inset::{CONE_INSET_DEG, JOINT_INSET_RAD};
+pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };

@@ -1,7 +1,7 @@
 //! The smooth joint path of a planned motion: a natural cubic spline through every
 //! [`KNOT_STRIDE`]-th waypoint (the controller's step-to-step jitter left out, so the joints'
-//! accelerations along the path stay low), each inner one moved a hair inside the joint limits
-//! and the tool cone ([`crate::inset`]), parametrised by the distance the TCP travels between
+//! accelerations along the path stay low), each inner one moved a hair inside the joint limits,
+//! clear of the arm's own links and inside the tool cone ([`crate::inset`]), parametrised by the distance the TCP travels between
 //! waypoints, checked against every task constraint on a dense sampling and refined where it
 //! fails.
 
@@ -52,9 +52,10 @@ impl SmoothPath {
     /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
     /// largest joint change, per step); the spline passes through the first, every
     /// [`KNOT_STRIDE`]-th and the last waypoint, each inner one moved
-    /// [`JOINT_INSET_RAD`](crate::JOINT_INSET_RAD) inside the joint limits and turned about its
-    /// TCP to [`CONE_INSET_DEG`](crate::CONE_INSET_DEG) inside the tool cone where it lies
-    /// closer to them (when the moved configuration holds every constraint). It is checked at
+    /// [`JOINT_INSET_RAD`](crate::JOINT_INSET_RAD) inside the joint limits, about its TCP to
+    /// [`CLEARANCE_INSET_M`](crate::CLEARANCE_INSET_M) clear of the arm's own links and to
+    /// [`CONE_INSET_DEG`](crate::CONE_INSET_DEG) inside the tool cone where it lies closer to
+    /// them (when the moved configuration holds every constraint). It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment, at the joints' turning points and at
     /// the tool angle's peaks; a segment that breaks a constraint gets back the middle waypoint
     /// it skipped, or, between consecutive waypoints, their chord midpoint moved likewise as a
@@ -92,14 +93,14 @@ impl SmoothPath {
             .filter(|k| k % KNOT_STRIDE == 0 || *k == last)
             .map(Some)
             .collect();
-        // A knot at an inner waypoint, moved inside the joint limits and the cone where that
-        // holds every constraint.
+        // A knot at an inner waypoint, moved inside the joint limits, clear of the links and
+        // inside the cone where that holds every constraint.
         let knot = |k: usize| {
             let q = waypoints[k];
             if k == 0 || k == last {
                 return q;
             }
-            inset(robot, task, constraints.theta_max_deg, &q)
+            inset(robot, task, constraints, &q)
                 .filter(|turned| *turned == q || valid(turned))
                 .unwrap_or(q)
         };
@@ -139,7 +140,7 @@ impl SmoothPath {
             }
             let midpoint = (midpoints < MAX_REFINEMENTS)
                 .then(|| (values[segment] + values[segment + 1]) / 2.0)
-                .and_then(|chord| inset(robot, task, constraints.theta_max_deg, &chord))
+                .and_then(|chord| inset(robot, task, constraints, &chord))
                 .filter(|q| valid(q));
             if let Some(midpoint) = midpoint {
                 knots.insert(segment + 1, (knots[segment] + knots[segment + 1]) / 2.0);
