@@ -167,6 +167,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          unseen tasks whose bound lies in each bucket (`cargo xtask search-eval`; \
          `docs/results/search.md` per budget):\n\n{shares}\n"
     );
+    let plan_times = crate::timing::plan_times_table(&args.results)?;
+    md += &format!(
+        "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
+         bound's note and the timed files, as `emg plan` computes them (`cargo xtask timing`; \
+         `docs/results/timing.md` per arm):\n\n{plan_times}\n"
+    );
     md += &crate::path_eval::report_section(&args.results)?;
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
@@ -176,7 +182,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             search_eval::README_END,
             &shares,
         )?;
-        println!("wrote the README's table of search shares");
+        workspace::replace_readme_section(
+            crate::timing::README_START,
+            crate::timing::README_END,
+            &plan_times,
+        )?;
+        println!("wrote the README's tables of search shares and of plan times");
     }
     Ok(())
 }

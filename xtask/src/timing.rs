@@ -12,13 +12,13 @@ use anyhow::Context;
 use emg_eval::{Summary, four};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind,
+    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind, SHIPPED_ROBOTS,
     limits_file_beside,
 };
 use emg_timing::Scaling;
 use plotters::prelude::*;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
@@ -72,7 +72,7 @@ struct Outcome {
 }
 
 /// The whole record written to `timing.json`.
-#[derive(Serialize)]
+#[derive(Serialize, Deserialize)]
 struct Record {
     robot: String,
     joint_limits: String,
@@ -261,6 +261,44 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         failures[0]
     );
     Ok(())
+}
+
+/// Markers of the README's table of `emg plan`'s time per task ([`plan_times_table`], written
+/// by `cargo xtask report`).
+pub const README_START: &str = "<!-- plan-times:start -->";
+/// The end marker of that table.
+pub const README_END: &str = "<!-- plan-times:end -->";
+
+/// For every shipped arm with a `timing.json` under `results` (the FR3's top-level, the others'
+/// in their sub-directories): the time of the whole `emg plan` per task (mean, median, 99th
+/// percentile, slowest), the timing's share of it (median) and the machine and threads it was
+/// measured with.
+pub fn plan_times_table(results: &Path) -> anyhow::Result<String> {
+    let mut md = String::from(
+        "| arm | tasks | mean ms | median ms | 99th percentile ms | slowest ms | timing alone, \
+         median ms | measured on |\n|---|---|---|---|---|---|---|---|\n",
+    );
+    for shipped in SHIPPED_ROBOTS {
+        let path = results.join(shipped.data_subdir()).join("timing.json");
+        if !path.exists() {
+            continue;
+        }
+        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
+            .with_context(|| format!("reading {}", path.display()))?;
+        md += &format!(
+            "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {}, {} threads busy |\n",
+            shipped.name,
+            record.task_count,
+            record.whole_plan_ms.mean,
+            record.whole_plan_ms_median,
+            record.whole_plan_ms_p99,
+            record.whole_plan_ms.max,
+            record.timing_ms_median,
+            record.machine,
+            record.threads,
+        );
+    }
+    Ok(md)
 }
 
 fn markdown(record: &Record) -> String {
