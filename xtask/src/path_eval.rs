@@ -499,13 +499,7 @@ fn markdown(record: &Record) -> String {
 pub fn report_section(results: &std::path::Path) -> anyhow::Result<String> {
     let mut rows = String::new();
     let mut lines = String::new();
-    for shipped in emg_planner::SHIPPED_ROBOTS {
-        let path = results.join(shipped.data_subdir()).join("paths.json");
-        if !path.exists() {
-            continue;
-        }
-        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
-            .with_context(|| format!("reading {}", path.display()))?;
+    for (shipped, record) in crate::report::shipped_results::<Record>(results, "paths.json")? {
         for row in &record.shapes {
             rows += &format!(
                 "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {} / {} / {} |\n",

@@ -102,6 +102,20 @@ pub(crate) fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
     serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }
 
+/// Every shipped arm with a result file `name` under `results` (the FR3's at the top, the
+/// others' in their sub-directories), with the typed record that file holds ([`read`]).
+pub(crate) fn shipped_results<T: DeserializeOwned>(
+    results: &Path,
+    name: &str,
+) -> anyhow::Result<Vec<(ShippedRobot, T)>> {
+    SHIPPED_ROBOTS
+        .into_iter()
+        .map(|shipped| (shipped, results.join(shipped.data_subdir()).join(name)))
+        .filter(|(_, path)| path.exists())
+        .map(|(shipped, path)| Ok((shipped, read(&path)?)))
+        .collect()
+}
+
 /// `mean / std / min / max` of one of the paper's entries.
 fn paper_four(values: &Four, decimals: usize) -> String {
     values

@@ -9,9 +9,7 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_control::CheckRollout;
 use emg_eval::{BoundShare, Summary, bound_shares, four};
-use emg_planner::{
-    PlanRequest, PlannerConfig, PlannerKind, SHIPPED_ROBOTS, SHORTFALL_SHARE, SearchConfig,
-};
+use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SHORTFALL_SHARE, SearchConfig};
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -278,18 +276,10 @@ pub fn shares_table(results: &Path) -> anyhow::Result<String> {
         "| arm | planner | < 0.5 m | 0.5 – 1 m | ≥ 1 m | all | below ½ bound | mean ms per plan |\n\
          |---|---|---|---|---|---|---|---|\n",
     );
-    for shipped in SHIPPED_ROBOTS {
-        let path = results.join(shipped.data_subdir()).join("search.json");
-        if !path.exists() {
-            continue;
-        }
-        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
-            .with_context(|| format!("reading {}", path.display()))?;
-        let cartesian = path.with_file_name("cartesian.json");
+    for (shipped, record) in crate::report::shipped_results::<Record>(results, "search.json")? {
+        let cartesian = results.join(shipped.data_subdir()).join("cartesian.json");
         if cartesian.exists() {
-            let baseline: crate::cartesian_eval::Record =
-                serde_json::from_str(&std::fs::read_to_string(&cartesian)?)
-                    .with_context(|| format!("reading {}", cartesian.display()))?;
+            let baseline: crate::cartesian_eval::Record = crate::report::read(&cartesian)?;
             md += &share_row(
                 shipped.name,
                 "MoveIt-style Cartesian path",

@@ -12,7 +12,7 @@ use anyhow::Context;
 use emg_eval::{Summary, four};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind, SHIPPED_ROBOTS,
+    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind,
     limits_file_beside,
 };
 use emg_timing::Scaling;
@@ -278,13 +278,7 @@ pub fn plan_times_table(results: &Path) -> anyhow::Result<String> {
         "| arm | tasks | mean ms | median ms | 99th percentile ms | slowest ms | timing alone, \
          median ms | measured on |\n|---|---|---|---|---|---|---|---|\n",
     );
-    for shipped in SHIPPED_ROBOTS {
-        let path = results.join(shipped.data_subdir()).join("timing.json");
-        if !path.exists() {
-            continue;
-        }
-        let record: Record = serde_json::from_str(&std::fs::read_to_string(&path)?)
-            .with_context(|| format!("reading {}", path.display()))?;
+    for (shipped, record) in crate::report::shipped_results::<Record>(results, "timing.json")? {
         md += &format!(
             "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {}, {} threads busy |\n",
             shipped.name,
