@@ -1,9 +1,9 @@
 //! The smooth joint path of a planned motion: a natural cubic spline through every
 //! [`KNOT_STRIDE`]-th waypoint (the controller's step-to-step jitter left out, so the joints'
 //! accelerations along the path stay low), each inner one moved a hair inside the joint limits,
-//! clear of the arm's own links and inside the tool cone ([`crate::inset`]), parametrised by the distance the TCP travels between
-//! waypoints, checked against every task constraint on a dense sampling and refined where it
-//! fails.
+//! clear of the arm's own links and inside the tool cone ([`crate::inset`]), parametrised by
+//! the distance the TCP travels between waypoints, checked against every task constraint on a
+//! dense sampling and refined where it fails.
 
 use emg_control::{ConstraintConfig, Task, Violation, first_violation};
 use emg_kinematics::{JointVector, Robot};
