@@ -29,7 +29,10 @@ pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };
-pub use path::{CHECKS_PER_SEGMENT, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M, SmoothPath};
+pub use path::{
+    CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M,
+    SmoothPath,
+};
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
     ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SAMPLES, MAX_SLOWDOWNS,
