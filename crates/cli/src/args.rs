@@ -96,8 +96,9 @@ pub struct CheckArgs {
     /// A task given on the command line instead of the file's.
     #[command(flatten)]
     pub line: TaskLineArgs,
-    /// JSON file as for `plan --config`: its `rollout.constraints` replace the file's.
-    #[arg(long, value_name = "JSON")]
+    /// As `plan --config` (a JSON file, or inline JSON starting with `{`): its
+    /// `rollout.constraints` replace the file's.
+    #[arg(long, value_name = "FILE|JSON")]
     pub config: Option<PathBuf>,
     /// Check a joint-trajectory file against these joint limits (MoveIt joint_limits.yaml,
     /// scaled by --velocity-scaling and --acceleration-scaling) instead of the file's own.
@@ -171,18 +172,19 @@ pub struct PlanArgs {
     pub path: Option<PathBuf>,
     /// Seed source: `dp` (the diffusion seeder), `generating` (the task's q0_seed), `home`
     /// (mid-range of the joint limits), `q_mu` / `q_jl` (heuristic ascents from q0_seed) or
-    /// `q=v1,...,v7` (radians). Default: `dp` when the --weights file exists, else `generating`
-    /// when the task has a q0_seed, else `home`.
+    /// `q=v1,...,vN` (radians, one per joint). Default: `dp` when the --weights file exists,
+    /// else `generating` when the task has a q0_seed, else `home`.
     #[arg(long, value_name = "SOURCE", value_parser = SeedSource::from_str, allow_hyphen_values = true)]
     pub seed: Option<SeedSource>,
     /// Diffusion-seeder weights for `--seed dp` (default: those shipped for a shipped robot).
     #[arg(long, value_name = "WEIGHTS")]
     pub weights: Option<PathBuf>,
-    /// Planner configuration (JSON): any of `rollout` (with `constraints`), `gains`, `switch`,
-    /// `measure`, `reach` and `search` (e.g. `{"search": {"budget_steps": 50000}}`); unset
-    /// fields keep their defaults (the work plate on). The schema is emg_planner's
-    /// PlannerConfig, documented in docs/ARCHITECTURE.md.
-    #[arg(long, value_name = "JSON")]
+    /// Planner configuration: a JSON file, or the JSON itself when the value starts with `{`
+    /// (e.g. `--config '{"search": {"budget_steps": 50000}}'`). Any of `rollout` (with
+    /// `constraints`), `gains`, `switch`, `measure`, `reach` and `search`; unset fields keep
+    /// their defaults (the work plate on). The schema is emg_planner's PlannerConfig,
+    /// documented in docs/ARCHITECTURE.md.
+    #[arg(long, value_name = "FILE|JSON")]
     pub config: Option<PathBuf>,
     /// Output path stem: writes STEM.json and STEM.csv (the planned path) and
     /// STEM.joint_trajectory.json (the motion timed rest to rest within the joint limits)
@@ -210,7 +212,8 @@ pub struct PlanArgs {
     pub policy: Option<PathBuf>,
     /// The part the line is drawn on, which the arm, all but the pen, keeps off: `plate` (a
     /// plate under the line, its top face in the plane through p0 with normal n: 0.2 m wide,
-    /// from 0.05 m behind p0 to 2 m beyond, 0.05 m thick; the config's
+    /// from 0.05 m behind p0 to 2 m beyond, or less where it would meet the arm's base, 0.05 m
+    /// thick; under a path it covers the path with those margins; the config's
     /// `rollout.constraints.work_surface` sets other sizes), `half-space` (everything beyond
     /// that plane) or `off` (the paper's protocol). Default: the --config file's
     /// `work_surface` when it sets one, else `plate`.

@@ -14,7 +14,7 @@ use emg_kinematics::{Robot, Vec3};
 use emg_verify::{JointDynamics, ReplayReport};
 
 use crate::args::CheckArgs;
-use emg_planner::{MotionTiming, PlannerConfig};
+use emg_planner::MotionTiming;
 
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
 pub fn run_check(args: &CheckArgs) -> Result<()> {
@@ -68,7 +68,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     };
     let (constraints, constraints_origin) = match (&args.config, &carried, &task_from) {
         (Some(path), _, _) => (
-            PlannerConfig::read(path)?.rollout.constraints,
+            crate::read_config(path)?.rollout.constraints,
             format!("--config {}", path.display()),
         ),
         (None, Some(c), _) => (c.constraints.clone(), "the file".to_string()),

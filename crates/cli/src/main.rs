@@ -8,8 +8,9 @@
 //! ```
 //!
 //! * Robot: `--robot fr3` (the default), `--robot iiwa14`, `--robot ur5e`, or `--robot <urdf>`
-//!   for any serial arm of six or seven revolute joints; the chain runs from the file's root link
-//!   to its only leaf unless `--base-link` and `--tip-link` name its ends. A shipped robot brings its own trained models.
+//!   for any serial arm of six or seven revolute joints; the chain runs from the file's only
+//!   root link to its only leaf unless `--base-link` or `--tip-link` names an end. A shipped
+//!   robot brings its own trained models.
 //! * Task: `--p0 x,y,z --d x,y,z --n x,y,z`, or `--task-file <file>` (JSON or the binary
 //!   `EMGTASKS` set, told apart by the content), or nothing for the demo task: from the
 //!   mid-range configuration, `p0` = its TCP, `n` = its tool axis, `d` = +y made ⟂ `n` (the
@@ -17,11 +18,13 @@
 //! * Seed: `--seed dp` (the diffusion seeder over `--weights`, default the robot's shipped
 //!   `diffusion-v1.weights`), `generating` (the task's `q0_seed`), `home` (the
 //!   mid-range configuration of the joint limits; the robot file carries no home pose),
-//!   `q_mu` / `q_jl` (heuristic ascents from `q0_seed`) or `q=v1,...,v7` (radians). Default: `dp` when the weights file exists, else `generating` when
-//!   the task has a `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
+//!   `q_mu` / `q_jl` (heuristic ascents from `q0_seed`) or `q=v1,...,vN` (radians, one per
+//!   joint). Default: `dp` when the weights file exists, else `generating` when the task has a
+//!   `q0_seed`, else `home`. A seed not already at `p0` with its tool axis in the
 //!   cone is Newton-projected onto the exact pose `(p0, n)`.
-//! * `--config <json>`: an `emg_planner::PlannerConfig`: optional `rollout`, `gains`, `switch`
-//!   (`tau_enter`, `tau_exit`) and `measure` objects; unset fields keep SPEC defaults.
+//! * `--config <file|json>`: an `emg_planner::PlannerConfig` (a file, or inline JSON starting
+//!   with `{`): optional `rollout`, `gains`, `switch` (`tau_enter`, `tau_exit`), `measure`,
+//!   `reach` and `search` objects; unset fields keep their defaults.
 //! * `--planner search` (default: `emg_planner`'s search: the pipeline's plan first, then many
 //!   candidate starts ranked by rollouts and detours repairing the longest, within a step
 //!   budget; never shorter than the pipeline's plan) or `controller` (the paper's pipeline, one
@@ -33,16 +36,20 @@
 //! * `--out <stem>` (default `trajectory`): `<stem>.json` + `<stem>.csv` +
 //!   `<stem>.joint_trajectory.json`; a task file with several tasks gives `<stem>-00000.json`,
 //!   ... and so on, each written as soon as its task is planned. Parent directories are created.
+//!   A run whose files would replace one of its inputs (robot, task, path, config, scene, limits,
+//!   model files) or one another is refused before anything is planned.
 //!   SIGINT (Ctrl-C) or SIGTERM lets the task being planned finish and write its files whole,
 //!   starts no further task, and exits with 128 + the signal number (130, 143).
 //! * `--reach on|off` (default on): also the task's reachability bound, how far along the line
 //!   the arm can be placed at all (`emg_planner::reach`), printed beside the path length and
 //!   recorded as `reachable_m`.
-//! * `--surface on|off` (default on): keep the arm, all but the pen, off the task's work
-//!   surface (the plane through `p0` with normal `n`, material where the pen points);
-//!   `--scene <json>`: obstacles (half-spaces, boxes, spheres, capsules, each with a clearance)
-//!   the whole arm keeps clear of (`docs/scene.md`). Both are constraints of every step, of the
-//!   search and of the checker, and are recorded in the written files.
+//! * `--surface plate|half-space|off` (default `plate`): the part the line is drawn on, which
+//!   the arm, all but the pen, keeps off: a plate under the line or path (its top face in the
+//!   plane through `p0` with normal `n`; on a path it covers the path with its margins, along a
+//!   line it ends where it would meet the arm's base), the whole half-space beyond that plane,
+//!   or none; `--scene <json>`: obstacles (half-spaces, boxes, spheres, capsules, each with a
+//!   clearance) the whole arm keeps clear of (`docs/scene.md`). Both are constraints of every
+//!   step, of the search and of the checker, and are recorded in the written files.
 //! * `--html <path>`: also a self-contained HTML page that animates the motion in 3D
 //!   (`<path without extension>-00000.html`, ... for several tasks).
 //!
@@ -61,6 +68,7 @@ mod check;
 mod import;
 mod interrupt;
 mod output;
+mod refusal;
 mod report;
 mod robot;
 mod tasks;
@@ -74,7 +82,7 @@ use emg_control::{Task, Trajectory};
 use emg_io::{PlanPaths, html_path};
 use emg_planner::{
     ControllerKind, Models, MotionTiming, Plan, PlanError, PlanFiles, PlanRecord, PlanRequest,
-    Planner, PlannerConfig, PlannerKind, SeedSource,
+    Planner, PlannerConfig, PlannerKind, SeedError, SeedSource,
 };
 
 use crate::args::{Cli, Command, OnOff, PlanArgs};
@@ -111,7 +119,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         args.tip_link.as_deref(),
     )?;
     let mut config = match &args.config {
-        Some(path) => PlannerConfig::read(path)?,
+        Some(config) => read_config(config)?,
         None => PlannerConfig::cell(),
     };
     if let Some(surface) = args.surface {
@@ -127,6 +135,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         policy_weights(args, controller)?.as_deref(),
     )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
+    refuse_overwriting_inputs(args, tasks.len())?;
     let timing = motion_timing(args, &robot, &config)?;
     let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
@@ -173,8 +182,31 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         } else {
             String::new()
         };
-        let plan = match planner.plan(task, &request) {
-            Ok(plan) => plan,
+        let task = match task {
+            Ok(task) => task,
+            Err(reason) => {
+                anyhow::ensure!(many, "refused, nothing written: {reason}");
+                eprintln!("{label}refused, nothing written: {reason}");
+                refused.push((index, reason.clone()));
+                continue;
+            }
+        };
+        let refuse = |violation: Option<&emg_control::Violation>| {
+            refusal::refusal(&planner, &args.robot, &request, task, violation)
+        };
+        let reason = match planner.plan(task, &request) {
+            Ok(plan) => match &plan.trajectory.termination {
+                emg_control::Termination::InvalidStart { violation } => {
+                    Err(refuse(Some(violation)))
+                }
+                _ => Ok(plan),
+            },
+            // The search found no configuration at p0 to start from.
+            Err(PlanError::Seed(SeedError::Projection { .. }))
+                if request.planner == PlannerKind::Search =>
+            {
+                Err(refuse(None))
+            }
             Err(error) if !many => return Err(plan_error(error, &request)),
             Err(error) => {
                 let error = plan_error(error, &request);
@@ -184,12 +216,15 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
                 continue;
             }
         };
-        if let Some(reason) = refusal(planner.robot(), &plan.trajectory) {
-            anyhow::ensure!(many, "refused, nothing written: {reason}");
-            eprintln!("{label}refused, nothing written: {reason}");
-            refused.push((index, reason));
-            continue;
-        }
+        let plan = match reason {
+            Ok(plan) => plan,
+            Err(reason) => {
+                anyhow::ensure!(many, "refused, nothing written: {reason}");
+                eprintln!("{label}refused, nothing written: {reason}");
+                refused.push((index, reason));
+                continue;
+            }
+        };
         let record = Record {
             request: &request,
             timing: &timing,
@@ -220,6 +255,66 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     Err(anyhow::anyhow!(summary))
 }
 
+/// The `--config` option: inline JSON when it starts with `{`, else a file.
+pub(crate) fn read_config(config: &Path) -> Result<PlannerConfig> {
+    match config.to_str().map(str::trim_start) {
+        Some(text) if text.starts_with('{') => Ok(PlannerConfig::from_json("--config", text)?),
+        _ => Ok(PlannerConfig::read(config)?),
+    }
+}
+
+/// Refuses, before anything is planned, a run whose files (`--out`'s, `--html`'s, for each of
+/// its `tasks` tasks) would replace one of its inputs or one another.
+fn refuse_overwriting_inputs(args: &PlanArgs, tasks: usize) -> Result<()> {
+    let robot_files = [
+        emg_kinematics::srdf_beside(&args.robot),
+        emg_planner::limits_file_beside(&args.robot),
+    ];
+    let config_file = args.config.as_deref().filter(|config| {
+        !config
+            .to_str()
+            .is_some_and(|t| t.trim_start().starts_with('{'))
+    });
+    let weights = args.weights_path();
+    let policy = args.policy_path();
+    let optional = [
+        ("--config", config_file),
+        ("--task-file", args.task_file.as_deref()),
+        ("--path", args.path.as_deref()),
+        ("--scene", args.scene.as_deref()),
+        ("--limits", args.limits.as_deref()),
+        ("--weights", weights.as_deref()),
+        ("--policy", policy.as_deref()),
+        ("robot's SRDF", Some(robot_files[0].as_path())),
+        ("robot's joint limits", Some(robot_files[1].as_path())),
+    ];
+    let mut inputs = vec![("--robot", args.robot.as_path())];
+    inputs.extend(
+        optional
+            .iter()
+            .filter_map(|(name, path)| Some((*name, (*path)?))),
+    );
+    let indices: Vec<Option<usize>> = match tasks {
+        1 => vec![None],
+        many => (0..many).map(Some).collect(),
+    };
+    let files: Vec<(PlanPaths, Option<std::path::PathBuf>)> = indices
+        .iter()
+        .map(|&index| {
+            let html = args.html.as_deref().map(|html| html_path(html, index));
+            (PlanPaths::new(&args.out, index), html)
+        })
+        .collect();
+    let mut outputs: Vec<(&str, &Path)> = Vec::with_capacity(4 * files.len());
+    for (paths, html) in &files {
+        for path in [&paths.json, &paths.csv, &paths.joint_trajectory] {
+            outputs.push(("--out", path));
+        }
+        outputs.extend(html.as_deref().map(|html| ("--html", html)));
+    }
+    Ok(emg_io::refuse_overwriting(&inputs, &outputs)?)
+}
+
 /// The controller: `--controller`, else hybrid when a policy is trained for the robot (given
 /// with --policy or shipped), else classical.
 fn controller(args: &PlanArgs) -> ControllerKind {
@@ -230,23 +325,6 @@ fn controller(args: &PlanArgs) -> ControllerKind {
             ControllerKind::Classical
         }
     })
-}
-
-/// Why a plan has no motion to execute, when its start was refused: the constraint the start
-/// breaks and what to try.
-fn refusal(robot: &emg_kinematics::Robot, trajectory: &Trajectory) -> Option<String> {
-    let emg_control::Termination::InvalidStart { violation } = &trajectory.termination else {
-        return None;
-    };
-    let hint = fixed_contact_hint(robot, trajectory);
-    let advice = if hint.is_empty() {
-        "; try another --seed, a task nearer the arm's mid-range, or --planner search"
-    } else {
-        ""
-    };
-    Some(format!(
-        "the start configuration breaks a constraint: {violation}{hint}{advice}"
-    ))
 }
 
 /// How the joint trajectories are timed: the limits file (`--limits`, else the one beside the
@@ -267,10 +345,19 @@ fn motion_timing(
         &config.rollout.constraints,
     )
     .map_err(|error| match error {
-        emg_planner::TimingSetupError::Request(e) => anyhow::anyhow!("{e}").context(format!(
-            "--tool-speed {tool_speed} / --rate-hz {}",
-            args.rate_hz
-        )),
+        emg_planner::TimingSetupError::Request(e) => {
+            let option = match &e {
+                emg_timing::TimingError::Request {
+                    field: "tool_speed_m_per_s",
+                    ..
+                } => format!("--tool-speed {tool_speed}"),
+                emg_timing::TimingError::Request {
+                    field: "rate_hz", ..
+                } => format!("--rate-hz {}", args.rate_hz),
+                _ => "the joint limits".to_string(),
+            };
+            anyhow::anyhow!("{e}").context(option)
+        }
         other => anyhow::Error::new(other),
     })
 }
@@ -291,12 +378,8 @@ fn plan_error(error: PlanError, request: &PlanRequest) -> anyhow::Error {
         PlanError::Controller(_) => format!("--controller {}", request.controller),
     };
     let hint = match (&error, request.planner) {
-        (PlanError::Seed(emg_planner::SeedError::Projection { .. }), PlannerKind::Controller) => {
-            " (try --planner search, which goes on from other starts, or another --seed)"
-        }
-        (PlanError::Seed(emg_planner::SeedError::Projection { .. }), PlannerKind::Search) => {
-            " (no configuration at p0 holds every constraint: move the part nearer the arm, or \
-             tilt n)"
+        (PlanError::Seed(SeedError::Projection { .. }), PlannerKind::Controller) => {
+            " (--planner search, the default, goes on from other starts)"
         }
         _ => "",
     };
@@ -372,6 +455,16 @@ fn write_plan(
         }
         _ => String::new(),
     };
+    let unreached = if timed.tool_speed_share < 0.005 && trajectory.path_length_m > 0.0 {
+        format!(
+            "\n  note: the joint limits never let the tool reach the requested {} m/s (--tool-speed): \
+             it moves as fast as they allow",
+            args.tool_speed
+                .unwrap_or(planner.config().rollout.speed_m_per_s)
+        )
+    } else {
+        String::new()
+    };
     let rests = match timed.rests_s.len() {
         0 => String::new(),
         1 => ", at rest at its corner".to_string(),
@@ -395,7 +488,7 @@ fn write_plan(
     };
     let (reachable, short) = match &bound {
         Some(bound) => (
-            format!(" of at most {:.2} m reachable", bound.reachable_m),
+            format!(" of at most {:.4} m reachable", bound.reachable_m),
             bound
                 .shortfall
                 .as_ref()
@@ -407,7 +500,7 @@ fn write_plan(
         "path length {:.4} m{reachable}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
          seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
-         requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}\n  \
+         requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}{unreached}\n  \
          wrote {}, {} and {}{viewer}",
         trajectory.path_length_m,
         trajectory.termination,
@@ -422,35 +515,6 @@ fn write_plan(
         paths.csv.display(),
         paths.joint_trajectory.display()
     ))
-}
-
-/// Why no plan can start, when the start was refused for a contact of a link that never moves
-/// (its capsules ride on the base): no configuration clears it, so the cell must change.
-fn fixed_contact_hint(robot: &emg_kinematics::Robot, trajectory: &Trajectory) -> String {
-    let emg_control::Termination::InvalidStart {
-        violation: emg_control::Violation::SceneContact { link, obstacle, .. },
-    } = &trajectory.termination
-    else {
-        return String::new();
-    };
-    let fixed = robot
-        .capsules()
-        .iter()
-        .filter(|c| &c.link == link)
-        .all(|c| c.segment == 0);
-    if !fixed {
-        return String::new();
-    }
-    let option = if obstacle == emg_control::WORK_SURFACE {
-        ", give the part's size (rollout.constraints.work_surface in --config), or plan with \
-         --surface off"
-    } else {
-        ""
-    };
-    format!(
-        "; the {obstacle} cuts {link}, which never moves: no configuration clears it; move the \
-         part or the base{option}"
-    )
 }
 
 /// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.

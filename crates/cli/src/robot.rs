@@ -61,6 +61,14 @@ pub fn load_checker(path: &Path, robot: &Robot) -> Result<ReferenceModel> {
         .with_context(|| format!("the checker cannot load robot {}", path.display()))
 }
 
+/// Whether `robot` is one of the shipped robots' files.
+pub fn is_shipped(robot: &Path) -> bool {
+    let data = data_dir();
+    SHIPPED_ROBOTS
+        .iter()
+        .any(|shipped| shipped.path(&data) == robot)
+}
+
 /// Model file `name` (e.g. `ppo-v1.weights`) shipped for the robot file `robot`, when that file
 /// is one of the shipped robots.
 pub fn shipped_model(robot: &Path, name: &str) -> Option<PathBuf> {

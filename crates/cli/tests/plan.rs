@@ -10,7 +10,7 @@ use emg_kinematics::{JointVector, Robot};
 use emg_verify::ReferenceModel;
 use serde_json::Value;
 
-use common::{NO_WEIGHTS, emg, read_json, task_json, temp_dir, text};
+use common::{NO_WEIGHTS, emg, read, read_json, task_json, temp_dir, text};
 
 fn stderr(output: &Output) -> String {
     text(&output.stderr)
@@ -601,7 +601,7 @@ fn an_unprojectable_seed_leaves_the_search_its_other_starts() {
     ];
     let error = plan_err(&[&line[..], &["--planner", "controller"]].concat());
     assert!(
-        error.contains("cannot project the home seed") && error.contains("try --planner search"),
+        error.contains("cannot project the home seed") && error.contains("--planner search"),
         "{error}"
     );
     assert_eq!(
@@ -613,4 +613,203 @@ fn an_unprojectable_seed_leaves_the_search_its_other_starts() {
     let doc = read_json(&tmp.path().join("up.json"));
     assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{out}");
     assert_ne!(doc["seed_source"], "home", "{out}");
+}
+
+/// Every kind of input a run reads, named by an output of the same run: refused before anything
+/// is planned, naming both, with the input unchanged and nothing written.
+#[test]
+fn no_output_replaces_an_input() {
+    let tmp = temp_dir("clash");
+    let dir = tmp.path();
+    let robot = Robot::from_urdf_file(common::fr3_path(), "link0", "pen_tip").unwrap();
+    let task = serde_json::to_string(&task_json(&robot, &robot.mid_range())).unwrap();
+    let path = r#"{"version": 1, "start": [0.5, -0.15, 0.2], "normal": [0, 0, -1],
+        "segments": [{"line": {"to": [0.5, 0.15, 0.2]}}]}"#;
+    let urdf = read(&common::fr3_path());
+    // (option, input file name, its contents, the options that name it as an output)
+    let cases: [(&str, &str, &str, &[&str]); 6] = [
+        ("--task-file", "job.json", &task, &["--out", "job"]),
+        ("--path", "slot.json", path, &["--out", "slot"]),
+        ("--config", "cfg.json", "{}", &["--out", "cfg"]),
+        (
+            "--scene",
+            "cell.json",
+            r#"{"obstacles": []}"#,
+            &["--out", "cell"],
+        ),
+        (
+            "--limits",
+            "limits.yaml",
+            "not read",
+            &["--html", "limits.yaml"],
+        ),
+        (
+            "--robot",
+            "robot.urdf",
+            &urdf,
+            &["--html", "./sub/../robot.urdf"],
+        ),
+    ];
+    for (option, name, contents, output) in cases {
+        let input = dir.join(name);
+        std::fs::write(&input, contents).unwrap();
+        let mut args = vec![option, input.to_str().unwrap()];
+        let named: Vec<String> = output
+            .chunks(2)
+            .flat_map(|pair| [pair[0].to_string(), dir.join(pair[1]).display().to_string()])
+            .collect();
+        args.extend(named.iter().map(String::as_str));
+        let error = plan_err(&args);
+        assert!(
+            error.contains(&format!("which is the {option} file"))
+                && error.contains(output[0])
+                && error.contains("nothing was written"),
+            "{option}: {error}"
+        );
+        assert_eq!(read(&input), contents, "{option}: the input is unchanged");
+        let written: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|entry| entry.unwrap().file_name().into_string().unwrap())
+            .filter(|file| file.ends_with(".csv") || file.ends_with(".html"))
+            .collect();
+        assert!(written.is_empty(), "{option}: wrote {written:?}");
+        std::fs::remove_file(&input).unwrap();
+    }
+}
+
+/// A task file plans every task it can: an unreachable task is refused and counted, the
+/// others are planned and written.
+#[test]
+fn a_task_file_plans_every_task_it_can() {
+    let tmp = temp_dir("partial");
+    let dir = tmp.path();
+    let robot = Robot::from_urdf_file(common::fr3_path(), "link0", "pen_tip").unwrap();
+    let valid = task_json(&robot, &robot.mid_range());
+    let unreachable = serde_json::json!({"p0": [3.0, 0.0, 0.2], "d": [0, 1, 0], "n": [0, 0, -1]});
+    let task_file = dir.join("tasks.json");
+    let tasks = serde_json::json!([valid, unreachable, valid]);
+    std::fs::write(&task_file, tasks.to_string()).unwrap();
+    let stem = dir.join("out/set");
+    let error = plan_err(&[
+        "--planner",
+        "controller",
+        "--task-file",
+        task_file.to_str().unwrap(),
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(
+        error.contains("2 of 3 tasks planned; 1 refused at their start, 0 failed")
+            && error.contains("task 1: ")
+            && error.contains("unreachable"),
+        "{error}"
+    );
+    assert!(dir.join("out/set-00000.json").is_file());
+    assert!(!dir.join("out/set-00001.json").exists());
+    assert!(dir.join("out/set-00002.json").is_file());
+}
+
+/// A start inside the arm's own base is refused saying so, and a refusal of the search never
+/// suggests the planner or the seed in use.
+#[test]
+fn a_start_no_configuration_can_hold_is_refused_with_its_cause() {
+    let tmp = temp_dir("inside");
+    let stem = tmp.path().join("inside");
+    let error = plan_err(&[
+        "--p0",
+        "0.0,0.02,0.2",
+        "--d",
+        "1,0,0",
+        "--n",
+        "0,0,-1",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(
+        error.contains("no configuration at p0 holds every constraint")
+            && error.contains("inside the space the arm's base occupies"),
+        "{error}"
+    );
+    assert!(
+        !error.contains("--planner") && !error.contains("--seed") && !error.contains("Newton"),
+        "{error}"
+    );
+    assert!(!tmp.path().join("inside.json").exists());
+}
+
+/// The default plate is a part: under a line heading at the arm it ends short of the arm's
+/// base, and under a circle it covers the circle only, whichever way the circle turns (the
+/// plate carried 2 m ahead of the start along the start tangent used to cut the base).
+#[test]
+fn the_default_plate_never_covers_the_arms_base() {
+    let tmp = temp_dir("plate");
+    let dir = tmp.path();
+    let toward = dir.join("toward");
+    plan_ok(&[
+        "--p0",
+        "0.4,0,0.2",
+        "--d",
+        "-1,0,0",
+        "--n",
+        "0,0,-1",
+        "--out",
+        toward.to_str().unwrap(),
+    ]);
+    let doc = read_json(&dir.join("toward.json"));
+    assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{doc}");
+    for sweep in [360, -360] {
+        let file = dir.join(format!("circle{sweep}.json"));
+        std::fs::write(
+            &file,
+            format!(
+                r#"{{"version": 1, "start": [0.5, 0.05, 0.2], "normal": [0, 0, -1],
+                "segments": [{{"arc": {{"centre": [0.5, -0.05, 0.2], "sweep_deg": {sweep}}}}}]}}"#
+            ),
+        )
+        .unwrap();
+        let stem = dir.join(format!("out/circle{sweep}"));
+        let out = plan_ok(&[
+            "--path",
+            file.to_str().unwrap(),
+            "--out",
+            stem.to_str().unwrap(),
+        ]);
+        assert!(
+            out.contains("reached the end of the path"),
+            "sweep {sweep}: {out}"
+        );
+        let check = emg(&[
+            "check",
+            &format!("{}.joint_trajectory.json", stem.display()),
+        ]);
+        assert!(check.status.success(), "sweep {sweep}: {}", stderr(&check));
+    }
+}
+
+/// First-hour inputs: a seed gives one value per joint, `--config` takes inline JSON, a bad
+/// rate is named as the rate, and a tool speed the joints never allow is said.
+#[test]
+fn first_hour_inputs_are_read_as_written() {
+    let tmp = temp_dir("first-hour");
+    let stem = tmp.path().join("x");
+    let out = ["--out", stem.to_str().unwrap()];
+    let error = plan_err(&[&["--robot", "ur5e", "--seed", "q=0,0,0,0,0,0,0"], &out[..]].concat());
+    assert!(
+        error.contains("gives 7 joint values, and the arm has 6 joints"),
+        "{error}"
+    );
+    let error = plan_err(&[&["--rate-hz", "0"], &out[..]].concat());
+    assert!(
+        error.contains("--rate-hz 0") && !error.contains("--tool-speed"),
+        "{error}"
+    );
+    let inline = r#"{"rollout": {"constraints": {"theta_max_deg": 20}}}"#;
+    plan_ok(&[&["--config", inline, "--reach", "off"], &out[..]].concat());
+    let doc = read_json(&tmp.path().join("x.json"));
+    assert_eq!(doc["config"]["constraints"]["theta_max_deg"], 20.0);
+    let fast = plan_ok(&[&["--tool-speed", "5", "--reach", "off"], &out[..]].concat());
+    assert!(
+        fast.contains("never let the tool reach the requested 5 m/s"),
+        "{fast}"
+    );
 }

@@ -32,6 +32,10 @@ pub struct Task {
     /// The path the tool follows, when it is not the straight line from `p0` along `d`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<Path>,
+    /// The space the arm's base occupies ([`Robot::base_column`]), where a line's plate ends:
+    /// derived from the robot whenever the task is validated, so not part of a task file.
+    #[serde(skip)]
+    base_column: Option<(Vec3, Vec3, f64)>,
 }
 
 /// Where the TCP stands along its task: how far it has come, which way the task goes on, and
@@ -163,6 +167,7 @@ impl Task {
             n,
             q0_seed,
             path: None,
+            base_column: robot.base_column(),
         })
     }
 
@@ -237,9 +242,15 @@ impl Task {
         }
     }
 
-    /// The work surface `surface` names, for this task: on a path task a plate grows to cover
-    /// the whole path, keeping its margins (half its width to each side of the path, `behind_m`
-    /// behind its rearmost point) and reaching at least as far ahead as it would along a line.
+    /// The work surface `surface` names, for this task. A plate is a part, and no part stands
+    /// where the arm's base does:
+    /// - on a path task it covers the path with its margins and no more: half its width to each
+    ///   side of the path, `behind_m` behind its rearmost point and as much beyond its foremost
+    ///   (`ahead_m` is a line's);
+    /// - on a line it reaches `ahead_m` beyond `p0`, or less: it ends where it would come
+    ///   within the arm's base column ([`Robot::base_column`]), which no configuration moves
+    ///   out of the way (tested with the plate's half-diagonal `√(half_width² + thickness²)`
+    ///   around the line; a line starting within it keeps the whole plate).
     pub fn work_surface(&self, surface: &WorkSurface) -> WorkSurface {
         match (surface, &self.path) {
             (WorkSurface::Plate(plate), Some(path)) => {
@@ -247,11 +258,42 @@ impl Task {
                 WorkSurface::Plate(Plate {
                     half_width_m: plate.half_width_m + extent.across_m,
                     behind_m: plate.behind_m + extent.behind_m,
-                    ahead_m: plate.ahead_m.max(extent.ahead_m + plate.half_width_m),
+                    ahead_m: extent.ahead_m + plate.behind_m,
                     thickness_m: plate.thickness_m,
                 })
             }
+            (WorkSurface::Plate(plate), None) => WorkSurface::Plate(Plate {
+                ahead_m: plate.ahead_m.min(self.base_clear_ahead_m(plate)),
+                ..*plate
+            }),
             _ => *surface,
+        }
+    }
+
+    /// Whether `p0` lies inside the space the arm's base occupies ([`Robot::base_column`]).
+    pub fn inside_base_column(&self) -> bool {
+        self.base_column.is_some_and(|(start, end, radius)| {
+            emg_kinematics::segment_distance(&self.p0, &self.p0, &start, &end) <= radius
+        })
+    }
+
+    /// How far along `d` a line's plate reaches before it would meet the base column
+    /// (unbounded when it never does, or when `p0` already lies within it).
+    fn base_clear_ahead_m(&self, plate: &Plate) -> f64 {
+        let Some((start, end, radius)) = &self.base_column else {
+            return f64::INFINITY;
+        };
+        let half_diagonal = plate.half_width_m.hypot(plate.thickness_m);
+        match emg_kinematics::capsule_ray_entry(
+            start,
+            end,
+            *radius,
+            half_diagonal,
+            &self.p0,
+            &self.d,
+        ) {
+            Some(s) if s > 0.0 => s,
+            _ => f64::INFINITY,
         }
     }
 

@@ -513,11 +513,21 @@ fn the_checker_refuses_a_path_rollout_checked_against_another_path_or_a_false_en
 }
 
 #[test]
-fn a_work_plate_grows_to_cover_a_path_and_stays_as_it_is_on_a_line() {
+fn a_work_plate_covers_a_path_with_its_margins_and_no_more() {
     use emg_kinematics::{Plate, WorkSurface};
     let (robot, task) = start();
     let plate = WorkSurface::Plate(Plate::default());
-    assert_eq!(task.work_surface(&plate), plate);
+    let WorkSurface::Plate(on_line) = task.work_surface(&plate) else {
+        panic!("a plate stays a plate");
+    };
+    assert_eq!(
+        Plate {
+            ahead_m: Plate::default().ahead_m,
+            ..on_line
+        },
+        Plate::default(),
+        "on a line only the plate's reach ahead may change"
+    );
     let (p, d, n) = (task.p0, task.d, task.n);
     let path = Path::new(rectangle(p, d, n, 0.3, 0.15, 0.0)).unwrap();
     let extent = path.extent();
@@ -530,7 +540,10 @@ fn a_work_plate_grows_to_cover_a_path_and_stays_as_it_is_on_a_line() {
     let default = Plate::default();
     assert!((grown.half_width_m - (default.half_width_m + 0.15)).abs() < 1e-12);
     assert!((grown.behind_m - default.behind_m).abs() < 1e-12);
-    assert_eq!(grown.ahead_m, default.ahead_m);
+    assert!(
+        (grown.ahead_m - (0.3 + default.behind_m)).abs() < 1e-12,
+        "the plate ends its margin beyond the path, not a line's reach beyond: {grown:?}"
+    );
     // A circle of radius 0.1 m whose start tangent is across `d`: it reaches 0.1 m behind its
     // start and 0.2 m to one side, in the frame of that tangent.
     let circle = spec(
@@ -549,6 +562,10 @@ fn a_work_plate_grows_to_cover_a_path_and_stays_as_it_is_on_a_line() {
     );
     assert!(
         (grown.half_width_m - (default.half_width_m + 0.2)).abs() < 1e-12,
+        "{grown:?}"
+    );
+    assert!(
+        (grown.ahead_m - (0.1 + default.behind_m)).abs() < 1e-12,
         "{grown:?}"
     );
 }

@@ -83,7 +83,7 @@ pub use joint_trajectory::{
 };
 pub use mesh::{MeshError, mesh_volume, read_mesh};
 pub use path_file::{PathFileError, parse_path, read_path};
-pub use paths::{PlanPaths, html_path};
+pub use paths::{OutputClash, PlanPaths, html_path, refuse_overwriting};
 pub use robot_import::{
     DisabledBecause, ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath,
     Pen, import_robot,
@@ -91,5 +91,6 @@ pub use robot_import::{
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};
 pub use task_file::{
-    TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_tasks, write_task_set,
+    TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_each_task, read_tasks,
+    write_task_set,
 };

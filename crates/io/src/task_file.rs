@@ -129,16 +129,36 @@ pub fn write_task_set(path: &Path, tasks: &[Task]) -> Result<(), TaskFileError> 
 /// `EMGTASKS` magic bytes, or JSON's opening `{` or `[`; the file name does not matter),
 /// validating every task against `robot`.
 pub fn read_tasks(path: &Path, robot: &Robot) -> Result<Vec<Task>, TaskFileError> {
+    read_each_task(path, robot)?.into_iter().collect()
+}
+
+/// Reads a task file as [`read_tasks`] does, but validates each task on its own: the file's
+/// own faults (unreadable, malformed) are the error, and each task is there or says why it is
+/// invalid, so the valid ones can be planned.
+pub fn read_each_task(
+    path: &Path,
+    robot: &Robot,
+) -> Result<Vec<Result<Task, TaskFileError>>, TaskFileError> {
     let bytes = std::fs::read(path).map_err(|source| TaskFileError::Io {
         path: path.display().to_string(),
         source,
     })?;
-    parse_tasks(&path.display().to_string(), &bytes, robot)
+    parse_each_task(&path.display().to_string(), &bytes, robot)
 }
 
 /// Parses the bytes of a task file (either layout, told apart by content as in
 /// [`read_tasks`]); `origin` names the bytes in errors.
 pub fn parse_tasks(origin: &str, bytes: &[u8], robot: &Robot) -> Result<Vec<Task>, TaskFileError> {
+    parse_each_task(origin, bytes, robot)?.into_iter().collect()
+}
+
+/// Parses the bytes of a task file as [`parse_tasks`] does, each task validated on its own
+/// ([`read_each_task`]).
+fn parse_each_task(
+    origin: &str,
+    bytes: &[u8],
+    robot: &Robot,
+) -> Result<Vec<Result<Task, TaskFileError>>, TaskFileError> {
     let name = origin.to_string();
     let first = bytes.iter().find(|b| !b.is_ascii_whitespace());
     let specs = if bytes.starts_with(MAGIC) {
@@ -161,7 +181,7 @@ pub fn parse_tasks(origin: &str, bytes: &[u8], robot: &Robot) -> Result<Vec<Task
                 .into(),
         });
     };
-    specs
+    Ok(specs
         .iter()
         .enumerate()
         .map(|(index, spec)| {
@@ -171,7 +191,7 @@ pub fn parse_tasks(origin: &str, bytes: &[u8], robot: &Robot) -> Result<Vec<Task
                 source,
             })
         })
-        .collect()
+        .collect())
 }
 
 fn parse_json(path: &str, bytes: &[u8]) -> Result<Vec<TaskSpec>, TaskFileError> {

@@ -59,6 +59,7 @@ pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
 pub use rotation::{rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
 pub use scene::{
     ContactHit, Obstacle, ObstacleError, Plate, Scene, Shape, ToolContact, WorkSurface,
+    capsule_ray_entry,
 };
 pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
 

@@ -527,6 +527,31 @@ impl Robot {
         self.limits.mid()
     }
 
+    /// The space the arm's base occupies whatever its configuration: a capsule along the first
+    /// joint's axis holding every capsule of the base link and of the body the first joint
+    /// turns, in every turn of that joint (the first body only spins about the axis, so no
+    /// configuration moves it out of the way). `(start, end, radius)` in the base frame; `None`
+    /// when those bodies carry no capsule.
+    pub fn base_column(&self) -> Option<(Vec3, Vec3, f64)> {
+        let kinematics = self.forward(&self.mid_range());
+        let origin = kinematics.joint_origin(0);
+        let axis = kinematics.joint_axis(0);
+        let mut heights = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut radius: f64 = 0.0;
+        for capsule in self.capsules.iter().filter(|c| c.segment <= 1) {
+            for local in [&capsule.start, &capsule.end] {
+                let offset = kinematics.segment_point(capsule.segment, local) - origin;
+                let height = offset.dot(&axis);
+                heights = (heights.0.min(height), heights.1.max(height));
+                radius = radius.max((offset - axis * height).norm() + capsule.radius);
+            }
+        }
+        heights
+            .0
+            .is_finite()
+            .then(|| (origin + axis * heights.0, origin + axis * heights.1, radius))
+    }
+
     /// A sphere (centre, radius) that contains every TCP position the arm can reach.
     pub fn reach_sphere(&self) -> (Vec3, f64) {
         (self.reach_centre, self.reach_radius)

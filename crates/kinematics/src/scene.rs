@@ -124,6 +124,53 @@ impl Shape {
     }
 }
 
+/// The first `s ≥ 0` at which the ray `origin + s·direction` (unit `direction`) comes
+/// within `inflation` of the capsule `start`–`end` of radius `radius` (the capsule grown by
+/// `inflation`): `Some(0)` when `origin` is already that near, `None` when the ray never
+/// is. Closed form: the first root over the two end spheres and the cylinder between them.
+pub fn capsule_ray_entry(
+    start: &Vec3,
+    end: &Vec3,
+    radius: f64,
+    inflation: f64,
+    origin: &Vec3,
+    direction: &Vec3,
+) -> Option<f64> {
+    let r = radius + inflation;
+    if segment_distance(origin, origin, start, end) <= r {
+        return Some(0.0);
+    }
+    // Smallest root s ≥ 0 of a·s² + 2b·s + c = 0 (c > 0: the origin is outside).
+    let first_root = |a: f64, b: f64, c: f64| {
+        let discriminant = b * b - a * c;
+        (a > 0.0 && discriminant >= 0.0)
+            .then(|| (-b - discriminant.sqrt()) / a)
+            .filter(|s| *s >= 0.0)
+    };
+    let sphere = |centre: &Vec3| {
+        let w = origin - centre;
+        first_root(1.0, direction.dot(&w), w.norm_squared() - r * r)
+    };
+    let axis = end - start;
+    let length = axis.norm();
+    let cylinder = (length > 0.0).then(|| {
+        let v = axis / length;
+        let w = origin - start;
+        let u_across = direction - v * direction.dot(&v);
+        let w_across = w - v * w.dot(&v);
+        first_root(
+            u_across.norm_squared(),
+            u_across.dot(&w_across),
+            w_across.norm_squared() - r * r,
+        )
+        .filter(|s| (0.0..=length).contains(&(w + direction * *s).dot(&v)))
+    });
+    [sphere(start), sphere(end), cylinder.flatten()]
+        .into_iter()
+        .flatten()
+        .reduce(f64::min)
+}
+
 /// Signed distance between the segment `a`–`b` and the box `|x_i| ≤ h_i` (all in the box's
 /// frame). Inside, the depth `min_i (h_i − |x_i|)` is the minimum of six functions linear along
 /// the segment, so its largest value lies at an end or where two of them cross; outside, the

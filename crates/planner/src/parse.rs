@@ -23,15 +23,27 @@ pub enum ParseError {
     Planner(String),
     /// Not the name of a seed source.
     #[error(
-        "unknown seed source '{0}': use dp, generating, home, q_mu, q_jl or q=v1,...,v7 (radians)"
+        "unknown seed source '{0}': use dp, generating, home, q_mu, q_jl or q=v1,...,vN (radians, \
+         one per joint)"
     )]
     Seed(String),
 }
 
-/// Parses exactly `N` comma-separated finite numbers (`x,y,z`, `v1,...,v7`).
-pub fn numbers<const N: usize>(s: &str) -> Result<[f64; N], ParseError> {
-    let values = s
-        .split(',')
+/// Parses one to `most` comma-separated finite numbers (`v1,...,vN`).
+pub fn number_list(s: &str, most: usize) -> Result<Vec<f64>, ParseError> {
+    let values = finite_numbers(s)?;
+    if values.len() > most {
+        return Err(ParseError::Count {
+            expected: most,
+            found: values.len(),
+        });
+    }
+    Ok(values)
+}
+
+/// Every comma-separated entry of `s` as a finite number.
+fn finite_numbers(s: &str) -> Result<Vec<f64>, ParseError> {
+    s.split(',')
         .map(|v| {
             let v = v.trim();
             match v.parse::<f64>() {
@@ -39,7 +51,12 @@ pub fn numbers<const N: usize>(s: &str) -> Result<[f64; N], ParseError> {
                 _ => Err(ParseError::NotFinite(v.to_string())),
             }
         })
-        .collect::<Result<Vec<f64>, ParseError>>()?;
+        .collect()
+}
+
+/// Parses exactly `N` comma-separated finite numbers (`x,y,z`).
+pub fn numbers<const N: usize>(s: &str) -> Result<[f64; N], ParseError> {
+    let values = finite_numbers(s)?;
     let found = values.len();
     values
         .try_into()

@@ -9,7 +9,10 @@ use crate::config::{ConfigError, PlannerConfig};
 use crate::controller::{ControllerKind, Executor, ExecutorError};
 use crate::models::Models;
 use crate::parse::ParseError;
-use crate::reach::{BoundNote, Reach, SHORTFALL_SHARE, far_end_chains, reach, shortfall};
+use crate::reach::{
+    BoundNote, Reach, SHORTFALL_SHARE, StartBlockers, far_end_chains, reach, shortfall,
+    start_blockers,
+};
 use crate::search::{SearchContext, search};
 use crate::seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed};
 
@@ -246,6 +249,17 @@ impl Planner {
             &self.config.rollout.constraints,
             &self.config.reach,
             &starts,
+        )
+    }
+
+    /// What keeps every configuration at `task`'s start from holding the configured
+    /// constraints ([`start_blockers`]): said when a task is refused at its start.
+    pub fn start_blockers(&self, task: &Task) -> StartBlockers {
+        start_blockers(
+            &self.robot,
+            task,
+            &self.config.rollout.constraints,
+            &self.config.reach,
         )
     }
 

@@ -465,6 +465,119 @@ impl Scan<'_> {
     }
 }
 
+/// What keeps every configuration at a task's start from holding the constraints: of the
+/// configurations the scan's IK finds at `p0` (the tool in its cone, the joints within their
+/// limits) from seeded random restarts, the contacts they break, worst clearance first within
+/// each kind.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StartBlockers {
+    /// Random restarts tried.
+    pub restarts: usize,
+    /// Configurations found at `p0` with the tool in its cone and the joints in their limits.
+    pub found: usize,
+    /// Each contact that blocks some of them (self-collision of two links, a link on an
+    /// obstacle or on the work surface), with how many it blocks and the deepest clearance
+    /// (m) among them; most frequent first.
+    pub contacts: Vec<StartContact>,
+}
+
+/// One contact that blocks configurations at a task's start ([`StartBlockers`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StartContact {
+    /// The violation of the configuration that breaks it deepest.
+    pub violation: emg_control::Violation,
+    /// How many of the configurations found break it first.
+    pub count: usize,
+}
+
+/// [`StartBlockers`] of `task`: `config.restarts` seeded random restarts of the scan's cone IK
+/// at `p0` (at least 64), each solution's first contact tallied by the links (and obstacle) it
+/// names. Deterministic for a given `config.seed`, whatever the number of threads.
+pub fn start_blockers(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    config: &ReachConfig,
+) -> StartBlockers {
+    let scan = Scan::new(robot, task, constraints, config);
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    let restarts = config.restarts.max(64);
+    let starts: Vec<JointVector> = (0..restarts)
+        .map(|_| random_configuration(robot, &mut rng))
+        .collect();
+    let solutions: Vec<Option<JointVector>> = starts
+        .par_iter()
+        .map(|start| solve_cone_ik(robot, start, &task.p0, &task.n, &scan.ik))
+        .collect();
+    let found: Vec<JointVector> = solutions.into_iter().flatten().collect();
+    let mut contacts: Vec<StartContact> = Vec::new();
+    for q in &found {
+        let Some(violation) = first_contact(robot, task, &robot.forward(q), constraints) else {
+            continue;
+        };
+        let same = |c: &&mut StartContact| same_contact(&c.violation, &violation);
+        match contacts.iter_mut().find(same) {
+            Some(contact) => {
+                contact.count += 1;
+                if clearance(&violation) < clearance(&contact.violation) {
+                    contact.violation = violation;
+                }
+            }
+            None => contacts.push(StartContact {
+                violation,
+                count: 1,
+            }),
+        }
+    }
+    contacts.sort_by(|a, b| b.count.cmp(&a.count));
+    StartBlockers {
+        restarts,
+        found: found.len(),
+        contacts,
+    }
+}
+
+/// Whether two contacts name the same links (and obstacle).
+fn same_contact(a: &emg_control::Violation, b: &emg_control::Violation) -> bool {
+    use emg_control::Violation::{SceneContact, SelfCollision};
+    match (a, b) {
+        (
+            SelfCollision {
+                first_link: a1,
+                second_link: a2,
+                ..
+            },
+            SelfCollision {
+                first_link: b1,
+                second_link: b2,
+                ..
+            },
+        ) => (a1, a2) == (b1, b2),
+        (
+            SceneContact {
+                link: a_link,
+                obstacle: a_obstacle,
+                ..
+            },
+            SceneContact {
+                link: b_link,
+                obstacle: b_obstacle,
+                ..
+            },
+        ) => (a_link, a_obstacle) == (b_link, b_obstacle),
+        _ => false,
+    }
+}
+
+/// The clearance (m) a contact reports.
+fn clearance(violation: &emg_control::Violation) -> f64 {
+    match violation {
+        emg_control::Violation::SelfCollision { clearance_m, .. }
+        | emg_control::Violation::SceneContact { clearance_m, .. } => *clearance_m,
+        _ => 0.0,
+    }
+}
+
 /// A configuration drawn uniformly within the joint limits, joint by joint in order.
 fn random_configuration(robot: &Robot, rng: &mut ChaCha8Rng) -> JointVector {
     let limits = robot.limits();

@@ -22,8 +22,9 @@ pub enum SeedSource {
     Generating,
     /// The mid-range configuration of the joint limits.
     Home,
-    /// A configuration given by the caller (rad).
-    Given(JointVector),
+    /// A configuration given by the caller (rad), one value per joint of the arm (checked when
+    /// the seed is prepared for a robot).
+    Given(Vec<f64>),
     /// Directional-manipulability ascent from `q0_seed` (`q_μ`, Sec. 5.1.3).
     QMu,
     /// Joint-centring ascent from `q0_seed` (`q_jl`, Sec. 5.1.3).
@@ -60,7 +61,7 @@ impl SeedSource {
 impl FromStr for SeedSource {
     type Err = ParseError;
 
-    /// `dp`, `generating`, `home`, `q_mu`, `q_jl` or `q=v1,...,v7` (radians).
+    /// `dp`, `generating`, `home`, `q_mu`, `q_jl` or `q=v1,...,vN` (radians, one per joint).
     fn from_str(s: &str) -> Result<Self, ParseError> {
         match s {
             "dp" => Ok(Self::Dp),
@@ -69,10 +70,7 @@ impl FromStr for SeedSource {
             "q_mu" => Ok(Self::QMu),
             "q_jl" => Ok(Self::QJl),
             _ => match s.strip_prefix("q=") {
-                Some(values) => {
-                    let q: [f64; MAX_DOF] = crate::parse::numbers(values)?;
-                    Ok(Self::Given(JointVector::from(q)))
-                }
+                Some(values) => Ok(Self::Given(crate::parse::number_list(values, MAX_DOF)?)),
                 None => Err(ParseError::Seed(s.to_string())),
             },
         }
@@ -135,9 +133,19 @@ pub enum SeedError {
     /// The source needs the task's `q0_seed`, which it does not have.
     #[error(
         "seed '{0}' needs the task's generating configuration (q0_seed), which this task does \
-         not have; use seed home or q=v1,...,v7"
+         not have; use seed home or q=v1,...,vN (one value per joint)"
     )]
     NoGeneratingConfiguration(&'static str),
+    /// A given seed whose number of values is not the arm's number of joints.
+    #[error(
+        "seed q= gives {given} joint values, and the arm has {joints} joints: give one per joint"
+    )]
+    GivenJoints {
+        /// Values given.
+        given: usize,
+        /// The arm's joints.
+        joints: usize,
+    },
     /// The seed cannot be put on the start pose.
     #[error("cannot project the {source_name} seed onto the task's start pose (p0, n)")]
     Projection {
@@ -189,7 +197,13 @@ pub fn prepare_seed(
         Some(SeedSource::Dp) => unreachable!("handled above"),
         Some(SeedSource::Generating) => (generating("generating")?, "generating"),
         Some(SeedSource::Home) => (robot.mid_range(), "home"),
-        Some(SeedSource::Given(q)) => (*q, "given"),
+        Some(SeedSource::Given(values)) if values.len() != robot.dof() => {
+            return Err(SeedError::GivenJoints {
+                given: values.len(),
+                joints: robot.dof(),
+            });
+        }
+        Some(SeedSource::Given(values)) => (robot.joint_vector(values), "given"),
         Some(source @ (SeedSource::QMu | SeedSource::QJl)) => {
             let q0 = generating(source.name())?;
             let objective = if *source == SeedSource::QMu {

@@ -88,7 +88,8 @@ impl Request {
                             planning.robot().dof()
                         ))
                     })?;
-                    SeedSource::Given(joint_vector(planning.robot(), &angles, "seed")?)
+                    let q = joint_vector(planning.robot(), &angles, "seed")?;
+                    SeedSource::Given(planning.robot().joints_of(&q).to_vec())
                 }
             }),
         };
