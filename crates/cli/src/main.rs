@@ -473,7 +473,6 @@ fn write_plan(
     let viewer = match &args.html {
         Some(html) => write_viewer(
             planner,
-            record.request.controller,
             task,
             trajectory,
             &html_path(html, index),
@@ -520,7 +519,6 @@ fn write_plan(
 /// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.
 fn write_viewer(
     planner: &Planner,
-    controller: ControllerKind,
     task: &Task,
     trajectory: &Trajectory,
     path: &Path,
@@ -529,7 +527,19 @@ fn write_viewer(
         .file_stem()
         .unwrap_or(path.as_os_str())
         .to_string_lossy();
-    let title = format!("{name}: {} controller", controller);
+    let acted: Vec<&str> = trajectory
+        .acting_controllers()
+        .into_iter()
+        .map(emg_control::ActingController::name)
+        .collect();
+    let title = match acted.as_slice() {
+        [] => format!("{name}: no step taken"),
+        [one] => format!("{name}: steps by the {one} controller"),
+        [first @ .., last] => format!(
+            "{name}: steps by the {} and {last} controllers",
+            first.join(", ")
+        ),
+    };
     let page = emg_viewer::render_html(&emg_viewer::ViewerInput {
         robot: planner.robot(),
         task,

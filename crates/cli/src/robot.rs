@@ -9,9 +9,27 @@ use emg_planner::{DataDir, SHIPPED_ROBOTS};
 use emg_verify::ReferenceModel;
 
 /// The shipped data: `$EMG_DATA` when set, else the `data/` directory of the workspace this
-/// binary was built in.
+/// binary was built in while it is there, else the copy compiled into the binary
+/// ([`emg_planner::embedded::extracted`]): an installed `emg` plans from anywhere.
 pub fn data_dir() -> DataDir {
-    DataDir::locate(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"))
+    static FOUND: std::sync::OnceLock<DataDir> = std::sync::OnceLock::new();
+    FOUND
+        .get_or_init(|| {
+            let checkout = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+            match std::env::var_os(DataDir::ENV) {
+                Some(dir) if !dir.is_empty() => DataDir::new(dir),
+                _ if checkout.join("robots").is_dir() => DataDir::new(checkout),
+                _ => emg_planner::embedded::extracted().unwrap_or_else(|error| {
+                    eprintln!(
+                        "warning: cannot write the shipped robots and models to the cache \
+                         directory ({error}); set XDG_CACHE_HOME to a writable directory, or \
+                         EMG_DATA to a copy of data/"
+                    );
+                    DataDir::new(checkout)
+                }),
+            }
+        })
+        .clone()
 }
 
 /// The FR3's robot file, the default robot.

@@ -89,6 +89,20 @@ pub struct Trajectory {
     pub path_length_m: f64,
 }
 
+impl Trajectory {
+    /// The controllers that computed its steps' commands, each once, in the order they first
+    /// acted.
+    pub fn acting_controllers(&self) -> Vec<ActingController> {
+        let mut acted = Vec::new();
+        for controller in self.steps.iter().filter_map(|step| step.controller) {
+            if !acted.contains(&controller) {
+                acted.push(controller);
+            }
+        }
+        acted
+    }
+}
+
 /// What one applied step did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum StepOutcome {

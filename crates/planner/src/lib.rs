@@ -34,6 +34,7 @@ mod cartesian;
 mod config;
 mod controller;
 mod demo;
+pub mod embedded;
 mod far_end;
 mod files;
 mod models;

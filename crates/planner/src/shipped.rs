@@ -20,15 +20,6 @@ impl DataDir {
         Self(path.into())
     }
 
-    /// `$EMG_DATA` when it is set (and not empty), else `default` (a binary passes the `data/`
-    /// directory next to its workspace).
-    pub fn locate(default: impl Into<PathBuf>) -> Self {
-        match std::env::var_os(Self::ENV) {
-            Some(dir) if !dir.is_empty() => Self::new(dir),
-            _ => Self::new(default),
-        }
-    }
-
     /// The directory itself.
     pub fn path(&self) -> &Path {
         &self.0

@@ -276,3 +276,62 @@ fn the_bound_does_not_depend_on_the_thread_count() {
     assert!(one.iter().all(|reach| reach.reachable_p0));
     assert_eq!(one, scan(3));
 }
+
+/// How many of the configurations the scan's IK finds at `task`'s start hold every constraint
+/// of `planner` ([`Planner::start_blockers`]: the same seeded IK solutions whatever the plate).
+fn valid_starts(planner: &Planner, task: &Task) -> usize {
+    let blockers = planner.start_blockers(task);
+    blockers.found - blockers.contacts.iter().map(|c| c.count).sum::<usize>()
+}
+
+/// The default plate is a part: on lines heading every way from points around the FR3 (eight
+/// headings and the one straight at its base) and on the path population, no task is refused
+/// at its start over the default plate unless it is over a plate of exactly its own extent too
+/// (no margins: a line's start point, a path's extent).
+#[test]
+fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allows() {
+    use emg_kinematics::{Plate, WorkSurface};
+    let default = planner()
+        .with_config(PlannerConfig::cell())
+        .expect("the cell's config");
+    let mut own = PlannerConfig::cell();
+    own.rollout.constraints.work_surface = WorkSurface::Plate(Plate {
+        half_width_m: 0.0,
+        behind_m: 0.0,
+        ahead_m: 0.0,
+        thickness_m: Plate::default().thickness_m,
+    });
+    let own = default.with_config(own).expect("a plate of the task's extent");
+    let robot = default.robot();
+    let mut tasks = Vec::new();
+    for (x, y) in [(0.3, 0.2), (0.3, -0.2), (0.5, 0.0), (0.2, 0.25)] {
+        let p0 = Vec3::new(x, y, 0.2);
+        let at_base = Vec3::new(-x, -y, 0.0).normalize();
+        let headings = (0..8).map(|k| {
+            let (sin, cos) = (f64::from(k) * std::f64::consts::FRAC_PI_4).sin_cos();
+            Vec3::new(cos, sin, 0.0)
+        });
+        for d in headings.chain([at_base]) {
+            tasks.extend(Task::new(robot, p0, d, -Vec3::z(), None).ok());
+        }
+    }
+    let anchors: Vec<Task> = eval_tasks(robot).into_iter().take(30).collect();
+    let paths = emg_control::path_tasks(robot, &anchors, 7).expect("the path population");
+    tasks.extend(paths.into_iter().map(|(_, task)| task));
+    let mut refused = 0;
+    for (index, task) in tasks.iter().enumerate() {
+        let over_default = valid_starts(&default, task);
+        let over_own = valid_starts(&own, task);
+        if over_default == 0 {
+            refused += 1;
+            assert_eq!(
+                over_own, 0,
+                "task {index} ({:?} along {:?}) is refused over the default plate alone: {:?}",
+                task.p0,
+                task.d,
+                default.start_blockers(task).contacts
+            );
+        }
+    }
+    assert!(refused < tasks.len() / 4, "{refused} of {} refused", tasks.len());
+}

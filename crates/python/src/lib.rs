@@ -15,7 +15,6 @@
 //! planned, [`CheckFailed`] when a file does not hold up; failed file writes raise `OSError`.
 
 mod check;
-mod embedded;
 mod planner;
 mod robot;
 mod timing;
@@ -53,11 +52,11 @@ create_exception!(
 );
 
 /// The shipped data: `$EMG_DATA` when set, else the copy compiled into the module
-/// ([`embedded::extracted`]), so an installed wheel needs no checkout.
+/// ([`emg_planner::embedded::extracted`]), so an installed wheel needs no checkout.
 fn data_dir() -> PyResult<DataDir> {
     match std::env::var_os(DataDir::ENV) {
         Some(dir) if !dir.is_empty() => Ok(DataDir::new(dir)),
-        _ => embedded::extracted().map_err(|e| {
+        _ => emg_planner::embedded::extracted().map_err(|e| {
             PyOSError::new_err(format!(
                 "cannot write the shipped robots and models to the cache directory: {e} (set \
                  XDG_CACHE_HOME to a writable directory, or EMG_DATA to a copy of data/)"

@@ -11,7 +11,7 @@ import extreme_line_motion as elm
 
 SCRIPT = """
 import extreme_line_motion as elm
-for robot in ("fr3", "iiwa14"):
+for robot in ("fr3", "iiwa14", "ur5e"):
     assert elm.Planner(robot).models == {"diffusion": True, "policy": True}, robot
 plan = elm.Planner("fr3").plan(p0=[0.45, -0.2, 0.25], d=[0, 1, 0], n=[0, 0, -1])
 print(repr(plan.path_length_m))

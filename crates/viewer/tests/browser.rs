@@ -1,9 +1,10 @@
 //! The viewer page in a real browser: headless Chromium draws a planned FR3 motion, and the
 //! screenshot, the page's render status and the browser console are checked.
 //!
-//! The browser is `$EMG_CHROMIUM`, else `chromium` or `chromium-browser` on `PATH`. Without one
-//! these tests print a notice and pass, unless `EMG_REQUIRE_BROWSER=1` (as in CI), where they
-//! fail.
+//! The browser is `$EMG_CHROMIUM`, else `chromium` or `chromium-browser` on `PATH`. The tests
+//! that need it are ignored (with that reason) unless run with `cargo test -- --include-ignored`,
+//! as `.ci/run` does after installing Chromium; so run, without one they print a notice and
+//! pass, unless `EMG_REQUIRE_BROWSER=1` (as in CI), where they fail.
 
 use std::collections::HashSet;
 use std::io::{BufReader, Read as _};
@@ -304,6 +305,7 @@ fn the_planned_motion_has_many_steps() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn screenshot_shows_the_arm() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("screenshot");
@@ -337,6 +339,7 @@ fn cell_page() -> (Trajectory, String) {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn the_cell_is_drawn() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("cell");
@@ -370,6 +373,7 @@ fn the_cell_is_drawn() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn screenshot_check_fails_when_the_page_draws_nothing() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("screenshot-blank");
@@ -391,6 +395,7 @@ fn without_steps(page: &str) -> String {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn page_reports_rendered_with_a_silent_console() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom");
@@ -403,6 +408,7 @@ fn page_reports_rendered_with_a_silent_console() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn status_check_catches_an_error_in_the_viewer_script() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom-broken-data");
@@ -422,6 +428,7 @@ fn status_check_catches_an_error_in_the_viewer_script() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn console_check_catches_errors_thrown_after_the_first_frame() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom-late-error");
@@ -451,6 +458,7 @@ fn console_check_catches_errors_thrown_after_the_first_frame() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn controls_scrub_orbit_and_zoom_without_errors() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom-controls");
@@ -508,6 +516,7 @@ fn controls_scrub_orbit_and_zoom_without_errors() {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn a_motion_of_only_the_seed_renders() {
     let Some(browser) = browser() else { return };
     let tmp = temp_dir("dom-seed-only");
@@ -571,6 +580,7 @@ fn circle_page() -> (Trajectory, String) {
 }
 
 #[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
 fn a_path_task_draws_its_path() {
     let (trajectory, page) = circle_page();
     assert_eq!(trajectory.termination, emg_control::Termination::Completed);

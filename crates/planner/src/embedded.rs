@@ -1,12 +1,12 @@
-//! The shipped data inside the extension: the shipped robots' files, joint limits and trained
-//! models are compiled in, so a wheel plans wherever it is copied, without the checkout it was
-//! built from. On first use they are written to a directory of the user's cache named by the
+//! The shipped data inside every binary that links the planner: the shipped robots' files,
+//! joint limits and trained models are compiled in, so an installed `emg` or a wheel plans
+//! wherever it is copied, without the checkout it was built from. On first use they are written to a directory of the user's cache named by the
 //! package version and a hash of the contents (each file written whole, so processes that start
 //! at once agree), and planned from there like any data directory.
 
 use std::path::PathBuf;
 
-use emg_planner::DataDir;
+use crate::DataDir;
 
 /// `(path, contents)` of the file at `path` in the workspace's `data/` directory.
 macro_rules! shipped {
@@ -28,6 +28,10 @@ const FILES: &[(&str, &[u8])] = &[
     shipped!("models/ppo-v1.weights"),
     shipped!("iiwa14/models/diffusion-v1.weights"),
     shipped!("iiwa14/models/ppo-v1.weights"),
+    shipped!("robots/ur5e_pen.urdf"),
+    shipped!("robots/ur5e_pen.joint_limits.yaml"),
+    shipped!("ur5e/models/diffusion-v1.weights"),
+    shipped!("ur5e/models/ppo-v1.weights"),
 ];
 
 /// The directory holding the compiled-in data, written there on first use:
