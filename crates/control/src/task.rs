@@ -283,7 +283,7 @@ impl Task {
         let Some((start, end, radius)) = &self.base_column else {
             return f64::INFINITY;
         };
-        let half_diagonal = plate.half_width_m.hypot(plate.thickness_m);
+        let half_diagonal = libm::hypot(plate.half_width_m, plate.thickness_m);
         match emg_kinematics::capsule_ray_entry(
             start,
             end,

@@ -308,7 +308,7 @@ fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allow
         let p0 = Vec3::new(x, y, 0.2);
         let at_base = Vec3::new(-x, -y, 0.0).normalize();
         let headings = (0..8).map(|k| {
-            let (sin, cos) = (f64::from(k) * std::f64::consts::FRAC_PI_4).sin_cos();
+            let (sin, cos) = libm::sincos(f64::from(k) * std::f64::consts::FRAC_PI_4);
             Vec3::new(cos, sin, 0.0)
         });
         for d in headings.chain([at_base]) {
@@ -334,4 +334,66 @@ fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allow
         }
     }
     assert!(refused < tasks.len() / 4, "{refused} of {} refused", tasks.len());
+}
+
+/// The bound counts a grid point as reachable when a point of the tolerance disc around it has
+/// a valid configuration: on a line whose exact points are blocked over a stretch (a rod of
+/// 3 mm radius lying on it, which the whole arm, pen included, keeps clear of), and that a
+/// 1 cm lateral offset clears, the bound goes on past the stretch, its witnesses there off the
+/// line by more than the rod's radius and within the tolerance; and no plan reads above it.
+#[test]
+fn the_bound_reaches_past_a_stretch_only_the_tolerance_disc_clears() {
+    use emg_kinematics::{Obstacle, Shape};
+    let task_line = |robot: &Robot| {
+        Task::new(
+            robot,
+            Vec3::new(0.45, -0.2, 0.25),
+            Vec3::y(),
+            -Vec3::z(),
+            None,
+        )
+        .expect("the README's line")
+    };
+    let (from_m, to_m, radius_m) = (0.25, 0.35, 0.003);
+    let mut config = PlannerConfig::default();
+    let rod = {
+        let robot = planner();
+        let task = task_line(robot.robot());
+        Shape::Capsule {
+            start: task.point_at(from_m),
+            end: task.point_at(to_m),
+            radius: radius_m,
+        }
+    };
+    config.rollout.constraints.scene.obstacles.push(Obstacle {
+        name: "rod".to_string(),
+        shape: rod.clone(),
+        clearance_m: 0.0,
+    });
+    let planner = planner().with_config(config).expect("a scene with a rod");
+    let robot = planner.robot();
+    let task = task_line(robot);
+    let reach = planner.reach(&task, &[]);
+    assert!(
+        reach.reachable_m > to_m + 0.1,
+        "the bound stops at the rod: {} m",
+        reach.reachable_m
+    );
+    let tolerance = planner.config().rollout.constraints.line_tolerance_m;
+    for (k, q) in reach.witnesses.iter().enumerate() {
+        let s = k as f64 * reach.grid_m;
+        let tcp = robot.forward(q).tcp();
+        let off_line = task.lateral_error(&tcp).norm();
+        assert!(off_line <= tolerance, "witness {k} is {off_line} m off the line");
+        if (from_m..=to_m).contains(&s) {
+            assert!(off_line > radius_m, "witness {k} at {s} m stands on the rod");
+        }
+    }
+    let request = PlanRequest {
+        planner: emg_planner::PlannerKind::Search,
+        seed: Some(SeedSource::Home),
+        controller: ControllerKind::Classical,
+    };
+    let plan = planner.plan(&task, &request).expect("the search plans");
+    assert!(plan.reach.expect("the search's bound").reachable_m >= plan.trajectory.path_length_m);
 }
