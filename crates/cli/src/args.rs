@@ -50,15 +50,18 @@ pub struct ImportArgs {
     /// below DIR whose package.xml names NAME), or NAME=DIR for one package. Repeatable.
     #[arg(long, value_name = "DIR|NAME=DIR")]
     pub package_path: Vec<emg_io::PackagePath>,
-    /// The link the pen attaches to, along its z axis (default: the file's only leaf link).
+    /// The link the pen attaches to, along its z axis (default: the file's only leaf link; of
+    /// several, `tool0`, else `flange`, as REP 199 names them).
     #[arg(long)]
     pub tool_link: Option<String>,
     /// The chain's base link, checked to reach the pen (default: the file's only root link).
     #[arg(long)]
     pub base_link: Option<String>,
-    /// Pen length from the tool link's origin to the tip (m).
-    #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().length_m)]
-    pub pen_length: f64,
+    /// Pen length from the tool link's origin to the tip (m) (default: 0.1 m beyond the tool's
+    /// collision geometry along its z axis, the links fixed to it included; 0.1 m when none lies
+    /// ahead of its origin).
+    #[arg(long, value_name = "M")]
+    pub pen_length: Option<f64>,
     /// Pen radius (m).
     #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().radius_m)]
     pub pen_radius: f64,

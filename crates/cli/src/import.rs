@@ -2,7 +2,10 @@
 //! a capsule URDF with a pen, and a report of what was fitted.
 
 use anyhow::{Context, Result};
-use emg_io::{DisabledBecause, ImportOptions, ImportedRobot, PEN_LINK, Pen, import_robot};
+use emg_io::{
+    DisabledBecause, ImportOptions, ImportedRobot, PEN_LINK, PEN_PROTRUSION_M,
+    PEN_REACH_TOLERANCE_M, Pen, ToolLinkChoice, import_robot,
+};
 use emg_kinematics::{PairRule, Robot, srdf_beside};
 
 use crate::args::ImportArgs;
@@ -15,10 +18,8 @@ pub fn run_import(args: &ImportArgs) -> Result<()> {
         package_paths: args.package_path.clone(),
         tool_link: args.tool_link.clone(),
         base_link: args.base_link.clone(),
-        pen: Pen {
-            length_m: args.pen_length,
-            radius_m: args.pen_radius,
-        },
+        pen_length_m: args.pen_length,
+        pen_radius_m: args.pen_radius,
         max_capsules_per_link: usize::from(args.max_capsules),
         srdf: args.srdf.clone(),
     };
@@ -42,6 +43,9 @@ pub fn run_import(args: &ImportArgs) -> Result<()> {
     write_text(&srdf, &imported.srdf)?;
     write_text(&limits, &joint_limits_yaml(&args.file, &robot))?;
     println!("{}", report(&imported, &robot));
+    if let Some(warning) = pen_warning(&imported) {
+        eprintln!("warning: {warning}");
+    }
     println!(
         "wrote {}, {} and {} (velocities from the vendor file, acceleration and jerk limits \
          assumed: replace them with the vendor's values); plan with: emg plan --robot {}",
@@ -69,9 +73,101 @@ fn joint_limits_yaml(vendor: &std::path::Path, robot: &Robot) -> String {
     emg_timing::DynamicLimits::assumed(robot).to_yaml(robot, &header)
 }
 
-/// The fit report: per link, what it held, the capsules and their volume against it.
+/// Where the tool's collision geometry ends along the pen axis, in words.
+fn reach_words(imported: &ImportedRobot) -> String {
+    let reach = &imported.tool_reach;
+    let quoted: Vec<String> = reach.links.iter().map(|l| format!("'{l}'")).collect();
+    let links = match quoted.as_slice() {
+        [only] => only.clone(),
+        [tool, rest @ ..] => format!(
+            "{tool} and what is fixed or merged to it ({})",
+            rest.join(", ")
+        ),
+        [] => String::new(),
+    };
+    let ahead = |z: f64| {
+        let side = if z < 0.0 { "behind" } else { "ahead of" };
+        format!("{:.4} m {side}", z.abs())
+    };
+    if reach.reach_m.is_finite() {
+        format!(
+            "the collision geometry of {links} ends {} '{}''s origin along its z axis, its \
+             capsules {} it",
+            ahead(reach.reach_m),
+            imported.tool_link,
+            ahead(reach.capsule_reach_m)
+        )
+    } else {
+        format!("{links} hold no collision geometry")
+    }
+}
+
+/// The warning when the pen's tip does not reach beyond the tool's own geometry (a given
+/// length), or beyond the capsules fitted to it (any length).
+fn pen_warning(imported: &ImportedRobot) -> Option<String> {
+    let reach = &imported.tool_reach;
+    let tip = format!(
+        "the pen's tip ({:.4} m from '{}''s origin{})",
+        imported.pen.length_m,
+        imported.tool_link,
+        if imported.pen_length_given {
+            ", --pen-length"
+        } else {
+            ""
+        }
+    );
+    if !imported.pen_protrudes() {
+        Some(format!(
+            "{tip} does not protrude beyond the tool's collision geometry: {}, so the tool \
+             touches the work surface before the tip; a pen longer than {:.4} m clears it and the \
+             capsules fitted to it, e.g. --pen-length {:.3} (the default, {PEN_PROTRUSION_M} m \
+             beyond it)",
+            reach_words(imported),
+            reach.reach_m.max(reach.capsule_reach_m),
+            Pen::default_length_m(reach.reach_m)
+        ))
+    } else if !imported.pen_clears_capsules() {
+        Some(format!(
+            "{tip} protrudes beyond the tool's collision geometry but not beyond the capsules \
+             fitted to it, which the planners and the checker test against the work surface: \
+             {}; a pen longer than {:.4} m clears them",
+            reach_words(imported),
+            reach.capsule_reach_m
+        ))
+    } else {
+        None
+    }
+}
+
+/// The fit report: how the tool link and the pen were chosen; per link, what it held, the
+/// capsules and their volume against it.
 fn report(imported: &ImportedRobot, robot: &Robot) -> String {
-    let mut text = format!(
+    let mut text = String::new();
+    if let ToolLinkChoice::Rep199 { leaves } = &imported.tool_link_choice {
+        text += &format!(
+            "tool link '{}': of the leaf links [{}], the tool frame REP 199 names (tool0, else \
+             flange); name another with --tool-link\n",
+            imported.tool_link,
+            leaves.join(", ")
+        );
+    }
+    let reach = reach_words(imported);
+    let why = if imported.pen_length_given {
+        format!("--pen-length; {reach}")
+    } else if imported.tool_reach.reach_m >= PEN_REACH_TOLERANCE_M {
+        format!("the default: {PEN_PROTRUSION_M} m beyond the tool's geometry; {reach}")
+    } else {
+        format!(
+            "the default: nothing of the tool lies more than {} mm ahead of its origin; {reach}",
+            PEN_REACH_TOLERANCE_M * 1e3
+        )
+    };
+    text += &format!(
+        "pen: {:.3} m from '{}''s origin along its z axis to the tip '{PEN_LINK}', radius {} m \
+         ({why})\n",
+        imported.pen.length_m, imported.tool_link, imported.pen.radius_m
+    );
+    text += &format!(
         "fitted capsules (pen of {} attached to '{}'; ratio = capsule volume / element volume):\n",
         PEN_LINK, imported.tool_link
     );

@@ -474,7 +474,7 @@ fn write_plan(
         Some(html) => write_viewer(
             planner,
             task,
-            trajectory,
+            &played_as_timed(trajectory, &files.step_times_s),
             &html_path(html, index),
         )?,
         None => String::new(),
@@ -514,6 +514,16 @@ fn write_plan(
         paths.csv.display(),
         paths.joint_trajectory.display()
     ))
+}
+
+/// `trajectory` with each step at the time the timed motion passes it: the viewer plays the
+/// motion the robot executes, at rest where it starts and ends.
+fn played_as_timed(trajectory: &Trajectory, step_times_s: &[f64]) -> Trajectory {
+    let mut played = trajectory.clone();
+    for (step, time_s) in played.steps.iter_mut().zip(step_times_s) {
+        step.time_s = *time_s;
+    }
+    played
 }
 
 /// Writes the `--html` viewer page of one planned task to `path`; returns the line to print.

@@ -135,3 +135,53 @@ fn fixed_contact_hint(robot: &Robot, violation: &Violation) -> String {
          part or the base{option}"
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fr3() -> Robot {
+        crate::robot::load_robot(&crate::robot::default_robot(), None, None).unwrap()
+    }
+
+    #[test]
+    fn an_imported_arms_self_collision_is_said_to_be_its_capsules() {
+        let robot = fr3();
+        let overlap = Violation::SelfCollision {
+            first_link: "shoulder_link".into(),
+            second_link: "forearm_link".into(),
+            clearance_m: -0.01175,
+        };
+        let imported = advice(&robot, Path::new("imported/ur10.urdf"), &overlap);
+        assert!(
+            imported.contains("capsules of shoulder_link and forearm_link overlap by 11.75 mm")
+                && imported.contains("--max-capsules")
+                && imported.contains("meshes may be clear"),
+            "{imported}"
+        );
+        let shipped = advice(&robot, &crate::robot::default_robot(), &overlap);
+        assert!(!shipped.contains("capsules"), "{shipped}");
+        for text in [imported, shipped] {
+            assert!(
+                !text.contains("--seed") && !text.contains("--planner"),
+                "{text}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_contact_of_a_link_that_never_moves_asks_for_the_cell_to_change() {
+        let robot = fr3();
+        let fixed = robot.capsules().iter().find(|c| c.segment == 0).unwrap();
+        let contact = Violation::SceneContact {
+            link: fixed.link.clone(),
+            obstacle: WORK_SURFACE.into(),
+            clearance_m: -0.01,
+        };
+        let text = advice(&robot, &crate::robot::default_robot(), &contact);
+        assert!(
+            text.contains("which never moves") && text.contains("--surface off"),
+            "{text}"
+        );
+    }
+}

@@ -68,7 +68,7 @@ const NOT_RUN: &[(&str, &str)] = &[
 const PAGES_NOT_RUN: &[(&str, &str)] = &[(
     "docs/robot-import.md",
     "its commands import a vendor's description that the user downloads (the repository ships \
-     none); crates/cli/tests/import.rs imports three such files when CI provides them",
+     none); crates/cli/tests/import.rs imports four such files when CI provides them",
 )];
 
 /// How long the slowest command may take before the test says so (debug builds plan slowly).

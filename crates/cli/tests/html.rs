@@ -54,7 +54,40 @@ fn html_page_holds_the_planned_motion() {
     );
     let page = read(&page_path);
     assert!(page.starts_with("<!DOCTYPE html>"));
-    assert!(page.contains("<title>demo: classical controller</title>"));
+    let recorded: Value = serde_json::from_str(&read(&dir.join("demo.json"))).unwrap();
+    let mut acted: Vec<&str> = Vec::new();
+    for step in recorded["steps"].as_array().unwrap() {
+        if let Some(name) = step["controller"]
+            .as_str()
+            .filter(|name| !acted.contains(name))
+        {
+            acted.push(name);
+        }
+    }
+    let title = match acted.as_slice() {
+        [one] => format!("<title>demo: steps by the {one} controller</title>"),
+        [first @ .., last] => format!(
+            "<title>demo: steps by the {} and {last} controllers</title>",
+            first.join(", ")
+        ),
+        [] => panic!("no step recorded a controller"),
+    };
+    assert!(
+        page.contains(&title),
+        "titled by the controllers that acted: {title}"
+    );
+    // The page plays the motion the robot executes: its last step at the timed motion's end.
+    let timed: Value =
+        serde_json::from_str(&read(&dir.join("demo.joint_trajectory.json"))).unwrap();
+    let duration_s = timed["timing"]["duration_s"].as_f64().unwrap();
+    let last_s = page
+        .rsplit_once(r#""t":"#)
+        .and_then(|(_, rest)| rest.split([',', '}']).next()?.parse::<f64>().ok())
+        .expect("the page's last step time");
+    assert!(
+        (last_s - duration_s).abs() < 0.01,
+        "the page plays {last_s} s, the timed motion takes {duration_s} s"
+    );
     assert!(!page.contains("http://") && !page.contains("https://"));
     let trajectory: Value = serde_json::from_str(&read(&dir.join("demo.json"))).unwrap();
     let steps = trajectory["steps"].as_array().unwrap();
@@ -113,7 +146,7 @@ fn html_pages_follow_the_per_task_suffix_rule() {
             stdout.contains(&format!("wrote {}", page.display())),
             "{stdout}"
         );
-        assert!(read(&page).contains(&format!("<title>set-{i:05}: classical controller</title>")));
+        assert!(read(&page).contains(&format!("<title>set-{i:05}: steps by the ")));
     }
 
     let without_extension = dir.join("bare/set");

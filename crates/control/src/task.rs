@@ -32,10 +32,11 @@ pub struct Task {
     /// The path the tool follows, when it is not the straight line from `p0` along `d`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<Path>,
-    /// The space the arm's base occupies ([`Robot::base_column`]), where a line's plate ends:
-    /// derived from the robot whenever the task is validated, so not part of a task file.
+    /// The space the arm's base occupies ([`Robot::base_column`]: start, end, radius), where a
+    /// line's plate ends: derived from the robot whenever the task is validated ([`Task::new`],
+    /// [`Task::revalidated`]), so not part of a task file.
     #[serde(skip)]
-    base_column: Option<(Vec3, Vec3, f64)>,
+    pub base_column: Option<(Vec3, Vec3, f64)>,
 }
 
 /// Where the TCP stands along its task: how far it has come, which way the task goes on, and

@@ -85,8 +85,9 @@ pub use mesh::{MeshError, mesh_volume, read_mesh};
 pub use path_file::{PathFileError, parse_path, read_path};
 pub use paths::{OutputClash, PlanPaths, html_path, refuse_overwriting};
 pub use robot_import::{
-    DisabledBecause, ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK, PackagePath,
-    Pen, import_robot,
+    DisabledBecause, ImportError, ImportOptions, ImportedRobot, LinkFit, PEN_LINK,
+    PEN_PROTRUSION_M, PEN_REACH_TOLERANCE_M, PackagePath, Pen, REP_199_TOOL_LINKS, ToolLinkChoice,
+    ToolReach, import_robot,
 };
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};

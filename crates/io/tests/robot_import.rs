@@ -5,12 +5,12 @@
 //! pen), and the planners' loader and the independent checker read the same capsules from it.
 //! The self-collision rule (adjacent links, links overlapping at mid-range, a given SRDF's pairs)
 //! is written as an SRDF that both loaders follow when it lies beside the robot file. Missing
-//! meshes and ambiguous tool links are refused with their names; a side link on a moving joint
-//! is merged with the joint at 0.
+//! meshes are refused with their names; of several leaf links, REP 199's `flange` is the tool
+//! link; a side link on a moving joint is merged with the joint at 0.
 
 use std::path::Path;
 
-use emg_io::{DisabledBecause, ImportOptions, PEN_LINK, PackagePath, import_robot};
+use emg_io::{DisabledBecause, ImportOptions, PEN_LINK, PackagePath, ToolLinkChoice, import_robot};
 use emg_kinematics::{
     JointVector, PairRule, Robot, Vec3, rotation_from_rpy, segment_distance, srdf_beside,
 };
@@ -411,13 +411,19 @@ fn what_cannot_be_imported_is_named() {
     };
     let error = import_robot(&path, &named).unwrap_err().to_string();
     assert!(error.contains("/nowhere/meshes/l2.stl"), "{error}");
+    // Of the leaf links [flange, extra], REP 199's flange is the tool link when none is named
+    // (a file with neither tool0 nor flange is refused, listing its leaves: the unit tests of
+    // robot_import.rs).
     let untold = ImportOptions {
         tool_link: None,
         ..fixture.options()
     };
-    let error = import_robot(&path, &untold).unwrap_err().to_string();
-    assert!(
-        error.contains("leaf links [flange, extra]") && error.contains("--tool-link"),
-        "{error}"
+    let imported = import_robot(&path, &untold).unwrap();
+    assert_eq!(imported.tool_link, "flange");
+    assert_eq!(
+        imported.tool_link_choice,
+        ToolLinkChoice::Rep199 {
+            leaves: vec!["flange".into(), "extra".into()]
+        }
     );
 }

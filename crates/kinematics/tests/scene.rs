@@ -334,3 +334,79 @@ fn an_obstacle_is_plain_data() {
     );
     assert_eq!(serde_json::from_str::<Scene>(&text).unwrap(), scene);
 }
+
+/// The first `s` at which a ray comes within a grown capsule, in closed form, against a fine
+/// march along the ray with the point distance from the solid's definition.
+#[test]
+fn capsule_ray_entry_matches_a_march_along_the_ray() {
+    let mut rng = rng(71);
+    let mut entered = 0;
+    for _ in 0..300 {
+        let start = random_point(&mut rng, 0.3);
+        let end = start + random_unit(&mut rng) * rng.random_range(0.0..0.4);
+        let radius = rng.random_range(0.01..0.1);
+        let inflation = rng.random_range(0.0..0.1);
+        let origin = random_point(&mut rng, 1.0);
+        // Aimed near the capsule, so that many rays enter it and many graze past.
+        let aim = (start + end) * 0.5 + random_point(&mut rng, 0.2);
+        let direction = (aim - origin).normalize();
+        let grown = Shape::Capsule {
+            start,
+            end,
+            radius: radius + inflation,
+        };
+        let step = 1e-4;
+        let marched = (0..40_000)
+            .map(|k| k as f64 * step)
+            .find(|s| point_signed_distance(&grown, &(origin + direction * *s)) <= 0.0);
+        let found =
+            emg_kinematics::capsule_ray_entry(&start, &end, radius, inflation, &origin, &direction);
+        match (found, marched) {
+            (Some(s), Some(m)) => {
+                assert!((s - m).abs() <= step, "closed form {s}, march {m}");
+                entered += 1;
+            }
+            (None, None) => {}
+            other => panic!("closed form and march disagree: {other:?}"),
+        }
+    }
+    assert!(entered > 30, "only {entered} rays entered");
+}
+
+/// The base column holds every capsule of the base link and of the first body, however the
+/// first joint (and every other) turns.
+#[test]
+fn the_base_column_holds_the_first_two_bodies_in_every_configuration() {
+    let robot = robot();
+    let (start, end, radius) = robot
+        .base_column()
+        .expect("the FR3's base carries capsules");
+    let column = Shape::Capsule { start, end, radius };
+    let mut rng = rng(72);
+    for _ in 0..200 {
+        let kin = robot.forward(&random_q(&mut rng, &robot));
+        for capsule in robot.capsules().iter().filter(|c| c.segment <= 1) {
+            for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
+                let centre = kin.segment_point(
+                    capsule.segment,
+                    &(capsule.start + (capsule.end - capsule.start) * t),
+                );
+                for direction in [
+                    Vec3::x(),
+                    -Vec3::x(),
+                    Vec3::y(),
+                    -Vec3::y(),
+                    Vec3::z(),
+                    -Vec3::z(),
+                ] {
+                    let surface = centre + direction * capsule.radius;
+                    assert!(
+                        point_signed_distance(&column, &surface) <= 1e-12,
+                        "{} sticks out of the column",
+                        capsule.link
+                    );
+                }
+            }
+        }
+    }
+}

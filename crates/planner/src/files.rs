@@ -38,6 +38,9 @@ pub struct PlanFiles {
     pub joint_trajectory: String,
     /// How the joint trajectory was timed.
     pub timing: TimingSummary,
+    /// When the timed motion passes each planned step (s): the planned steps played at the
+    /// executed motion's pace ([`emg_timing::TimedMotion::passing_times_s`]).
+    pub step_times_s: Vec<f64>,
 }
 
 /// Why a plan's files could not be written.
@@ -99,11 +102,13 @@ impl PlanFiles {
         )?;
         let mut joint_trajectory = joint.to_json();
         joint_trajectory.push('\n');
+        let planned: Vec<_> = trajectory.steps.iter().map(|step| step.q).collect();
         Ok(Self {
             json: file.to_json(),
             csv: trajectory_csv(&trajectory.steps, robot.dof()),
             timing: joint.timing.clone(),
             joint_trajectory,
+            step_times_s: motion.passing_times_s(&planned),
         })
     }
 

@@ -529,7 +529,7 @@ pub fn start_blockers(
             }),
         }
     }
-    contacts.sort_by(|a, b| b.count.cmp(&a.count));
+    contacts.sort_by_key(|contact| std::cmp::Reverse(contact.count));
     StartBlockers {
         restarts,
         found: found.len(),

@@ -301,7 +301,9 @@ fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allow
         ahead_m: 0.0,
         thickness_m: Plate::default().thickness_m,
     });
-    let own = default.with_config(own).expect("a plate of the task's extent");
+    let own = default
+        .with_config(own)
+        .expect("a plate of the task's extent");
     let robot = default.robot();
     let mut tasks = Vec::new();
     for (x, y) in [(0.3, 0.2), (0.3, -0.2), (0.5, 0.0), (0.2, 0.25)] {
@@ -325,7 +327,8 @@ fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allow
         if over_default == 0 {
             refused += 1;
             assert_eq!(
-                over_own, 0,
+                over_own,
+                0,
                 "task {index} ({:?} along {:?}) is refused over the default plate alone: {:?}",
                 task.p0,
                 task.d,
@@ -333,7 +336,11 @@ fn the_default_plate_refuses_no_start_that_a_plate_of_the_tasks_own_extent_allow
             );
         }
     }
-    assert!(refused < tasks.len() / 4, "{refused} of {} refused", tasks.len());
+    assert!(
+        refused < tasks.len() / 4,
+        "{refused} of {} refused",
+        tasks.len()
+    );
 }
 
 /// The bound counts a grid point as reachable when a point of the tolerance disc around it has
@@ -384,9 +391,15 @@ fn the_bound_reaches_past_a_stretch_only_the_tolerance_disc_clears() {
         let s = k as f64 * reach.grid_m;
         let tcp = robot.forward(q).tcp();
         let off_line = task.lateral_error(&tcp).norm();
-        assert!(off_line <= tolerance, "witness {k} is {off_line} m off the line");
+        assert!(
+            off_line <= tolerance,
+            "witness {k} is {off_line} m off the line"
+        );
         if (from_m..=to_m).contains(&s) {
-            assert!(off_line > radius_m, "witness {k} at {s} m stands on the rod");
+            assert!(
+                off_line > radius_m,
+                "witness {k} at {s} m stands on the rod"
+            );
         }
     }
     let request = PlanRequest {

@@ -78,6 +78,11 @@ pub struct TimingReport {
     pub rests_s: Vec<f64>,
 }
 
+/// How far (rad, largest joint difference) the motion may move past the sample nearest a
+/// waypoint before [`TimedMotion::passing_times_s`] stops looking for a nearer one: more than a
+/// planned step moves (a few hundredths), less than a path takes to come back.
+pub const PASSING_WINDOW_RAD: f64 = 0.2;
+
 /// A rest-to-rest motion at a fixed rate, with its path and report.
 #[derive(Clone, Debug)]
 pub struct TimedMotion {
@@ -226,6 +231,33 @@ pub fn rest_waypoints(robot: &Robot, task: &Task, waypoints: &[JointVector]) -> 
 }
 
 impl TimedMotion {
+    /// When the motion passes each of `waypoints` (the planned configurations it was timed
+    /// through, in order): the time (s) of the sample nearest each in joint space (largest
+    /// joint difference), searched forward from the previous waypoint's sample, and only until
+    /// the motion has moved [`PASSING_WINDOW_RAD`] past the nearest one so far (a path that
+    /// comes back near itself is not taken for its return). A motion cut short gives its last
+    /// sample's time to the waypoints beyond its end.
+    pub fn passing_times_s(&self, waypoints: &[JointVector]) -> Vec<f64> {
+        let mut from = 0;
+        waypoints
+            .iter()
+            .map(|waypoint| {
+                let distance = |k: usize| (self.samples[k].q - waypoint).amax();
+                let mut best = from;
+                for k in from..self.samples.len() {
+                    let d = distance(k);
+                    if d < distance(best) {
+                        best = k;
+                    } else if d > distance(best) + PASSING_WINDOW_RAD {
+                        break;
+                    }
+                }
+                from = best;
+                self.samples.get(best).map_or(0.0, TimedSample::time_s)
+            })
+            .collect()
+    }
+
     /// This motion, then `next` (which starts at rest where this one ends, at waypoint
     /// `first_waypoint` of the whole motion): its samples after its first follow on the grid
     /// of `rate_hz`, its grid after this one's path parameters, its report added to this one's.
