@@ -14,6 +14,18 @@ use crate::output::write_text;
 /// Imports, checks that the planners read the result as a chain of six or seven joints ending in
 /// the pen, writes it and prints the fit report.
 pub fn run_import(args: &ImportArgs) -> Result<()> {
+    let srdf = srdf_beside(&args.out);
+    let limits = emg_planner::limits_file_beside(&args.out);
+    let mut inputs = vec![("vendor URDF", args.file.as_path())];
+    inputs.extend(args.srdf.as_deref().map(|file| ("--srdf", file)));
+    emg_io::refuse_overwriting(
+        &inputs,
+        &[
+            ("--out", args.out.as_path()),
+            ("--out (its SRDF)", srdf.as_path()),
+            ("--out (its joint limits)", limits.as_path()),
+        ],
+    )?;
     let options = ImportOptions {
         package_paths: args.package_path.clone(),
         tool_link: args.tool_link.clone(),
@@ -37,8 +49,6 @@ pub fn run_import(args: &ImportArgs) -> Result<()> {
         .with_context(|| {
             format!("the imported chain from '{base}' to the pen cannot be planned with")
         })?;
-    let srdf = srdf_beside(&args.out);
-    let limits = emg_planner::limits_file_beside(&args.out);
     write_text(&args.out, &imported.urdf)?;
     write_text(&srdf, &imported.srdf)?;
     write_text(&limits, &joint_limits_yaml(&args.file, &robot))?;

@@ -443,3 +443,38 @@ fn example_robot_datas_ur5_takes_tool0_and_plans_end_to_end() {
         "{report}"
     );
 }
+
+/// An import never writes over what it reads: `--out` naming the vendor file, or an `--out`
+/// whose SRDF beside it is the `--srdf` file, is refused with the input unchanged.
+#[test]
+fn an_import_never_writes_over_its_inputs() {
+    let tmp = temp_dir("import-clash");
+    let dir = tmp.path();
+    let vendor = dir.join("arm.urdf");
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    std::fs::copy(examples.join("fr3_no_pen.urdf"), &vendor).unwrap();
+    let before = read(&vendor);
+    let output = emg(&[
+        "import-robot",
+        vendor.to_str().unwrap(),
+        "--out",
+        vendor.to_str().unwrap(),
+    ]);
+    let error = text(&output.stderr);
+    assert!(!output.status.success());
+    assert!(error.contains("which is the vendor URDF file"), "{error}");
+    assert_eq!(read(&vendor), before, "the vendor file is unchanged");
+    let srdf = dir.join("cell.srdf");
+    std::fs::write(&srdf, "<robot name=\"arm\"/>").unwrap();
+    let output = emg(&[
+        "import-robot",
+        vendor.to_str().unwrap(),
+        "--srdf",
+        srdf.to_str().unwrap(),
+        "--out",
+        dir.join("cell.urdf").to_str().unwrap(),
+    ]);
+    let error = text(&output.stderr);
+    assert!(error.contains("which is the --srdf file"), "{error}");
+    assert!(!dir.join("cell.urdf").exists(), "nothing was written");
+}

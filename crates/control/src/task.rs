@@ -18,7 +18,7 @@ pub const SEED_POSITION_TOLERANCE_M: f64 = 1e-6;
 /// A straight-line task: start `p0`, unit direction `d`, unit task-plane normal `n` (`d ⟂ n`),
 /// and optionally the configuration that generated it (`q0_seed`, the fallback seed); or a
 /// path task ([`Task::on_path`]): a [`Path`] from `p0`, with `d` its tangent at the start.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Task {
     /// Start position `p0` (m).
     pub p0: Vec3,
@@ -37,6 +37,15 @@ pub struct Task {
     /// [`Task::revalidated`]), so not part of a task file.
     #[serde(skip)]
     pub base_column: Option<(Vec3, Vec3, f64)>,
+}
+
+/// Tasks are equal when what a task file holds is (`p0`, `d`, `n`, `q0_seed`, the path): the
+/// base column is the robot's, derived again whenever a task is validated.
+impl PartialEq for Task {
+    fn eq(&self, other: &Self) -> bool {
+        (self.p0, self.d, self.n, self.q0_seed) == (other.p0, other.d, other.n, other.q0_seed)
+            && self.path == other.path
+    }
 }
 
 /// Where the TCP stands along its task: how far it has come, which way the task goes on, and

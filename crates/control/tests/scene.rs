@@ -101,7 +101,7 @@ fn library_and_checker_agree_on_scene_contact() {
             continue;
         }
         let library = first_contact(&robot, task, &kin, &constraints);
-        let bounds: Bounds = (&constraints).into();
+        let bounds: Bounds = emg_control::task_bounds(task, &constraints);
         let line: Line = task.into();
         let Some((margin, link, obstacle)) = checker.scene_margin(&q, &line, &bounds) else {
             assert_eq!(library, None, "nothing to touch");

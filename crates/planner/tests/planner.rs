@@ -197,7 +197,13 @@ fn names_parse_back() {
     }
     let given: SeedSource = "q=0,0.1,0,-1.5,0,1.5,0.7".parse().unwrap();
     assert_eq!(given.name(), "given");
-    let error = "q=0,1".parse::<SeedSource>().unwrap_err().to_string();
+    // One value per joint: the count is checked against the arm when the seed is prepared;
+    // more than any arm has is refused at once.
+    assert_eq!(
+        "q=0,1,2,3,4,5".parse::<SeedSource>().unwrap(),
+        SeedSource::Given(vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
+    );
+    let error = "q=0,1,2,3,4,5,6,7".parse::<SeedSource>().unwrap_err().to_string();
     assert!(error.contains("expected 7"), "{error}");
 }
 
