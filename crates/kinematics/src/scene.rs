@@ -296,7 +296,9 @@ impl std::str::FromStr for WorkSurface {
 /// `p0` to `ahead_m` beyond it along `d`, `half_width_m` to each side, `thickness_m` deep below
 /// the plane through `p0` with normal `n`. The defaults (0.2 m wide, 0.05 m behind, 2 m ahead,
 /// 0.05 m thick) make a strip longer than any line a 7-DoF arm of a metre's reach can draw, so
-/// the plate never ends a line, and narrow enough that an arm beside it keeps clear of it.
+/// the plate never ends a line, and narrow enough that an arm beside it keeps clear of it. A
+/// task shapes it to itself (`emg_control::Task::work_surface`): under a path it covers the path
+/// with these margins, along a line it ends short of the arm's base column.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Plate {
