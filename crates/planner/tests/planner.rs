@@ -203,7 +203,10 @@ fn names_parse_back() {
         "q=0,1,2,3,4,5".parse::<SeedSource>().unwrap(),
         SeedSource::Given(vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0])
     );
-    let error = "q=0,1,2,3,4,5,6,7".parse::<SeedSource>().unwrap_err().to_string();
+    let error = "q=0,1,2,3,4,5,6,7"
+        .parse::<SeedSource>()
+        .unwrap_err()
+        .to_string();
     assert!(error.contains("expected 7"), "{error}");
 }
 
