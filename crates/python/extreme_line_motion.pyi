@@ -262,3 +262,30 @@ def load_tasks(path: PathLike, robot: PathLike = "fr3") -> list[Task]:
 
 def check(path: PathLike, robot: Optional[PathLike] = None) -> CheckReport:
     """Verifies a trajectory file with the independent checker; raises CheckFailed."""
+
+class ExportReport:
+    """What an export wrote (``export``)."""
+
+    format: str
+    files: list[Path]
+    summary: str
+    points_before: Optional[int]
+    points_after: Optional[int]
+    tolerance_rad: Optional[float]
+    max_joint_deviation_rad: Optional[float]
+    max_tool_deviation_m: Optional[float]
+    servoj_targets: int
+
+def export(
+    path: PathLike,
+    format: Literal["ros2-mcap", "urscript"],
+    out: PathLike,
+    robot: Optional[PathLike] = None,
+    tolerance_rad: Optional[float] = None,
+    max_servoj_lines: Optional[int] = None,
+) -> ExportReport:
+    """Exports a joint trajectory file as ``emg export`` does: ``"ros2-mcap"`` (a ROS 2
+    trajectory_msgs/msg/JointTrajectory in an MCAP file, its points thinned within
+    ``tolerance_rad``, default 1e-5) or ``"urscript"`` (a program for a six-joint Universal
+    Robots arm, a servoj target every 2 ms, at most ``max_servoj_lines`` per program, default
+    2500). Raises InputError for a wrong input, writing nothing."""

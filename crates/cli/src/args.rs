@@ -34,6 +34,11 @@ pub enum Command {
     /// write a standard URDF the planners and the checker read, with an SRDF beside it listing
     /// the link pairs not checked for self-collision (see docs/robot-import.md).
     ImportRobot(ImportArgs),
+    /// Export a joint trajectory for a robot's own stack: `ros2-mcap` (a ROS 2
+    /// trajectory_msgs/msg/JointTrajectory in an MCAP bag, joint names as the vendor's driver
+    /// names them) or `urscript` (a program for a Universal Robots e-Series controller); see
+    /// docs/robot-export.md.
+    Export(crate::export::ExportArgs),
 }
 
 /// Options of `emg import-robot`.
@@ -248,6 +253,10 @@ pub struct PlanArgs {
     /// Samples per second of the joint trajectory (1000 for libfranka).
     #[arg(long, value_name = "HZ", default_value_t = emg_planner::DEFAULT_RATE_HZ)]
     pub rate_hz: f64,
+    /// Also export each joint trajectory for a robot's own stack, as `emg export` does:
+    /// `ros2-mcap` (STEM.mcap) or `urscript` (STEM.script).
+    #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
+    pub export: Option<emg_io::ExportFormat>,
 }
 
 /// A feature switched on or off on the command line.

@@ -65,6 +65,7 @@
 
 mod args;
 mod check;
+mod export;
 mod import;
 mod interrupt;
 mod output;
@@ -95,6 +96,7 @@ fn main() -> ExitCode {
         Command::Plan(args) => run_plan(&args),
         Command::Check(args) => check::run_check(&args),
         Command::ImportRobot(args) => import::run_import(&args),
+        Command::Export(args) => export::run_export(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -136,6 +138,7 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     )?;
     let tasks = tasks::requested_tasks(&robot, args)?;
     refuse_overwriting_inputs(args, tasks.len())?;
+    export::refuse_plan_export(args, &robot, tasks.len())?;
     let timing = motion_timing(args, &robot, &config)?;
     let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
@@ -448,6 +451,7 @@ fn write_plan(
         },
     )?;
     files.write(&paths)?;
+    let exported = export::after_plan(args, planner.robot(), &paths)?;
     let timed = &files.timing;
     let cut = match (&timed.cut_at_point, &timed.cut_reason) {
         (Some(point), Some(reason)) => {
@@ -500,7 +504,7 @@ fn write_plan(
          seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
          requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}{unreached}\n  \
-         wrote {}, {} and {}{viewer}",
+         wrote {}, {} and {}{viewer}{exported}",
         trajectory.path_length_m,
         trajectory.termination,
         plan.seed.source,

@@ -13,6 +13,9 @@
 //! * [`read_path`]: a path task's segments (JSON, see [`emg_control::PathSpec`]).
 //! * [`import_robot`]: a vendor description (boxes, cylinders, STL/OBJ meshes) as a standard
 //!   capsule URDF with a pen, and [`read_mesh`]: mesh files as triangles.
+//! * [`export`]: a joint trajectory for a robot's own stack: a ROS 2 `JointTrajectory` in an
+//!   MCAP file (its points thinned, [`ThinningReport`]) or a URScript program
+//!   (`docs/robot-export.md`).
 //! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
 //!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
 //!   for one job's identity.
@@ -64,6 +67,7 @@ mod atomic;
 mod contents;
 mod csv;
 mod error;
+mod export;
 mod joint_trajectory;
 mod mesh;
 mod path_file;
@@ -77,6 +81,11 @@ pub use atomic::{JournalError, open_journal, write_atomically};
 pub use contents::{Carried, ReadError, TrajectoryContents, VerifyFailure, task_file_beside};
 pub use csv::{csv_header, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;
+pub use export::{
+    DRIVER_PROFILES, DriverProfile, Export, ExportError, ExportFormat, ExportOptions, ExportRobot,
+    JOINT_TRAJECTORY_TYPE, ThinningReport, UR_JOINT_NAMES, export, is_universal_robots_arm,
+    read_joint_trajectory,
+};
 pub use joint_trajectory::{
     JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint, TimeFromStart, TimingLimits,
     TimingSummary,

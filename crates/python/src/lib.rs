@@ -8,13 +8,16 @@
 //!   byte;
 //! * [`robot::Robot`]: forward kinematics and the position Jacobian;
 //! * [`check::check`]: a trajectory file verified by the independent checker, as a report;
-//! * [`planner::load_tasks`]: a task file (JSON or `EMGTASKS`).
+//! * [`planner::load_tasks`]: a task file (JSON or `EMGTASKS`);
+//! * [`export::export`]: a joint trajectory exported for a robot's own stack (ROS 2 MCAP,
+//!   URScript).
 //!
 //! Errors raise [`Error`] subclasses whose messages are the library's: [`InputError`] for bad
 //! input (naming the argument, field and value), [`PlanningError`] when a task cannot be
 //! planned, [`CheckFailed`] when a file does not hold up; failed file writes raise `OSError`.
 
 mod check;
+mod export;
 mod planner;
 mod robot;
 mod timing;
@@ -110,5 +113,7 @@ fn extreme_line_motion(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<check::CheckReport>()?;
     module.add_function(wrap_pyfunction!(planner::load_tasks, module)?)?;
     module.add_function(wrap_pyfunction!(check::check, module)?)?;
+    module.add_class::<export::ExportReport>()?;
+    module.add_function(wrap_pyfunction!(export::export, module)?)?;
     Ok(())
 }

@@ -1,0 +1,187 @@
+//! `emg export` and `emg plan --export`: a joint trajectory written for a robot's own stack (a
+//! ROS 2 `JointTrajectory` in an MCAP bag, or a URScript program), by [`emg_io::export`].
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use emg_io::{DriverProfile, ExportFormat, ExportOptions, ExportRobot, PlanPaths};
+use emg_kinematics::Robot;
+use emg_planner::ShippedRobot;
+
+use crate::args::PlanArgs;
+
+/// Options of `emg export`.
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// The joint trajectory to export (`STEM.joint_trajectory.json`, emg-joint-trajectory/2).
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file) or `urscript` (a
+    /// program for a Universal Robots e-Series controller; six-joint UR arms only).
+    #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
+    pub format: ExportFormat,
+    /// The file to write (a URScript motion too long for one program is split where the arm
+    /// rests: OUT with -part1, -part2, ... before its extension).
+    #[arg(long, value_name = "PATH")]
+    pub out: PathBuf,
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) or a robot file (URDF). Default:
+    /// the file's `robot` field.
+    #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot)]
+    pub robot: Option<PathBuf>,
+    /// ros2-mcap: the largest joint deviation (rad) of the controller's quintic spline through
+    /// the points kept from any sample of the file.
+    #[arg(long, value_name = "RAD", default_value_t = ExportOptions::default().tolerance_rad)]
+    pub tolerance: f64,
+    /// urscript: most servoj lines (2 ms each) per program.
+    #[arg(long, value_name = "N", default_value_t = ExportOptions::default().max_servoj_lines)]
+    pub max_servoj: usize,
+}
+
+/// Parses `--format` and `--export`.
+pub fn parse_format(value: &str) -> Result<ExportFormat, String> {
+    value
+        .parse()
+        .map_err(|e: emg_io::ExportError| e.to_string())
+}
+
+/// The driver profile of `robot_file` when it is a shipped robot's file.
+fn shipped_profile(robot_file: &Path) -> Option<&'static DriverProfile> {
+    ShippedRobot::by_path(robot_file, &crate::robot::data_dir())
+        .and_then(|shipped| DriverProfile::for_shipped(shipped.name))
+}
+
+/// Runs `emg export`: reads the file, resolves its robot, exports, and prints what it wrote.
+pub fn run_export(args: &ExportArgs) -> Result<()> {
+    let trajectory = emg_io::read_joint_trajectory(&args.file)?;
+    let robot_file = match &args.robot {
+        Some(path) => path.clone(),
+        None => {
+            let named = PathBuf::from(&trajectory.robot);
+            anyhow::ensure!(
+                named.is_file(),
+                "field 'robot' of {} names {}, which is not a file here; give --robot NAME|URDF",
+                args.file.display(),
+                trajectory.robot
+            );
+            named
+        }
+    };
+    let robot = crate::robot::load_robot(&robot_file, None, None)?;
+    let options = ExportOptions {
+        tolerance_rad: args.tolerance,
+        max_servoj_lines: args.max_servoj,
+    };
+    let text = export_to(
+        &trajectory,
+        args.format,
+        &args.out,
+        &robot_file,
+        &robot,
+        &options,
+        &args.file,
+    )?;
+    println!("{text}");
+    Ok(())
+}
+
+/// Exports `trajectory` (read from `input`) for the robot of `robot_file`; returns what to
+/// print.
+fn export_to(
+    trajectory: &emg_io::JointTrajectory,
+    format: ExportFormat,
+    out: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+    options: &ExportOptions,
+    input: &Path,
+) -> Result<String> {
+    let file = robot_file.display().to_string();
+    let target = ExportRobot {
+        file: &file,
+        shipped: shipped_profile(robot_file),
+        kinematics: Some(robot),
+    };
+    let export = emg_io::export(trajectory, format, out, &target, options)?;
+    export.write(&[("joint trajectory", input), ("robot", robot_file)])?;
+    let written: Vec<String> = export
+        .files
+        .iter()
+        .map(|(path, _)| path.display().to_string())
+        .collect();
+    Ok(format!(
+        "{}\n  wrote {}",
+        export.summary,
+        written.join(", ")
+    ))
+}
+
+/// The file `emg plan --export` writes beside a task's files: `STEM.mcap` or `STEM.script`.
+fn plan_output(paths: &PlanPaths, format: ExportFormat) -> PathBuf {
+    paths.json.with_extension(format.extension())
+}
+
+/// Refuses, before anything is planned, an `emg plan --export` that cannot be done: URScript
+/// for a robot that is not a Universal Robots arm, or an output replacing an input.
+pub fn refuse_plan_export(args: &PlanArgs, robot: &Robot, tasks: usize) -> Result<()> {
+    let Some(format) = args.export else {
+        return Ok(());
+    };
+    let names = robot.joint_names();
+    let shipped = shipped_profile(&args.robot);
+    let is_ur = match shipped {
+        Some(profile) => profile.joint_names == emg_io::UR_JOINT_NAMES,
+        None => emg_io::is_universal_robots_arm(names),
+    };
+    if format == ExportFormat::UrScript && !is_ur {
+        return Err(anyhow::Error::new(
+            emg_io::ExportError::NotUniversalRobots {
+                robot: args.robot.display().to_string(),
+                joints: names.len(),
+                names: names.join(", "),
+            },
+        ))
+        .context("--export urscript: nothing was planned or written");
+    }
+    let indices: Vec<Option<usize>> = match tasks {
+        1 => vec![None],
+        many => (0..many).map(Some).collect(),
+    };
+    let outputs: Vec<PathBuf> = indices
+        .iter()
+        .map(|&index| plan_output(&PlanPaths::new(&args.out, index), format))
+        .collect();
+    let outputs: Vec<(&str, &Path)> = outputs.iter().map(|p| ("--export", p.as_path())).collect();
+    Ok(emg_io::refuse_overwriting(
+        &[("--robot", args.robot.as_path())],
+        &outputs,
+    )?)
+}
+
+/// After `emg plan` wrote a task's files: exports its joint trajectory when `--export` asks;
+/// returns the lines to print.
+pub fn after_plan(args: &PlanArgs, robot: &Robot, paths: &PlanPaths) -> Result<String> {
+    let Some(format) = args.export else {
+        return Ok(String::new());
+    };
+    let input = &paths.joint_trajectory;
+    let trajectory = emg_io::read_joint_trajectory(input)?;
+    let text = export_to(
+        &trajectory,
+        format,
+        &plan_output(paths, format),
+        &args.robot,
+        robot,
+        &ExportOptions::default(),
+        input,
+    )
+    .with_context(|| {
+        format!(
+            "--export {format}: the plan's files were written, the export was not ({} {} --format \
+             {format} --out FILE exports them)",
+            "emg export",
+            input.display()
+        )
+    })?;
+    Ok(format!("\n  export: {text}"))
+}

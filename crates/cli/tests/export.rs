@@ -1,0 +1,380 @@
+//! `emg export` and `emg plan --export`, checked against readers this project did not write:
+//! the MCAP file read back with the `mcap` crate's reader (its CDR message decoded here by hand,
+//! independently of the encoder), every point compared with the joint trajectory and the
+//! controller's quintic spline between the kept points checked against every sample; the
+//! URScript program parsed back, every `servoj` target compared with the trajectory at its time
+//! and checked against the UR5e's limits; wrong inputs refused with nothing written.
+
+mod common;
+
+use std::path::Path;
+
+use common::{data_dir, read_json, temp_dir, text};
+use serde_json::Value;
+
+/// Runs `emg` in `dir`; returns (exit code, stdout, stderr).
+fn run(dir: &Path, args: &[&str]) -> (Option<i32>, String, String) {
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run emg");
+    (
+        output.status.code(),
+        text(&output.stdout),
+        text(&output.stderr),
+    )
+}
+
+/// A little-endian CDR reader (alignment relative to the end of the 4-byte encapsulation).
+struct Cdr<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Cdr<'_> {
+    fn align(&mut self, n: usize) {
+        self.at += (n - self.at % n) % n;
+    }
+    fn take(&mut self, n: usize) -> &[u8] {
+        self.align(n.min(8));
+        let out = &self.bytes[self.at..self.at + n];
+        self.at += n;
+        out
+    }
+    fn u32(&mut self) -> u32 {
+        u32::from_le_bytes(self.take(4).try_into().unwrap())
+    }
+    fn i32(&mut self) -> i32 {
+        i32::from_le_bytes(self.take(4).try_into().unwrap())
+    }
+    fn f64s(&mut self) -> Vec<f64> {
+        let n = self.u32() as usize;
+        (0..n)
+            .map(|_| f64::from_le_bytes(self.take(8).try_into().unwrap()))
+            .collect()
+    }
+    fn string(&mut self) -> String {
+        let n = self.u32() as usize;
+        let raw = &self.bytes[self.at..self.at + n];
+        self.at += n;
+        assert_eq!(raw.last(), Some(&0), "CDR strings end in NUL");
+        String::from_utf8(raw[..n - 1].to_vec()).unwrap()
+    }
+}
+
+/// A decoded `trajectory_msgs/msg/JointTrajectory`: (frame_id, joint names, points as
+/// (positions, velocities, accelerations, effort, nanoseconds)).
+type Decoded = (String, Vec<String>, Vec<[Vec<f64>; 4]>, Vec<i64>);
+
+fn decode(data: &[u8]) -> Decoded {
+    assert_eq!(&data[..4], &[0, 1, 0, 0], "CDR little-endian encapsulation");
+    let mut cdr = Cdr {
+        bytes: &data[4..],
+        at: 0,
+    };
+    let (_sec, _nanosec) = (cdr.i32(), cdr.u32());
+    let frame = cdr.string();
+    let names = (0..cdr.u32()).map(|_| cdr.string()).collect();
+    let count = cdr.u32();
+    let mut points = Vec::new();
+    let mut times = Vec::new();
+    for _ in 0..count {
+        points.push([cdr.f64s(), cdr.f64s(), cdr.f64s(), cdr.f64s()]);
+        let (sec, nanosec) = (cdr.i32(), cdr.u32());
+        times.push(i64::from(sec) * 1_000_000_000 + i64::from(nanosec));
+    }
+    assert_eq!(cdr.at, cdr.bytes.len(), "nothing after the message");
+    (frame, names, points, times)
+}
+
+fn numbers(value: &Value) -> Vec<f64> {
+    value
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+fn nanoseconds(point: &Value) -> i64 {
+    let t = &point["time_from_start"];
+    t["sec"].as_i64().unwrap() * 1_000_000_000 + t["nanosec"].as_i64().unwrap()
+}
+
+/// The quintic through (p, v, a) at both ends of `h` seconds, at `t` (written here from the
+/// boundary conditions, apart from the exporter's).
+fn quintic(start: [f64; 3], end: [f64; 3], h: f64, t: f64) -> f64 {
+    // Solve for c3..c5 from p(h), p'(h), p''(h).
+    let [p0, v0, a0] = start;
+    let [p1, v1, a1] = end;
+    let r0 = p1 - p0 - v0 * h - 0.5 * a0 * h * h;
+    let r1 = v1 - v0 - a0 * h;
+    let r2 = a1 - a0;
+    let c3 = (10.0 * r0 - 4.0 * r1 * h + 0.5 * r2 * h * h) / h.powi(3);
+    let c4 = (-15.0 * r0 + 7.0 * r1 * h - r2 * h * h) / h.powi(4);
+    let c5 = (6.0 * r0 - 3.0 * r1 * h + 0.5 * r2 * h * h) / h.powi(5);
+    p0 + v0 * t + 0.5 * a0 * t * t + c3 * t.powi(3) + c4 * t.powi(4) + c5 * t.powi(5)
+}
+
+#[test]
+fn ros2_mcap_holds_every_point_and_the_spline_stays_within_tolerance() {
+    let dir = temp_dir("export-mcap");
+    let (code, stdout, stderr) = run(
+        dir.path(),
+        &[
+            "plan",
+            "--p0",
+            "0.45,-0.2,0.25",
+            "--d",
+            "0,1,0",
+            "--n",
+            "0,0,-1",
+            "--out",
+            "line",
+            "--export",
+            "ros2-mcap",
+        ],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("wrote line.mcap"), "{stdout}");
+    let file = read_json(&dir.path().join("line.joint_trajectory.json"));
+    let points = file["points"].as_array().unwrap();
+    let bytes = std::fs::read(dir.path().join("line.mcap")).unwrap();
+    let messages: Vec<_> = mcap::MessageStream::new(&bytes)
+        .unwrap()
+        .collect::<Result<_, _>>()
+        .unwrap();
+    assert_eq!(messages.len(), 1);
+    let message = &messages[0];
+    let schema = message.channel.schema.as_ref().unwrap();
+    assert_eq!(
+        (schema.name.as_str(), schema.encoding.as_str()),
+        ("trajectory_msgs/msg/JointTrajectory", "ros2msg")
+    );
+    assert_eq!(message.channel.message_encoding, "cdr");
+    assert_eq!(
+        message.channel.topic,
+        "/fr3_arm_controller/joint_trajectory"
+    );
+    let (frame, names, kept, times) = decode(&message.data);
+    assert_eq!(frame, "fr3_link0");
+    let fr3: Vec<String> = (1..=7).map(|i| format!("fr3_joint{i}")).collect();
+    assert_eq!(names, fr3);
+    assert!(
+        kept.len() > 2 && kept.len() < points.len() / 10,
+        "{}",
+        kept.len()
+    );
+    // Every kept point is a sample of the file, bit for bit, the first and the last among them.
+    let by_time: std::collections::BTreeMap<i64, &Value> =
+        points.iter().map(|p| (nanoseconds(p), p)).collect();
+    assert_eq!(times[0], 0);
+    assert_eq!(*times.last().unwrap(), nanoseconds(points.last().unwrap()));
+    for (point, time) in kept.iter().zip(&times) {
+        let sample = by_time[time];
+        assert_eq!(point[0], numbers(&sample["positions"]));
+        assert_eq!(point[1], numbers(&sample["velocities"]));
+        assert_eq!(point[2], numbers(&sample["accelerations"]));
+        assert!(point[3].is_empty(), "no efforts");
+    }
+    // The quintic between kept points stays within the stated tolerance of every sample.
+    let tolerance = 1e-5;
+    let mut worst = 0.0_f64;
+    for window in 0..kept.len() - 1 {
+        let (t0, t1) = (times[window], times[window + 1]);
+        let h = (t1 - t0) as f64 * 1e-9;
+        for (t, sample) in by_time.range(t0 + 1..t1) {
+            let q = numbers(&sample["positions"]);
+            for (j, q) in q.iter().enumerate() {
+                let end = |k: usize| [kept[k][0][j], kept[k][1][j], kept[k][2][j]];
+                let s = quintic(end(window), end(window + 1), h, (t - t0) as f64 * 1e-9);
+                worst = worst.max((s - q).abs());
+            }
+        }
+    }
+    assert!(worst <= tolerance * (1.0 + 1e-6), "worst deviation {worst}");
+    let summary = mcap::Summary::read(&bytes).unwrap().unwrap();
+    let index = &summary.metadata_indexes[0];
+    let notes = mcap::read::metadata(&bytes, index).unwrap();
+    assert_eq!(notes.name, "emg_export");
+    assert_eq!(notes.metadata["points_after"], kept.len().to_string());
+}
+
+/// The UR5e's limits file's `max_velocity` and `max_acceleration` of every joint.
+fn ur5e_limits() -> (Vec<f64>, Vec<f64>) {
+    let yaml =
+        std::fs::read_to_string(data_dir().join("robots/ur5e_pen.joint_limits.yaml")).unwrap();
+    let values = |key: &str| -> Vec<f64> {
+        yaml.lines()
+            .filter_map(|line| line.trim().strip_prefix(key))
+            .map(|v| v.trim().parse().unwrap())
+            .collect()
+    };
+    (values("max_velocity:"), values("max_acceleration:"))
+}
+
+#[test]
+fn urscript_targets_are_the_trajectory_every_2_ms_within_the_ur5e_limits() {
+    let dir = temp_dir("export-urscript");
+    let (code, stdout, stderr) = run(
+        dir.path(),
+        &[
+            "plan", "--robot", "ur5e", "--out", "demo", "--export", "urscript",
+        ],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("wrote demo.script"), "{stdout}");
+    let file = read_json(&dir.path().join("demo.joint_trajectory.json"));
+    let points = file["points"].as_array().unwrap();
+    let by_time: std::collections::BTreeMap<i64, Vec<f64>> = points
+        .iter()
+        .map(|p| (nanoseconds(p), numbers(&p["positions"])))
+        .collect();
+    let script = std::fs::read_to_string(dir.path().join("demo.script")).unwrap();
+    let vector = |text: &str| -> Vec<f64> {
+        let inner = &text[text.find('[').unwrap() + 1..text.find(']').unwrap()];
+        inner
+            .split(',')
+            .map(|v| v.trim().parse().unwrap())
+            .collect()
+    };
+    let body: Vec<&str> = script
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.starts_with('#') && !l.is_empty())
+        .collect();
+    assert_eq!(body[0], "def emg_motion():");
+    assert!(body[1].starts_with("movej(["), "{}", body[1]);
+    assert_eq!(vector(body[1]), numbers(&points[0]["positions"]));
+    let servoj: Vec<&str> = body
+        .iter()
+        .copied()
+        .filter(|l| l.starts_with("servoj("))
+        .collect();
+    let stream = &servoj[..servoj.len() - 1];
+    let end_ns = nanoseconds(points.last().unwrap());
+    assert_eq!(stream.len() as i64, (end_ns + 1_999_999) / 2_000_000);
+    let (velocity, acceleration) = ur5e_limits();
+    assert_eq!((velocity.len(), acceleration.len()), (6, 6));
+    let robot = urdf_rs::read_file(data_dir().join("robots/ur5e_pen.urdf")).unwrap();
+    let limits: Vec<(f64, f64)> = [
+        "shoulder_pan_joint",
+        "shoulder_lift_joint",
+        "elbow_joint",
+        "wrist_1_joint",
+        "wrist_2_joint",
+        "wrist_3_joint",
+    ]
+    .iter()
+    .map(|name| {
+        let joint = robot.joints.iter().find(|j| j.name == *name).unwrap();
+        (joint.limit.lower, joint.limit.upper)
+    })
+    .collect();
+    let mut previous: Vec<Vec<f64>> = vec![vector(body[1])];
+    for (k, line) in stream.iter().enumerate() {
+        assert!(line.ends_with(", 0, 0, 0.002, 0.1, 300)"), "{line}");
+        let q = vector(line);
+        let t = ((k as i64 + 1) * 2_000_000).min(end_ns);
+        assert_eq!(&q, &by_time[&t], "servoj target {k} at {t} ns");
+        for (j, value) in q.iter().enumerate() {
+            assert!(
+                limits[j].0 <= *value && *value <= limits[j].1,
+                "target {k} joint {j}"
+            );
+            let last = &previous[previous.len() - 1];
+            let speed = (value - last[j]).abs() / 0.002;
+            assert!(speed <= velocity[j], "target {k} joint {j}: {speed} rad/s");
+            if previous.len() >= 2 {
+                let before = &previous[previous.len() - 2];
+                let accel = (value - 2.0 * last[j] + before[j]).abs() / 4e-6;
+                assert!(
+                    accel <= acceleration[j] * 1.01,
+                    "target {k} joint {j}: {accel}"
+                );
+            }
+        }
+        previous.push(q);
+    }
+    let hold = servoj.last().unwrap();
+    assert!(hold.ends_with(", 0, 0, 0.2, 0.1, 300)"), "{hold}");
+    assert_eq!(vector(hold), numbers(&points.last().unwrap()["positions"]));
+    assert_eq!(body[body.len() - 2], "stopj(1.4)");
+    assert_eq!(body[body.len() - 1], "end");
+}
+
+#[test]
+fn wrong_inputs_are_refused_and_nothing_is_written() {
+    let dir = temp_dir("export-wrong");
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let bad = examples.join("bad.joint_trajectory.json");
+    let bad = bad.to_str().unwrap();
+    let out = |name: &str| dir.path().join(name);
+    let cases: [(Vec<&str>, &str, i32); 4] = [
+        (
+            vec![
+                "--format", "urscript", "--out", "a.script", "--robot", "fr3",
+            ],
+            "urscript runs on Universal Robots controllers only: robot",
+            1,
+        ),
+        (
+            vec![
+                "--format",
+                "ros2-mcap",
+                "--out",
+                "b.mcap",
+                "--robot",
+                "ur5e",
+            ],
+            "field 'joint_names' is",
+            1,
+        ),
+        (
+            vec!["--format", "ros3", "--out", "c.mcap"],
+            "unknown export format 'ros3': give ros2-mcap or urscript",
+            2,
+        ),
+        (
+            vec!["--format", "ros2-mcap", "--out", bad, "--robot", "fr3"],
+            "which is the joint trajectory file",
+            1,
+        ),
+    ];
+    for (args, message, status) in cases {
+        let mut all = vec!["export", bad];
+        all.extend(&args);
+        let (code, _, stderr) = run(dir.path(), &all);
+        assert_eq!(code, Some(status), "{all:?}: {stderr}");
+        assert!(stderr.contains(message), "{all:?}: {stderr}");
+    }
+    let json = examples.join("plan.json");
+    let (code, _, stderr) = run(
+        dir.path(),
+        &[
+            "export",
+            json.to_str().unwrap(),
+            "--format",
+            "ros2-mcap",
+            "--out",
+            "d.mcap",
+        ],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("is not a joint trajectory (emg-joint-trajectory/2"),
+        "{stderr}"
+    );
+    let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(names.is_empty(), "{names:?}");
+    assert!(!out("a.script").exists());
+    // Planning with --export urscript on a seven-joint arm is refused before anything is planned.
+    let (code, _, stderr) = run(dir.path(), &["plan", "--out", "e", "--export", "urscript"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("nothing was planned or written"),
+        "{stderr}"
+    );
+    assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+}

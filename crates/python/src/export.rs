@@ -1,0 +1,89 @@
+//! `export`: a joint trajectory written for a robot's own stack, as `emg export` writes it.
+
+use std::path::{Path, PathBuf};
+
+use emg_io::{DriverProfile, ExportError, ExportFormat, ExportOptions, ExportRobot};
+use emg_planner::ShippedRobot;
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+
+use crate::robot::Robot;
+use crate::{InputError, data_dir, message};
+
+/// What an export wrote.
+#[pyclass(frozen, get_all, module = "extreme_line_motion")]
+pub struct ExportReport {
+    /// `"ros2-mcap"` or `"urscript"`.
+    format: &'static str,
+    /// The files written (several URScript programs for a motion split where it rests).
+    files: Vec<PathBuf>,
+    /// What was exported, in words (as `emg export` prints it).
+    summary: String,
+    /// ros2-mcap: points of the joint trajectory, and points kept in the message.
+    points_before: Option<usize>,
+    /// ros2-mcap: points kept.
+    points_after: Option<usize>,
+    /// ros2-mcap: the tolerance (rad) of the quintic spline through the kept points.
+    tolerance_rad: Option<f64>,
+    /// ros2-mcap: its largest joint deviation from any sample (rad).
+    max_joint_deviation_rad: Option<f64>,
+    /// ros2-mcap: its largest deviation at the tool (m).
+    max_tool_deviation_m: Option<f64>,
+    /// urscript: the `servoj` targets, one every 2 ms.
+    servoj_targets: usize,
+}
+
+/// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) as `format`
+/// (`"ros2-mcap"` or `"urscript"`) to `out`, for its own robot or `robot` (a shipped robot's
+/// name or a robot file), as `emg export` does: nothing is written on an error, and `out` never
+/// replaces `path`.
+#[pyfunction]
+#[pyo3(signature = (path, format, out, robot = None, tolerance_rad = None, max_servoj_lines = None))]
+pub fn export(
+    path: PathBuf,
+    format: &str,
+    out: PathBuf,
+    robot: Option<PathBuf>,
+    tolerance_rad: Option<f64>,
+    max_servoj_lines: Option<usize>,
+) -> PyResult<ExportReport> {
+    let fail = |e: ExportError| match &e {
+        ExportError::Read { .. } | ExportError::Write { .. } => PyOSError::new_err(message(&e)),
+        _ => InputError::new_err(message(&e)),
+    };
+    let format: ExportFormat = format.parse().map_err(fail)?;
+    let trajectory = emg_io::read_joint_trajectory(&path).map_err(fail)?;
+    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(&trajectory.robot)))?;
+    let shipped = ShippedRobot::by_path(&robot.file, &data_dir()?)
+        .and_then(|s| DriverProfile::for_shipped(s.name));
+    let file = robot.file.display().to_string();
+    let defaults = ExportOptions::default();
+    let options = ExportOptions {
+        tolerance_rad: tolerance_rad.unwrap_or(defaults.tolerance_rad),
+        max_servoj_lines: max_servoj_lines.unwrap_or(defaults.max_servoj_lines),
+    };
+    let target = ExportRobot {
+        file: &file,
+        shipped,
+        kinematics: Some(&robot.inner),
+    };
+    let export = emg_io::export(&trajectory, format, &out, &target, &options).map_err(fail)?;
+    export
+        .write(&[
+            ("joint trajectory", path.as_path()),
+            ("robot", Path::new(&robot.file)),
+        ])
+        .map_err(fail)?;
+    let thinning = export.thinning.as_ref();
+    Ok(ExportReport {
+        format: format.name(),
+        files: export.files.iter().map(|(p, _)| p.clone()).collect(),
+        summary: export.summary.clone(),
+        points_before: thinning.map(|t| t.points_before),
+        points_after: thinning.map(|t| t.points_after),
+        tolerance_rad: thinning.map(|t| t.tolerance_rad),
+        max_joint_deviation_rad: thinning.map(|t| t.max_joint_deviation_rad),
+        max_tool_deviation_m: thinning.and_then(|t| t.max_tool_deviation_m),
+        servoj_targets: export.servoj_targets,
+    })
+}
