@@ -202,6 +202,8 @@ class Planner:
         models: Optional[PathLike] = None,
         config: Union[PathLike, dict, None] = None,
         surface: Optional[str] = None,
+        tolerance_mm: Optional[float] = None,
+        cone_deg: Optional[float] = None,
     ) -> None: ...
     @property
     def robot(self) -> Robot:

@@ -227,6 +227,16 @@ pub struct PlanArgs {
     /// `work_surface` when it sets one, else `plate`.
     #[arg(long, value_name = "plate|half-space|off", value_parser = WorkSurface::from_str)]
     pub surface: Option<WorkSurface>,
+    /// How far the tool may leave the line or path (mm): the line tolerance of every step, of
+    /// the bound, of the timed motion and of the checker. Default: the --config file's
+    /// `rollout.constraints.line_tolerance_m`, else 20 mm (the paper's benchmark; a pen or a
+    /// bead wants 0.5 mm or less).
+    #[arg(long, value_name = "MM", value_parser = positive)]
+    pub tolerance: Option<f64>,
+    /// Half-angle of the cone around the surface normal the tool axis stays in (degrees).
+    /// Default: the --config file's `rollout.constraints.theta_max_deg`, else 30°.
+    #[arg(long, value_name = "DEG", value_parser = positive)]
+    pub cone: Option<f64>,
     /// Scene file (JSON) of obstacles the whole arm, pen included, keeps clear of: half-spaces,
     /// boxes, spheres and capsules in the base frame, each with its clearance (see
     /// docs/scene.md). Replaces the --config file's `rollout.constraints.scene`.
@@ -281,6 +291,14 @@ impl PlanArgs {
         self.policy
             .clone()
             .or_else(|| crate::robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE))
+    }
+}
+
+/// Parses a positive finite number.
+fn positive(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(value) if value.is_finite() && value > 0.0 => Ok(value),
+        _ => Err(format!("'{s}' is not a positive number")),
     }
 }
 

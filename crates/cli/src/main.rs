@@ -127,6 +127,12 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
     if let Some(surface) = args.surface {
         config.rollout.constraints.work_surface = surface;
     }
+    if let Some(tolerance_mm) = args.tolerance {
+        config.rollout.constraints.line_tolerance_m = tolerance_mm * 1e-3;
+    }
+    if let Some(cone_deg) = args.cone {
+        config.rollout.constraints.theta_max_deg = cone_deg;
+    }
     if let Some(path) = &args.scene {
         config.rollout.constraints.scene = emg_io::read_scene(path)?;
     }

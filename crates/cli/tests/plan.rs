@@ -813,3 +813,41 @@ fn first_hour_inputs_are_read_as_written() {
         "{fast}"
     );
 }
+
+/// `--tolerance MM` and `--cone DEG` set the line tolerance and the tool cone of the plan, the
+/// bound, the timed motion and the checker, and every file records them; a bad value names the
+/// option.
+#[test]
+fn tolerance_and_cone_are_options_every_file_records() {
+    let tmp = temp_dir("tolerance");
+    let stem = tmp.path().join("fine");
+    plan_ok(&[
+        "--tolerance",
+        "0.5",
+        "--cone",
+        "20",
+        "--out",
+        stem.to_str().unwrap(),
+    ]);
+    let rollout = read_json(&tmp.path().join("fine.json"));
+    let timed = read_json(&tmp.path().join("fine.joint_trajectory.json"));
+    for constraints in [&rollout["config"]["constraints"], &timed["constraints"]] {
+        assert_eq!(constraints["line_tolerance_m"], 0.0005, "{constraints}");
+        assert_eq!(constraints["theta_max_deg"], 20.0, "{constraints}");
+    }
+    let check = emg(&[
+        "check",
+        tmp.path()
+            .join("fine.joint_trajectory.json")
+            .to_str()
+            .unwrap(),
+    ]);
+    assert!(check.status.success(), "{}", stderr(&check));
+    let refused = emg(&["plan", "--tolerance", "0", "--out", stem.to_str().unwrap()]);
+    let error = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(2), "a usage error: {error}");
+    assert!(
+        error.contains("--tolerance") && error.contains("positive"),
+        "{error}"
+    );
+}

@@ -30,7 +30,9 @@ use emg_timing::Scaling;
 /// `config`: a planner configuration, as a JSON file or a dict of its fields (`rollout`,
 /// `gains`, `switch`, `measure`, `reach`, `search`); unset fields keep the defaults, the work
 /// plate on. `surface`: the part the line is drawn on, `"plate"` (the default: a plate under
-/// the line), `"half-space"` or `"off"` (the paper's protocol), over the config's; the same
+/// the line), `"half-space"` or `"off"` (the paper's protocol), over the config's;
+/// `tolerance_mm`: how far the tool may leave the line or path (default: the config's, else
+/// 20 mm); `cone_deg`: the tool cone's half-angle (default: the config's, else 30°); the same
 /// defaults as `emg plan`.
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct Planner {
@@ -245,13 +247,15 @@ pub(crate) fn array1<'py>(
 #[pymethods]
 impl Planner {
     #[new]
-    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None, surface = None))]
+    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None, surface = None, tolerance_mm = None, cone_deg = None))]
     fn new(
         py: Python<'_>,
         robot: PathBuf,
         models: Option<PathBuf>,
         config: Option<&Bound<'_, PyAny>>,
         surface: Option<&str>,
+        tolerance_mm: Option<f64>,
+        cone_deg: Option<f64>,
     ) -> PyResult<Self> {
         let robot = Robot::load(&robot)?;
         let mut config = read_config(config)?;
@@ -259,6 +263,22 @@ impl Planner {
             config.rollout.constraints.work_surface = surface
                 .parse::<WorkSurface>()
                 .map_err(|e| InputError::new_err(format!("surface: {e}")))?;
+        }
+        let positive = |name: &str, value: f64| {
+            if value.is_finite() && value > 0.0 {
+                Ok(value)
+            } else {
+                Err(InputError::new_err(format!(
+                    "{name}: must be a positive number, got {value}"
+                )))
+            }
+        };
+        if let Some(tolerance_mm) = tolerance_mm {
+            config.rollout.constraints.line_tolerance_m =
+                positive("tolerance_mm", tolerance_mm)? * 1e-3;
+        }
+        if let Some(cone_deg) = cone_deg {
+            config.rollout.constraints.theta_max_deg = positive("cone_deg", cone_deg)?;
         }
         let [diffusion, policy] = model_files(&robot.file, models.as_deref())?;
         let loaded = Models::load(&robot.inner, diffusion.as_deref(), policy.as_deref())

@@ -108,6 +108,23 @@ def test_the_work_surface_and_a_scene_plan_as_the_cli_plans_them(tmp_path, plann
     assert elm.check(tmp_path / "python.joint_trajectory.json").points > 0
 
 
+def test_a_cells_tolerance_and_cone_plan_as_the_cli_plans_them(tmp_path, tasks):
+    task = tasks[5]
+    fine = elm.Planner("fr3", surface="off", tolerance_mm=0.5, cone_deg=20)
+    plan = fine.plan(task.p0, task.d, task.n, seed="dp", controller="hybrid",
+                     planner="controller", reach=False)
+    assert np.all(plan.tool_angle_deg <= 20.0)
+    plan.save(tmp_path / "python")
+    run_cli(
+        "plan", "--p0", vector(task.p0), "--d", vector(task.d), "--n", vector(task.n),
+        "--seed", "dp", "--controller", "hybrid", "--planner", "controller", "--reach", "off",
+        "--surface", "off", "--tolerance", "0.5", "--cone", "20", "--out", tmp_path / "cli",
+    )
+    assert_same_files(tmp_path / "python", tmp_path / "cli")
+    with pytest.raises(elm.InputError, match="tolerance_mm"):
+        elm.Planner("fr3", tolerance_mm=0)
+
+
 def test_plan_arrays_describe_the_motion(planner, tasks):
     task = tasks[0]
     plan = planner.plan(task.p0, task.d, task.n, reach=True)
