@@ -258,20 +258,13 @@ fn urscript_targets_are_the_trajectory_every_2_ms_within_the_ur5e_limits() {
     let (velocity, acceleration) = ur5e_limits();
     assert_eq!((velocity.len(), acceleration.len()), (6, 6));
     let robot = urdf_rs::read_file(data_dir().join("robots/ur5e_pen.urdf")).unwrap();
-    let limits: Vec<(f64, f64)> = [
-        "shoulder_pan_joint",
-        "shoulder_lift_joint",
-        "elbow_joint",
-        "wrist_1_joint",
-        "wrist_2_joint",
-        "wrist_3_joint",
-    ]
-    .iter()
-    .map(|name| {
-        let joint = robot.joints.iter().find(|j| j.name == *name).unwrap();
-        (joint.limit.lower, joint.limit.upper)
-    })
-    .collect();
+    let limits: Vec<(f64, f64)> = emg_io::UR_JOINT_NAMES
+        .iter()
+        .map(|name| {
+            let joint = robot.joints.iter().find(|j| j.name == *name).unwrap();
+            (joint.limit.lower, joint.limit.upper)
+        })
+        .collect();
     let mut previous: Vec<Vec<f64>> = vec![vector(body[1])];
     for (k, line) in stream.iter().enumerate() {
         assert!(line.ends_with(", 0, 0, 0.002, 0.1, 300)"), "{line}");

@@ -23,29 +23,24 @@ pub struct DriverProfile {
     pub base_relation: &'static str,
 }
 
+/// The FR3's joints, as the shipped robot file and franka_ros2 both name them.
+const FR3_JOINT_NAMES: &[&str] = &[
+    "fr3_joint1",
+    "fr3_joint2",
+    "fr3_joint3",
+    "fr3_joint4",
+    "fr3_joint5",
+    "fr3_joint6",
+    "fr3_joint7",
+];
+
 /// The Franka Research 3 through franka_ros2 (frankaemika/franka_ros2, its `fr3_arm_controller`
 /// of `franka_moveit_config`): joints `fr3_joint1..7`, base `fr3_link0`.
 const FR3: DriverProfile = DriverProfile {
     robot: "fr3",
     driver: "franka_ros2 (frankaemika/franka_ros2)",
-    file_joint_names: &[
-        "fr3_joint1",
-        "fr3_joint2",
-        "fr3_joint3",
-        "fr3_joint4",
-        "fr3_joint5",
-        "fr3_joint6",
-        "fr3_joint7",
-    ],
-    joint_names: &[
-        "fr3_joint1",
-        "fr3_joint2",
-        "fr3_joint3",
-        "fr3_joint4",
-        "fr3_joint5",
-        "fr3_joint6",
-        "fr3_joint7",
-    ],
+    file_joint_names: FR3_JOINT_NAMES,
+    joint_names: FR3_JOINT_NAMES,
     topic: "/fr3_arm_controller/joint_trajectory",
     base_frame: "fr3_link0",
     base_relation: "the shipped base frame link0 is franka_description's fr3_link0 (the same \
