@@ -32,7 +32,7 @@ pub struct ExportArgs {
     /// ros2-mcap: the largest joint deviation (rad) of the controller's quintic spline through
     /// the points kept from any sample of the file.
     #[arg(long, value_name = "RAD", default_value_t = ExportOptions::default().tolerance_rad)]
-    pub tolerance: f64,
+    pub thinning_tolerance: f64,
     /// urscript: most servoj lines (2 ms each) per program.
     #[arg(long, value_name = "N", default_value_t = ExportOptions::default().max_servoj_lines)]
     pub max_servoj: usize,
@@ -69,7 +69,7 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
     };
     let robot = crate::robot::load_robot(&robot_file, None, None)?;
     let options = ExportOptions {
-        tolerance_rad: args.tolerance,
+        tolerance_rad: args.thinning_tolerance,
         max_servoj_lines: args.max_servoj,
     };
     let text = export_to(

@@ -191,42 +191,39 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         } else {
             String::new()
         };
-        let task = match task {
-            Ok(task) => task,
-            Err(reason) => {
-                anyhow::ensure!(many, "refused, nothing written: {reason}");
-                eprintln!("{label}refused, nothing written: {reason}");
-                refused.push((index, reason.clone()));
-                continue;
-            }
-        };
-        let refuse = |violation: Option<&emg_control::Violation>| {
-            refusal::refusal(&planner, &args.robot, &request, task, violation)
-        };
-        let reason = match planner.plan(task, &request) {
-            Ok(plan) => match &plan.trajectory.termination {
-                emg_control::Termination::InvalidStart { violation } => {
-                    Err(refuse(Some(violation)))
+        // A task is planned, refused at its start (invalid, or no start holds), or failed.
+        let planned = match task {
+            Err(reason) => Err(reason.clone()),
+            Ok(task) => {
+                let refuse = |violation: Option<&emg_control::Violation>| {
+                    refusal::refusal(&planner, &args.robot, &request, task, violation)
+                };
+                match planner.plan(task, &request) {
+                    Ok(plan) => match &plan.trajectory.termination {
+                        emg_control::Termination::InvalidStart { violation } => {
+                            Err(refuse(Some(violation)))
+                        }
+                        _ => Ok((task, plan)),
+                    },
+                    // The search found no configuration at p0 to start from.
+                    Err(PlanError::Seed(SeedError::Projection { .. }))
+                        if request.planner == PlannerKind::Search =>
+                    {
+                        Err(refuse(None))
+                    }
+                    Err(error) if !many => return Err(plan_error(error, &request)),
+                    Err(error) => {
+                        let error = plan_error(error, &request);
+                        let text = error_text(&error);
+                        eprintln!("{label}error: {text}");
+                        failures.push((index, text));
+                        continue;
+                    }
                 }
-                _ => Ok(plan),
-            },
-            // The search found no configuration at p0 to start from.
-            Err(PlanError::Seed(SeedError::Projection { .. }))
-                if request.planner == PlannerKind::Search =>
-            {
-                Err(refuse(None))
-            }
-            Err(error) if !many => return Err(plan_error(error, &request)),
-            Err(error) => {
-                let error = plan_error(error, &request);
-                let text = error_text(&error);
-                eprintln!("{label}error: {text}");
-                failures.push((index, text));
-                continue;
             }
         };
-        let plan = match reason {
-            Ok(plan) => plan,
+        let (task, plan) = match planned {
+            Ok(planned) => planned,
             Err(reason) => {
                 anyhow::ensure!(many, "refused, nothing written: {reason}");
                 eprintln!("{label}refused, nothing written: {reason}");
@@ -266,10 +263,18 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
 
 /// The `--config` option: inline JSON when it starts with `{`, else a file.
 pub(crate) fn read_config(config: &Path) -> Result<PlannerConfig> {
-    match config.to_str().map(str::trim_start) {
-        Some(text) if text.starts_with('{') => Ok(PlannerConfig::from_json("--config", text)?),
-        _ => Ok(PlannerConfig::read(config)?),
+    match inline_json(config) {
+        Some(text) => Ok(PlannerConfig::from_json("--config", text)?),
+        None => Ok(PlannerConfig::read(config)?),
     }
+}
+
+/// The JSON text of a `--config` value given inline (starting with `{`), `None` for a file.
+fn inline_json(config: &Path) -> Option<&str> {
+    config
+        .to_str()
+        .map(str::trim_start)
+        .filter(|text| text.starts_with('{'))
 }
 
 /// Refuses, before anything is planned, a run whose files (`--out`'s, `--html`'s, for each of
@@ -279,11 +284,10 @@ fn refuse_overwriting_inputs(args: &PlanArgs, tasks: usize) -> Result<()> {
         emg_kinematics::srdf_beside(&args.robot),
         emg_planner::limits_file_beside(&args.robot),
     ];
-    let config_file = args.config.as_deref().filter(|config| {
-        !config
-            .to_str()
-            .is_some_and(|t| t.trim_start().starts_with('{'))
-    });
+    let config_file = args
+        .config
+        .as_deref()
+        .filter(|config| inline_json(config).is_none());
     let weights = args.weights_path();
     let policy = args.policy_path();
     let optional = [

@@ -33,28 +33,24 @@ pub fn refusal(
         };
         return format!("the start configuration breaks a constraint: {violation}{fixed}{advice}");
     }
-    let blockers = planner.start_blockers(task);
-    let theta = planner.config().rollout.constraints.theta_max_deg;
-    format!(
-        "no configuration at p0 holds every constraint: {}",
-        blockers_text(robot, robot_file, task, &blockers, theta)
-    )
+    let why = if task.inside_base_column() {
+        "p0 lies inside the space the arm's base occupies (its base link and first body, turned \
+         about the first joint), where no part can be; move the part away from the base"
+            .to_string()
+    } else {
+        let theta = planner.config().rollout.constraints.theta_max_deg;
+        blockers_text(robot, robot_file, &planner.start_blockers(task), theta)
+    };
+    format!("no configuration at p0 holds every constraint: {why}")
 }
 
 /// What the configurations at `p0` break, and what would change it.
 fn blockers_text(
     robot: &Robot,
     robot_file: &Path,
-    task: &Task,
     blockers: &StartBlockers,
     theta_max_deg: f64,
 ) -> String {
-    if task.inside_base_column() {
-        return "p0 lies inside the space the arm's base occupies (its base link and first \
-                body, turned about the first joint), where no part can be; move the part away \
-                from the base"
-            .to_string();
-    }
     let Some(first) = blockers.contacts.first() else {
         return format!(
             "none of {} inverse-kinematics restarts puts the TCP at p0 with the tool within \

@@ -295,7 +295,7 @@ fn ros2(
     let tolerance = options.tolerance_rad;
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(ExportError::Option {
-            option: "--tolerance",
+            option: "--thinning-tolerance",
             value: tolerance.to_string(),
             problem: "expected a positive number of radians",
         });
