@@ -34,11 +34,12 @@ mod rollout;
 mod sampler;
 mod step;
 mod task;
+mod tracking;
 mod verification;
 
 pub use classical::{ClassicalController, lead_axis};
 pub use config::{
-    ClassicalGains, ConstraintConfig, MAX_STEPS_CAP, OutOfRange, RolloutConfig,
+    ClassicalGains, ConstraintConfig, MAX_STEPS_CAP, OutOfRange, RolloutConfig, Tracking,
     VelocityLimitFraction,
 };
 pub use constraints::{Violation, WORK_SURFACE, first_contact, first_violation, tool_angle_deg};
@@ -57,4 +58,5 @@ pub use task::{
     ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task,
     TaskError,
 };
+pub use tracking::{CORRECTION_TRIGGER, MAX_CORRECTIONS, correct_onto_task, onto_task};
 pub use verification::{CheckRollout, task_bounds};

@@ -3,11 +3,12 @@
 use emg_kinematics::{JointVector, Robot};
 use serde::{Deserialize, Serialize};
 
-use crate::config::RolloutConfig;
+use crate::config::{RolloutConfig, Tracking};
 use crate::constraints::{Violation, admit, first_violation, tool_angle_deg};
 use crate::controller::{ActingController, NullSpaceController};
 use crate::step::{NullAction, StepContext};
 use crate::task::Task;
+use crate::tracking::{CORRECTION_TRIGGER, correct_onto_task};
 
 /// Steps a rollout reserves room for up front (the default step cap and its seed fit); longer
 /// rollouts grow their record as they go, so memory follows the steps taken, not the cap.
@@ -128,9 +129,9 @@ pub enum StepOutcome {
 /// Each step: read the [`StepContext`] at `q_t` ([`Episode::context`], computed once when the
 /// step was accepted), choose an action, and [`Episode::apply`] it: clip to `[−1, 1]⁴`,
 /// integrate `q̇ = J⁺ẋ + a_max B a` for `Δt` (on a path, for the share of it that lands on the
-/// next corner or the end when a full step would pass it, [`StepContext::step_fraction`]), and
-/// accept `q_{t+1}` only if it holds every
-/// constraint.
+/// next corner or the end when a full step would pass it, [`StepContext::step_fraction`]),
+/// under [`Tracking::Corrected`] correct its end onto the line or path where it drifted, and
+/// accept `q_{t+1}` only if it holds every constraint.
 ///
 /// Joint-velocity limits are honoured by time scaling: a step whose `q̇` would exceed
 /// `fraction · v_max,i` on some joint keeps its shape but lasts `Δt · max_i |q̇_i| / (fraction ·
@@ -203,9 +204,10 @@ impl<'a> Episode<'a> {
             ..
         } = self.current;
         let action = action.map(|a| a.clamp(-1.0, 1.0));
-        let velocity = self.current.joint_velocity(&action);
         let fraction = self.current.step_fraction();
-        let next = self.current.q + velocity * (config.dt_s * fraction);
+        let step_s = config.dt_s * fraction;
+        let mut velocity = self.current.joint_velocity(&action);
+        let mut next = self.current.q + velocity * step_s;
         // The context already holds this configuration's tool angle and ρ.
         self.push_record(Some(acting), self.current.tool_angle_deg, self.current.rho);
         // The next configuration's kinematics are written in place; the rest of the context is
@@ -213,7 +215,19 @@ impl<'a> Episode<'a> {
         // and taken on once the step is accepted.
         let previous_tcp = self.current.kinematics.tcp();
         robot.forward_into(&next, &mut self.current.kinematics);
-        let derived = self.current.derive();
+        let mut derived = self.current.derive();
+        let mut applied = action;
+        if config.tracking == Tracking::Corrected
+            && step_s > 0.0
+            && derived.along.lateral.norm()
+                > CORRECTION_TRIGGER * config.constraints.line_tolerance_m
+            && let Some(corrected) = self.corrected_step(&action, step_s, next)
+        {
+            (next, applied) = corrected;
+            // The joints' mean velocity over the corrected step.
+            velocity = (next - self.current.q) / step_s;
+            derived = self.current.derive();
+        }
         let tool_angle_deg = match admit(robot, task, &self.current.kinematics, &config.constraints)
         {
             Ok(tool_angle_deg) => tool_angle_deg,
@@ -233,7 +247,7 @@ impl<'a> Episode<'a> {
         };
         self.time_s += self.step_duration(&velocity) * fraction;
         self.current
-            .advance(self.steps.len(), tool_angle_deg, action, derived);
+            .advance(self.steps.len(), tool_angle_deg, applied, derived);
         if task.completed(self.current.along.s_m) {
             self.record(None);
             self.termination = Some(Termination::Completed);
@@ -245,6 +259,50 @@ impl<'a> Episode<'a> {
             return StepOutcome::Truncated { progress_m };
         }
         StepOutcome::Continued { progress_m }
+    }
+
+    /// The corrected step of [`Tracking::Corrected`] from the current configuration, whose
+    /// paper step of `step_s` seconds with `action` ended at `paper_end` (the kinematics in the
+    /// context): Newton corrections `Δq = J⁺ e` toward the nearest line or path point, then the
+    /// same without the null-space motion. The end configuration and the action it applied,
+    /// with the context's kinematics at it; `None`, the kinematics back at `paper_end`, where
+    /// neither comes within [`CORRECTION_TRIGGER`] of the tolerance.
+    fn corrected_step(
+        &mut self,
+        action: &NullAction,
+        step_s: f64,
+        paper_end: JointVector,
+    ) -> Option<(JointVector, NullAction)> {
+        let StepContext {
+            robot,
+            task,
+            config,
+            ..
+        } = self.current;
+        let target_m = CORRECTION_TRIGGER * config.constraints.line_tolerance_m;
+        let without_self_motion = NullAction::zeros();
+        for applied in [*action, without_self_motion] {
+            let mut q = if applied == *action {
+                paper_end
+            } else {
+                let q = self.current.q + self.current.joint_velocity(&applied) * step_s;
+                robot.forward_into(&q, &mut self.current.kinematics);
+                q
+            };
+            if correct_onto_task(
+                robot,
+                task,
+                &self.current.pseudo_inverse,
+                self.current.along.s_m,
+                target_m,
+                &mut q,
+                &mut self.current.kinematics,
+            ) {
+                return Some((q, applied));
+            }
+        }
+        robot.forward_into(&paper_end, &mut self.current.kinematics);
+        None
     }
 
     /// Whether the episode is over.

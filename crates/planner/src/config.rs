@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use emg_control::{ClassicalGains, OutOfRange, RolloutConfig};
+use emg_control::{ClassicalGains, OutOfRange, RolloutConfig, Tracking};
 use emg_hybrid::{BoundaryMeasure, SwitchConfig, SwitchConfigError};
 use emg_kinematics::WorkSurface;
 use serde::{Deserialize, Serialize};
@@ -16,7 +16,8 @@ use crate::search::SearchConfig;
 /// Every setting of a plan; unset fields keep their defaults (SPEC §2–4, Sec. 4.3):
 /// `rollout` ([`RolloutConfig`]: `dt_s` 0.05 s, `speed_m_per_s` 0.2 m/s, `max_steps` 500,
 /// `null_speed_max_rad_per_s` 0.5, `lateral_gain_per_s` 5, constraints: `line_tolerance_m` 0.02,
-/// `theta_max_deg` 30, `collision_margin_m` 0, `velocity_limit_fraction` 1), `gains`
+/// `theta_max_deg` 30, `collision_margin_m` 0, `velocity_limit_fraction` 1; `tracking`
+/// `first_order`, the paper's step), `gains`
 /// ([`ClassicalGains`]: `k_mu` 0.8, `k_jl` 0.4, `k_theta` 0.2, `cone_gate_width_deg` 8,
 /// `k_lead` 0),
 /// `switch` ([`SwitchConfig`]: `tau_enter` 0.98, `tau_exit` 0.94), `measure`
@@ -49,6 +50,9 @@ pub struct PlannerConfig {
 /// Where a configuration's JSON sets the work surface.
 const SURFACE_FIELD: &str = "/rollout/constraints/work_surface";
 
+/// Where a configuration's JSON sets how the step tracks its line or path.
+const TRACKING_FIELD: &str = "/rollout/tracking";
+
 /// Why a configuration file cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
@@ -80,11 +84,13 @@ pub enum ConfigError {
 impl PlannerConfig {
     /// The configuration of a work cell, what `emg plan` and Python plan with when given none:
     /// the defaults with the task's work plate on ([`WorkSurface::plate`]: the arm keeps off a
-    /// plate under the line). [`PlannerConfig::default`] is the paper's protocol, with no work
-    /// surface.
+    /// plate under the line) and the corrected step ([`Tracking::Corrected`]: the TCP held on
+    /// its line or path at any tolerance). [`PlannerConfig::default`] is the paper's protocol,
+    /// with no work surface and the paper's step.
     pub fn cell() -> Self {
         let mut config = Self::default();
         config.rollout.constraints.work_surface = WorkSurface::plate();
+        config.rollout.tracking = Tracking::Corrected;
         config
     }
 
@@ -128,7 +134,8 @@ impl PlannerConfig {
 
     /// Parses and validates a configuration's JSON text; `origin` names it in errors. Unset
     /// fields keep the values of [`PlannerConfig::cell`]: a text that sets no
-    /// `rollout.constraints.work_surface` plans with the work plate.
+    /// `rollout.constraints.work_surface` plans with the work plate, one that sets no
+    /// `rollout.tracking` with the corrected step.
     pub fn from_json(origin: &str, text: &str) -> Result<Self, ConfigError> {
         let parse_error = |e: serde_json::Error| ConfigError::Parse {
             path: origin.to_string(),
@@ -138,6 +145,9 @@ impl PlannerConfig {
         let value: serde_json::Value = serde_json::from_str(text).map_err(parse_error)?;
         if value.pointer(SURFACE_FIELD).is_none() {
             config.rollout.constraints.work_surface = WorkSurface::plate();
+        }
+        if value.pointer(TRACKING_FIELD).is_none() {
+            config.rollout.tracking = Tracking::Corrected;
         }
         config.validate()?;
         Ok(config)

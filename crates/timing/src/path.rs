@@ -5,7 +5,7 @@
 //! the distance the TCP travels between waypoints, checked against every task constraint on a
 //! dense sampling and refined where it fails.
 
-use emg_control::{ConstraintConfig, Task, Violation, first_violation};
+use emg_control::{ConstraintConfig, Task, Violation, first_violation, onto_task};
 use emg_kinematics::{JointVector, Robot};
 
 use crate::inset::{inset, tool_angle_gradient};
@@ -58,7 +58,8 @@ impl SmoothPath {
     /// them (when the moved configuration holds every constraint). It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment, at the joints' turning points and at
     /// the tool angle's peaks; a segment that breaks a constraint gets back the middle waypoint
-    /// it skipped, or, between consecutive waypoints, their chord midpoint moved likewise as a
+    /// it skipped, or, between consecutive waypoints, their chord midpoint (moved onto the line
+    /// or path where it lies more than half the tolerance off, [`onto_task`]) moved likewise as a
     /// new knot (when that holds the constraints, up to [`MAX_REFINEMENTS`] midpoints in all),
     /// else the path ends at the segment's first waypoint.
     ///
@@ -140,6 +141,7 @@ impl SmoothPath {
             }
             let midpoint = (midpoints < MAX_REFINEMENTS)
                 .then(|| (values[segment] + values[segment + 1]) / 2.0)
+                .map(|chord| onto_task(robot, task, &chord, constraints.line_tolerance_m))
                 .and_then(|chord| inset(robot, task, constraints, &chord))
                 .filter(|q| valid(q));
             if let Some(midpoint) = midpoint {

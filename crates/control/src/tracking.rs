@@ -1,0 +1,73 @@
+//! Holding the TCP on its line or path to a cell's tolerance: the Newton correction that the
+//! corrected step ([`crate::Tracking::Corrected`]) and the timing's smooth path share.
+
+use emg_kinematics::{
+    DampedPseudoInverse, DampingConfig, JointVector, Kinematics, Robot, damped_pseudo_inverse,
+};
+
+use crate::task::Task;
+
+/// The share of the line tolerance beyond which a configuration's TCP is corrected onto its line
+/// or path, and within which the corrections stop: half the tube stays free for the spline the
+/// timing lays between the steps.
+pub const CORRECTION_TRIGGER: f64 = 0.5;
+
+/// Newton corrections tried at most on one configuration.
+pub const MAX_CORRECTIONS: usize = 3;
+
+/// Moves `q`, whose forward kinematics `kinematics` holds, toward the nearest point of the task's
+/// line or path (searched near the progress `s_hint`) by Newton corrections `q ← q + J⁺ e`,
+/// `e` the TCP's offset to that point, with the pseudo-inverse `pseudo_inverse` of a
+/// configuration near `q` (the chord method; no allocation). `kinematics` follows `q`. Whether
+/// the TCP came within `target_m` of the line or path in at most [`MAX_CORRECTIONS`]
+/// corrections.
+pub fn correct_onto_task(
+    robot: &Robot,
+    task: &Task,
+    pseudo_inverse: &DampedPseudoInverse,
+    s_hint: f64,
+    target_m: f64,
+    q: &mut JointVector,
+    kinematics: &mut Kinematics,
+) -> bool {
+    for _ in 0..MAX_CORRECTIONS {
+        let offset = task.along(&kinematics.tcp(), s_hint).lateral;
+        *q += pseudo_inverse.matrix * offset;
+        robot.forward_into(q, kinematics);
+        if task.along(&kinematics.tcp(), s_hint).lateral.norm() <= target_m {
+            return true;
+        }
+    }
+    false
+}
+
+/// `q` moved onto the task's line or path where its TCP lies more than [`CORRECTION_TRIGGER`]
+/// of `tolerance_m` off it ([`correct_onto_task`] with the pseudo-inverse at `q`, damped as
+/// the rollout's default); `q` itself where it lies closer or the corrections do not get it
+/// there.
+pub fn onto_task(robot: &Robot, task: &Task, q: &JointVector, tolerance_m: f64) -> JointVector {
+    let target_m = CORRECTION_TRIGGER * tolerance_m;
+    let mut kinematics = robot.forward(q);
+    // A line needs no hint; on a path, the nearest point of the whole path.
+    let s_hint = task.path.as_ref().map_or(0.0, |path| {
+        path.locate(&kinematics.tcp(), 0.0, path.length_m()).s
+    });
+    if task.along(&kinematics.tcp(), s_hint).lateral.norm() <= target_m {
+        return *q;
+    }
+    let pseudo_inverse = damped_pseudo_inverse(kinematics.jacobian(), &DampingConfig::default());
+    let mut corrected = *q;
+    if correct_onto_task(
+        robot,
+        task,
+        &pseudo_inverse,
+        s_hint,
+        target_m,
+        &mut corrected,
+        &mut kinematics,
+    ) {
+        corrected
+    } else {
+        *q
+    }
+}
