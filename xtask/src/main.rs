@@ -21,6 +21,7 @@ mod label_seeds;
 mod limit;
 mod make_tasks;
 mod path_eval;
+mod precision_eval;
 mod progress;
 mod protocol;
 mod readme_picture;
@@ -88,6 +89,9 @@ enum Command {
     /// controller and the search beside the bound, checked and timed; rectangles also one line
     /// at a time (docs/results/paths.*).
     PathEval(path_eval::Args),
+    /// The search at 20 mm, 0.5 mm and 0.1 mm with the paper's and the corrected step, on lines
+    /// and paths, checked and timed (docs/results/precision.*).
+    PrecisionEval(precision_eval::Args),
     /// Every shipped task set, label file, model and result, each pipeline in dependency order
     /// (resumable: finished stages are journaled in target/regenerate/; --list, --from STAGE).
     Regenerate(regenerate::Args),
@@ -113,6 +117,7 @@ fn main() -> anyhow::Result<()> {
         Command::Limit(args) => limit::run(&args),
         Command::Timing(args) => timing::run(&args),
         Command::PathEval(args) => path_eval::run(&args),
+        Command::PrecisionEval(args) => precision_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
     }
 }

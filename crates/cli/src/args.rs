@@ -39,6 +39,10 @@ pub enum Command {
     /// names them) or `urscript` (a program for a Universal Robots e-Series controller); see
     /// docs/robot-export.md.
     Export(crate::export::ExportArgs),
+    /// Plan a job: a job file or an SVG drawing, every stroke to the limit (resumed after a
+    /// reconfiguration where one motion cannot finish it), safe moves between strokes, one timed
+    /// program written as an emg-job/1 file (see docs/jobs.md).
+    Job(crate::job::JobArgs),
 }
 
 /// Options of `emg import-robot`.

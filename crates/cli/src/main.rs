@@ -68,6 +68,7 @@ mod check;
 mod export;
 mod import;
 mod interrupt;
+mod job;
 mod output;
 mod refusal;
 mod report;
@@ -97,6 +98,7 @@ fn main() -> ExitCode {
         Command::Check(args) => check::run_check(&args),
         Command::ImportRobot(args) => import::run_import(&args),
         Command::Export(args) => export::run_export(&args),
+        Command::Job(args) => job::run_job(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -425,6 +425,87 @@ impl Path {
         })
     }
 
+    /// The stretch of the path from arc length `from_s` to `to_s` (clamped to it), its pieces,
+    /// blends included, as segments of their own (no blend radius: a blend is already an arc
+    /// tangent to its neighbours); `None` where it holds less than [`MIN_SEGMENT_M`].
+    pub fn stretch(&self, from_s: f64, to_s: f64) -> Option<Self> {
+        let (from_s, to_s) = (from_s.max(0.0), to_s.min(self.length_m));
+        let mut segments = Vec::new();
+        let mut start = None;
+        for piece in &self.pieces {
+            let begin = from_s.max(piece.start_s);
+            let end = to_s.min(piece.start_s + piece.length_m);
+            if end - begin < MIN_SEGMENT_M {
+                continue;
+            }
+            let from = piece.point(begin - piece.start_s);
+            let to = piece.point(end - piece.start_s);
+            start.get_or_insert(from);
+            segments.push(match piece.outline().2 {
+                None => SegmentSpec::Line { to: to.into() },
+                Some((centre, axis)) => {
+                    let turn = if axis.dot(&self.normal) >= 0.0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    SegmentSpec::Arc {
+                        centre: Some(centre.into()),
+                        through: None,
+                        to: None,
+                        sweep_deg: Some(
+                            turn * ((end - begin) / (from - centre).norm()).to_degrees(),
+                        ),
+                    }
+                }
+            });
+        }
+        Self::new(PathSpec {
+            version: PATH_FORMAT_VERSION,
+            start: start?.into(),
+            normal: self.normal.into(),
+            blend_radius_m: 0.0,
+            segments,
+        })
+        .ok()
+    }
+
+    /// The same path travelled from its end to its start (its pieces as segments of their own,
+    /// as [`Path::stretch`] gives them); `None` where a piece, a short blend, is shorter than a
+    /// segment may be.
+    pub fn reversed(&self) -> Option<Self> {
+        let mut segments = Vec::new();
+        for piece in self.pieces.iter().rev() {
+            let (from, to, arc) = piece.outline();
+            segments.push(match arc {
+                None => SegmentSpec::Line { to: from.into() },
+                Some((centre, axis)) => {
+                    let turn = if axis.dot(&self.normal) >= 0.0 {
+                        -1.0
+                    } else {
+                        1.0
+                    };
+                    SegmentSpec::Arc {
+                        centre: Some(centre.into()),
+                        through: None,
+                        to: None,
+                        sweep_deg: Some(
+                            turn * (piece.length_m / (to - centre).norm()).to_degrees(),
+                        ),
+                    }
+                }
+            });
+        }
+        Self::new(PathSpec {
+            version: PATH_FORMAT_VERSION,
+            start: self.point_at(self.length_m).into(),
+            normal: self.normal.into(),
+            blend_radius_m: 0.0,
+            segments,
+        })
+        .ok()
+    }
+
     /// The spec the path was validated from.
     pub fn spec(&self) -> &PathSpec {
         &self.spec

@@ -75,6 +75,7 @@ mod paths;
 mod robot_import;
 mod rollout_file;
 mod scene_file;
+mod svg;
 mod task_file;
 
 pub use atomic::{JournalError, open_journal, write_atomically};
@@ -100,6 +101,10 @@ pub use robot_import::{
 };
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};
+pub use svg::{
+    Drawing, DrawingBounds, MAX_SMOOTH_JOIN_DEG, MIN_CURVE_TOLERANCE_M, Placement, SVG_PX_M,
+    SvgError, SvgFileError, SvgOptions, read_svg, read_svg_file,
+};
 pub use task_file::{
     TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_each_task, read_tasks,
     write_task_set,

@@ -16,6 +16,7 @@
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
 mod dynamics;
+mod free;
 mod inset;
 mod limits;
 mod path;
@@ -25,6 +26,7 @@ mod spline;
 mod topp;
 
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
+pub use free::{FREE_GRID_PER_RAD, time_free_move};
 pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,

@@ -1,0 +1,226 @@
+//! `emg job`: a job file or an SVG drawing planned as one program (`emg_job::plan_job`), with a
+//! progress bar and a summary; writes the `emg-job/1` file.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_job::{Job, JobSettings, Order, plan_job};
+use emg_planner::{ControllerKind, Models, MotionTiming, PlanRequest, Planner, PlannerConfig};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::output::write_text;
+use crate::robot;
+
+/// The line tolerance of a job unless `--tolerance` says otherwise (mm).
+pub const JOB_TOLERANCE_MM: f64 = 0.5;
+
+/// Options of `emg job`.
+#[derive(Debug, Args)]
+pub struct JobArgs {
+    /// The job: a job file (JSON, docs/jobs.md) or an SVG drawing (every subpath a stroke).
+    #[arg(value_name = "JOB")]
+    pub file: PathBuf,
+    /// The program to write (an emg-job/1 file).
+    #[arg(long, value_name = "FILE", default_value = "job.json")]
+    pub out: PathBuf,
+    /// Robot: fr3, iiwa14, ur5e, or a URDF path.
+    #[arg(long, value_parser = robot::parse_robot, default_value_os_t = robot::default_robot())]
+    pub robot: PathBuf,
+    /// The strokes' line tolerance (mm).
+    #[arg(long, value_name = "MM", default_value_t = JOB_TOLERANCE_MM)]
+    pub tolerance: f64,
+    /// The tool cone's half-angle around the surface normal (degrees).
+    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
+    pub cone: f64,
+    /// The drawing order: `shortest` (default: order and directions that cut the pen-up travel)
+    /// or `given`; overrides the job file's.
+    #[arg(long, value_parser = parse_order)]
+    pub order: Option<Order>,
+    /// SVG only: where the drawing's centre goes (m, base frame).
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
+    pub origin: Option<Vec<f64>>,
+    /// SVG only: the surface normal the pen points along.
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
+    pub normal: Option<Vec<f64>>,
+    /// SVG only: the drawing's x axis on the surface.
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
+    pub x_axis: Option<Vec<f64>>,
+    /// SVG only: the drawing's width (m).
+    #[arg(long, value_name = "M")]
+    pub width: Option<f64>,
+}
+
+fn parse_order(value: &str) -> Result<Order, String> {
+    match value {
+        "shortest" => Ok(Order::Shortest),
+        "given" => Ok(Order::Given),
+        other => Err(format!("'{other}' is not an order: shortest or given")),
+    }
+}
+
+/// Reads the job, plans it, prints its summary and writes its program.
+pub fn run_job(args: &JobArgs) -> Result<()> {
+    let robot = robot::load_robot(&args.robot, None, None)?;
+    emg_io::refuse_overwriting(
+        &[
+            ("job", args.file.as_path()),
+            ("robot file", args.robot.as_path()),
+        ],
+        &[("--out", args.out.as_path())],
+    )?;
+    let job = read_job(args, &robot)?;
+    let mut config = PlannerConfig::cell();
+    config.rollout.constraints.line_tolerance_m = args.tolerance * 1e-3;
+    config.rollout.constraints.theta_max_deg = args.cone;
+    config.validate()?;
+    let diffusion = robot::shipped_model(&args.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
+    let policy = robot::shipped_model(&args.robot, emg_planner::POLICY_WEIGHTS_FILE);
+    let controller = if policy.is_some() {
+        ControllerKind::Hybrid
+    } else {
+        ControllerKind::Classical
+    };
+    let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
+    let timing = MotionTiming::for_robot_file(
+        &robot,
+        &args.robot,
+        None,
+        emg_timing::Scaling::default(),
+        config.rollout.speed_m_per_s,
+        emg_planner::DEFAULT_RATE_HZ,
+        &config.rollout.constraints,
+    )?;
+    let planner = Planner::new(robot, models, config)?;
+    let request = PlanRequest {
+        controller,
+        ..PlanRequest::default()
+    };
+    let bar = ProgressBar::new(job.strokes.len() as u64).with_style(
+        ProgressStyle::with_template("{msg:>8} [{bar:40}] {pos}/{len} strokes, {elapsed}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message("planning");
+    let file = plan_job(
+        &planner,
+        &request,
+        &job,
+        &timing,
+        &args.robot.display().to_string(),
+        &|done, _| bar.set_position(done as u64),
+    )?;
+    bar.finish_and_clear();
+    let s = &file.summary;
+    println!(
+        "{} strokes: {} complete, {} resumed after a reconfiguration, {} short",
+        file.strokes.len(),
+        s.complete,
+        s.resumed,
+        s.short
+    );
+    println!(
+        "pen down {:.4} m of {:.4} m ({:.1} %); pen-up travel {:.3} m in the order drawn ({:.3} m as given)",
+        s.drawn_m,
+        s.total_m,
+        100.0 * s.drawn_m / s.total_m.max(f64::MIN_POSITIVE),
+        s.travel_m,
+        s.travel_given_m
+    );
+    println!(
+        "program {:.2} s ({:.2} s pen down, {:.2} s pen up; {} straight moves, {} found by the \
+         sampling planner); planned in {:.2} s ({} searches)",
+        s.duration_s,
+        s.pen_down_s,
+        s.pen_up_s,
+        s.straight_moves,
+        s.sampled_moves,
+        s.planning_s,
+        s.searches
+    );
+    for stroke in file.strokes.iter().filter(|r| !r.unreached.is_empty()) {
+        for (stretch, at) in stroke.unreached.iter().zip(&stroke.unreached_at) {
+            println!(
+                "  stroke {}: {:.4} m out of reach from {:.4} m along it, at ({:.3}, {:.3}, {:.3})",
+                stroke.stroke,
+                stretch.to_s - stretch.from_s,
+                stretch.from_s,
+                at[0],
+                at[1],
+                at[2]
+            );
+        }
+    }
+    write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+/// The job of a job file, or of an SVG drawing placed as the options say.
+fn read_job(args: &JobArgs, robot: &emg_kinematics::Robot) -> Result<Job> {
+    let is_svg = args
+        .file
+        .extension()
+        .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"));
+    let mut job = if is_svg {
+        let placement = placement(args)?;
+        let drawing = read_svg_file(&args.file, &placement, &SvgOptions::default())?;
+        if drawing.dropped_tiny > 0 {
+            println!(
+                "{}: {} strokes shorter than {} mm dropped",
+                args.file.display(),
+                drawing.dropped_tiny,
+                SvgOptions::default().min_stroke_m * 1e3
+            );
+        }
+        Job::from_spec(
+            emg_job::JobSpec {
+                version: emg_job::JOB_FORMAT_VERSION,
+                strokes: drawing.strokes,
+                settings: JobSettings::default(),
+                home: None,
+            },
+            robot,
+        )?
+    } else {
+        if [&args.origin, &args.normal, &args.x_axis]
+            .iter()
+            .any(|o| o.is_some())
+            || args.width.is_some()
+        {
+            anyhow::bail!(
+                "--origin, --normal, --x-axis and --width place an SVG drawing; {} is a job file, \
+                 whose strokes are already placed",
+                args.file.display()
+            );
+        }
+        let text = std::fs::read_to_string(&args.file)
+            .with_context(|| format!("cannot read {}", args.file.display()))?;
+        Job::from_json(&args.file.display().to_string(), &text, robot)?
+    };
+    if let Some(order) = args.order {
+        job.settings.order = order;
+    }
+    Ok(job)
+}
+
+/// The drawing's placement: the default with what the options set.
+fn placement(args: &JobArgs) -> Result<Placement> {
+    let mut placement = Placement::default();
+    let vector = |values: &Vec<f64>| [values[0], values[1], values[2]];
+    if let Some(origin) = &args.origin {
+        placement.origin_m = vector(origin);
+    }
+    if let Some(normal) = &args.normal {
+        placement.normal = vector(normal);
+    }
+    if let Some(x_axis) = &args.x_axis {
+        placement.x_axis = vector(x_axis);
+    }
+    if let Some(width) = args.width {
+        placement.width_m = Some(width);
+        placement.scale_m_per_unit = None;
+    }
+    Ok(placement)
+}

@@ -1,0 +1,257 @@
+//! The connect stage's geometry: which configurations are free (the joint limits,
+//! self-collision, every stroke's work plate and the scene, the tool's tip never inside the
+//! part), the straight joint-space edges between them checked at a resolution no link can step
+//! over, the lifted configuration above a point of a stroke, and the collision-free move
+//! between two configurations (the straight edge, else dual RRT-Connect with shortcuts).
+
+use emg_control::{ConstraintConfig, Path, PathSpec, SegmentSpec, Task, first_contact};
+use emg_kinematics::{DampingConfig, JointVector, Robot, Vec3, damped_pseudo_inverse};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The farthest any point of the arm moves between two configurations an edge check visits
+/// (m): far less than the radius of any link's capsule.
+pub const MAX_POINT_TRAVEL_M: f64 = 0.005;
+
+/// Newton iterations of the lift's inverse kinematics, and the TCP error they stop within (m).
+const LIFT_ITERATIONS: usize = 50;
+const LIFT_TOLERANCE_M: f64 = 1e-6;
+
+/// Step of the sampling planner's trees (rad, joint-space distance).
+const RRT_EXTEND_RAD: f64 = 0.1;
+
+/// Shortcut attempts on a sampled move.
+const SHORTCUTS: usize = 200;
+
+/// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
+const SAME_PLANE: f64 = 1e-6;
+
+/// One task per plane of `tasks` whose path is a rectangle holding all their paths' points
+/// (sampled every centimetre, 1 mm added round): its work plate covers the part those strokes
+/// lie on, so the arm keeps off the whole part between strokes with one check per plane. A
+/// plane whose rectangle makes no task keeps its strokes' own tasks.
+pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
+    let mut planes: Vec<(Vec3, Vec3, Vec<&Task>)> = Vec::new();
+    for task in tasks {
+        let found = planes.iter_mut().find(|(point, normal, _)| {
+            normal.dot(&task.n) > 1.0 - SAME_PLANE
+                && (task.p0 - *point).dot(normal).abs() < SAME_PLANE
+        });
+        match found {
+            Some((_, _, members)) => members.push(task),
+            None => planes.push((task.p0, task.n, vec![task])),
+        }
+    }
+    let mut surfaces = Vec::new();
+    for (point, normal, members) in planes {
+        let u = members[0].d;
+        let w = normal.cross(&u);
+        let mut low = [f64::INFINITY; 2];
+        let mut high = [f64::NEG_INFINITY; 2];
+        for task in &members {
+            let Some(path) = &task.path else { continue };
+            let samples = (path.length_m() / 0.01).ceil() as usize;
+            for k in 0..=samples {
+                let offset = path.point_at(path.length_m() * k as f64 / samples as f64) - point;
+                for (axis, value) in [offset.dot(&u), offset.dot(&w)].into_iter().enumerate() {
+                    low[axis] = low[axis].min(value - 1e-3);
+                    high[axis] = high[axis].max(value + 1e-3);
+                }
+            }
+        }
+        let corner = |a: f64, b: f64| point + u * a + w * b;
+        let rectangle = PathSpec {
+            version: emg_control::PATH_FORMAT_VERSION,
+            start: corner(low[0], low[1]).into(),
+            normal: normal.into(),
+            blend_radius_m: 0.0,
+            segments: [
+                corner(high[0], low[1]),
+                corner(high[0], high[1]),
+                corner(low[0], high[1]),
+                corner(low[0], low[1]),
+            ]
+            .into_iter()
+            .map(|to| SegmentSpec::Line { to: to.into() })
+            .collect(),
+        };
+        match Path::new(rectangle)
+            .ok()
+            .and_then(|path| Task::on_path(robot, path, None).ok())
+        {
+            Some(task) => surfaces.push(task),
+            None => surfaces.extend(members.into_iter().cloned()),
+        }
+    }
+    surfaces
+}
+
+/// Free space of a job's arm.
+pub struct FreeSpace<'a> {
+    robot: &'a Robot,
+    /// Tasks whose work plates the arm keeps off (one per stroke part).
+    surfaces: Vec<Task>,
+    constraints: &'a ConstraintConfig,
+    /// Each stroke's plane (a point on it, its normal) and the radius around that point inside
+    /// which the tool's tip stays on the near side of it.
+    planes: Vec<(Vec3, Vec3, f64)>,
+    /// Largest `Σ|Δq_i|` between two checked configurations of an edge (rad).
+    step_l1_rad: f64,
+}
+
+impl<'a> FreeSpace<'a> {
+    /// The free space of `robot` around the tasks `surfaces` (their plates, scene and margin as
+    /// `constraints` sets them), the tool's tip kept on the near side of each task's plane within
+    /// its path's extent and 5 cm more.
+    pub fn new(robot: &'a Robot, surfaces: Vec<Task>, constraints: &'a ConstraintConfig) -> Self {
+        let planes = surfaces
+            .iter()
+            .map(|task| {
+                let radius = task.path.as_ref().map_or(0.0, |path| {
+                    let extent = path.extent();
+                    extent.behind_m.max(extent.ahead_m) + extent.across_m
+                });
+                (task.p0, task.n, radius + 0.05)
+            })
+            .collect();
+        // A joint turning by Δ moves a point at most |Δ| times its distance from the joint's
+        // axis, which is at most the diameter of the sphere the arm reaches.
+        let (_, reach) = robot.reach_sphere();
+        Self {
+            robot,
+            surfaces,
+            constraints,
+            planes,
+            step_l1_rad: MAX_POINT_TRAVEL_M / (2.0 * reach),
+        }
+    }
+
+    /// Whether `q` is free: within the joint limits, no link touching another, a plate or an
+    /// obstacle, the tool's tip not inside the part.
+    pub fn free(&self, q: &JointVector) -> bool {
+        if self.robot.limits().first_violation(q, 0.0).is_some() {
+            return false;
+        }
+        let kinematics = self.robot.forward(q);
+        let tcp = kinematics.tcp();
+        let inside = self.planes.iter().any(|(point, normal, radius)| {
+            let offset = tcp - point;
+            let depth = offset.dot(normal);
+            depth > self.constraints.line_tolerance_m && (offset - normal * depth).norm() <= *radius
+        });
+        !inside
+            && self.surfaces.iter().all(|task| {
+                first_contact(self.robot, task, &kinematics, self.constraints).is_none()
+            })
+    }
+
+    /// Whether the straight joint-space edge from `a` to `b` is free at every configuration
+    /// visited, no two of them more than [`MAX_POINT_TRAVEL_M`] apart at any point of the arm.
+    pub fn edge_free(&self, a: &JointVector, b: &JointVector) -> bool {
+        let steps = ((b - a).abs().sum() / self.step_l1_rad).ceil().max(1.0) as usize;
+        (0..=steps).all(|k| self.free(&(a + (b - a) * (k as f64 / steps as f64))))
+    }
+
+    /// The configuration near `q` whose TCP lies at `target` (Newton steps on the TCP position
+    /// with the damped pseudo-inverse), if they converge to a free configuration joined to `q`
+    /// by a free edge.
+    pub fn reach_point(&self, q: &JointVector, target: &Vec3) -> Option<JointVector> {
+        let mut current = *q;
+        for _ in 0..LIFT_ITERATIONS {
+            let kinematics = self.robot.forward(&current);
+            let error = target - kinematics.tcp();
+            if error.norm() <= LIFT_TOLERANCE_M {
+                return (self.free(&current) && self.edge_free(q, &current)).then_some(current);
+            }
+            let pseudo_inverse =
+                damped_pseudo_inverse(kinematics.jacobian(), &DampingConfig::default());
+            current += pseudo_inverse.matrix * error;
+        }
+        None
+    }
+
+    /// A free move from `a` to `b`: the straight edge where it is free, else a path of dual
+    /// RRT-Connect (the `rrt` crate, samples uniform within the joint limits from `seed`,
+    /// at most `max_samples`), every edge checked as [`FreeSpace::edge_free`] checks it, then
+    /// shortened by shortcuts. `None` where no free move was found.
+    pub fn connect(
+        &self,
+        a: &JointVector,
+        b: &JointVector,
+        seed: u64,
+        max_samples: usize,
+    ) -> Option<Vec<JointVector>> {
+        if self.edge_free(a, b) {
+            return Some(vec![*a, *b]);
+        }
+        let dof = self.robot.dof();
+        let limits = self.robot.limits();
+        // The sampler is called as a shared closure: its generator sits in a cell.
+        let rng = std::cell::RefCell::new(ChaCha8Rng::seed_from_u64(seed));
+        let sampled = rrt::dual_rrt_connect(
+            &a.as_slice()[..dof],
+            &b.as_slice()[..dof],
+            |q: &[f64]| self.free(&self.robot.joint_vector(q)),
+            || {
+                let mut rng = rng.borrow_mut();
+                (0..dof)
+                    .map(|i| rng.random_range(limits.lower[i]..=limits.upper[i]))
+                    .collect()
+            },
+            RRT_EXTEND_RAD,
+            max_samples,
+        )
+        .ok()?;
+        let mut path: Vec<JointVector> =
+            sampled.iter().map(|q| self.robot.joint_vector(q)).collect();
+        // The trees checked their nodes only: split every edge that is not free at the check's
+        // resolution by its midpoint, where that is free, a few times.
+        path = self.refine(path)?;
+        Some(self.shortcut(path, seed))
+    }
+
+    /// `path` with every edge free, midpoints inserted where an edge is not (up to 6 halvings);
+    /// `None` where an edge stays blocked.
+    fn refine(&self, path: Vec<JointVector>) -> Option<Vec<JointVector>> {
+        let mut refined = vec![path[0]];
+        for pair in path.windows(2) {
+            self.refine_edge(&pair[0], &pair[1], 6, &mut refined)?;
+        }
+        Some(refined)
+    }
+
+    fn refine_edge(
+        &self,
+        a: &JointVector,
+        b: &JointVector,
+        depth: usize,
+        out: &mut Vec<JointVector>,
+    ) -> Option<()> {
+        if self.edge_free(a, b) {
+            out.push(*b);
+            return Some(());
+        }
+        let middle = (a + b) / 2.0;
+        if depth == 0 || !self.free(&middle) {
+            return None;
+        }
+        self.refine_edge(a, &middle, depth - 1, out)?;
+        self.refine_edge(&middle, b, depth - 1, out)
+    }
+
+    /// Shortcuts: two vertices drawn from `seed`, joined straight where that edge is free.
+    fn shortcut(&self, mut path: Vec<JointVector>, seed: u64) -> Vec<JointVector> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x5eed);
+        for _ in 0..SHORTCUTS {
+            if path.len() <= 2 {
+                break;
+            }
+            let i = rng.random_range(0..path.len() - 2);
+            let j = rng.random_range(i + 2..path.len());
+            if self.edge_free(&path[i], &path[j]) {
+                path.drain(i + 1..j);
+            }
+        }
+        path
+    }
+}

@@ -1,0 +1,256 @@
+//! Jobs: a drawing or a set of seams planned as one program a robot runs. A job is planned in
+//! stages with one job each, above the planner:
+//!
+//! 1. **read** ([`spec`]): a job file or a drawing's strokes, validated into a [`Job`];
+//! 2. **order** ([`order`]): the drawing order and directions that shorten the pen-up travel;
+//! 3. **plan strokes** ([`stroke`]): each stroke to the limit by the search, resumed after a
+//!    reconfiguration where one motion cannot finish it;
+//! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
+//!    approach along n;
+//! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory, every segment
+//!    with its time span, as an `emg-job/1` file.
+//!
+//! [`plan_job`] runs them in order.
+
+pub mod free_space;
+pub mod order;
+pub mod program;
+pub mod spec;
+pub mod stroke;
+
+use std::time::Instant;
+
+use emg_control::Task;
+use emg_kinematics::JointVector;
+use emg_planner::{MotionTiming, PlanRequest, Planner};
+use rayon::prelude::*;
+
+pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, part_surfaces};
+pub use order::{Ordering, Oriented, order_strokes};
+pub use program::{
+    JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
+};
+pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order};
+pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
+
+/// Why a planned job cannot be written.
+#[derive(Debug, thiserror::Error)]
+pub enum JobPlanError {
+    /// No part of any stroke could be drawn with a safe move to it.
+    #[error(
+        "no stroke of the job can be drawn: {0} (move the drawing where the arm reaches it, or \
+         change its size or normal)"
+    )]
+    NothingDrawn(String),
+    /// The program is too long for the trajectory format.
+    #[error("the program lasts longer than a joint trajectory file holds")]
+    TooLong,
+}
+
+/// Plans `job` with `planner` as `request` asks (the search; its constraints and scene) and
+/// times it with `timing`;
+/// `robot_file` is recorded in the file; `progress` is told each stroke planned (strokes
+/// planned so far, strokes in all). Strokes are planned in parallel; the result does not depend
+/// on the number of threads.
+pub fn plan_job(
+    planner: &Planner,
+    request: &PlanRequest,
+    job: &Job,
+    timing: &MotionTiming,
+    robot_file: &str,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<JobFile, JobPlanError> {
+    let started = Instant::now();
+    let settings = &job.settings;
+    let robot = planner.robot();
+    let dof = robot.dof();
+    let constraints = &planner.config().rollout.constraints;
+    let ordering = order_strokes(&job.strokes, settings.order);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let plans: Vec<StrokePlan> = ordering
+        .sequence
+        .par_iter()
+        .map(|oriented| {
+            let stroke = &job.strokes[oriented.stroke];
+            let path = if oriented.reversed {
+                stroke
+                    .reversed()
+                    .expect("only reversible strokes are reversed")
+            } else {
+                stroke.clone()
+            };
+            let plan = plan_stroke(planner, request, &path, settings);
+            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            progress(finished, ordering.sequence.len());
+            plan
+        })
+        .collect();
+    let tasks: Vec<Task> = plans
+        .iter()
+        .flat_map(|plan| plan.parts.iter().map(|part| part.task.clone()))
+        .collect();
+    let free = FreeSpace::new(robot, part_surfaces(robot, &tasks), constraints);
+    let mut program = Program::default();
+    let mut reports = Vec::new();
+    let (mut straight_moves, mut sampled_moves) = (0, 0);
+    let mut failure = None;
+    for (oriented, plan) in ordering.sequence.iter().zip(&plans) {
+        let mut parts_without_move = 0;
+        let mut drawn_parts = Vec::new();
+        for (index, part) in plan.parts.iter().enumerate() {
+            let timed = match timing.time(robot, &part.task, constraints, &part.trajectory) {
+                Ok(timed) => timed,
+                Err(e) => {
+                    failure.get_or_insert(format!("timing: {e}"));
+                    parts_without_move += 1;
+                    continue;
+                }
+            };
+            let start = timed.samples.first().expect("a timed motion has samples").q;
+            let end = timed.samples.last().expect("a timed motion has samples").q;
+            let lift = -part.task.n * settings.lift_m;
+            let above = |q: &JointVector| free.reach_point(q, &(robot.forward(q).tcp() + lift));
+            let (Some(above_start), Some(above_end)) = (above(&start), above(&end)) else {
+                failure.get_or_insert("no free configuration above a stroke's end".to_string());
+                parts_without_move += 1;
+                continue;
+            };
+            let from = program.last().or(job.home);
+            let travel = match from {
+                None => Some(Vec::new()),
+                Some(from) => free
+                    .connect(
+                        &from,
+                        &above_start,
+                        settings.seed.wrapping_add(program.segments().len() as u64),
+                        settings.rrt_max_samples,
+                    )
+                    .map(|vertices| {
+                        if vertices.len() == 2 {
+                            straight_moves += 1;
+                        } else {
+                            sampled_moves += 1;
+                        }
+                        vertices
+                    }),
+            };
+            let Some(travel) = travel else {
+                failure.get_or_insert("no free move to a stroke's start".to_string());
+                parts_without_move += 1;
+                continue;
+            };
+            // Without a home the program begins above the first stroke.
+            if !travel.is_empty() {
+                program.append_move(SegmentKind::Travel, &travel, timing, dof);
+            }
+            program.append_move(SegmentKind::Approach, &[above_start, start], timing, dof);
+            program.append(
+                SegmentKind::Stroke {
+                    stroke: oriented.stroke,
+                    part: index,
+                },
+                &timed.samples,
+                &[],
+                dof,
+            );
+            program.append_move(SegmentKind::Retreat, &[end, above_end], timing, dof);
+            drawn_parts.push(part);
+        }
+        let drawn = StrokePlan {
+            parts: drawn_parts.into_iter().cloned().collect(),
+            ..plan.clone()
+        };
+        reports.push(StrokeReport {
+            stroke: oriented.stroke,
+            reversed: oriented.reversed,
+            length_m: plan.path.length_m(),
+            drawn_m: drawn.drawn_m(),
+            parts: drawn.parts.len(),
+            unreached_at: plan
+                .unreached
+                .iter()
+                .map(|u| plan.path.point_at(u.from_s).into())
+                .collect(),
+            unreached: plan.unreached.clone(),
+            parts_without_move,
+        });
+    }
+    if let Some(home) = job.home
+        && let Some(last) = program.last()
+    {
+        if let Some(vertices) = free.connect(
+            &last,
+            &home,
+            settings.seed.wrapping_add(u64::MAX / 2),
+            settings.rrt_max_samples,
+        ) {
+            program.append_move(SegmentKind::Travel, &vertices, timing, dof);
+        }
+    }
+    if program.segments().is_empty() {
+        return Err(JobPlanError::NothingDrawn(
+            failure.unwrap_or_else(|| "no stroke has a reachable start".to_string()),
+        ));
+    }
+    let summary = summarise(
+        &reports,
+        &program,
+        &ordering,
+        (straight_moves, sampled_moves),
+        &plans,
+        started,
+    );
+    Ok(JobFile {
+        format: JOB_FILE_FORMAT.to_string(),
+        robot: robot_file.to_string(),
+        joint_names: robot.joint_names().to_vec(),
+        constraints: constraints.clone(),
+        limits: timing.record(),
+        settings: settings.clone(),
+        ordering,
+        strokes: reports,
+        summary,
+        segments: program.segments().to_vec(),
+        points: program.points(dof).ok_or(JobPlanError::TooLong)?,
+    })
+}
+
+/// The job's totals.
+fn summarise(
+    reports: &[StrokeReport],
+    program: &Program,
+    ordering: &Ordering,
+    (straight_moves, sampled_moves): (usize, usize),
+    plans: &[StrokePlan],
+    started: Instant,
+) -> JobSummary {
+    let whole =
+        |r: &&StrokeReport| r.unreached.is_empty() && r.parts_without_move == 0 && r.parts > 0;
+    let pen_down_s = program
+        .segments()
+        .iter()
+        .filter(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
+        .map(|s| s.end_s - s.start_s)
+        .sum::<f64>();
+    let duration_s = program.segments().last().map_or(0.0, |s| s.end_s);
+    JobSummary {
+        complete: reports
+            .iter()
+            .filter(whole)
+            .filter(|r| r.parts == 1)
+            .count(),
+        resumed: reports.iter().filter(whole).filter(|r| r.parts > 1).count(),
+        short: reports.iter().filter(|r| !whole(r)).count(),
+        drawn_m: reports.iter().map(|r| r.drawn_m).sum(),
+        total_m: reports.iter().map(|r| r.length_m).sum(),
+        travel_given_m: ordering.travel_given_m,
+        travel_m: ordering.travel_m,
+        duration_s,
+        pen_down_s,
+        pen_up_s: duration_s - pen_down_s,
+        straight_moves,
+        sampled_moves,
+        searches: plans.iter().map(|p| p.searches).sum(),
+        planning_s: started.elapsed().as_secs_f64(),
+    }
+}

@@ -1,0 +1,217 @@
+//! The connect, time and write stages: the planned strokes joined by safe moves (retreat along
+//! −n, a free joint-space move, approach along n) into one timed joint trajectory, every segment
+//! listed with its time span, written as an `emg-job/1` file.
+
+use emg_control::ConstraintConfig;
+use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
+use emg_kinematics::JointVector;
+use emg_planner::MotionTiming;
+use emg_timing::{TimedSample, time_free_move};
+use serde::{Deserialize, Serialize};
+
+use crate::order::Ordering;
+use crate::spec::JobSettings;
+use crate::stroke::Unreached;
+
+/// The format tag of a job file.
+pub const JOB_FILE_FORMAT: &str = "emg-job/1";
+
+/// What a segment of the program does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum SegmentKind {
+    /// Pen down along part `part` of stroke `stroke` (the job's index).
+    Stroke {
+        /// The stroke's index in the job.
+        stroke: usize,
+        /// The part (0 unless the stroke was resumed).
+        part: usize,
+    },
+    /// The tool lifted off the surface along −n.
+    Retreat,
+    /// A free joint-space move between two lifted configurations (or home).
+    Travel,
+    /// The tool set down along n.
+    Approach,
+}
+
+/// One segment of the program and its span.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Segment {
+    /// What it does.
+    #[serde(flatten)]
+    pub kind: SegmentKind,
+    /// When it starts and ends (s from the program's start).
+    pub start_s: f64,
+    /// See `start_s`.
+    pub end_s: f64,
+    /// Vertices of a move's joint-space polyline (2 for a straight move; none for a stroke).
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub vertices: Vec<Vec<f64>>,
+}
+
+/// What became of one stroke.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StrokeReport {
+    /// Its index in the job.
+    pub stroke: usize,
+    /// Whether it was drawn from its end.
+    pub reversed: bool,
+    /// Its length (m).
+    pub length_m: f64,
+    /// The arc length drawn (m).
+    pub drawn_m: f64,
+    /// The parts it was drawn in.
+    pub parts: usize,
+    /// Stretches no motion reached (arc length along the stroke as drawn), and where each
+    /// starts (base frame, m).
+    pub unreached: Vec<Unreached>,
+    /// See `unreached`.
+    pub unreached_at: Vec<[f64; 3]>,
+    /// Parts planned but left out because no free move reached them.
+    pub parts_without_move: usize,
+}
+
+/// The job's totals.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JobSummary {
+    /// Strokes drawn whole in one part, whole in several (resumed), and not whole (short).
+    pub complete: usize,
+    /// See `complete`.
+    pub resumed: usize,
+    /// See `complete`.
+    pub short: usize,
+    /// Pen-down length drawn and in all (m).
+    pub drawn_m: f64,
+    /// See `drawn_m`.
+    pub total_m: f64,
+    /// Straight-line travel between strokes before and after ordering (m).
+    pub travel_given_m: f64,
+    /// See `travel_given_m`.
+    pub travel_m: f64,
+    /// Program duration, and its time pen down and pen up (s).
+    pub duration_s: f64,
+    /// See `duration_s`.
+    pub pen_down_s: f64,
+    /// See `duration_s`.
+    pub pen_up_s: f64,
+    /// Free moves straight in joint space, and those the sampling planner found.
+    pub straight_moves: usize,
+    /// See `straight_moves`.
+    pub sampled_moves: usize,
+    /// Searches run over all strokes, and the planning time (s) of the whole job.
+    pub searches: usize,
+    /// See `searches`.
+    pub planning_s: f64,
+}
+
+/// A job's program as its file holds it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JobFile {
+    /// [`JOB_FILE_FORMAT`].
+    pub format: String,
+    /// The robot file.
+    pub robot: String,
+    /// The arm's joints, base to tip.
+    pub joint_names: Vec<String>,
+    /// The constraints every stroke holds.
+    pub constraints: ConstraintConfig,
+    /// The joint limits every point holds.
+    pub limits: TimingLimits,
+    /// The job's settings.
+    pub settings: JobSettings,
+    /// The drawing order.
+    pub ordering: Ordering,
+    /// Every stroke's outcome, in drawing order.
+    pub strokes: Vec<StrokeReport>,
+    /// The totals.
+    pub summary: JobSummary,
+    /// The segments in time order.
+    pub segments: Vec<Segment>,
+    /// The samples of the whole program, from rest to rest.
+    pub points: Vec<JointTrajectoryPoint>,
+}
+
+/// The program being assembled: samples on one time line and the segments they make.
+#[derive(Default)]
+pub struct Program {
+    samples: Vec<TimedSample>,
+    segments: Vec<Segment>,
+}
+
+impl Program {
+    /// The configuration the program ends at, if it has begun.
+    pub fn last(&self) -> Option<JointVector> {
+        self.samples.last().map(|sample| sample.q)
+    }
+
+    /// Appends `samples` (a rest-to-rest motion from the program's last configuration, its times
+    /// from 0) as a segment of `kind`.
+    pub fn append(
+        &mut self,
+        kind: SegmentKind,
+        samples: &[TimedSample],
+        vertices: &[JointVector],
+        dof: usize,
+    ) {
+        let offset_ns = self.samples.last().map_or(0, |last| last.time_ns);
+        let skip = usize::from(!self.samples.is_empty());
+        let start_s = offset_ns as f64 * 1e-9;
+        self.samples
+            .extend(samples.iter().skip(skip).map(|sample| TimedSample {
+                time_ns: sample.time_ns + offset_ns,
+                ..*sample
+            }));
+        let end_s = self
+            .samples
+            .last()
+            .map_or(0.0, |last| last.time_ns as f64 * 1e-9);
+        self.segments.push(Segment {
+            kind,
+            start_s,
+            end_s,
+            vertices: vertices
+                .iter()
+                .map(|q| q.as_slice()[..dof].to_vec())
+                .collect(),
+        });
+    }
+
+    /// A free move through `vertices` timed rest to rest (a segment of `kind`).
+    pub fn append_move(
+        &mut self,
+        kind: SegmentKind,
+        vertices: &[JointVector],
+        timing: &MotionTiming,
+        dof: usize,
+    ) {
+        let samples = time_free_move(vertices, timing.request());
+        self.append(kind, &samples, vertices, dof);
+    }
+
+    /// The segments so far.
+    pub fn segments(&self) -> &[Segment] {
+        &self.segments
+    }
+
+    /// The samples as joint trajectory points (the arm's `dof` joints); `None` where a time is
+    /// past what the format holds.
+    pub fn points(&self, dof: usize) -> Option<Vec<JointTrajectoryPoint>> {
+        self.samples
+            .iter()
+            .map(|sample| {
+                Some(JointTrajectoryPoint {
+                    positions: sample.q.as_slice()[..dof].to_vec(),
+                    velocities: sample.qd.as_slice()[..dof].to_vec(),
+                    accelerations: sample.qdd.as_slice()[..dof].to_vec(),
+                    time_from_start: TimeFromStart::from_nanoseconds(sample.time_ns)?,
+                })
+            })
+            .collect()
+    }
+
+    /// The samples.
+    pub fn samples(&self) -> &[TimedSample] {
+        &self.samples
+    }
+}

@@ -1,0 +1,238 @@
+//! The read stage: a job file (`emg-job` input, version 1) or a drawing's strokes, validated
+//! into a [`Job`].
+
+use emg_control::{Path, PathError, PathSpec};
+use emg_kinematics::{JointVector, Robot};
+use serde::{Deserialize, Serialize};
+
+/// The job file version this build reads.
+pub const JOB_FORMAT_VERSION: u32 = 1;
+
+/// A job file: strokes, shared settings, an optional home configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JobSpec {
+    /// [`JOB_FORMAT_VERSION`].
+    pub version: u32,
+    /// The strokes, each a path as in a path file (docs/paths.md).
+    pub strokes: Vec<PathSpec>,
+    /// Settings shared by every stroke and move.
+    #[serde(default)]
+    pub settings: JobSettings,
+    /// Where the arm starts and ends, one value per joint (rad); without it the job starts
+    /// above its first stroke and ends above its last.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub home: Option<Vec<f64>>,
+}
+
+/// The order the strokes are drawn in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Order {
+    /// As listed, each in its own direction.
+    Given,
+    /// The order and directions that shorten the pen-up travel (nearest neighbour, then 2-opt
+    /// with reversals).
+    #[default]
+    Shortest,
+}
+
+/// Settings shared by every stroke and move of a job.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct JobSettings {
+    /// How far the tool lifts off the surface (along −n) between strokes (m).
+    pub lift_m: f64,
+    /// The order of the strokes.
+    pub order: Order,
+    /// Where a stroke is resumed after a reconfiguration, the tool sets down this far back
+    /// along it (m).
+    pub overlap_m: f64,
+    /// A stroke is resumed while a part gains at least this much (m); where a part gains
+    /// less, the stretch is skipped by this much and reported out of reach.
+    pub min_gain_m: f64,
+    /// Parts a stroke is planned in at most (reconfigurations plus one).
+    pub max_parts: usize,
+    /// Seed of the sampling planner of the free moves.
+    pub seed: u64,
+    /// Samples the sampling planner draws at most per move.
+    pub rrt_max_samples: usize,
+}
+
+impl Default for JobSettings {
+    fn default() -> Self {
+        Self {
+            lift_m: 0.03,
+            order: Order::Shortest,
+            overlap_m: 0.002,
+            min_gain_m: 0.005,
+            max_parts: 6,
+            seed: 20_261_127,
+            rrt_max_samples: 4000,
+        }
+    }
+}
+
+/// A validated job.
+#[derive(Clone, Debug)]
+pub struct Job {
+    /// The strokes, in the file's order.
+    pub strokes: Vec<Path>,
+    /// The settings.
+    pub settings: JobSettings,
+    /// The home configuration, if given.
+    pub home: Option<JointVector>,
+}
+
+/// Why a job cannot be planned; each names the field.
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// The text is not a job file.
+    #[error("{origin}: not a job file: {message}")]
+    Parse {
+        /// The file.
+        origin: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// Another version.
+    #[error("job field 'version' is {found}; this build reads version {JOB_FORMAT_VERSION}")]
+    Version {
+        /// The version found.
+        found: u32,
+    },
+    /// Nothing to draw.
+    #[error("job field 'strokes' is empty: a job needs at least one stroke")]
+    NoStrokes,
+    /// A stroke is not a valid path.
+    #[error("job field 'strokes[{index}]': {source}")]
+    Stroke {
+        /// Its index.
+        index: usize,
+        /// What is wrong.
+        source: PathError,
+    },
+    /// A setting is out of range.
+    #[error("job field 'settings.{field}' must be {allowed}, got {value}")]
+    Setting {
+        /// The field.
+        field: &'static str,
+        /// The value given.
+        value: f64,
+        /// The allowed range.
+        allowed: &'static str,
+    },
+    /// The home configuration does not fit the arm.
+    #[error("job field 'home': {0}")]
+    Home(String),
+}
+
+impl JobSettings {
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), JobError> {
+        let require = |field, value: f64, allowed, ok: bool| {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(JobError::Setting {
+                    field,
+                    value,
+                    allowed,
+                })
+            }
+        };
+        require(
+            "lift_m",
+            self.lift_m,
+            "in (0, 0.5] m",
+            self.lift_m > 0.0 && self.lift_m <= 0.5,
+        )?;
+        require(
+            "overlap_m",
+            self.overlap_m,
+            "in [0, 0.05] m",
+            (0.0..=0.05).contains(&self.overlap_m),
+        )?;
+        require(
+            "min_gain_m",
+            self.min_gain_m,
+            "in (0, 0.5] m",
+            self.min_gain_m > 0.0 && self.min_gain_m <= 0.5,
+        )?;
+        require(
+            "max_parts",
+            self.max_parts as f64,
+            "in [1, 100]",
+            (1..=100).contains(&self.max_parts),
+        )?;
+        require(
+            "rrt_max_samples",
+            self.rrt_max_samples as f64,
+            "in [1, 1000000]",
+            (1..=1_000_000).contains(&self.rrt_max_samples),
+        )
+    }
+}
+
+impl Job {
+    /// The job of `spec` for `robot`: every stroke a valid path, the settings in range, the
+    /// home within the joint limits.
+    pub fn from_spec(spec: JobSpec, robot: &Robot) -> Result<Self, JobError> {
+        if spec.version != JOB_FORMAT_VERSION {
+            return Err(JobError::Version {
+                found: spec.version,
+            });
+        }
+        if spec.strokes.is_empty() {
+            return Err(JobError::NoStrokes);
+        }
+        spec.settings.validate()?;
+        let strokes = spec
+            .strokes
+            .into_iter()
+            .enumerate()
+            .map(|(index, stroke)| {
+                Path::new(stroke).map_err(|source| JobError::Stroke { index, source })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let home = spec.home.map(|values| home(robot, &values)).transpose()?;
+        Ok(Self {
+            strokes,
+            settings: spec.settings,
+            home,
+        })
+    }
+
+    /// Reads a job file's text; `origin` names it in errors.
+    pub fn from_json(origin: &str, text: &str, robot: &Robot) -> Result<Self, JobError> {
+        let spec: JobSpec = serde_json::from_str(text).map_err(|e| JobError::Parse {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        Self::from_spec(spec, robot)
+    }
+}
+
+/// The home configuration of `values`: one finite value per joint, within the limits.
+fn home(robot: &Robot, values: &[f64]) -> Result<JointVector, JobError> {
+    if values.len() != robot.dof() {
+        return Err(JobError::Home(format!(
+            "has {} values; {} has {} joints",
+            values.len(),
+            robot.name(),
+            robot.dof()
+        )));
+    }
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err(JobError::Home(format!("{values:?} is not finite")));
+    }
+    let q = robot.joint_vector(values);
+    if let Some(joint) = robot.limits().first_violation(&q, 0.0) {
+        return Err(JobError::Home(format!(
+            "joint {} ({} rad) is outside its limits",
+            joint + 1,
+            values[joint]
+        )));
+    }
+    Ok(q)
+}

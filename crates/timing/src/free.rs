@@ -1,0 +1,167 @@
+//! The timing of a move through free space (the tool lifted between two strokes): a polyline in
+//! joint space whose every edge was checked collision-free, so the motion keeps to the edges
+//! exactly and comes to rest at each inner vertex. Each edge is timed from rest to rest,
+//! time-optimal within the joint velocity and acceleration limits (TOPP-RA on the straight
+//! edge) and jerk-limited by averaging that profile over the window its jerk bound needs.
+
+use emg_kinematics::JointVector;
+
+use crate::dynamics::TimedSample;
+use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::retime::TimingRequest;
+use crate::topp::{GridPoint, topp_ra};
+
+/// Grid intervals of TOPP-RA per radian of an edge (the joint-space distance): the profile on a
+/// straight edge is exact up to the grid's interpolation of its acceleration bounds.
+pub const FREE_GRID_PER_RAD: f64 = 100.0;
+
+/// Samples at `request.rate_hz` of the rest-to-rest motion along the polyline `vertices`
+/// (from rest at the first to rest at the last, at rest at every inner vertex), the times from
+/// 0. Edges shorter than 1e-9 rad are skipped; a single vertex is one sample at rest.
+///
+/// # Panics
+///
+/// If `vertices` is empty.
+pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<TimedSample> {
+    let first = *vertices.first().expect("a move has a vertex");
+    let mut samples = vec![TimedSample {
+        time_ns: 0,
+        q: first,
+        qd: JointVector::zeros(),
+        qdd: JointVector::zeros(),
+    }];
+    let mut elapsed_s = 0.0;
+    for edge in vertices.windows(2) {
+        let chord = edge[1] - edge[0];
+        let length = chord.norm();
+        if length < 1e-9 {
+            continue;
+        }
+        let direction = chord / length;
+        let profile = edge_profile(&direction, length, request);
+        let duration = profile.duration();
+        let rate = request.rate_hz;
+        let mut hints = [0, 0];
+        let mut k = 1u64;
+        loop {
+            let local = (k as f64 / rate).min(duration);
+            let state = profile.state_from(local, &mut hints);
+            let end = local >= duration;
+            let q = if end {
+                edge[1]
+            } else {
+                edge[0] + direction * state.s
+            };
+            samples.push(TimedSample {
+                time_ns: ((elapsed_s + local) * 1e9).round() as u64,
+                q,
+                qd: direction * state.sd,
+                qdd: direction * state.sdd,
+            });
+            if end {
+                break;
+            }
+            k += 1;
+        }
+        elapsed_s += duration;
+    }
+    samples
+}
+
+/// The jerk-limited rest-to-rest profile along a straight edge of `length` rad in the unit
+/// joint direction `direction`.
+fn edge_profile(direction: &JointVector, length: f64, request: &TimingRequest) -> SmoothedProfile {
+    let limits = &request.limits;
+    let speed_bound = (0..direction.len())
+        .filter(|&j| direction[j].abs() > 1e-12)
+        .map(|j| limits.velocity[j] / direction[j].abs())
+        .fold(f64::INFINITY, f64::min);
+    let intervals = ((length * FREE_GRID_PER_RAD).ceil() as usize).max(2);
+    let grid: Vec<GridPoint> = (0..=intervals)
+        .map(|i| GridPoint {
+            s: length * i as f64 / intervals as f64,
+            dq: *direction,
+            ddq: JointVector::zeros(),
+            x_max: speed_bound * speed_bound,
+        })
+        .collect();
+    let x = topp_ra(&grid, &limits.acceleration, &vec![1.0; grid.len()]);
+    let largest_sdd = grid
+        .windows(2)
+        .zip(x.windows(2))
+        .map(|(g, x)| ((x[1] - x[0]) / (2.0 * (g[1].s - g[0].s))).abs())
+        .fold(0.0, f64::max);
+    // Averaging over `w` bounds the path jerk by `2 max|s̈| / w`; joint j's jerk is that times
+    // `|direction_j|`.
+    let window = (0..direction.len())
+        .filter(|&j| direction[j].abs() > 1e-12)
+        .map(|j| 2.0 * largest_sdd * direction[j].abs() / limits.jerk[j])
+        .fold(1e-6, f64::max);
+    SmoothedProfile::new(SpeedProfile::new(&grid, &x), window)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::DynamicLimits;
+
+    fn request() -> TimingRequest {
+        let mut velocity = JointVector::zeros();
+        let mut acceleration = JointVector::zeros();
+        let mut jerk = JointVector::zeros();
+        for j in 0..7 {
+            velocity[j] = 1.0 + 0.1 * j as f64;
+            acceleration[j] = 3.0;
+            jerk[j] = 30.0;
+        }
+        TimingRequest {
+            limits: DynamicLimits {
+                velocity,
+                acceleration,
+                jerk,
+            },
+            tool_speed_m_per_s: 0.2,
+            rate_hz: 1000.0,
+        }
+    }
+
+    #[test]
+    fn a_free_move_keeps_its_edges_rests_at_its_vertices_and_holds_the_limits() {
+        let request = request();
+        let a = JointVector::zeros();
+        let mut b = a;
+        b[0] = 1.0;
+        b[3] = -0.5;
+        let mut c = b;
+        c[1] = 0.4;
+        let samples = time_free_move(&[a, b, c], &request);
+        assert_eq!(samples.first().unwrap().q, a);
+        assert_eq!(samples.last().unwrap().q, c);
+        assert_eq!(samples.last().unwrap().qd, JointVector::zeros());
+        // The motion passes b at rest.
+        let at_b = samples.iter().find(|s| s.q == b).expect("b is a sample");
+        assert!(at_b.qd.norm() < 1e-9);
+        for pair in samples.windows(2) {
+            let dt = (pair[1].time_ns - pair[0].time_ns) as f64 * 1e-9;
+            assert!(dt > 0.0 && dt <= 1e-3 + 1e-9);
+            for j in 0..7 {
+                assert!(pair[1].qd[j].abs() <= request.limits.velocity[j] * (1.0 + 1e-6));
+                assert!(pair[1].qdd[j].abs() <= request.limits.acceleration[j] * (1.0 + 1e-3));
+                let jerk = (pair[1].qdd[j] - pair[0].qdd[j]) / dt;
+                assert!(jerk.abs() <= request.limits.jerk[j] * 1.05, "jerk {jerk}");
+            }
+            // On an edge: the sample lies on a straight line between two vertices.
+            let q = pair[1].q;
+            let on_ab = ((q - a).norm() + (b - q).norm() - (b - a).norm()).abs() < 1e-9;
+            let on_bc = ((q - b).norm() + (c - q).norm() - (c - b).norm()).abs() < 1e-9;
+            assert!(on_ab || on_bc, "{q:?} off the polyline");
+        }
+        // The velocity matches the positions' finite differences.
+        for pair in samples.windows(2) {
+            let dt = (pair[1].time_ns - pair[0].time_ns) as f64 * 1e-9;
+            let mean = (pair[1].q - pair[0].q) / dt;
+            let average = (pair[1].qd + pair[0].qd) / 2.0;
+            assert!((mean - average).norm() < 5e-3, "{mean:?} vs {average:?}");
+        }
+    }
+}
