@@ -19,6 +19,9 @@ use emg_planner::MotionTiming;
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
 pub fn run_check(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
+    if let Some(job) = read_job_file(file)? {
+        return check_job(args, file, &job);
+    }
     let contents = TrajectoryContents::read(file)?;
     let carried = contents.carried();
     // A CSV carries no task: by default it is taken from the JSON written beside it.
@@ -161,6 +164,63 @@ fn read_task_from(path: &Path) -> Result<Carried> {
 
 /// The robot file a trajectory file names; it must exist (paths are as given to `emg plan`,
 /// relative to the working directory).
+/// The job program in `file`, when it is an `emg-job/1` file.
+fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    #[derive(serde::Deserialize)]
+    struct Format {
+        format: Option<String>,
+    }
+    let is_job = text.trim_start().starts_with('{')
+        && serde_json::from_str::<Format>(&text)
+            .ok()
+            .and_then(|f| f.format)
+            .is_some_and(|format| format == emg_job::JOB_FILE_FORMAT);
+    if !is_job {
+        return Ok(None);
+    }
+    Ok(Some(serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{} is not a valid {} file",
+            file.display(),
+            emg_job::JOB_FILE_FORMAT
+        )
+    })?))
+}
+
+/// `emg check` on a job's program: every segment replayed by the independent checker.
+fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()> {
+    let robot_path = match &args.robot {
+        Some(path) => path.clone(),
+        None => named_robot(&job.robot, file)?,
+    };
+    let robot = crate::robot::load_robot(
+        &robot_path,
+        args.base_link.as_deref(),
+        args.tip_link.as_deref(),
+    )?;
+    let model = crate::robot::load_checker(&robot_path, &robot)?;
+    let check = emg_job::verify_job(job, &model, robot.joint_names())
+        .map_err(|failure| anyhow::anyhow!("{} does not hold up: {failure}", file.display()))?;
+    println!(
+        "{}: {} program, robot {}",
+        file.display(),
+        emg_job::JOB_FILE_FORMAT,
+        robot_path.display()
+    );
+    println!(
+        "  {} stroke parts on their paths ({}), {} moves clear of the arm, the plates and the \
+         scene; {} points from rest to rest within the file's joint limits",
+        check.stroke_parts,
+        describe(&job.constraints),
+        check.moves,
+        check.points
+    );
+    println!("OK");
+    Ok(())
+}
+
 fn named_robot(robot: &str, file: &Path) -> Result<PathBuf> {
     let path = PathBuf::from(robot);
     anyhow::ensure!(

@@ -8,7 +8,9 @@
 //! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
 //!    approach along n;
 //! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory, every segment
-//!    with its time span, as an `emg-job/1` file.
+//!    with its time span, as an `emg-job/1` file;
+//!
+//! and [`verify_job`] re-checks a written program with the independent checker.
 //!
 //! [`plan_job`] runs them in order.
 
@@ -17,6 +19,7 @@ pub mod order;
 pub mod program;
 pub mod spec;
 pub mod stroke;
+pub mod verify;
 
 use std::time::Instant;
 
@@ -32,6 +35,7 @@ pub use program::{
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order};
 pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
+pub use verify::{JobCheck, JobCheckError, verify_job};
 
 /// Why a planned job cannot be written.
 #[derive(Debug, thiserror::Error)]
@@ -151,6 +155,7 @@ pub fn plan_job(
                 },
                 &timed.samples,
                 &[],
+                Some(&part.task),
                 dof,
             );
             program.append_move(SegmentKind::Retreat, &[end, above_end], timing, dof);

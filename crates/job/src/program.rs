@@ -2,7 +2,7 @@
 //! −n, a free joint-space move, approach along n) into one timed joint trajectory, every segment
 //! listed with its time span, written as an `emg-job/1` file.
 
-use emg_control::ConstraintConfig;
+use emg_control::{ConstraintConfig, Task};
 use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
 use emg_kinematics::JointVector;
 use emg_planner::MotionTiming;
@@ -48,6 +48,9 @@ pub struct Segment {
     /// Vertices of a move's joint-space polyline (2 for a straight move; none for a stroke).
     #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub vertices: Vec<Vec<f64>>,
+    /// A stroke part's task: the stretch of the stroke it follows.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub task: Option<Task>,
 }
 
 /// What became of one stroke.
@@ -146,12 +149,13 @@ impl Program {
     }
 
     /// Appends `samples` (a rest-to-rest motion from the program's last configuration, its times
-    /// from 0) as a segment of `kind`.
+    /// from 0) as a segment of `kind` (a stroke part with its `task`).
     pub fn append(
         &mut self,
         kind: SegmentKind,
         samples: &[TimedSample],
         vertices: &[JointVector],
+        task: Option<&Task>,
         dof: usize,
     ) {
         let offset_ns = self.samples.last().map_or(0, |last| last.time_ns);
@@ -174,6 +178,7 @@ impl Program {
                 .iter()
                 .map(|q| q.as_slice()[..dof].to_vec())
                 .collect(),
+            task: task.cloned(),
         });
     }
 
@@ -186,7 +191,7 @@ impl Program {
         dof: usize,
     ) {
         let samples = time_free_move(vertices, timing.request());
-        self.append(kind, &samples, vertices, dof);
+        self.append(kind, &samples, vertices, None, dof);
     }
 
     /// The segments so far.
