@@ -217,15 +217,17 @@ impl<'a> Episode<'a> {
         robot.forward_into(&next, &mut self.current.kinematics);
         let mut derived = self.current.derive();
         let mut applied = action;
+        // The share of the step a corrected step lasts (1 for the paper's).
+        let mut share = 1.0;
         if config.tracking == Tracking::Corrected
             && step_s > 0.0
             && derived.along.lateral.norm()
                 > CORRECTION_TRIGGER * config.constraints.line_tolerance_m
             && let Some(corrected) = self.corrected_step(&action, step_s, next)
         {
-            (next, applied) = corrected;
+            (next, applied, share) = corrected;
             // The joints' mean velocity over the corrected step.
-            velocity = (next - self.current.q) / step_s;
+            velocity = (next - self.current.q) / (step_s * share);
             derived = self.current.derive();
         }
         let tool_angle_deg = match admit(robot, task, &self.current.kinematics, &config.constraints)
@@ -245,7 +247,7 @@ impl<'a> Episode<'a> {
             None => (self.current.kinematics.tcp() - previous_tcp).dot(&task.d),
             Some(_) => derived.along.s_m - self.current.along.s_m,
         };
-        self.time_s += self.step_duration(&velocity) * fraction;
+        self.time_s += self.step_duration(&velocity) * fraction * share;
         self.current
             .advance(self.steps.len(), tool_angle_deg, applied, derived);
         if task.completed(self.current.along.s_m) {
@@ -263,16 +265,18 @@ impl<'a> Episode<'a> {
 
     /// The corrected step of [`Tracking::Corrected`] from the current configuration, whose
     /// paper step of `step_s` seconds with `action` ended at `paper_end` (the kinematics in the
-    /// context): Newton corrections `Δq = J⁺ e` toward the nearest line or path point, then the
-    /// same without the null-space motion. The end configuration and the action it applied,
-    /// with the context's kinematics at it; `None`, the kinematics back at `paper_end`, where
-    /// neither comes within [`CORRECTION_TRIGGER`] of the tolerance.
+    /// context): Newton corrections `Δq = J⁺ e` toward the nearest line or path point; then the
+    /// same without the null-space motion, and without it over a half and a quarter of the step
+    /// (the tool slower where the arm cannot follow the line at full speed). The end
+    /// configuration, the action it applied and the share of the step it lasts, with the
+    /// context's kinematics at it; `None`, the kinematics back at `paper_end`, where none comes
+    /// within [`CORRECTION_TRIGGER`] of the tolerance.
     fn corrected_step(
         &mut self,
         action: &NullAction,
         step_s: f64,
         paper_end: JointVector,
-    ) -> Option<(JointVector, NullAction)> {
+    ) -> Option<(JointVector, NullAction, f64)> {
         let StepContext {
             robot,
             task,
@@ -280,12 +284,13 @@ impl<'a> Episode<'a> {
             ..
         } = self.current;
         let target_m = CORRECTION_TRIGGER * config.constraints.line_tolerance_m;
-        let without_self_motion = NullAction::zeros();
-        for applied in [*action, without_self_motion] {
-            let mut q = if applied == *action {
+        let still = NullAction::zeros();
+        let attempts = [(*action, 1.0), (still, 1.0), (still, 0.5), (still, 0.25)];
+        for (index, (applied, share)) in attempts.into_iter().enumerate() {
+            let mut q = if index == 0 {
                 paper_end
             } else {
-                let q = self.current.q + self.current.joint_velocity(&applied) * step_s;
+                let q = self.current.q + self.current.joint_velocity(&applied) * (step_s * share);
                 robot.forward_into(&q, &mut self.current.kinematics);
                 q
             };
@@ -298,7 +303,7 @@ impl<'a> Episode<'a> {
                 &mut q,
                 &mut self.current.kinematics,
             ) {
-                return Some((q, applied));
+                return Some((q, applied, share));
             }
         }
         robot.forward_into(&paper_end, &mut self.current.kinematics);

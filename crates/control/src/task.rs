@@ -309,9 +309,14 @@ impl Task {
 
     /// The distance (m) from `p` to the line, or to the nearest point of the whole path.
     pub fn distance(&self, p: &Vec3) -> f64 {
+        self.offset(p).norm()
+    }
+
+    /// The vector from `p` to the nearest point of the line, or of the whole path.
+    pub fn offset(&self, p: &Vec3) -> Vec3 {
         match &self.path {
-            None => self.lateral_error(p).norm(),
-            Some(path) => (path.locate(p, 0.0, path.length_m()).point - p).norm(),
+            None => self.lateral_error(p),
+            Some(path) => path.locate(p, 0.0, path.length_m()).point - p,
         }
     }
 

@@ -57,7 +57,8 @@ impl SmoothPath {
     /// [`CONE_INSET_DEG`](crate::CONE_INSET_DEG) inside the tool cone where it lies closer to
     /// them (when the moved configuration holds every constraint). It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment, at the joints' turning points and at
-    /// the tool angle's peaks; a segment that breaks a constraint gets back the middle waypoint
+    /// the peaks of the tool angle and of the distance from the line or path; a segment that
+    /// breaks a constraint gets back the middle waypoint
     /// it skipped, or, between consecutive waypoints, their chord midpoint (moved onto the line
     /// or path where it lies more than half the tolerance off, [`onto_task`]) moved likewise as a
     /// new knot (when that holds the constraints, up to [`MAX_REFINEMENTS`] midpoints in all),
@@ -181,14 +182,14 @@ impl SmoothPath {
     }
 }
 
-/// Bisection steps that place a peak of the tool angle inside a check interval (an interval of
+/// Bisection steps that place a peak of the tool angle or of the distance inside a check interval (an interval of
 /// a few millimetres shrinks below a nanometre).
 const PEAK_BISECTIONS: usize = 24;
 
 /// The first segment of `spline` with a checked inside point that breaks a constraint.
 /// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points, every joint's turning points (where
 /// a joint's extreme values inside the segment lie, so the joint limits hold on the whole
-/// segment) and the tool angle's peaks ([`tool_angle_peaks`]).
+/// segment) and the peaks of the tool angle and of the distance from the line or path ([`peaks`]).
 fn first_failing_segment(
     robot: &Robot,
     task: &Task,
@@ -202,7 +203,7 @@ fn first_failing_segment(
                 knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64
             })
             .collect();
-        let peaks = tool_angle_peaks(robot, task, spline, k, &even);
+        let peaks = peaks(robot, task, spline, k, &even);
         even.iter()
             .copied()
             .chain(spline.turning_points(k))
@@ -214,43 +215,48 @@ fn first_failing_segment(
     })
 }
 
-/// Where the tool angle `θ(s) = ∠(z(q(s)), n)` peaks inside segment `k` of `spline`: in each
-/// interval between consecutive points of the segment's knots and `inner` (increasing) where
-/// the angle's rate `θ' = ∇θ · q'` turns from rising to falling, the root of `θ'` found by
-/// [`PEAK_BISECTIONS`] bisections. The largest angle on an interval lies at one of its ends or
-/// at such a peak, unless the rate changes sign more than once inside it; so a spline that
-/// holds the cone at its check points and peaks holds it between them, where the timed samples
-/// fall.
-fn tool_angle_peaks(
-    robot: &Robot,
-    task: &Task,
-    spline: &JointSpline,
-    k: usize,
-    inner: &[f64],
-) -> Vec<f64> {
-    let rate = |s: f64| {
+/// Where the tool angle `θ(s) = ∠(z(q(s)), n)` and the TCP's distance `δ(s)` from the line or
+/// path peak inside segment `k` of `spline`: in each interval between consecutive points of the
+/// segment's knots and `inner` (increasing) where a rate (`θ' = ∇θ · q'`, and `(δ²/2)' = −e ·
+/// J q'` with `e` the TCP's offset to the nearest line or path point) turns from rising to
+/// falling, its root found by [`PEAK_BISECTIONS`] bisections. The largest value on an interval
+/// lies at one of its ends or at such a peak, unless the rate changes sign more than once inside
+/// it; so a spline that holds the cone and the tolerance at its check points and peaks holds
+/// them between them, where the timed samples fall.
+fn peaks(robot: &Robot, task: &Task, spline: &JointSpline, k: usize, inner: &[f64]) -> Vec<f64> {
+    let rates = |s: f64| {
         let point = spline.eval(s);
-        tool_angle_gradient(&robot.forward(&point.q), &task.n).map_or(0.0, |g| g.dot(&point.dq))
+        let kinematics = robot.forward(&point.q);
+        let angle = tool_angle_gradient(&kinematics, &task.n).map_or(0.0, |g| g.dot(&point.dq));
+        let distance = -task
+            .offset(&kinematics.tcp())
+            .dot(&(kinematics.jacobian() * point.dq));
+        [angle, distance]
     };
     let knots = spline.knots();
     let points: Vec<f64> = std::iter::once(knots[k])
         .chain(inner.iter().copied())
         .chain(std::iter::once(knots[k + 1]))
         .collect();
-    let rates: Vec<f64> = points.iter().map(|&s| rate(s)).collect();
-    (0..points.len() - 1)
-        .filter(|&i| rates[i] > 0.0 && rates[i + 1] <= 0.0)
-        .map(|i| {
-            let (mut rising, mut falling) = (points[i], points[i + 1]);
-            for _ in 0..PEAK_BISECTIONS {
-                let middle = 0.5 * (rising + falling);
-                if rate(middle) > 0.0 {
-                    rising = middle;
-                } else {
-                    falling = middle;
-                }
-            }
-            0.5 * (rising + falling)
+    let at_points: Vec<[f64; 2]> = points.iter().map(|&s| rates(s)).collect();
+    (0..2)
+        .flat_map(|which| {
+            let rate = |s: f64| rates(s)[which];
+            (0..points.len() - 1)
+                .filter(|&i| at_points[i][which] > 0.0 && at_points[i + 1][which] <= 0.0)
+                .map(|i| {
+                    let (mut rising, mut falling) = (points[i], points[i + 1]);
+                    for _ in 0..PEAK_BISECTIONS {
+                        let middle = 0.5 * (rising + falling);
+                        if rate(middle) > 0.0 {
+                            rising = middle;
+                        } else {
+                            falling = middle;
+                        }
+                    }
+                    0.5 * (rising + falling)
+                })
+                .collect::<Vec<_>>()
         })
         .collect()
 }
