@@ -152,6 +152,11 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
             );
         }
     }
+    for stroke in &file.strokes {
+        for why in &stroke.parts_left_out {
+            println!("  stroke {}, {why}", stroke.stroke);
+        }
+    }
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());
     Ok(())

@@ -126,6 +126,16 @@ impl<'a> FreeSpace<'a> {
         }
     }
 
+    /// The arm.
+    pub fn robot(&self) -> &'a Robot {
+        self.robot
+    }
+
+    /// The constraints (plates, scene, margin) the arm keeps.
+    pub fn constraints(&self) -> &'a ConstraintConfig {
+        self.constraints
+    }
+
     /// Whether `q` is free: within the joint limits, no link touching another, a plate or an
     /// obstacle, the tool's tip not inside the part.
     pub fn free(&self, q: &JointVector) -> bool {

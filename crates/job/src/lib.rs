@@ -94,55 +94,48 @@ pub fn plan_job(
         .flat_map(|plan| plan.parts.iter().map(|part| part.task.clone()))
         .collect();
     let free = FreeSpace::new(robot, part_surfaces(robot, &tasks), constraints);
+    let connector = Connector {
+        free: &free,
+        timing,
+        settings,
+    };
     let mut program = Program::default();
     let mut reports = Vec::new();
     let (mut straight_moves, mut sampled_moves) = (0, 0);
-    let mut failure = None;
     for (oriented, plan) in ordering.sequence.iter().zip(&plans) {
-        let mut parts_without_move = 0;
+        let mut parts_left_out = Vec::new();
         let mut drawn_parts = Vec::new();
-        for (index, part) in plan.parts.iter().enumerate() {
-            let timed = match timing.time(robot, &part.task, constraints, &part.trajectory) {
-                Ok(timed) => timed,
-                Err(e) => {
-                    failure.get_or_insert(format!("timing: {e}"));
-                    parts_without_move += 1;
+        for (index, planned) in plan.parts.iter().enumerate() {
+            let from = program.last().or(job.home);
+            let seed = settings.seed.wrapping_add(program.segments().len() as u64);
+            // Where the searched start cannot be reached, the part is planned again from the
+            // configuration the arm is in, moved above the part's start and set down there.
+            let placed = connector.place(planned, from, seed).or_else(|why| {
+                let from = from.ok_or(why.clone())?;
+                let again = connector
+                    .from_nearby(planner, request, planned, &from)
+                    .ok_or(why.clone())?;
+                connector.place(&again, Some(from), seed).map_err(|_| why)
+            });
+            let (part, placed) = match placed {
+                Ok(placed) => placed,
+                Err(why) => {
+                    parts_left_out.push(format!("part {index}: {why}"));
                     continue;
                 }
             };
-            let start = timed.samples.first().expect("a timed motion has samples").q;
-            let end = timed.samples.last().expect("a timed motion has samples").q;
-            let lift = -part.task.n * settings.lift_m;
-            let above = |q: &JointVector| free.reach_point(q, &(robot.forward(q).tcp() + lift));
-            let (Some(above_start), Some(above_end)) = (above(&start), above(&end)) else {
-                failure.get_or_insert("no free configuration above a stroke's end".to_string());
-                parts_without_move += 1;
-                continue;
-            };
-            let from = program.last().or(job.home);
-            let travel = match from {
-                None => Some(Vec::new()),
-                Some(from) => free
-                    .connect(
-                        &from,
-                        &above_start,
-                        settings.seed.wrapping_add(program.segments().len() as u64),
-                        settings.rrt_max_samples,
-                    )
-                    .map(|vertices| {
-                        if vertices.len() == 2 {
-                            straight_moves += 1;
-                        } else {
-                            sampled_moves += 1;
-                        }
-                        vertices
-                    }),
-            };
-            let Some(travel) = travel else {
-                failure.get_or_insert("no free move to a stroke's start".to_string());
-                parts_without_move += 1;
-                continue;
-            };
+            let Placed {
+                timed,
+                above_start,
+                above_end,
+                travel,
+            } = placed;
+            let (start, end) = (timed.samples[0].q, timed.samples[timed.samples.len() - 1].q);
+            match travel.len() {
+                0 => {}
+                2 => straight_moves += 1,
+                _ => sampled_moves += 1,
+            }
             // Without a home the program begins above the first stroke.
             if !travel.is_empty() {
                 program.append_move(SegmentKind::Travel, &travel, timing, dof);
@@ -162,7 +155,7 @@ pub fn plan_job(
             drawn_parts.push(part);
         }
         let drawn = StrokePlan {
-            parts: drawn_parts.into_iter().cloned().collect(),
+            parts: drawn_parts,
             ..plan.clone()
         };
         reports.push(StrokeReport {
@@ -177,7 +170,7 @@ pub fn plan_job(
                 .map(|u| plan.path.point_at(u.from_s).into())
                 .collect(),
             unreached: plan.unreached.clone(),
-            parts_without_move,
+            parts_left_out,
         });
     }
     if let Some(home) = job.home
@@ -193,9 +186,13 @@ pub fn plan_job(
         }
     }
     if program.segments().is_empty() {
-        return Err(JobPlanError::NothingDrawn(
-            failure.unwrap_or_else(|| "no stroke has a reachable start".to_string()),
-        ));
+        let why = reports
+            .iter()
+            .flat_map(|r| r.parts_left_out.first())
+            .next()
+            .cloned()
+            .unwrap_or_else(|| "no stroke has a reachable start".to_string());
+        return Err(JobPlanError::NothingDrawn(why));
     }
     let summary = summarise(
         &reports,
@@ -220,6 +217,106 @@ pub fn plan_job(
     })
 }
 
+/// A stroke part made ready to join the program: timed, with its free configurations above
+/// its start and end and the free move to the first from where the arm was.
+struct Placed {
+    timed: emg_timing::TimedMotion,
+    above_start: JointVector,
+    above_end: JointVector,
+    /// Empty when the program begins here.
+    travel: Vec<JointVector>,
+}
+
+/// The connect stage for one part at a time.
+struct Connector<'a> {
+    free: &'a FreeSpace<'a>,
+    timing: &'a MotionTiming,
+    settings: &'a JobSettings,
+}
+
+impl Connector<'_> {
+    /// `part` timed and joined to the arm's configuration `from` (none at the program's start):
+    /// lifted at both ends, the free move to above its start; or why it cannot be.
+    fn place(
+        &self,
+        part: &StrokePart,
+        from: Option<JointVector>,
+        seed: u64,
+    ) -> Result<(StrokePart, Placed), String> {
+        let robot = self.free.robot();
+        let timed = self
+            .timing
+            .time(robot, &part.task, self.free.constraints(), &part.trajectory)
+            .map_err(|e| format!("cannot be timed: {e}"))?;
+        let start = timed.samples[0].q;
+        let end = timed.samples[timed.samples.len() - 1].q;
+        let lift = -part.task.n * self.settings.lift_m;
+        let above = |q: &JointVector, what: &str| {
+            self.free
+                .reach_point(q, &(robot.forward(q).tcp() + lift))
+                .ok_or_else(|| {
+                    format!(
+                        "the tool cannot lift {} m off its {what} into free space",
+                        self.settings.lift_m
+                    )
+                })
+        };
+        let above_start = above(&start, "start")?;
+        let above_end = above(&end, "end")?;
+        let travel = match from {
+            None => Vec::new(),
+            Some(from) => self
+                .free
+                .connect(&from, &above_start, seed, self.settings.rrt_max_samples)
+                .ok_or_else(|| {
+                    format!(
+                        "no free move to its start found in {} samples",
+                        self.settings.rrt_max_samples
+                    )
+                })?,
+        };
+        Ok((
+            part.clone(),
+            Placed {
+                timed,
+                above_start,
+                above_end,
+                travel,
+            },
+        ))
+    }
+
+    /// `part`'s stretch planned again by one rollout from the configuration reached from
+    /// `from` (lifted, above the part's start) by moving the tool straight above the start and
+    /// down onto it, the arm keeping its branch; `None` where that move is not free.
+    fn from_nearby(
+        &self,
+        planner: &Planner,
+        request: &PlanRequest,
+        part: &StrokePart,
+        from: &JointVector,
+    ) -> Option<StrokePart> {
+        let robot = self.free.robot();
+        let start_point = part.task.p0;
+        let lift = -part.task.n * self.settings.lift_m;
+        let above = self.free.reach_point(from, &(start_point + lift))?;
+        let start = self.free.reach_point(&above, &start_point)?;
+        let rollout = PlanRequest {
+            planner: emg_planner::PlannerKind::Controller,
+            seed: Some(emg_planner::SeedSource::Given(
+                robot.joints_of(&start).to_vec(),
+            )),
+            controller: request.controller,
+        };
+        let planned = planner.plan(&part.task, &rollout).ok()?;
+        (planned.trajectory.steps.len() > 1).then(|| StrokePart {
+            from_s: part.from_s,
+            task: part.task.clone(),
+            trajectory: planned.trajectory,
+        })
+    }
+}
+
 /// The job's totals.
 fn summarise(
     reports: &[StrokeReport],
@@ -230,7 +327,7 @@ fn summarise(
     started: Instant,
 ) -> JobSummary {
     let whole =
-        |r: &&StrokeReport| r.unreached.is_empty() && r.parts_without_move == 0 && r.parts > 0;
+        |r: &&StrokeReport| r.unreached.is_empty() && r.parts_left_out.is_empty() && r.parts > 0;
     let pen_down_s = program
         .segments()
         .iter()

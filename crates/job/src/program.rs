@@ -71,8 +71,9 @@ pub struct StrokeReport {
     pub unreached: Vec<Unreached>,
     /// See `unreached`.
     pub unreached_at: Vec<[f64; 3]>,
-    /// Parts planned but left out because no free move reached them.
-    pub parts_without_move: usize,
+    /// Parts planned but left out, each with why: no safe move reached them or they could not
+    /// be timed.
+    pub parts_left_out: Vec<String>,
 }
 
 /// The job's totals.

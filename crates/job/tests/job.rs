@@ -1,0 +1,205 @@
+//! Jobs end to end: a real line-art icon (lucide-static 1.62.0's `pencil`, vendored with the
+//! SVG reader's tests) planned on the FR3 and on the UR5e, its program re-checked segment by
+//! segment by the independent checker; the order stage; wrong jobs refused naming what is wrong.
+
+use std::path::PathBuf;
+
+use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_job::{
+    JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, SegmentKind, plan_job, verify_job,
+};
+use emg_kinematics::Robot;
+use emg_planner::{
+    DEFAULT_RATE_HZ, DataDir, Models, MotionTiming, PlanRequest, Planner, PlannerConfig,
+    ShippedRobot,
+};
+use emg_verify::ReferenceModel;
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn icon(name: &str) -> PathBuf {
+    workspace().join(format!("crates/io/tests/data/icons/{name}.svg"))
+}
+
+/// A shipped arm's planner as `emg job` builds it (the cell's plate, 0.5 mm), its timing and
+/// its checker.
+fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
+    let data = DataDir::new(workspace().join("data"));
+    let shipped = ShippedRobot::by_name(name).expect("a shipped robot");
+    let file = shipped.path(&data);
+    let robot = Robot::from_chain_file(&file).expect("robot loads");
+    let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
+        .expect("checker loads");
+    let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
+    let mut config = PlannerConfig::cell();
+    config.rollout.constraints.line_tolerance_m = 5e-4;
+    let timing = MotionTiming::for_robot_file(
+        &robot,
+        &file,
+        None,
+        emg_timing::Scaling::default(),
+        config.rollout.speed_m_per_s,
+        DEFAULT_RATE_HZ,
+        &config.rollout.constraints,
+    )
+    .expect("timing");
+    let planner = Planner::new(robot, models, config).expect("planner");
+    (planner, timing, checker, file)
+}
+
+fn icon_job(robot: &Robot, name: &str, placement: &Placement) -> Job {
+    let drawing = read_svg_file(&icon(name), placement, &SvgOptions::default()).expect("icon");
+    Job::from_spec(
+        JobSpec {
+            version: JOB_FORMAT_VERSION,
+            strokes: drawing.strokes,
+            settings: JobSettings::default(),
+            home: None,
+        },
+        robot,
+    )
+    .expect("a valid job")
+}
+
+fn plans_and_checks_the_pencil_icon(name: &str) {
+    let (planner, timing, checker, file) = setup(name);
+    let job = icon_job(planner.robot(), "pencil", &Placement::default());
+    let program = plan_job(
+        &planner,
+        &PlanRequest::default(),
+        &job,
+        &timing,
+        &file.display().to_string(),
+        &|_, _| {},
+    )
+    .expect("the job plans");
+    let summary = &program.summary;
+    assert_eq!(program.strokes.len(), job.strokes.len());
+    assert!(
+        summary.drawn_m >= 0.95 * summary.total_m,
+        "{name}: drew {} of {} m",
+        summary.drawn_m,
+        summary.total_m
+    );
+    // Pen down, lifted between strokes: every stroke part has a retreat after it.
+    let kinds: Vec<SegmentKind> = program.segments.iter().map(|s| s.kind).collect();
+    for (k, kind) in kinds.iter().enumerate() {
+        if matches!(kind, SegmentKind::Stroke { .. }) {
+            assert_eq!(
+                kinds.get(k + 1),
+                Some(&SegmentKind::Retreat),
+                "{name}: {kinds:?}"
+            );
+            assert_eq!(kinds[k - 1], SegmentKind::Approach, "{name}: {kinds:?}");
+        }
+    }
+    for pair in program.segments.windows(2) {
+        assert_eq!(
+            pair[0].end_s, pair[1].start_s,
+            "segments follow one another"
+        );
+    }
+    let check = verify_job(&program, &checker, planner.robot().joint_names())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(check.points, program.points.len());
+    assert!(check.moves >= 2 * check.stroke_parts - 1);
+    // A program moved off its stroke is refused.
+    let mut moved = program.clone();
+    let stroke = moved
+        .segments
+        .iter()
+        .position(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
+        .expect("a stroke segment");
+    let task = moved.segments[stroke].task.as_mut().expect("its task");
+    task.p0.x += 0.01;
+    if let Some(path) = &task.path {
+        let mut spec = path.spec().clone();
+        spec.start[0] += 0.01;
+        for segment in &mut spec.segments {
+            if let emg_control::SegmentSpec::Line { to } = segment {
+                to[0] += 0.01;
+            }
+            if let emg_control::SegmentSpec::Arc {
+                centre: Some(c), ..
+            } = segment
+            {
+                c[0] += 0.01;
+            }
+        }
+        task.path = Some(emg_control::Path::new(spec).expect("the moved stroke"));
+    }
+    let failure = verify_job(&moved, &checker, planner.robot().joint_names()).unwrap_err();
+    assert!(failure.to_string().contains("off the line"), "{failure}");
+}
+
+#[test]
+fn an_icon_is_planned_and_checked_on_the_fr3() {
+    plans_and_checks_the_pencil_icon("fr3");
+}
+
+#[test]
+fn an_icon_is_planned_and_checked_on_the_ur5e() {
+    plans_and_checks_the_pencil_icon("ur5e");
+}
+
+#[test]
+fn wrong_jobs_are_refused_naming_what_is_wrong() {
+    let (planner, timing, _, file) = setup("fr3");
+    let robot = planner.robot();
+    let parse = |text: &str| {
+        Job::from_json("job.json", text, robot)
+            .map(|_| ())
+            .unwrap_err()
+    };
+    assert!(matches!(
+        parse(r#"{"version": 1, "strokes": []}"#),
+        JobError::NoStrokes
+    ));
+    let off_plane = parse(
+        r#"{"version": 1, "strokes": [{"version": 1, "start": [0.45, 0, 0.25], "normal": [0, 0, -1],
+            "segments": [{"line": {"to": [0.5, 0, 0.3]}}]}]}"#,
+    );
+    assert!(
+        off_plane
+            .to_string()
+            .starts_with("job field 'strokes[0]': path field 'segments[0].line.to' lies"),
+        "{off_plane}"
+    );
+    assert!(matches!(
+        parse(r#"{"version": 2, "strokes": []}"#),
+        JobError::Version { found: 2 }
+    ));
+    let home = parse(
+        r#"{"version": 1, "home": [0, 0, 0], "strokes": [{"version": 1, "start": [0.45, 0, 0.25],
+            "normal": [0, 0, -1], "segments": [{"line": {"to": [0.45, 0.1, 0.25]}}]}]}"#,
+    );
+    assert!(home.to_string().contains("has 3 values"), "{home}");
+    let lift = parse(
+        r#"{"version": 1, "settings": {"lift_m": -1}, "strokes": [{"version": 1, "start": [0.45, 0, 0.25],
+            "normal": [0, 0, -1], "segments": [{"line": {"to": [0.45, 0.1, 0.25]}}]}]}"#,
+    );
+    assert!(lift.to_string().contains("settings.lift_m"), "{lift}");
+    // A drawing placed where the arm cannot reach any of it.
+    let far = Placement {
+        origin_m: [3.0, 0.0, 0.25],
+        ..Placement::default()
+    };
+    let job = icon_job(robot, "heart", &far);
+    let failure = plan_job(
+        &planner,
+        &PlanRequest::default(),
+        &job,
+        &timing,
+        &file.display().to_string(),
+        &|_, _| {},
+    )
+    .unwrap_err();
+    assert!(
+        failure
+            .to_string()
+            .starts_with("no stroke of the job can be drawn"),
+        "{failure}"
+    );
+}
