@@ -23,6 +23,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
+/// The README's markers around the table of [`readme_table`].
+pub const README_START: &str = "<!-- precision:start -->";
+/// See [`README_START`].
+pub const README_END: &str = "<!-- precision:end -->";
+
 /// The tolerances compared (mm): the paper's benchmark, then two a cell uses.
 pub const TOLERANCES_MM: [f64; 3] = [20.0, 0.5, 0.1];
 
@@ -565,4 +570,43 @@ fn markdown(record: &Record) -> String {
         }
     }
     md
+}
+
+/// One row per shipped arm, tolerance and step of every `precision.json` under `results`:
+/// Σ plan / Σ bound over all lines and all paths, the share of line motions the tolerance ended,
+/// the paths completed, checker failures.
+pub fn readme_table(results: &std::path::Path) -> anyhow::Result<String> {
+    let mut md = String::from(
+        "| arm | tolerance | step | lines: Σ plan / Σ bound | lines ended by the tolerance | \
+         paths: Σ plan / Σ bound | paths completed | checker failures |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for (shipped, record) in crate::report::shipped_results::<Record>(results, "precision.json")? {
+        let rows_of = |kind: Kind| record.rows.iter().filter(move |r| r.kind == kind);
+        for line in rows_of(Kind::Lines).filter(|r| r.setting.learned) {
+            let path = rows_of(Kind::Paths).find(|r| r.setting == line.setting);
+            let all = |row: &Row| {
+                row.bound_shares
+                    .iter()
+                    .find(|b| b.bucket == "all")
+                    .map_or(f64::NAN, |b| b.share)
+            };
+            md.push_str(&format!(
+                "| {} | {} mm | {} | {:.3} | {:.1} % | {} | {} | {} |\n",
+                shipped.name,
+                line.setting.tolerance_mm,
+                line.setting.step_name(),
+                all(line),
+                100.0 * line.ended_by_line_tolerance as f64 / line.lengths_m.len().max(1) as f64,
+                path.map_or("—".to_string(), |p| format!("{:.3}", all(p))),
+                path.map_or("—".to_string(), |p| format!(
+                    "{} of {}",
+                    p.completed,
+                    p.lengths_m.len()
+                )),
+                line.checker_failures + path.map_or(0, |p| p.checker_failures),
+            ));
+        }
+    }
+    Ok(md)
 }

@@ -188,6 +188,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          `docs/results/timing.md` per arm):\n\n{plan_times}\n"
     );
     md += &crate::path_eval::report_section(&args.results)?;
+    let precision = crate::precision_eval::readme_table(&args.results)?;
+    md += &format!(
+        "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
+         corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
+         `docs/results/precision.md` per arm):\n\n{precision}\n"
+    );
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     if args.results == workspace::root().join("docs/results") {
@@ -201,7 +207,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             crate::timing::README_END,
             &plan_times,
         )?;
-        println!("wrote the README's tables of search shares and of plan times");
+        workspace::replace_readme_section(
+            crate::precision_eval::README_START,
+            crate::precision_eval::README_END,
+            &precision,
+        )?;
+        println!("wrote the README's tables of search shares, plan times and precision");
     }
     Ok(())
 }

@@ -198,3 +198,9 @@ fn one() {
         }
     }
 }
+#[test]
+fn segs() {
+    let text = r#"<svg xmlns="http://www.w3.org/2000/svg" width="24" height="24" viewBox="0 0 24 24" fill="none" stroke="black"><path d="M3.262 15.326A1 1 0 0 0 4 17H20A1 1 0 0 0 20.74 15.327C20.209 14.779 19.665 14.218 19.203 13.454" /></svg>"#;
+    let tree = usvg::Tree::from_str(text, &usvg::Options::default()).unwrap();
+    for n in tree.root().children() { if let usvg::Node::Path(p) = n { for s in p.data().segments() { println!("{s:?}"); } } }
+}

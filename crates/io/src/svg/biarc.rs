@@ -82,6 +82,12 @@ fn fit_part(
     let fits = fitted.is_some_and(|pieces| deviation(curve, &pieces) <= tolerance);
     let last_halving = depth >= MAX_DEPTH || curve.hull_length() < shortest;
     if fits || last_halving {
+        if std::env::var("DBG").is_ok() { if let Some(pcs) = fitted {
+            let n = 3000; let samples: Vec<V2> = (0..=n).map(|i| curve.point(i as f64 / n as f64)).collect();
+            let there = samples.iter().map(|p| distance_to(&pcs, *p)).fold(0.0, f64::max);
+            let worst = samples.iter().enumerate().map(|(i,p)| (distance_to(&pcs, *p), i)).fold((0.0,0), |a, b| if b.0 > a.0 {b} else {a});
+            eprintln!("depth {depth} fits {fits} dev {:.3e} dense {there:.3e} at {} ta {ta:?} tb {tb:?} curve {:?} pieces {pcs:?}", deviation(curve, &pcs), worst.1, curve.p);
+        }}
         match fitted {
             Some(pieces) => out.extend(pieces.into_iter().filter(|p| p.length() > 0.0)),
             None if a != b => out.push(Piece::Line { from: a, to: b }),
