@@ -527,11 +527,7 @@ fn markdown(record: &Record) -> String {
                 row.setting.step_name()
             ));
             for share in &row.bound_shares {
-                md.push_str(&format!(
-                    " {} ({}) |",
-                    format!("{:.3}", share.share),
-                    share.tasks
-                ));
+                md.push_str(&format!(" {:.3} ({}) |", share.share, share.tasks));
             }
             md.push_str(&format!(
                 " {} ({:.1} %) |",
@@ -560,12 +556,12 @@ fn markdown(record: &Record) -> String {
         );
         for path in &record.unfinished_at_tightest {
             md.push_str(&format!(
-                "| {} | {} | {} | {} | {} |\n",
+                "| {} | {} | {:.4} | {:.4} | {:.4} |\n",
                 path.index,
                 path.shape.name(),
-                format!("{:.4}", path.length_m),
-                format!("{:.4}", path.reached_m),
-                format!("{:.4}", path.bound_m)
+                path.length_m,
+                path.reached_m,
+                path.bound_m
             ));
         }
     }

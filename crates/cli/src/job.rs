@@ -152,6 +152,11 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
             );
         }
     }
+    if !s.ends_at_home {
+        println!(
+            "  no free move back to the job's home was found: the program ends above its last stroke"
+        );
+    }
     for stroke in &file.strokes {
         for why in &stroke.parts_left_out {
             println!("  stroke {}, {why}", stroke.stroke);

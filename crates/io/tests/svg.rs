@@ -383,7 +383,7 @@ fn an_ellipse_is_biarcs_within_the_tolerance() {
         let drawing = read_and_check(&text, &Placement::default(), &options);
         let spec = &drawing.strokes[0];
         assert_eq!(arcs(spec).len(), spec.segments.len());
-        assert!(spec.segments.len() >= 8 && spec.segments.len() % 2 == 0);
+        assert!(spec.segments.len() >= 8 && spec.segments.len().is_multiple_of(2));
         assert_eq!(validated(spec).corners_m().count(), 0);
     }
 }

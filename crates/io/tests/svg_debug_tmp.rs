@@ -148,59 +148,59 @@ fn deviations(path: &Path, original: &[Vec3]) -> (f64, f64) {
 }
 
 #[test]
-fn one() {
-    let name = std::env::var("ICON").unwrap();
-    let tol: f64 = std::env::var("TOL").unwrap().parse().unwrap();
-    let width: f64 = std::env::var("WIDTH").unwrap().parse().unwrap();
-    let text = std::fs::read_to_string(format!("/tmp/lucide/package/icons/{name}.svg")).unwrap();
-    let placement = Placement {
-        width_m: Some(width),
-        ..Placement::default()
-    };
-    let options = SvgOptions {
-        curve_tolerance_m: tol,
-        ..SvgOptions::default()
-    };
-    let d = read_svg(&text, &placement, &options).unwrap();
-    let originals = original_strokes(&text, &d, &placement);
-    for (k, (spec, original)) in d.strokes.iter().zip(&originals).enumerate() {
-        let p = validated(spec);
-        let (a, b) = deviations(&p, original);
-        println!(
-            "stroke {k}: {a:.3e} {b:.3e}, {} segments",
-            spec.segments.len()
-        );
-        if a.max(b) > tol * 1.01 {
-            // where
-            for q in original.iter() {
-                let l = p.locate(q, 0.0, p.length_m());
-                let dd = (l.point - q).norm();
-                if dd > tol * 1.01 {
-                    println!(
-                        "  original point {:?} off {dd:.3e} at s {:.5} of {:.5}",
-                        (q.x, q.y),
-                        l.s,
-                        p.length_m()
-                    );
-                    break;
+fn all_icons() {
+    let configs: Vec<(f64, f64)> = std::env::var("CONFIGS")
+        .unwrap()
+        .split(';')
+        .map(|c| {
+            let v: Vec<f64> = c.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[0], v[1])
+        })
+        .collect();
+    for (tol, width) in configs {
+        let mut worst = (0.0, String::new());
+        let (mut corners, mut strokes, mut dropped, mut segs, mut failed) = (0, 0, 0, 0, 0);
+        for entry in std::fs::read_dir("/tmp/lucide/package/icons").unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let placement = Placement {
+                width_m: Some(width),
+                ..Placement::default()
+            };
+            let options = SvgOptions {
+                curve_tolerance_m: tol,
+                ..SvgOptions::default()
+            };
+            let d = match read_svg(&text, &placement, &options) {
+                Ok(d) => d,
+                Err(_) => {
+                    failed += 1;
+                    continue;
+                }
+            };
+            dropped += d.dropped_tiny;
+            if d.dropped_tiny > 0 {
+                continue;
+            }
+            let originals = original_strokes(&text, &d, &placement);
+            assert_eq!(originals.len(), d.strokes.len(), "{path:?}");
+            for (spec, original) in d.strokes.iter().zip(&originals) {
+                let p = validated(spec);
+                strokes += 1;
+                segs += spec.segments.len();
+                corners += p.corners_m().count();
+                let (a, b) = deviations(&p, original);
+                let e = a.max(b) / tol;
+                if e > worst.0 {
+                    worst = (e, format!("{path:?} {a:.3e} {b:.3e}"));
+                }
+                if e > 1.03 {
+                    println!("{path:?}: {a:.3e} {b:.3e}");
                 }
             }
-            for (i, piece) in p.pieces().iter().enumerate() {
-                println!(
-                    "  piece {i}: s {:.5} len {:.6} corner {} {:?}",
-                    piece.start_s,
-                    piece.length_m,
-                    piece.corner_before,
-                    piece.outline()
-                );
-            }
-            println!("{}", serde_json::to_string(spec).unwrap());
         }
+        println!(
+            "tol {tol} width {width}: failed {failed} strokes {strokes} segments {segs} corners {corners} dropped {dropped} worst {worst:?}"
+        );
     }
-}
-#[test]
-fn segs() {
-    let text = r#"<svg xmlns="http://www.w3.org/2000/svg" width="24" height="24" viewBox="0 0 24 24" fill="none" stroke="black"><path d="M3.262 15.326A1 1 0 0 0 4 17H20A1 1 0 0 0 20.74 15.327C20.209 14.779 19.665 14.218 19.203 13.454" /></svg>"#;
-    let tree = usvg::Tree::from_str(text, &usvg::Options::default()).unwrap();
-    for n in tree.root().children() { if let usvg::Node::Path(p) = n { for s in p.data().segments() { println!("{s:?}"); } } }
 }

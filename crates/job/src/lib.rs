@@ -113,7 +113,7 @@ pub fn plan_job(
             let placed = connector.place(planned, from, seed).or_else(|why| {
                 let from = from.ok_or(why.clone())?;
                 let again = connector
-                    .from_nearby(planner, request, planned, &from)
+                    .replanned_nearby(planner, request, planned, &from)
                     .ok_or(why.clone())?;
                 connector.place(&again, Some(from), seed).map_err(|_| why)
             });
@@ -173,17 +173,18 @@ pub fn plan_job(
             parts_left_out,
         });
     }
+    let mut ends_at_home = job.home.is_none();
     if let Some(home) = job.home
         && let Some(last) = program.last()
-    {
-        if let Some(vertices) = free.connect(
+        && let Some(vertices) = free.connect(
             &last,
             &home,
             settings.seed.wrapping_add(u64::MAX / 2),
             settings.rrt_max_samples,
-        ) {
-            program.append_move(SegmentKind::Travel, &vertices, timing, dof);
-        }
+        )
+    {
+        program.append_move(SegmentKind::Travel, &vertices, timing, dof);
+        ends_at_home = true;
     }
     if program.segments().is_empty() {
         let why = reports
@@ -194,7 +195,7 @@ pub fn plan_job(
             .unwrap_or_else(|| "no stroke has a reachable start".to_string());
         return Err(JobPlanError::NothingDrawn(why));
     }
-    let summary = summarise(
+    let mut summary = summarise(
         &reports,
         &program,
         &ordering,
@@ -202,6 +203,7 @@ pub fn plan_job(
         &plans,
         started,
     );
+    summary.ends_at_home = ends_at_home;
     Ok(JobFile {
         format: JOB_FILE_FORMAT.to_string(),
         robot: robot_file.to_string(),
@@ -289,7 +291,7 @@ impl Connector<'_> {
     /// `part`'s stretch planned again by one rollout from the configuration reached from
     /// `from` (lifted, above the part's start) by moving the tool straight above the start and
     /// down onto it, the arm keeping its branch; `None` where that move is not free.
-    fn from_nearby(
+    fn replanned_nearby(
         &self,
         planner: &Planner,
         request: &PlanRequest,
@@ -354,5 +356,6 @@ fn summarise(
         sampled_moves,
         searches: plans.iter().map(|p| p.searches).sum(),
         planning_s: started.elapsed().as_secs_f64(),
+        ends_at_home: true,
     }
 }

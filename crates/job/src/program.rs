@@ -107,6 +107,9 @@ pub struct JobSummary {
     pub searches: usize,
     /// See `searches`.
     pub planning_s: f64,
+    /// Whether the program ends at the job's home (always, without one); false where no free
+    /// move back to it was found.
+    pub ends_at_home: bool,
 }
 
 /// A job's program as its file holds it.

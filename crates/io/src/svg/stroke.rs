@@ -16,7 +16,7 @@
 use emg_control::MIN_SEGMENT_M;
 
 use super::bezier::{Cubic, V2};
-use super::biarc::{PIECE_SAMPLES, fit_cubic};
+use super::biarc::{PIECE_SAMPLES, UNSPLIT_PIECES, fit_cubic};
 use super::outline::{Segment, Subpath};
 use super::piece::{Piece, arc_from, arc_to, biarc, distance_to};
 
@@ -48,10 +48,10 @@ impl Item {
 
 /// The largest turn (rad) between two segments made smooth at `tolerance` when the option
 /// asks for `smooth_join_rad`: bending a curve's end by `φ` within the tolerance takes about
-/// `4 tolerance / φ` of it, which must not fall below the curve fitter's shortest part
-/// (0.4 mm), so at most `tolerance / 0.2 mm`.
+/// `4 tolerance / φ` of it, which must not fall below the shortest part the curve fitter
+/// splits (0.8 mm, [`UNSPLIT_PIECES`] shortest segments), so at most `tolerance / 0.2 mm`.
 pub(crate) fn smooth_join_limit(tolerance: f64, smooth_join_rad: f64) -> f64 {
-    smooth_join_rad.min(tolerance / (2.0 * MIN_SEGMENT_M))
+    smooth_join_rad.min(4.0 * tolerance / (UNSPLIT_PIECES * MIN_SEGMENT_M))
 }
 
 /// The pieces of `subpath` (plane coordinates in metres), each at least [`MIN_SEGMENT_M`]
@@ -66,7 +66,7 @@ pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) ->
         match *item {
             Item::Line { from, to } => raw.push(Piece::Line { from, to }),
             Item::Curve { curve, start, end } => {
-                fit_cubic(&curve, start, end, tolerance, 4.0 * SHORTEST, &mut raw)
+                fit_cubic(&curve, start, end, tolerance, SHORTEST, &mut raw)
             }
         }
     }
@@ -312,7 +312,7 @@ mod tests {
         let pieces = super::pieces(&path, 5e-5, 0.04);
         assert!((turns(&pieces)[0] - 0.05).abs() < 1e-9);
         // At 1 µm there is no room to bend the curve by 0.05 rad: the limit is 0.005 rad.
-        assert_eq!(smooth_join_limit(1e-6, 0.1), 0.005);
+        assert!((smooth_join_limit(1e-6, 0.1) - 0.005).abs() < 1e-15);
         let pieces = super::pieces(&path, 1e-6, 0.1);
         assert!((turns(&pieces)[0] - 0.05).abs() < 1e-9);
         // A real corner stays one.
