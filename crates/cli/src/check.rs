@@ -165,19 +165,10 @@ fn read_task_from(path: &Path) -> Result<Carried> {
 /// The robot file a trajectory file names; it must exist (paths are as given to `emg plan`,
 /// relative to the working directory).
 /// The job program in `file`, when it is an `emg-job/1` file.
-fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
+pub(crate) fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
-    #[derive(serde::Deserialize)]
-    struct Format {
-        format: Option<String>,
-    }
-    let is_job = text.trim_start().starts_with('{')
-        && serde_json::from_str::<Format>(&text)
-            .ok()
-            .and_then(|f| f.format)
-            .is_some_and(|format| format == emg_job::JOB_FILE_FORMAT);
-    if !is_job {
+    if !emg_job::JobFile::is_job(&text) {
         return Ok(None);
     }
     Ok(Some(serde_json::from_str(&text).with_context(|| {

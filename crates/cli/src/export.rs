@@ -14,7 +14,8 @@ use crate::args::PlanArgs;
 /// Options of `emg export`.
 #[derive(Debug, Args)]
 pub struct ExportArgs {
-    /// The joint trajectory to export (`STEM.joint_trajectory.json`, emg-joint-trajectory/2).
+    /// The motion to export: a joint trajectory (`STEM.joint_trajectory.json`,
+    /// emg-joint-trajectory/2) or a job's program (emg-job/1).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
     /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file) or `urscript` (a
@@ -53,16 +54,25 @@ fn shipped_profile(robot_file: &Path) -> Option<&'static DriverProfile> {
 
 /// Runs `emg export`: reads the file, resolves its robot, exports, and prints what it wrote.
 pub fn run_export(args: &ExportArgs) -> Result<()> {
-    let trajectory = emg_io::read_joint_trajectory(&args.file)?;
+    let job = crate::check::read_job_file(&args.file)?;
+    let trajectory = match &job {
+        Some(_) => None,
+        None => Some(emg_io::read_joint_trajectory(&args.file)?),
+    };
+    let (points, robot_field) = match (&job, &trajectory) {
+        (Some(job), _) => (job.timed_points(), job.robot.as_str()),
+        (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
+        (None, None) => unreachable!("a file is read as one or the other"),
+    };
     let robot_file = match &args.robot {
         Some(path) => path.clone(),
         None => {
-            let named = PathBuf::from(&trajectory.robot);
+            let named = PathBuf::from(robot_field);
             anyhow::ensure!(
                 named.is_file(),
                 "field 'robot' of {} names {}, which is not a file here; give --robot NAME|URDF",
                 args.file.display(),
-                trajectory.robot
+                robot_field
             );
             named
         }
@@ -73,7 +83,7 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
         max_servoj_lines: args.max_servoj,
     };
     let text = export_to(
-        &trajectory,
+        points,
         args.format,
         &args.out,
         &robot_file,
@@ -85,10 +95,10 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
     Ok(())
 }
 
-/// Exports `trajectory` (read from `input`) for the robot of `robot_file`; returns what to
-/// print.
-fn export_to(
-    trajectory: &emg_io::JointTrajectory,
+/// Exports the timed motion `trajectory` (read from `input`: a joint trajectory or a job's
+/// program) for the robot of `robot_file`; returns what to print.
+pub fn export_to(
+    trajectory: emg_io::TimedPoints<'_>,
     format: ExportFormat,
     out: &Path,
     robot_file: &Path,
@@ -127,22 +137,8 @@ pub fn refuse_plan_export(args: &PlanArgs, robot: &Robot, tasks: usize) -> Resul
     let Some(format) = args.export else {
         return Ok(());
     };
-    let names = robot.joint_names();
-    let shipped = shipped_profile(&args.robot);
-    let is_ur = match shipped {
-        Some(profile) => profile.joint_names == emg_io::UR_JOINT_NAMES,
-        None => emg_io::is_universal_robots_arm(names),
-    };
-    if format == ExportFormat::UrScript && !is_ur {
-        return Err(anyhow::Error::new(
-            emg_io::ExportError::NotUniversalRobots {
-                robot: args.robot.display().to_string(),
-                joints: names.len(),
-                names: names.join(", "),
-            },
-        ))
-        .context("--export urscript: nothing was planned or written");
-    }
+    refuse_format(format, &args.robot, robot)
+        .context("--export urscript: nothing was planned or written")?;
     let indices: Vec<Option<usize>> = match tasks {
         1 => vec![None],
         many => (0..many).map(Some).collect(),
@@ -158,6 +154,26 @@ pub fn refuse_plan_export(args: &PlanArgs, robot: &Robot, tasks: usize) -> Resul
     )?)
 }
 
+/// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when
+/// shipped, else by its joint names).
+pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> Result<()> {
+    let names = robot.joint_names();
+    let is_ur = match shipped_profile(robot_file) {
+        Some(profile) => profile.joint_names == emg_io::UR_JOINT_NAMES,
+        None => emg_io::is_universal_robots_arm(names),
+    };
+    if format == ExportFormat::UrScript && !is_ur {
+        return Err(anyhow::Error::new(
+            emg_io::ExportError::NotUniversalRobots {
+                robot: robot_file.display().to_string(),
+                joints: names.len(),
+                names: names.join(", "),
+            },
+        ));
+    }
+    Ok(())
+}
+
 /// After `emg plan` wrote a task's files: exports its joint trajectory when `--export` asks;
 /// returns the lines to print.
 pub fn after_plan(args: &PlanArgs, robot: &Robot, paths: &PlanPaths) -> Result<String> {
@@ -167,7 +183,7 @@ pub fn after_plan(args: &PlanArgs, robot: &Robot, paths: &PlanPaths) -> Result<S
     let input = &paths.joint_trajectory;
     let trajectory = emg_io::read_joint_trajectory(input)?;
     let text = export_to(
-        &trajectory,
+        (&trajectory).into(),
         format,
         &plan_output(paths, format),
         &args.robot,

@@ -50,6 +50,10 @@ pub struct JobArgs {
     /// SVG only: the drawing's width (m).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
+    /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
+    /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
+    #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
+    pub export: Option<emg_io::ExportFormat>,
 }
 
 fn parse_order(value: &str) -> Result<Order, String> {
@@ -63,13 +67,22 @@ fn parse_order(value: &str) -> Result<Order, String> {
 /// Reads the job, plans it, prints its summary and writes its program.
 pub fn run_job(args: &JobArgs) -> Result<()> {
     let robot = robot::load_robot(&args.robot, None, None)?;
+    let exported = args
+        .export
+        .map(|format| args.out.with_extension(format.extension()));
+    let mut outputs = vec![("--out", args.out.as_path())];
+    outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     emg_io::refuse_overwriting(
         &[
             ("job", args.file.as_path()),
             ("robot file", args.robot.as_path()),
         ],
-        &[("--out", args.out.as_path())],
+        &outputs,
     )?;
+    if let Some(format) = args.export {
+        crate::export::refuse_format(format, &args.robot, &robot)
+            .context("--export urscript: nothing was planned or written")?;
+    }
     let job = read_job(args, &robot)?;
     let mut config = PlannerConfig::cell();
     config.rollout.constraints.line_tolerance_m = args.tolerance * 1e-3;
@@ -164,6 +177,18 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
     }
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());
+    if let (Some(format), Some(path)) = (args.export, &exported) {
+        let text = crate::export::export_to(
+            file.timed_points(),
+            format,
+            path,
+            &args.robot,
+            planner.robot(),
+            &emg_io::ExportOptions::default(),
+            &args.out,
+        )?;
+        println!("{text}");
+    }
     Ok(())
 }
 

@@ -225,13 +225,82 @@ fn urscript_targets_are_the_trajectory_every_2_ms_within_the_ur5e_limits() {
     );
     assert_eq!(code, Some(0), "{stderr}");
     assert!(stdout.contains("wrote demo.script"), "{stdout}");
-    let file = read_json(&dir.path().join("demo.joint_trajectory.json"));
+    assert_urscript_follows(
+        &dir.path().join("demo.joint_trajectory.json"),
+        &dir.path().join("demo.script"),
+    );
+}
+
+#[test]
+fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
+    let dir = temp_dir("export-job");
+    let icon = Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/data/icons/pencil.svg");
+    let icon = icon.to_str().unwrap();
+    let (code, stdout, stderr) = run(
+        dir.path(),
+        &[
+            "job",
+            icon,
+            "--robot",
+            "ur5e",
+            "--out",
+            "pencil.job.json",
+            "--export",
+            "urscript",
+        ],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("wrote pencil.job.script"), "{stdout}");
+    let job = read_json(&dir.path().join("pencil.job.json"));
+    let strokes = job["segments"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["kind"] == "stroke")
+        .count();
+    assert!(strokes >= 2, "{strokes} strokes");
+    assert_urscript_follows(
+        &dir.path().join("pencil.job.json"),
+        &dir.path().join("pencil.job.script"),
+    );
+    let (code, stdout, stderr) = run(
+        dir.path(),
+        &[
+            "export",
+            "pencil.job.json",
+            "--format",
+            "ros2-mcap",
+            "--out",
+            "pencil.mcap",
+        ],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("wrote pencil.mcap"), "{stdout}");
+    // The FR3 has no URScript: refused before anything is planned.
+    let (code, _, stderr) = run(
+        dir.path(),
+        &["job", icon, "--out", "fr3.job.json", "--export", "urscript"],
+    );
+    assert_eq!(code, Some(1));
+    assert!(
+        stderr.contains("nothing was planned or written"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("fr3.job.json").exists());
+}
+
+/// The URScript program `script` exported from the timed motion in `motion` (a joint
+/// trajectory or a job's program): a `movej` to its first point, then one `servoj` target
+/// every 2 ms, each the motion's sample at that time, within the UR5e's joint, velocity and
+/// acceleration limits, then a hold at its last point and `stopj`.
+fn assert_urscript_follows(motion: &Path, script: &Path) {
+    let file = read_json(motion);
     let points = file["points"].as_array().unwrap();
     let by_time: std::collections::BTreeMap<i64, Vec<f64>> = points
         .iter()
         .map(|p| (nanoseconds(p), numbers(&p["positions"])))
         .collect();
-    let script = std::fs::read_to_string(dir.path().join("demo.script")).unwrap();
+    let script = std::fs::read_to_string(script).unwrap();
     let vector = |text: &str| -> Vec<f64> {
         let inner = &text[text.find('[').unwrap() + 1..text.find(']').unwrap()];
         inner

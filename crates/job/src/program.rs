@@ -139,6 +139,30 @@ pub struct JobFile {
     pub points: Vec<JointTrajectoryPoint>,
 }
 
+impl JobFile {
+    /// Whether `text` is a job's program: JSON whose `format` is [`JOB_FILE_FORMAT`].
+    pub fn is_job(text: &str) -> bool {
+        #[derive(Deserialize)]
+        struct Format {
+            format: Option<String>,
+        }
+        text.trim_start().starts_with('{')
+            && serde_json::from_str::<Format>(text)
+                .ok()
+                .and_then(|f| f.format)
+                .is_some_and(|format| format == JOB_FILE_FORMAT)
+    }
+
+    /// The samples as an export reads them ([`emg_io::export`]).
+    pub fn timed_points(&self) -> emg_io::TimedPoints<'_> {
+        emg_io::TimedPoints {
+            joint_names: &self.joint_names,
+            limits: &self.limits,
+            points: &self.points,
+        }
+    }
+}
+
 /// The program being assembled: samples on one time line and the segments they make.
 #[derive(Default)]
 pub struct Program {

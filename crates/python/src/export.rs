@@ -67,7 +67,8 @@ pub fn export(
         shipped,
         kinematics: Some(&robot.inner),
     };
-    let export = emg_io::export(&trajectory, format, &out, &target, &options).map_err(fail)?;
+    let export =
+        emg_io::export((&trajectory).into(), format, &out, &target, &options).map_err(fail)?;
     export
         .write(&[
             ("joint trajectory", path.as_path()),

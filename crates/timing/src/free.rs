@@ -16,8 +16,8 @@ use crate::topp::{GridPoint, topp_ra};
 pub const FREE_GRID_PER_RAD: f64 = 100.0;
 
 /// Samples at `request.rate_hz` of the rest-to-rest motion along the polyline `vertices`
-/// (from rest at the first to rest at the last, at rest at every inner vertex), the times from
-/// 0. Edges shorter than 1e-9 rad are skipped; a single vertex is one sample at rest.
+/// (from rest at the first to rest at the last, at rest at every inner vertex), every one at a
+/// time `k / rate` from 0. Edges shorter than 1e-9 rad are skipped; a single vertex is one sample at rest.
 ///
 /// # Panics
 ///
@@ -30,7 +30,10 @@ pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<
         qd: JointVector::zeros(),
         qdd: JointVector::zeros(),
     }];
-    let mut elapsed_s = 0.0;
+    // Every sample lies on the grid `k / rate`; an edge's last sample, on the first grid time at
+    // or after its end, holds its end vertex at rest.
+    let period_ns = 1e9 / request.rate_hz;
+    let mut elapsed = 0u64;
     for edge in vertices.windows(2) {
         let chord = edge[1] - edge[0];
         let length = chord.norm();
@@ -40,30 +43,32 @@ pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<
         let direction = chord / length;
         let profile = edge_profile(&direction, length, request);
         let duration = profile.duration();
-        let rate = request.rate_hz;
+        let last = ((duration * request.rate_hz).ceil() as u64).max(1);
         let mut hints = [0, 0];
-        let mut k = 1u64;
-        loop {
-            let local = (k as f64 / rate).min(duration);
+        for k in 1..=last {
+            let local = (k as f64 / request.rate_hz).min(duration);
             let state = profile.state_from(local, &mut hints);
-            let end = local >= duration;
-            let q = if end {
-                edge[1]
-            } else {
-                edge[0] + direction * state.s
-            };
+            let end = k == last;
             samples.push(TimedSample {
-                time_ns: ((elapsed_s + local) * 1e9).round() as u64,
-                q,
-                qd: direction * state.sd,
-                qdd: direction * state.sdd,
+                time_ns: ((elapsed + k) as f64 * period_ns).round() as u64,
+                q: if end {
+                    edge[1]
+                } else {
+                    edge[0] + direction * state.s
+                },
+                qd: if end {
+                    JointVector::zeros()
+                } else {
+                    direction * state.sd
+                },
+                qdd: if end {
+                    JointVector::zeros()
+                } else {
+                    direction * state.sdd
+                },
             });
-            if end {
-                break;
-            }
-            k += 1;
         }
-        elapsed_s += duration;
+        elapsed += last;
     }
     samples
 }

@@ -29,7 +29,7 @@ use urscript::{
     SERVO_PERIOD_S, resample,
 };
 
-use crate::joint_trajectory::JointTrajectory;
+use crate::joint_trajectory::{JointTrajectory, JointTrajectoryPoint, TimingLimits};
 use crate::paths::OutputClash;
 
 /// What a joint trajectory is exported as.
@@ -237,6 +237,28 @@ impl Export {
     }
 }
 
+/// What an export reads from a timed motion, a joint trajectory file's or a job's program: the
+/// joint names, the limits it holds and its samples.
+#[derive(Clone, Copy, Debug)]
+pub struct TimedPoints<'a> {
+    /// The arm's joints, base to tip.
+    pub joint_names: &'a [String],
+    /// The joint limits every sample holds.
+    pub limits: &'a TimingLimits,
+    /// The samples, from rest to rest.
+    pub points: &'a [JointTrajectoryPoint],
+}
+
+impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {
+    fn from(trajectory: &'a JointTrajectory) -> Self {
+        Self {
+            joint_names: &trajectory.joint_names,
+            limits: &trajectory.limits,
+            points: &trajectory.points,
+        }
+    }
+}
+
 /// Reads a joint-trajectory file, with an error naming the file and the field.
 pub fn read_joint_trajectory(path: &Path) -> Result<JointTrajectory, ExportError> {
     let text = std::fs::read_to_string(path).map_err(|source| ExportError::Read {
@@ -249,30 +271,30 @@ pub fn read_joint_trajectory(path: &Path) -> Result<JointTrajectory, ExportError
     })
 }
 
-/// Exports `trajectory` for `robot` as `format` to `out` (a URScript motion longer than one
-/// program: `out` with `-part1`, `-part2`, ... before its extension), in memory.
+/// Exports the timed motion `trajectory` for `robot` as `format` to `out` (a URScript motion
+/// longer than one program: `out` with `-part1`, `-part2`, ... before its extension), in memory.
 pub fn export(
-    trajectory: &JointTrajectory,
+    trajectory: TimedPoints<'_>,
     format: ExportFormat,
     out: &Path,
     robot: &ExportRobot<'_>,
     options: &ExportOptions,
 ) -> Result<Export, ExportError> {
     if let Some(kinematics) = robot.kinematics
-        && kinematics.joint_names() != trajectory.joint_names.as_slice()
+        && kinematics.joint_names() != trajectory.joint_names
     {
         return Err(ExportError::Joints {
             robot: robot.file.to_string(),
-            file: trajectory.joint_names.clone(),
+            file: trajectory.joint_names.to_vec(),
             expected: kinematics.joint_names().to_vec(),
         });
     }
     if let Some(profile) = robot.shipped
-        && profile.file_joint_names != trajectory.joint_names.as_slice()
+        && profile.file_joint_names != trajectory.joint_names
     {
         return Err(ExportError::Joints {
             robot: robot.file.to_string(),
-            file: trajectory.joint_names.clone(),
+            file: trajectory.joint_names.to_vec(),
             expected: profile
                 .file_joint_names
                 .iter()
@@ -287,7 +309,7 @@ pub fn export(
 }
 
 fn ros2(
-    trajectory: &JointTrajectory,
+    trajectory: TimedPoints<'_>,
     out: &Path,
     robot: &ExportRobot<'_>,
     options: &ExportOptions,
@@ -315,7 +337,7 @@ fn ros2(
             p.base_relation,
         ),
         None => (
-            trajectory.joint_names.clone(),
+            trajectory.joint_names.to_vec(),
             "/joint_trajectory_controller/joint_trajectory",
             "base_link",
             "none known: the robot file's joint names are kept",
@@ -357,7 +379,7 @@ fn ros2(
         notes,
     };
     let bytes =
-        ros2_mcap::mcap_bytes(trajectory, &kept, &message).map_err(ExportError::Encoding)?;
+        ros2_mcap::mcap_bytes(trajectory.points, &kept, &message).map_err(ExportError::Encoding)?;
     let summary = format!(
         "{JOINT_TRAJECTORY_TYPE} on {topic} (joint names of {driver}; frame_id {frame_id}: \
          {relation})\n  {} of {} points kept: the quintic spline through them stays within \
@@ -380,7 +402,7 @@ fn ros2(
 }
 
 fn ur_script(
-    trajectory: &JointTrajectory,
+    trajectory: TimedPoints<'_>,
     out: &Path,
     robot: &ExportRobot<'_>,
     options: &ExportOptions,
@@ -403,7 +425,7 @@ fn ur_script(
             problem: "expected at least 2 lines per program",
         });
     }
-    let targets = resample(trajectory);
+    let targets = resample(trajectory.points);
     let parts = urscript::split(&targets, options.max_servoj_lines).map_err(|(from, to)| {
         ExportError::TooLong {
             from_s: from,

@@ -8,7 +8,7 @@ use std::io::Cursor;
 
 use serde::Serialize;
 
-use crate::joint_trajectory::{JointTrajectory, JointTrajectoryPoint};
+use crate::joint_trajectory::JointTrajectoryPoint;
 
 /// The message type, as ROS 2 names it.
 pub const JOINT_TRAJECTORY_TYPE: &str = "trajectory_msgs/msg/JointTrajectory";
@@ -121,14 +121,14 @@ fn cdr(message: &Ros2Message<'_>, points: &[&JointTrajectoryPoint]) -> Result<Ve
     Ok(bytes)
 }
 
-/// The MCAP file holding one message on `message.topic` with the points `kept` of
-/// `trajectory`, logged at time 0.
+/// The MCAP file holding one message on `message.topic` with the points `kept` of `points`,
+/// logged at time 0.
 pub fn mcap_bytes(
-    trajectory: &JointTrajectory,
+    points: &[JointTrajectoryPoint],
     kept: &[usize],
     message: &Ros2Message<'_>,
 ) -> Result<Vec<u8>, String> {
-    let points: Vec<&JointTrajectoryPoint> = kept.iter().map(|&k| &trajectory.points[k]).collect();
+    let points: Vec<&JointTrajectoryPoint> = kept.iter().map(|&k| &points[k]).collect();
     let data = cdr(message, &points)?;
     let fail = |e: mcap::McapError| format!("MCAP writing failed: {e}");
     let options = mcap::WriteOptions::new()

@@ -3,7 +3,7 @@
 //! through the two samples around each target's time, exact where the samples fall on the 2 ms
 //! grid), held at the end and stopped.
 
-use crate::joint_trajectory::JointTrajectory;
+use crate::joint_trajectory::JointTrajectoryPoint;
 
 /// The e-Series controller's cycle, the time each `servoj` target is tracked for (s).
 pub const SERVO_PERIOD_S: f64 = 0.002;
@@ -38,8 +38,7 @@ pub struct Target {
 
 /// The motion resampled every [`SERVO_PERIOD_S`] from its start to its end (the last target at
 /// the last point, at rest).
-pub fn resample(trajectory: &JointTrajectory) -> Vec<Target> {
-    let points = &trajectory.points;
+pub fn resample(points: &[JointTrajectoryPoint]) -> Vec<Target> {
     let Some(last) = points.last() else {
         return Vec::new();
     };
