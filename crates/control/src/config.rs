@@ -162,9 +162,8 @@ pub enum Tracking {
     /// step's pseudo-inverse, `e` the offset to the nearest line or path point, up to
     /// [`MAX_CORRECTIONS`](crate::MAX_CORRECTIONS)); where those leave it off, the step is
     /// taken again with no null-space motion (the damping near a singularity does not buy
-    /// self-motion with task error), then over a half and a quarter of its time (the tool
-    /// slower where the arm cannot follow at full speed). Steps that track well are the
-    /// paper's, bit for bit; what `emg plan` and Python plan with.
+    /// self-motion with task error). Steps that track well are the paper's, bit for bit; what
+    /// `emg plan`, `emg job` and Python plan with.
     Corrected,
 }
 

@@ -32,8 +32,8 @@ pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };
 pub use path::{
-    CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, MAX_REFINEMENTS, MIN_KNOT_STEP_M,
-    SmoothPath,
+    CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, LINE_CHECK_MARGIN_M, MAX_REFINEMENTS,
+    MIN_KNOT_STEP_M, SmoothPath,
 };
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
