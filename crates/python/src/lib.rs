@@ -18,6 +18,7 @@
 
 mod check;
 mod export;
+mod job;
 mod planner;
 mod robot;
 mod timing;
@@ -106,6 +107,7 @@ fn extreme_line_motion(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("PlanningError", py.get_type::<PlanningError>())?;
     module.add("CheckFailed", py.get_type::<CheckFailed>())?;
     module.add_class::<planner::Planner>()?;
+    module.add_class::<job::JobPlan>()?;
     module.add_class::<planner::Plan>()?;
     module.add_class::<planner::Task>()?;
     module.add_class::<timing::Motion>()?;

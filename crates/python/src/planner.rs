@@ -368,6 +368,27 @@ impl Planner {
         self.plan_task(py, task, &request)
     }
 
+    /// Plans a job — a drawing or a set of seams — as one program (docs/jobs.md): `job` a job
+    /// file or an SVG drawing (a path; an SVG placed by `placement`, a dict of `origin_m`,
+    /// `normal`, `x_axis`, `width_m`, by default pen down on a plate in front of the arm) or a
+    /// dict in the job file's layout; `tolerance_mm` the strokes' line tolerance (default
+    /// 0.5 mm, as `emg job`). Every stroke is searched to the limit, resumed where one motion
+    /// cannot finish it, the strokes joined by checked free moves; the GIL is released while
+    /// planning. A malformed job raises `InputError` naming the field; one of which no stroke
+    /// can be drawn raises `PlanningError`.
+    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5))]
+    fn plan_job(
+        &self,
+        py: Python<'_>,
+        job: &Bound<'_, PyAny>,
+        placement: Option<&Bound<'_, PyDict>>,
+        tolerance_mm: f64,
+    ) -> PyResult<crate::job::JobPlan> {
+        let robot = self.robot.get();
+        let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        crate::job::plan(py, &self.inner, &robot.file, &job, tolerance_mm)
+    }
+
     /// Plans every task of `tasks` (`Task` objects, e.g. from `load_tasks`, or `(p0, d, n)`
     /// triples) in parallel on all cores with the GIL released; the plans come in task order
     /// and do not depend on the number of threads. Arguments as for `plan`; the first task

@@ -1,0 +1,241 @@
+//! `Planner.plan_job` and `JobPlan`: a drawing or a set of seams planned as one program from
+//! Python (`emg_job::plan_job`).
+
+use std::path::PathBuf;
+
+use emg_job::{JOB_FORMAT_VERSION, Job, JobFile, JobSettings, JobSpec};
+use emg_planner::{DEFAULT_RATE_HZ, PlanRequest};
+use emg_timing::Scaling;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::{InputError, PlanningError, input_error, message};
+
+/// A job's program: every stroke to the limit, the safe moves between them, one timed joint
+/// trajectory (docs/jobs.md). Arrays have one row per sample at 1 kHz.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct JobPlan {
+    pub(crate) file: JobFile,
+}
+
+/// The job of `job`: a job file or an SVG drawing (`str` or `os.PathLike`; an SVG is placed by
+/// `placement`, a dict of `origin_m`, `normal`, `x_axis`, `width_m` or `scale_m_per_unit`), or
+/// a `dict` in the job file's layout.
+pub(crate) fn read_job(
+    py: Python<'_>,
+    robot: &emg_kinematics::Robot,
+    job: &Bound<'_, PyAny>,
+    placement: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Job> {
+    let dumps = |value: &Bound<'_, PyAny>| -> PyResult<String> {
+        py.import("json")?
+            .call_method1("dumps", (value,))?
+            .extract()
+    };
+    let invalid =
+        |e: &(dyn std::error::Error + 'static)| InputError::new_err(format!("job: {}", message(e)));
+    if job.is_instance_of::<PyDict>() {
+        return Job::from_json("job", &dumps(job)?, robot).map_err(|e| invalid(&e));
+    }
+    let path: PathBuf = job
+        .extract()
+        .map_err(|_| InputError::new_err("job: give a job file's or an SVG's path, or a dict"))?;
+    if path
+        .extension()
+        .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"))
+    {
+        let placement: emg_io::Placement = match placement {
+            Some(dict) => serde_json::from_str(&dumps(dict.as_any())?)
+                .map_err(|e| InputError::new_err(format!("placement: {e}")))?,
+            None => emg_io::Placement::default(),
+        };
+        let drawing = emg_io::read_svg_file(&path, &placement, &emg_io::SvgOptions::default())
+            .map_err(|e| invalid(&e))?;
+        let spec = JobSpec {
+            version: JOB_FORMAT_VERSION,
+            strokes: drawing.strokes,
+            settings: JobSettings::default(),
+            home: None,
+        };
+        return Job::from_spec(spec, robot).map_err(|e| invalid(&e));
+    }
+    if placement.is_some() {
+        return Err(InputError::new_err(
+            "placement: places an SVG drawing; a job file's strokes are already placed",
+        ));
+    }
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
+    Job::from_json(&path.display().to_string(), &text, robot).map_err(|e| invalid(&e))
+}
+
+/// Plans `job` with `planner` at `tolerance_mm`; the GIL is released while planning.
+pub(crate) fn plan(
+    py: Python<'_>,
+    planner: &emg_planner::Planner,
+    robot_file: &std::path::Path,
+    job: &Job,
+    tolerance_mm: f64,
+) -> PyResult<JobPlan> {
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
+        return Err(InputError::new_err(format!(
+            "tolerance_mm: must be a positive number, got {tolerance_mm}"
+        )));
+    }
+    let mut config = planner.config().clone();
+    config.rollout.constraints.line_tolerance_m = tolerance_mm * 1e-3;
+    let planner = planner
+        .with_config(config)
+        .map_err(|e| input_error("tolerance_mm", &e))?;
+    let timing = crate::timing::motion_timing(
+        &planner,
+        robot_file,
+        None,
+        Scaling::default(),
+        None,
+        DEFAULT_RATE_HZ,
+    )?;
+    let request = PlanRequest {
+        controller: planner.models().best_controller(),
+        ..PlanRequest::default()
+    };
+    let file = py
+        .detach(|| {
+            emg_job::plan_job(
+                &planner,
+                &request,
+                job,
+                &timing,
+                &robot_file.display().to_string(),
+                &|_, _| {},
+            )
+        })
+        .map_err(|e| PlanningError::new_err(message(&e)))?;
+    Ok(JobPlan { file })
+}
+
+/// A JSON value of the program as Python objects.
+fn python<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).expect("a job's program serialises");
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+#[pymethods]
+impl JobPlan {
+    /// The totals `emg job` prints: `complete`, `resumed`, `short`, `drawn_m`, `total_m`,
+    /// `travel_given_m`, `travel_m`, `duration_s`, `pen_down_s`, `pen_up_s`, `straight_moves`,
+    /// `sampled_moves`, `searches`, `planning_s`, `ends_at_home`.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        python(py, &self.file.summary)
+    }
+
+    /// Every stroke's outcome in drawing order (dicts: `stroke`, `reversed`, `length_m`,
+    /// `drawn_m`, `parts`, `unreached`, `unreached_at`, `parts_left_out`).
+    #[getter]
+    fn strokes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        python(py, &self.file.strokes)
+    }
+
+    /// The segments in time order, each a dict: `kind` (`stroke`, `retreat`, `travel`,
+    /// `approach`), `stroke` and `part` for a stroke, `start_s`, `end_s`, and its samples as
+    /// arrays `time_s` (n,) and `q` (n, joints).
+    #[getter]
+    fn segments<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let times = self.times();
+        let list = PyList::empty(py);
+        for segment in &self.file.segments {
+            let dict = PyDict::new(py);
+            let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
+            let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
+            match segment.kind {
+                emg_job::SegmentKind::Stroke { stroke, part } => {
+                    dict.set_item("kind", "stroke")?;
+                    dict.set_item("stroke", stroke)?;
+                    dict.set_item("part", part)?;
+                }
+                emg_job::SegmentKind::Retreat => dict.set_item("kind", "retreat")?,
+                emg_job::SegmentKind::Travel => dict.set_item("kind", "travel")?,
+                emg_job::SegmentKind::Approach => dict.set_item("kind", "approach")?,
+            }
+            dict.set_item("start_s", segment.start_s)?;
+            dict.set_item("end_s", segment.end_s)?;
+            dict.set_item("time_s", times[first..last].to_vec().into_pyarray(py))?;
+            dict.set_item("q", self.rows(py, first..last, |p| &p.positions))?;
+            list.append(dict)?;
+        }
+        Ok(list)
+    }
+
+    /// Time of every sample (s), shape (n,).
+    #[getter]
+    fn time_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.times().into_pyarray(py)
+    }
+
+    /// Joint positions of every sample (rad), shape (n, joints).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.rows(py, 0..self.file.points.len(), |p| &p.positions)
+    }
+
+    /// Joint velocities of every sample (rad/s), shape (n, joints).
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.rows(py, 0..self.file.points.len(), |p| &p.velocities)
+    }
+
+    /// Joint accelerations of every sample (rad/s²), shape (n, joints).
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        self.rows(py, 0..self.file.points.len(), |p| &p.accelerations)
+    }
+
+    /// Writes the program as an `emg-job/1` file (`emg check` verifies it).
+    fn write(&self, path: PathBuf) -> PyResult<()> {
+        let text = serde_json::to_string(&self.file).expect("a job's program serialises") + "\n";
+        emg_io::write_atomically(&path, text)
+            .map_err(|e| PyOSError::new_err(format!("cannot write {}: {e}", path.display())))
+    }
+
+    fn __repr__(&self) -> String {
+        let s = &self.file.summary;
+        format!(
+            "JobPlan({} strokes: {} complete, {} resumed, {} short; {:.4} m of {:.4} m drawn; {:.2} s)",
+            self.file.strokes.len(),
+            s.complete,
+            s.resumed,
+            s.short,
+            s.drawn_m,
+            s.total_m,
+            s.duration_s
+        )
+    }
+}
+
+impl JobPlan {
+    fn times(&self) -> Vec<f64> {
+        self.file
+            .points
+            .iter()
+            .map(|p| p.time_from_start.seconds())
+            .collect()
+    }
+
+    fn rows<'py>(
+        &self,
+        py: Python<'py>,
+        range: std::ops::Range<usize>,
+        values: impl Fn(&emg_io::JointTrajectoryPoint) -> &Vec<f64>,
+    ) -> Bound<'py, PyArray2<f64>> {
+        let joints = self.file.joint_names.len();
+        let points = &self.file.points[range];
+        let flat: Vec<f64> = points.iter().flat_map(|p| values(p).clone()).collect();
+        Array2::from_shape_vec((points.len(), joints), flat)
+            .expect("one value per joint")
+            .into_pyarray(py)
+    }
+}
