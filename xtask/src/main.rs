@@ -17,6 +17,7 @@ mod cartesian_eval;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
+mod job_eval;
 mod label_seeds;
 mod limit;
 mod make_tasks;
@@ -89,6 +90,9 @@ enum Command {
     /// controller and the search beside the bound, checked and timed; rectangles also one line
     /// at a time (docs/results/paths.*).
     PathEval(path_eval::Args),
+    /// Jobs on line-art icons and tilted seams planned as `emg job` plans them, checked, beside
+    /// the baseline of strokes planned alone and joined straight (docs/results/jobs.*).
+    JobEval(job_eval::Args),
     /// The search at 20 mm, 0.5 mm and 0.1 mm with the paper's and the corrected step, on lines
     /// and paths, checked and timed (docs/results/precision.*).
     PrecisionEval(precision_eval::Args),
@@ -118,6 +122,7 @@ fn main() -> anyhow::Result<()> {
         Command::Timing(args) => timing::run(&args),
         Command::PathEval(args) => path_eval::run(&args),
         Command::PrecisionEval(args) => precision_eval::run(&args),
+        Command::JobEval(args) => job_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
     }
 }
