@@ -182,6 +182,14 @@ impl SmoothPath {
     }
 }
 
+/// Points a check interval is scanned at for the peak inside it, where its value rises at the
+/// start and ends lower though still rising at the end.
+const PEAK_SCAN: usize = 8;
+
+/// Times such a scan narrows down on the last stretch of its interval, where the value keeps
+/// rising until it drops (8⁶: to a few nanometres of a millimetre-long interval).
+const PEAK_ZOOMS: usize = 6;
+
 /// How much closer than the tolerance (m) the spline's checked points must lie to the line or
 /// path: a timed sample falls between checked points, where the spline departs from the
 /// distance at its neighbouring checks and peaks by well under this (measured up to 0.5 µm at
@@ -231,33 +239,66 @@ fn first_failing_segment(
 /// path peak inside segment `k` of `spline`: in each interval between consecutive points of the
 /// segment's knots and `inner` (increasing) where a rate (`θ' = ∇θ · q'`, and `(δ²/2)' = −e ·
 /// J q'` with `e` the TCP's offset to the nearest line or path point) turns from rising to
-/// falling, its root found by [`PEAK_BISECTIONS`] bisections. The largest value on an interval
-/// lies at one of its ends or at such a peak, unless the rate changes sign more than once inside
-/// it; so a spline that holds the cone and the tolerance at its check points and peaks holds
-/// them between them, where the timed samples fall.
+/// falling, or rises at the start and ends lower (found then among [`PEAK_SCAN`] points of the
+/// interval, narrowed [`PEAK_ZOOMS`] times onto its last stretch where it rises to the end: the
+/// distance to a path is not smooth where its nearest point jumps from one piece to the next),
+/// its root found by [`PEAK_BISECTIONS`] bisections. The largest value on an
+/// interval lies at one of its ends or at such a peak, unless the rate changes sign more than
+/// once inside it; so a spline that holds the cone and the tolerance at its check points and
+/// peaks holds them between them, where the timed samples fall.
 fn peaks(robot: &Robot, task: &Task, spline: &JointSpline, k: usize, inner: &[f64]) -> Vec<f64> {
-    let rates = |s: f64| {
+    // The rates and the values themselves (the tool angle's cosine falls as the angle rises).
+    let measures = |s: f64| {
         let point = spline.eval(s);
         let kinematics = robot.forward(&point.q);
+        let offset = task.offset(&kinematics.tcp());
         let angle = tool_angle_gradient(&kinematics, &task.n).map_or(0.0, |g| g.dot(&point.dq));
-        let distance = -task
-            .offset(&kinematics.tcp())
-            .dot(&(kinematics.jacobian() * point.dq));
-        [angle, distance]
+        let distance = -offset.dot(&(kinematics.jacobian() * point.dq));
+        let angle_value = -kinematics.tool_axis().dot(&task.n);
+        [[angle, angle_value], [distance, offset.norm()]]
     };
     let knots = spline.knots();
     let points: Vec<f64> = std::iter::once(knots[k])
         .chain(inner.iter().copied())
         .chain(std::iter::once(knots[k + 1]))
         .collect();
-    let at_points: Vec<[f64; 2]> = points.iter().map(|&s| rates(s)).collect();
+    let at_points: Vec<[[f64; 2]; 2]> = points.iter().map(|&s| measures(s)).collect();
     (0..2)
         .flat_map(|which| {
-            let rate = |s: f64| rates(s)[which];
+            let rate = |s: f64| measures(s)[which][0];
+            let at = |i: usize| at_points[i][which];
             (0..points.len() - 1)
-                .filter(|&i| at_points[i][which] > 0.0 && at_points[i + 1][which] <= 0.0)
-                .map(|i| {
+                .filter_map(|i| {
+                    let (start, end) = (at(i), at(i + 1));
+                    // Rising at the start, and falling at the end or ending lower: a peak inside
+                    // (a value that is not smooth, the distance to a path's corner, may rise again
+                    // just before the end).
+                    if !(start[0] > 0.0 && (end[0] <= 0.0 || end[1] < start[1])) {
+                        return None;
+                    }
                     let (mut rising, mut falling) = (points[i], points[i + 1]);
+                    if end[0] > 0.0 {
+                        // Rising all along the scan, the value drops in its last stretch: look
+                        // there, down to where it jumps.
+                        let mut bracket = None;
+                        for _ in 0..PEAK_ZOOMS {
+                            let step = (falling - rising) / PEAK_SCAN as f64;
+                            match (1..PEAK_SCAN)
+                                .map(|j| rising + step * j as f64)
+                                .find(|&s| rate(s) <= 0.0)
+                            {
+                                Some(s) => {
+                                    bracket = Some((s - step, s));
+                                    break;
+                                }
+                                None => rising = falling - step,
+                            }
+                        }
+                        match bracket {
+                            Some(found) => (rising, falling) = found,
+                            None => return Some(rising),
+                        }
+                    }
                     for _ in 0..PEAK_BISECTIONS {
                         let middle = 0.5 * (rising + falling);
                         if rate(middle) > 0.0 {
@@ -266,7 +307,7 @@ fn peaks(robot: &Robot, task: &Task, spline: &JointSpline, k: usize, inner: &[f6
                             falling = middle;
                         }
                     }
-                    0.5 * (rising + falling)
+                    Some(0.5 * (rising + falling))
                 })
                 .collect::<Vec<_>>()
         })
