@@ -1,6 +1,8 @@
 //! Hot-path benchmarks: forward kinematics with the Jacobian, one classical control step, one
 //! constraint check, one full classical rollout, and the full step (`full_step`: everything one
-//! accepted step of a rollout costs, measured over a long rollout).
+//! accepted step of a rollout costs, measured over a long rollout), also with the corrected step
+//! (`full_step_corrected`: the same rollout, where no step needs a correction at 20 mm, and
+//! `full_step_corrected_0.5mm`, where steps are corrected).
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -8,7 +10,7 @@ use std::time::{Duration, Instant};
 use criterion::{Criterion, criterion_group, criterion_main};
 use emg_benches::{Fixture, LongRollout};
 use emg_control::{
-    ClassicalController, NullAction, NullSpaceController, RolloutConfig, StepContext,
+    ClassicalController, NullAction, NullSpaceController, RolloutConfig, StepContext, Tracking,
     first_violation, rollout,
 };
 
@@ -46,26 +48,43 @@ fn benches(c: &mut Criterion) {
     let LongRollout {
         task: long_task,
         seed: long_seed,
-        steps,
+        ..
     } = fixture.long_rollout();
-    c.bench_function("full_step", |b| {
-        b.iter_custom(|iterations| {
-            let mut elapsed = Duration::ZERO;
-            for _ in 0..iterations {
-                let mut controller = ClassicalController::default();
-                let start = Instant::now();
-                black_box(rollout(
-                    robot,
-                    black_box(long_task),
-                    &long_seed,
-                    &mut controller,
-                    &config,
-                ));
-                elapsed += start.elapsed();
-            }
-            elapsed / steps as u32
-        })
-    });
+    let corrected = RolloutConfig {
+        tracking: Tracking::Corrected,
+        ..config.clone()
+    };
+    let mut tight = corrected.clone();
+    tight.constraints.line_tolerance_m = 5e-4;
+    for (name, config) in [
+        ("full_step", &config),
+        ("full_step_corrected", &corrected),
+        ("full_step_corrected_0.5mm", &tight),
+    ] {
+        let mut controller = ClassicalController::default();
+        let steps = rollout(robot, long_task, &long_seed, &mut controller, config)
+            .steps
+            .len()
+            - 1;
+        c.bench_function(name, |b| {
+            b.iter_custom(|iterations| {
+                let mut elapsed = Duration::ZERO;
+                for _ in 0..iterations {
+                    let mut controller = ClassicalController::default();
+                    let start = Instant::now();
+                    black_box(rollout(
+                        robot,
+                        black_box(long_task),
+                        &long_seed,
+                        &mut controller,
+                        config,
+                    ));
+                    elapsed += start.elapsed();
+                }
+                elapsed / steps as u32
+            })
+        });
+    }
 }
 
 criterion_group!(control, benches);
