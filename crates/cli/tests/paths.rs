@@ -60,6 +60,65 @@ fn the_documented_slot_is_planned_to_its_end_and_every_file_checks() {
     }
 }
 
+/// Plans `args` at a tenth of a millimetre into `stem`, checks every file it writes with `emg
+/// check`, and returns the trajectory file.
+fn planned_at_a_tenth_of_a_millimetre(dir: &Path, stem: &str, args: &[&str]) -> serde_json::Value {
+    let out = dir.join(stem);
+    let mut all = vec!["plan", "--tolerance", "0.1", "--out", out.to_str().unwrap()];
+    all.extend_from_slice(args);
+    let output = emg(&all);
+    assert!(output.status.success(), "{stem}: {}", text(&output.stderr));
+    for ext in ["json", "joint_trajectory.json"] {
+        let path = dir.join(format!("{stem}.{ext}"));
+        let output = emg(&["check", path.to_str().unwrap()]);
+        assert!(
+            output.status.success(),
+            "{stem}.{ext}: {}{}",
+            text(&output.stdout),
+            text(&output.stderr)
+        );
+    }
+    read_json(&dir.join(format!("{stem}.json")))
+}
+
+#[test]
+fn a_circle_a_blended_rectangle_and_a_long_line_are_planned_and_checked_at_a_tenth_of_a_millimetre()
+{
+    let dir = temp_dir("tenth");
+    let circle = dir.path().join("circle.path.json");
+    std::fs::write(
+        &circle,
+        r#"{"version": 1, "start": [0.6, 0.0, 0.2], "normal": [0, 0, -1],
+            "segments": [{"arc": {"centre": [0.5, 0.0, 0.2], "sweep_deg": 360}}]}"#,
+    )
+    .unwrap();
+    let rectangle = dir.path().join("rectangle.path.json");
+    std::fs::write(
+        &rectangle,
+        r#"{"version": 1, "start": [0.4, -0.2, 0.2], "normal": [0, 0, -1], "blend_radius_m": 0.02,
+            "segments": [{"line": {"to": [0.6, -0.2, 0.2]}}, {"line": {"to": [0.6, 0.2, 0.2]}},
+                         {"line": {"to": [0.4, 0.2, 0.2]}}, {"line": {"to": [0.4, -0.2, 0.2]}}]}"#,
+    )
+    .unwrap();
+    for (stem, path) in [("circle", &circle), ("rectangle", &rectangle)] {
+        let written = planned_at_a_tenth_of_a_millimetre(
+            dir.path(),
+            stem,
+            &["--path", path.to_str().unwrap()],
+        );
+        assert_eq!(written["termination"]["reason"], "completed", "{stem}");
+        assert_eq!(written["config"]["constraints"]["line_tolerance_m"], 1e-4);
+    }
+    // The README's line: a metre at 0.1 mm, as at 20 mm.
+    let line = planned_at_a_tenth_of_a_millimetre(
+        dir.path(),
+        "line",
+        &["--p0", "0.45,-0.2,0.25", "--d", "0,1,0", "--n", "0,0,-1"],
+    );
+    let length = line["path_length_m"].as_f64().unwrap();
+    assert!(length > 1.0, "{length} m at 0.1 mm");
+}
+
 #[test]
 fn a_malformed_path_file_is_refused_naming_the_field() {
     let dir = temp_dir("bad-path");

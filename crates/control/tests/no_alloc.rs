@@ -1,14 +1,15 @@
 //! The control step allocates nothing: building a step's context, choosing the classical action,
 //! integrating the joint velocity and checking every constraint run with zero heap allocations
 //! (counted by a global allocator wrapper, per thread: the test harness's own threads may
-//! allocate meanwhile).
+//! allocate meanwhile); nor does an episode's step when it corrects its end onto the line
+//! (`Tracking::Corrected` at 0.1 mm).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use emg_control::{
-    ClassicalController, NullAction, NullSpaceController, RolloutConfig, SamplerConfig,
-    StepContext, candidate, first_violation,
+    ClassicalController, Episode, NullAction, NullSpaceController, RolloutConfig, SamplerConfig,
+    StepContext, Tracking, candidate, first_violation,
 };
 use emg_kinematics::Robot;
 
@@ -74,6 +75,46 @@ fn classical_control_step_and_constraint_check_do_not_allocate() {
         assert_eq!(allocations(), before, "the control step allocated");
     }
     assert!(steps > 200, "only {steps} steps exercised");
+}
+
+#[test]
+fn the_corrected_step_does_not_allocate() {
+    let robot = Robot::from_urdf_file(fr3_path(), "link0", "pen_tip").expect("robot loads");
+    let mut config = RolloutConfig {
+        tracking: Tracking::Corrected,
+        ..RolloutConfig::default()
+    };
+    config.constraints.line_tolerance_m = 1e-4;
+    let paper = RolloutConfig {
+        tracking: Tracking::FirstOrder,
+        ..config.clone()
+    };
+    let tasks: Vec<_> = (0..20)
+        .filter_map(|i| candidate(&robot, &SamplerConfig::default(), i))
+        .collect();
+    let (mut steps, mut longer) = (0, 0);
+    for task in &tasks {
+        let seed = task.q0_seed.expect("sampled tasks keep their seed");
+        // The episode reserves its record when it starts; its steps allocate nothing.
+        let mut episode = Episode::start(&robot, task, &seed, &config);
+        let mut controller = ClassicalController::default();
+        let before = allocations();
+        while let Some(context) = episode.context() {
+            let (action, acting) = controller.act(context);
+            episode.apply(&action, acting);
+            steps += 1;
+        }
+        assert_eq!(allocations(), before, "the corrected step allocated");
+        let corrected = episode.finish();
+        let mut controller = ClassicalController::default();
+        let first_order = emg_control::rollout(&robot, task, &seed, &mut controller, &paper);
+        longer += usize::from(corrected.path_length_m > first_order.path_length_m);
+    }
+    assert!(steps > 200, "only {steps} steps exercised");
+    assert!(
+        longer * 2 > tasks.len(),
+        "the corrections engaged on {longer} tasks"
+    );
 }
 
 /// The workspace's shipped data directory.

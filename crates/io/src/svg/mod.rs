@@ -1,45 +1,5 @@
 //! SVG drawings as strokes: every subpath of every drawn element, placed on the work surface as
-//! a path of lines and circular arcs ([`emg_control::PathSpec`]).
-//!
-//! * **Reading** ([`usvg`]): shapes (`rect`, `circle`, `ellipse`, `line`, `polyline`,
-//!   `polygon`, `path`), `use`, groups, transforms, units and the viewBox are resolved by usvg;
-//!   every subpath of every visible element, stroked or filled, is one stroke, in document
-//!   order. The drawing's units are usvg's: CSS pixels of the root's `width` and `height`, the
-//!   viewBox mapped onto them ([`SVG_PX_M`] metres each at the drawing's own size). usvg hands
-//!   over arcs, circles and ellipses as cubic Béziers (within 2.7e-4 of their radius) and
-//!   coordinates in single precision; the strokes follow that geometry. Text, images, clipping
-//!   and masks are not drawn.
-//! * **Placing** ([`Placement`]): the centre of the drawing's bounding box (of all its
-//!   subpaths' geometry, tiny ones included) goes to `origin_m`, its x along `x_axis` and its
-//!   y along `normal × x_axis`, so that it reads right, never mirrored, seen along `normal`.
-//! * **Fitting**: straight segments stay lines; quadratic and cubic Béziers become biarcs
-//!   (pairs of tangent arcs), halved until each is within [`SvgOptions::curve_tolerance_m`] of
-//!   its curve (measured both ways, at 32 points of the curve and 16 of each arc, in metres
-//!   after placement). Where the drawing is smooth the path is too: its pieces meet within
-//!   [`emg_control::CORNER_RAD`], so the tool passes without stopping. Joints that turn less
-//!   than [`SvgOptions::smooth_join_deg`] count as smooth (drawings round their coordinates:
-//!   icon sets leave joints they mean to be smooth a few degrees off): the curves there are
-//!   fitted to one tangent, still within the tolerance; two lines keep their corner. A `Z` adds
-//!   the closing line when it is at least [`emg_control::MIN_SEGMENT_M`] long; pieces shorter
-//!   than that are merged with a neighbour (there the path may leave the drawing by up to
-//!   that length).
-//! * **Checking**: every stroke is validated as an [`emg_control::Path`] (the checks the path
-//!   file reader makes); strokes shorter than [`SvgOptions::min_stroke_m`] are dropped and
-//!   counted.
-//!
-//! ```
-//! use emg_io::{Placement, SvgOptions, read_svg};
-//! let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 50">
-//!                <rect x="0" y="0" width="100" height="50"/>
-//!                <circle cx="50" cy="25" r="20"/>
-//!              </svg>"#;
-//! let drawing = read_svg(svg, &Placement::default(), &SvgOptions::default())?;
-//! assert_eq!(drawing.strokes.len(), 2);
-//! assert!((drawing.size_m()[0] - 0.2).abs() < 1e-12);
-//! let rect = emg_control::Path::new(drawing.strokes[0].clone())?;
-//! assert!((rect.length_m() - 0.6).abs() < 1e-9); // 0.2 m by 0.1 m, closed
-//! # Ok::<(), Box<dyn std::error::Error>>(())
-//! ```
+//! a path of lines and circular arcs ([`read_svg`], whose documentation tells how).
 
 mod bezier;
 mod biarc;
@@ -185,7 +145,53 @@ impl Drawing {
     }
 }
 
-/// Reads the SVG `text` into strokes placed by `placement` (see the module documentation).
+/// Reads the SVG `text` into strokes placed by `placement`: every subpath of every drawn
+/// element, as a path of lines and circular arcs ([`emg_control::PathSpec`]).
+///
+/// * **Reading** ([`usvg`]): shapes (`rect`, `circle`, `ellipse`, `line`, `polyline`,
+///   `polygon`, `path`), `use`, groups, transforms, units and the viewBox are resolved by usvg;
+///   every subpath of every visible element, stroked or filled, is one stroke, in document
+///   order. The drawing's units are usvg's: CSS pixels of the root's `width` and `height`, the
+///   viewBox mapped onto them ([`SVG_PX_M`] metres each at the drawing's own size). usvg hands
+///   over arcs, circles and ellipses as cubic Béziers (within 2.7e-4 of their radius) and
+///   coordinates in single precision; the strokes follow that geometry. Text, images, clipping
+///   and masks are not drawn.
+/// * **Placing** ([`Placement`]): the centre of the drawing's bounding box (of all its
+///   subpaths' geometry, tiny ones included) goes to `origin_m`, its x along `x_axis` and its
+///   y along `normal × x_axis`, so that it reads right, never mirrored, seen along `normal`.
+/// * **Fitting**: straight segments stay lines; quadratic and cubic Béziers become biarcs
+///   (pairs of tangent arcs), halved until each is within [`SvgOptions::curve_tolerance_m`] of
+///   its curve (measured both ways, at 32 points of the curve and 16 of each arc, in metres
+///   after placement). Where the drawing is smooth the path is too: its pieces meet within
+///   [`emg_control::CORNER_RAD`], so the tool passes without stopping. Joints that turn less
+///   than [`SvgOptions::smooth_join_deg`] count as smooth (drawings round their coordinates:
+///   icon sets leave joints they mean to be smooth a few degrees off): the curves there are
+///   fitted to one tangent, still within the tolerance; two lines keep their corner. A `Z` adds
+///   the closing line when it is at least the path format's shortest segment
+///   ([`emg_control::MIN_SEGMENT_M`], 0.1 mm) long, and leaves a shorter gap open. Shorter
+///   pieces are merged with a neighbour: where a drawing has features that fine (an `h.04`
+///   at 1 mm per unit), the path may leave it by about the length merged.
+/// * **Checking**: every stroke is validated as an [`emg_control::Path`] (the checks the path
+///   file reader makes); strokes shorter than [`SvgOptions::min_stroke_m`] are dropped and
+///   counted.
+///
+/// Refused ([`SvgError`], never a panic) when the text is not SVG, when nothing drawn is long
+/// enough, when `width_m` is asked of a drawing without width, and when a placement field or
+/// an option is unusable (each message names which and why).
+///
+/// ```
+/// use emg_io::{Placement, SvgOptions, read_svg};
+/// let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 50">
+///                <rect x="0" y="0" width="100" height="50"/>
+///                <circle cx="50" cy="25" r="20"/>
+///              </svg>"#;
+/// let drawing = read_svg(svg, &Placement::default(), &SvgOptions::default())?;
+/// assert_eq!(drawing.strokes.len(), 2);
+/// assert!((drawing.size_m()[0] - 0.2).abs() < 1e-12);
+/// let rect = emg_control::Path::new(drawing.strokes[0].clone())?;
+/// assert!((rect.length_m() - 0.6).abs() < 1e-9); // 0.2 m by 0.1 m, closed
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn read_svg(
     text: &str,
     placement: &Placement,

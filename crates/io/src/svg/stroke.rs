@@ -6,19 +6,21 @@
 //!   coordinates, and leave joints they mean to be smooth a few degrees off), both take one
 //!   tangent (a line's, or their mean) and the curves are fitted to it within the tolerance, so
 //!   the path passes there without a corner. Two lines keep their corner.
-//! * A `Z` adds the closing line when it is at least [`MIN_SEGMENT_M`] long.
+//! * A `Z` adds the closing line back to the start when it is at least [`MIN_SEGMENT_M`]
+//!   long; a shorter gap stays open (the stroke ends that close to its start).
 //! * An arc of radius under [`MIN_SEGMENT_M`] (a dot) becomes its chord; a piece shorter than
-//!   [`MIN_SEGMENT_M`] is merged with its neighbour: the two become one biarc between their
-//!   outer ends and tangents where that stays within the tolerance of them, otherwise one arc
-//!   keeping the outer tangent of the longer side (the drawing there is finer than the path
-//!   format holds; the path may leave it by about that piece's length).
+//!   [`MIN_SEGMENT_M`] is merged with its neighbour: the two become one line or arc where that
+//!   keeps both outer tangents, else one biarc between their outer ends and tangents where that
+//!   stays within the tolerance of them, otherwise one arc keeping the outer tangent of the
+//!   longer side (the drawing there is finer than the path format holds; the path may leave
+//!   it by about the length merged).
 
 use emg_control::MIN_SEGMENT_M;
 
 use super::bezier::{Cubic, V2};
 use super::biarc::{PIECE_SAMPLES, UNSPLIT_PIECES, fit_cubic};
 use super::outline::{Segment, Subpath};
-use super::piece::{Piece, arc_from, arc_to, biarc, distance_to};
+use super::piece::{Piece, STRAIGHT_RAD, arc_from, arc_to, biarc, distance_to};
 
 /// The shortest piece or radius produced: the path format's, with a margin for rounding.
 const SHORTEST: f64 = MIN_SEGMENT_M * (1.0 + 1e-6);
@@ -70,6 +72,8 @@ pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) ->
             }
         }
     }
+    // A shorter closing line would move the last piece's end by its length (merged): left
+    // open, the gap is half as far from the drawing's closing line.
     if let Some(last) = raw.last()
         && subpath.closed
         && (subpath.start - last.end()).norm() >= SHORTEST
@@ -87,14 +91,15 @@ pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) ->
     out
 }
 
-/// The segments of `subpath` that have a length, with their own tangents.
+/// The segments of `subpath` that have a length and a direction, with their own tangents.
 fn items(subpath: &Subpath) -> Vec<Item> {
     let mut items = Vec::new();
     let mut at = subpath.start;
     for segment in &subpath.segments {
         match segment {
             Segment::Line(to) => {
-                if *to != at {
+                // Below a femtometre a line has no direction (and no length worth drawing).
+                if (to - at).norm() > 1e-15 {
                     items.push(Item::Line { from: at, to: *to });
                 }
             }
@@ -178,18 +183,28 @@ fn merged(first: &Piece, second: &Piece, tolerance: f64) -> Vec<Piece> {
         return Vec::new();
     }
     let old = [*first, *second];
+    let one = if first.length() >= second.length() {
+        arc_from(a, ta, b)
+    } else {
+        arc_to(a, b, tb)
+    }
+    .map(without_dot)
+    .unwrap_or(Piece::Line { from: a, to: b });
+    // One piece where it keeps both outer tangents (two lines in line, two arcs of one
+    // circle), two tangent arcs otherwise.
+    let turn = |u: V2, v: V2| libm::acos(u.dot(&v).clamp(-1.0, 1.0));
+    if turn(one.start_tangent(), ta).max(turn(one.end_tangent(), tb)) <= STRAIGHT_RAD
+        && apart(&[one], &old) <= tolerance
+    {
+        return vec![one];
+    }
     if let Some(pair) = biarc(a, ta, b, tb)
         && pair.iter().all(|p| !is_short(p) && without_dot(*p) == *p)
         && apart(&pair, &old) <= tolerance
     {
         return pair.to_vec();
     }
-    let one = if first.length() >= second.length() {
-        arc_from(a, ta, b)
-    } else {
-        arc_to(a, b, tb)
-    };
-    vec![without_dot(one.unwrap_or(Piece::Line { from: a, to: b }))]
+    vec![one]
 }
 
 /// How far apart two chains lie, each sampled against the other.
@@ -249,6 +264,20 @@ mod tests {
             true,
         );
         assert_eq!(super::pieces(&closed, 5e-5, 0.1).len(), 3);
+        // A gap of 20 µm is too short for a closing line: it stays open.
+        let nearly = subpath(
+            (0.0, 0.0),
+            vec![
+                line(0.01, 0.0),
+                line(0.01, 0.01),
+                line(0.0, 0.01),
+                line(0.0, 2e-5),
+            ],
+            true,
+        );
+        let pieces = super::pieces(&nearly, 5e-5, 0.1);
+        assert_eq!(pieces.len(), 4);
+        assert_eq!(pieces[3].end(), V2::new(0.0, 2e-5));
     }
 
     #[test]
