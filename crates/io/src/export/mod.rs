@@ -326,8 +326,8 @@ fn ros2(
         velocity: &trajectory.limits.max_velocity,
         acceleration: &trajectory.limits.max_acceleration,
     };
-    let kept = thin(&trajectory.points, tolerance, &limits);
-    let report = measure(&trajectory.points, &kept, tolerance, robot.kinematics);
+    let kept = thin(trajectory.points, tolerance, &limits);
+    let report = measure(trajectory.points, &kept, tolerance, robot.kinematics);
     let (joint_names, topic, frame_id, driver, relation) = match robot.shipped {
         Some(p) => (
             p.joint_names.iter().map(|s| s.to_string()).collect(),
