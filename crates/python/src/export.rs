@@ -33,7 +33,8 @@ pub struct ExportReport {
     servoj_targets: usize,
 }
 
-/// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) as `format`
+/// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
+/// there (an `emg-job/1` file) as `format`
 /// (`"ros2-mcap"` or `"urscript"`) to `out`, for its own robot or `robot` (a shipped robot's
 /// name or a robot file), as `emg export` does: nothing is written on an error, and `out` never
 /// replaces `path`.
@@ -52,8 +53,25 @@ pub fn export(
         _ => InputError::new_err(message(&e)),
     };
     let format: ExportFormat = format.parse().map_err(fail)?;
-    let trajectory = emg_io::read_joint_trajectory(&path).map_err(fail)?;
-    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(&trajectory.robot)))?;
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
+    let job = if emg_job::JobFile::is_job(&text) {
+        Some(serde_json::from_str::<emg_job::JobFile>(&text).map_err(|e| {
+            InputError::new_err(format!("{} is not a valid job program: {e}", path.display()))
+        })?)
+    } else {
+        None
+    };
+    let trajectory = match &job {
+        Some(_) => None,
+        None => Some(emg_io::read_joint_trajectory(&path).map_err(fail)?),
+    };
+    let (points, robot_field) = match (&job, &trajectory) {
+        (Some(job), _) => (job.timed_points(), job.robot.clone()),
+        (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.clone()),
+        (None, None) => unreachable!("a file is read as one or the other"),
+    };
+    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(robot_field)))?;
     let shipped = ShippedRobot::by_path(&robot.file, &data_dir()?)
         .and_then(|s| DriverProfile::for_shipped(s.name));
     let file = robot.file.display().to_string();
@@ -68,7 +86,7 @@ pub fn export(
         kinematics: Some(&robot.inner),
     };
     let export =
-        emg_io::export((&trajectory).into(), format, &out, &target, &options).map_err(fail)?;
+        emg_io::export(points, format, &out, &target, &options).map_err(fail)?;
     export
         .write(&[
             ("joint trajectory", path.as_path()),

@@ -33,13 +33,10 @@ def ur5e_line(tmp_path_factory):
     return directory / "demo.joint_trajectory.json"
 
 
-def test_ros2_mcap_holds_every_point_of_the_file(ur5e_line, tmp_path):
-    out = tmp_path / "demo.mcap"
-    report = elm.export(ur5e_line, "ros2-mcap", out)
-    assert report.files == [out]
-    assert report.max_joint_deviation_rad <= report.tolerance_rad == 1e-5
-    assert report.points_after < report.points_before / 10
-    trajectory = json.loads(ur5e_line.read_text())
+def assert_mcap_holds_the_points_of(motion, out, report):
+    """The MCAP `out` holds one JointTrajectory message whose points are samples of `motion` (a
+    joint trajectory file or a job's program) at their times, the first and the last kept."""
+    trajectory = json.loads(motion.read_text())
     by_time = {nanoseconds(p["time_from_start"]): p for p in trajectory["points"]}
     with open(out, "rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
@@ -63,6 +60,33 @@ def test_ros2_mcap_holds_every_point_of_the_file(ur5e_line, tmp_path):
         assert list(point.velocities) == sample["velocities"]
         assert list(point.accelerations) == sample["accelerations"]
         assert list(point.effort) == []
+
+
+def test_ros2_mcap_holds_every_point_of_the_file(ur5e_line, tmp_path):
+    out = tmp_path / "demo.mcap"
+    report = elm.export(ur5e_line, "ros2-mcap", out)
+    assert report.files == [out]
+    assert report.max_joint_deviation_rad <= report.tolerance_rad == 1e-5
+    assert report.points_after < report.points_before / 10
+    assert_mcap_holds_the_points_of(ur5e_line, out, report)
+
+
+def test_a_job_of_several_strokes_exports_as_one_trajectory(tmp_path):
+    """A lucide icon planned by `emg job` on the UR5e: its whole program in one message."""
+    icon = Path(__file__).resolve().parents[2] / "io" / "tests" / "data" / "icons" / "pencil.svg"
+    subprocess.run(
+        [os.environ.get("EMG_CLI", "emg"), "job", icon, "--robot", "ur5e", "--out", "pencil.job.json"],
+        cwd=tmp_path,
+        check=True,
+        capture_output=True,
+    )
+    job = tmp_path / "pencil.job.json"
+    strokes = [s for s in json.loads(job.read_text())["segments"] if s["kind"] == "stroke"]
+    assert len(strokes) >= 2
+    out = tmp_path / "pencil.mcap"
+    report = elm.export(job, "ros2-mcap", out)
+    assert report.max_joint_deviation_rad <= report.tolerance_rad
+    assert_mcap_holds_the_points_of(job, out, report)
 
 
 def test_urscript_and_wrong_inputs(ur5e_line, tmp_path):
