@@ -324,14 +324,7 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
     let constraints = &planner.config().rollout.constraints;
     let mut motions = Vec::new();
     for oriented in &ordering.sequence {
-        let stroke = &job.strokes[oriented.stroke];
-        let path = if oriented.reversed {
-            stroke
-                .reversed()
-                .expect("only reversible strokes are reversed")
-        } else {
-            stroke.clone()
-        };
+        let path = oriented.path(&job.strokes);
         let plan = plan_stroke(planner, &request, &path, &settings);
         motions.extend(
             plan.parts

@@ -11,7 +11,7 @@ use anyhow::{Context, Result, bail};
 use emg_control::{ConstraintConfig, Task};
 use emg_io::{Carried, TrajectoryContents};
 use emg_kinematics::{Robot, Vec3};
-use emg_verify::{JointDynamics, ReplayReport};
+use emg_verify::{JointDynamics, ReferenceModel, ReplayReport};
 
 use crate::args::CheckArgs;
 use emg_planner::MotionTiming;
@@ -39,12 +39,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
         (None, Some((path, c)), None) => named_robot(&c.robot, path)?,
         (None, None, None) => crate::robot::default_robot(),
     };
-    let robot = crate::robot::load_robot(
-        &robot_path,
-        args.base_link.as_deref(),
-        args.tip_link.as_deref(),
-    )?;
-    let model = crate::robot::load_checker(&robot_path, &robot)?;
+    let (robot, model) = robot_and_checker(args, &robot_path)?;
 
     let (task, task_origin) = match (args.line.p0, args.line.d, args.line.n, &task_from, &carried) {
         (Some(p0), Some(d), Some(n), _, _) => (
@@ -186,12 +181,7 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
         Some(path) => path.clone(),
         None => named_robot(&job.robot, file)?,
     };
-    let robot = crate::robot::load_robot(
-        &robot_path,
-        args.base_link.as_deref(),
-        args.tip_link.as_deref(),
-    )?;
-    let model = crate::robot::load_checker(&robot_path, &robot)?;
+    let (robot, model) = robot_and_checker(args, &robot_path)?;
     let check = emg_job::verify_job(job, &model, robot.joint_names())
         .map_err(|failure| anyhow::anyhow!("{} does not hold up: {failure}", file.display()))?;
     println!(
@@ -210,6 +200,18 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
     );
     println!("OK");
     Ok(())
+}
+
+/// The robot of `robot_path` (with the chain's ends the options name) and its independent
+/// checker.
+fn robot_and_checker(args: &CheckArgs, robot_path: &Path) -> Result<(Robot, ReferenceModel)> {
+    let robot = crate::robot::load_robot(
+        robot_path,
+        args.base_link.as_deref(),
+        args.tip_link.as_deref(),
+    )?;
+    let model = crate::robot::load_checker(robot_path, &robot)?;
+    Ok((robot, model))
 }
 
 fn named_robot(robot: &str, file: &Path) -> Result<PathBuf> {

@@ -75,14 +75,7 @@ pub fn plan_job(
         .sequence
         .par_iter()
         .map(|oriented| {
-            let stroke = &job.strokes[oriented.stroke];
-            let path = if oriented.reversed {
-                stroke
-                    .reversed()
-                    .expect("only reversible strokes are reversed")
-            } else {
-                stroke.clone()
-            };
+            let path = oriented.path(&job.strokes);
             let plan = plan_stroke(planner, request, &path, settings);
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(finished, ordering.sequence.len());

@@ -16,6 +16,21 @@ pub struct Oriented {
     pub reversed: bool,
 }
 
+impl Oriented {
+    /// The stroke as drawn, from `strokes` (the job's): reversed where it is drawn from its
+    /// end (only reversible strokes are, [`order_strokes`]).
+    pub fn path(&self, strokes: &[Path]) -> Path {
+        let stroke = &strokes[self.stroke];
+        if self.reversed {
+            stroke
+                .reversed()
+                .expect("only reversible strokes are reversed")
+        } else {
+            stroke.clone()
+        }
+    }
+}
+
 /// The order chosen and the pen-up travel it saves.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Ordering {
