@@ -54,6 +54,11 @@ pub struct JobArgs {
     /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
+    /// Also write the program's viewer page (self-contained HTML): the arm playing the whole
+    /// program, every stroke on the part (drawn stretches solid, the rest faint), the pen-up
+    /// moves dashed, the segment under way named.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
 }
 
 fn parse_order(value: &str) -> Result<Order, String> {
@@ -72,6 +77,7 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         .map(|format| args.out.with_extension(format.extension()));
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
+    outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(
         &[
             ("job", args.file.as_path()),
@@ -189,7 +195,88 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         )?;
         println!("{text}");
     }
+    if let Some(path) = &args.html {
+        write_text(path, &job_page(&file, &job, planner.robot(), &args.file))?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
+}
+
+/// The viewer page of `file`, the program of `job` (read from `source`) on `robot`.
+fn job_page(
+    file: &emg_job::JobFile,
+    job: &Job,
+    robot: &emg_kinematics::Robot,
+    source: &std::path::Path,
+) -> String {
+    // Every stroke as drawn: reversed where the order draws it from its end.
+    let strokes: Vec<emg_control::Path> = job
+        .strokes
+        .iter()
+        .enumerate()
+        .map(|(index, stroke)| {
+            let reversed = file
+                .ordering
+                .sequence
+                .iter()
+                .any(|o| o.stroke == index && o.reversed);
+            reversed
+                .then(|| stroke.reversed())
+                .flatten()
+                .unwrap_or_else(|| stroke.clone())
+        })
+        .collect();
+    let segments: Vec<emg_viewer::JobSegment<'_>> = file
+        .segments
+        .iter()
+        .map(|segment| emg_viewer::JobSegment {
+            kind: match segment.kind {
+                emg_job::SegmentKind::Stroke { stroke, part } => {
+                    emg_viewer::JobSegmentKind::Stroke { stroke, part }
+                }
+                emg_job::SegmentKind::Retreat => emg_viewer::JobSegmentKind::Retreat,
+                emg_job::SegmentKind::Travel => emg_viewer::JobSegmentKind::Travel,
+                emg_job::SegmentKind::Approach => emg_viewer::JobSegmentKind::Approach,
+            },
+            start_s: segment.start_s,
+            end_s: segment.end_s,
+            task: segment.task.as_ref(),
+        })
+        .collect();
+    let samples: Vec<emg_viewer::JobSample> = file
+        .points
+        .iter()
+        .map(|point| emg_viewer::JobSample {
+            time_s: point.time_from_start.seconds(),
+            q: robot.joint_vector(&point.positions),
+        })
+        .collect();
+    let tasks: Vec<emg_control::Task> = file
+        .segments
+        .iter()
+        .filter_map(|s| s.task.clone())
+        .collect();
+    let reached = emg_viewer::drawn_stretches(robot, &strokes, &segments, &samples);
+    let s = &file.summary;
+    let name = source
+        .file_stem()
+        .unwrap_or(source.as_os_str())
+        .to_string_lossy();
+    emg_viewer::render_job_html(&emg_viewer::JobViewerInput {
+        robot,
+        strokes: &strokes,
+        reached: &reached,
+        segments: &segments,
+        samples: &samples,
+        surfaces: &emg_job::part_surfaces(robot, &tasks),
+        constraints: &file.constraints,
+        title: &format!(
+            "{name}: {} strokes, {:.1} % drawn, {:.2} s",
+            file.strokes.len(),
+            100.0 * s.drawn_m / s.total_m.max(f64::MIN_POSITIVE),
+            s.duration_s
+        ),
+    })
 }
 
 /// The job of a job file, or of an SVG drawing placed as the options say.

@@ -1,4 +1,5 @@
-//! A self-contained HTML motion viewer: one page that animates a planned straight-line motion.
+//! A self-contained HTML motion viewer: one page that animates a planned motion along a line or
+//! a path ([`render_html`]), or a whole job's program ([`render_job_html`]).
 //!
 //! [`render_html`] turns a robot, its task, the rollout and the constraints it was planned under
 //! into a single HTML document with inline CSS, inline JavaScript and the motion as an inline
@@ -43,11 +44,25 @@
 //! assert!(!page.contains("http://") && !page.contains("https://"));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! [`render_job_html`] draws a job's program ([`JobViewerInput`]: plain paths, tasks and
+//! configurations, so that this crate does not depend on the job's file format): the arm
+//! animated through the whole program at its timing, every stroke on the part (the stretches
+//! drawn solid, the rest faint, [`drawn_stretches`]), the ink laid so far, the TCP's pen-up
+//! moves (retreat, travel, approach) dashed, the segment under way named (`stroke 3 part 0`,
+//! `travel`), the work plates and the obstacles; a timeline coloured by segment kind. Both
+//! pages run on one core script (projection, painter's order, the arm, the cell, the controls)
+//! and one template.
 
+mod job;
 mod page;
 mod scene;
 
-pub use page::render_html;
+pub use job::{
+    JOB_PAGE_RATE_HZ, JobSample, JobSegment, JobSegmentKind, JobViewerInput, MIN_UNREACHED_M,
+    MOVE_POINT_SPACING_M, drawn_stretches,
+};
+pub use page::{render_html, render_job_html};
 
 use emg_control::{ConstraintConfig, Task, Trajectory};
 use emg_kinematics::Robot;

@@ -1,24 +1,82 @@
-//! Assembling the page: the template with its style, script, title and data filled in.
+//! Assembling a page: the template with its style, script, title, read-out and data filled in.
+//! Both pages share the template, the style and the viewer's core script (`viewer.js`: the
+//! projection, painter's order, the arm, the cell and the controls); each adds its own script
+//! (`motion.js`, `job.js`) and read-out.
 
-use crate::ViewerInput;
+use crate::job::JobScene;
 use crate::scene::Scene;
+use crate::{JobViewerInput, ViewerInput};
 
 const TEMPLATE: &str = include_str!("viewer.html");
 const STYLE: &str = include_str!("viewer.css");
-const SCRIPT: &str = include_str!("viewer.js");
+/// The core both pages run: error reporting, projection, painter's order, the arm, the cell,
+/// the timeline, the controls.
+const CORE: &str = include_str!("viewer.js");
+/// The motion page on the core.
+const MOTION: &str = include_str!("motion.js");
+/// The job page on the core.
+const JOB: &str = include_str!("job.js");
+
+/// The motion page's read-out: (label as HTML, element id).
+const MOTION_READOUT: &[(&str, &str)] = &[
+    ("time", "r-time"),
+    ("path", "r-path"),
+    ("line error", "r-lateral"),
+    ("tool angle", "r-angle"),
+    ("&rho;", "r-rho"),
+    ("step", "r-step"),
+];
+
+/// The job page's read-out: (label as HTML, element id).
+const JOB_READOUT: &[(&str, &str)] = &[
+    ("time", "r-time"),
+    ("segment", "r-segment"),
+    ("stroke", "r-stroke"),
+    ("line error", "r-lateral"),
+    ("tool angle", "r-angle"),
+    ("sample", "r-step"),
+];
 
 /// The viewer page for `input`: one self-contained HTML document (inline style, script and
 /// data; no external references).
 pub fn render_html(input: &ViewerInput<'_>) -> String {
     let scene = Scene::new(input);
     let json = serde_json::to_string(&scene).expect("the scene holds only numbers and strings");
+    page(input.title, MOTION_READOUT, MOTION, &json)
+}
+
+/// The job page for `input`: one self-contained HTML document (inline style, script and data;
+/// no external references) that plays the whole program at its timing: the arm, every stroke
+/// on the part (its stretches drawn solid, the rest faint), the ink laid so far, the TCP's
+/// pen-up moves dashed, the segment under way named, and the work plates and obstacles.
+///
+/// # Panics
+///
+/// Where the input disagrees with itself: a stroke segment naming a stroke `input.strokes`
+/// lacks or without a task, or `input.reached` not one entry per stroke.
+pub fn render_job_html(input: &JobViewerInput<'_>) -> String {
+    let scene = JobScene::new(input);
+    let json = serde_json::to_string(&scene).expect("the scene holds only numbers and strings");
+    page(input.title, JOB_READOUT, JOB, &json)
+}
+
+/// The template filled with `title`, the read-out rows, the core script followed by `script`,
+/// and `json` as the page's data.
+fn page(title: &str, readout: &[(&str, &str)], script: &str, json: &str) -> String {
+    let rows: String = readout
+        .iter()
+        .map(|(label, id)| {
+            format!("    <div><span class=\"key\">{label}</span> <span id=\"{id}\"></span></div>\n")
+        })
+        .collect();
     fill(
         TEMPLATE,
         &[
-            ("TITLE", &escape_html(input.title)),
+            ("TITLE", &escape_html(title)),
             ("STYLE", STYLE),
-            ("SCRIPT", SCRIPT),
-            ("DATA", &escape_script_json(&json)),
+            ("READOUT", rows.trim_end()),
+            ("SCRIPT", &format!("{CORE}\n{script}")),
+            ("DATA", &escape_script_json(json)),
         ],
     )
 }
@@ -87,6 +145,7 @@ mod tests {
             &[
                 ("TITLE", "t"),
                 ("STYLE", "s"),
+                ("READOUT", "r"),
                 ("SCRIPT", "j"),
                 ("DATA", "{}"),
             ],
@@ -96,8 +155,10 @@ mod tests {
 
     #[test]
     fn script_and_style_cannot_end_their_elements() {
-        assert!(!SCRIPT.to_ascii_lowercase().contains("</script"));
-        assert!(!SCRIPT.contains("<!--"));
+        for script in [CORE, MOTION, JOB] {
+            assert!(!script.to_ascii_lowercase().contains("</script"));
+            assert!(!script.contains("<!--"));
+        }
         assert!(!STYLE.to_ascii_lowercase().contains("</style"));
     }
 

@@ -1,17 +1,13 @@
-//! The viewer page in a real browser: headless Chromium draws a planned FR3 motion, and the
-//! screenshot, the page's render status and the browser console are checked.
+//! The viewer pages in a real browser: headless Chromium draws a planned FR3 motion and a job's
+//! program, and the screenshot, the page's render status, its read-out and the browser console
+//! are checked (the helpers are in `support/`).
 //!
 //! The browser is `$EMG_CHROMIUM`, else `chromium` or `chromium-browser` on `PATH`. The tests
 //! that need it are ignored (with that reason) unless run with `cargo test -- --include-ignored`,
 //! as `.ci/run` does after installing Chromium; so run, without one they print a notice and
 //! pass, unless `EMG_REQUIRE_BROWSER=1` (as in CI), where they fail.
 
-use std::collections::HashSet;
-use std::io::{BufReader, Read as _};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{Duration, Instant};
+mod support;
 
 use emg_control::{
     ActingController, ClassicalController, RolloutConfig, Task, Trajectory, rollout,
@@ -19,42 +15,11 @@ use emg_control::{
 use emg_kinematics::{Robot, Vec3};
 use emg_viewer::{ViewerInput, render_html};
 
-/// The colour the page paints link capsules with, read from the page's own script.
-fn link_colour() -> [u8; 3] {
-    let script = include_str!("../src/viewer.js");
-    let line = script
-        .lines()
-        .find(|l| l.contains("const LINK_COLOUR = \"#"))
-        .expect("viewer.js defines LINK_COLOUR");
-    let hex = line.split('#').nth(1).expect("a # colour")[..6].to_owned();
-    let channel = |i: usize| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).expect("hex colour");
-    [channel(0), channel(1), channel(2)]
-}
-
-/// The Chromium binary, or `None` (after a notice) when there is none and none is required.
-fn browser() -> Option<PathBuf> {
-    if let Some(path) = std::env::var_os("EMG_CHROMIUM").filter(|p| !p.is_empty()) {
-        return Some(PathBuf::from(path));
-    }
-    let found = std::env::var_os("PATH").and_then(|paths| {
-        std::env::split_paths(&paths)
-            .flat_map(|dir| ["chromium", "chromium-browser"].map(|name| dir.join(name)))
-            .find(|candidate| candidate.is_file())
-    });
-    if found.is_none() {
-        assert!(
-            std::env::var("EMG_REQUIRE_BROWSER").as_deref() != Ok("1"),
-            "EMG_REQUIRE_BROWSER=1 but no browser was found: install Chromium (`chromium` or \
-             `chromium-browser` on PATH) or point EMG_CHROMIUM at its binary"
-        );
-        eprintln!(
-            "notice: skipping the headless-browser check of the viewer page: no `chromium` or \
-             `chromium-browser` on PATH and EMG_CHROMIUM is unset (set EMG_REQUIRE_BROWSER=1 to \
-             make this a failure)"
-        );
-    }
-    found
-}
+use support::browser::{
+    body_data, browser, dump_dom, page_problems, scrub_and_record, with_extra_script,
+};
+use support::job::{fr3_path, synthetic_job};
+use support::screenshot::{blank_screenshot_problem, pixels_of, screenshot, script_colour};
 
 /// A fresh directory under the system temp dir, removed when dropped.
 fn temp_dir(name: &str) -> tempfile::TempDir {
@@ -104,185 +69,6 @@ fn planned_page() -> (Trajectory, String) {
     page_of(
         RolloutConfig::default().max_steps,
         "FR3 line along +y (classical)",
-    )
-}
-
-/// What one headless Chromium run left behind.
-struct BrowserRun {
-    stdout: String,
-    stderr: String,
-}
-
-/// Runs Chromium headless on `page` (written into `dir`) with the shared flags plus `extra`.
-fn run_browser(browser: &Path, dir: &Path, page: &str, extra: &[String]) -> BrowserRun {
-    static RUN: AtomicUsize = AtomicUsize::new(0);
-    let run = RUN.fetch_add(1, Ordering::Relaxed);
-    let page_path = dir.join(format!("page-{run}.html"));
-    std::fs::write(&page_path, page).expect("write the page");
-    let profile = dir.join(format!("profile-{run}"));
-    let mut child = Command::new(browser)
-        .args([
-            "--headless=new",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--hide-scrollbars",
-            "--window-size=1000,700",
-            "--virtual-time-budget=3000",
-            "--no-first-run",
-            "--no-default-browser-check",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .arg(format!("file://{}", page_path.display()))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap_or_else(|e| panic!("cannot start the browser {}: {e}", browser.display()));
-    // Read both pipes on threads so a chatty browser never blocks on a full pipe.
-    let drain = |pipe: Option<Box<dyn std::io::Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut text = String::new();
-            if let Some(mut pipe) = pipe {
-                let mut bytes = Vec::new();
-                let _ = pipe.read_to_end(&mut bytes);
-                text = String::from_utf8_lossy(&bytes).into_owned();
-            }
-            text
-        })
-    };
-    let stdout = drain(child.stdout.take().map(|p| Box::new(p) as _));
-    let stderr = drain(child.stderr.take().map(|p| Box::new(p) as _));
-    let deadline = Instant::now() + Duration::from_secs(120);
-    loop {
-        match child.try_wait().expect("wait for the browser") {
-            Some(_) => break,
-            None if Instant::now() > deadline => {
-                let _ = child.kill();
-                let _ = child.wait();
-                panic!(
-                    "the browser did not finish within 120 s on {}",
-                    page_path.display()
-                );
-            }
-            None => std::thread::sleep(Duration::from_millis(50)),
-        }
-    }
-    BrowserRun {
-        stdout: stdout.join().expect("stdout reader"),
-        stderr: stderr.join().expect("stderr reader"),
-    }
-}
-
-/// Renders `page` to a PNG screenshot and returns it as RGB pixels `(width, height, rgb)`.
-fn screenshot(browser: &Path, dir: &Path, page: &str) -> (u32, u32, Vec<[u8; 3]>) {
-    let png_path = dir.join("screenshot.png");
-    let _ = std::fs::remove_file(&png_path);
-    let run = run_browser(
-        browser,
-        dir,
-        page,
-        &[format!("--screenshot={}", png_path.display())],
-    );
-    let file = std::fs::File::open(&png_path).unwrap_or_else(|e| {
-        panic!(
-            "no screenshot at {}: {e}\nbrowser stderr:\n{}",
-            png_path.display(),
-            run.stderr
-        )
-    });
-    let mut decoder = png::Decoder::new(BufReader::new(file));
-    decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
-    let mut reader = decoder.read_info().expect("a PNG screenshot");
-    let mut buffer = vec![0; reader.output_buffer_size().expect("a sane PNG size")];
-    let info = reader
-        .next_frame(&mut buffer)
-        .expect("decode the screenshot");
-    let channels = info.color_type.samples();
-    let pixels = buffer[..info.buffer_size()]
-        .chunks_exact(channels)
-        .map(|px| match channels {
-            1 | 2 => [px[0]; 3],
-            _ => [px[0], px[1], px[2]],
-        })
-        .collect();
-    (info.width, info.height, pixels)
-}
-
-/// Why a screenshot looks blank: too few distinct colours, or too few pixels in the link colour.
-fn blank_screenshot_problem(pixels: &[[u8; 3]]) -> Option<String> {
-    const MIN_COLOURS: usize = 300;
-    const MIN_LINK_PIXELS: usize = 3000;
-    let colours = pixels.iter().collect::<HashSet<_>>().len();
-    let link = link_colour();
-    let link_pixels = pixels
-        .iter()
-        .filter(|px| (0..3).all(|c| px[c].abs_diff(link[c]) <= 8))
-        .count();
-    let mut problems = Vec::new();
-    if colours < MIN_COLOURS {
-        problems.push(format!(
-            "{colours} distinct colours (expected at least {MIN_COLOURS})"
-        ));
-    }
-    if link_pixels < MIN_LINK_PIXELS {
-        problems.push(format!(
-            "{link_pixels} pixels in the link colour {link:?} (expected at least {MIN_LINK_PIXELS})"
-        ));
-    }
-    (!problems.is_empty()).then(|| problems.join("; "))
-}
-
-/// Dumps the DOM of `page` after it ran, with the browser's console logged to stderr.
-fn dump_dom(browser: &Path, dir: &Path, page: &str) -> BrowserRun {
-    run_browser(
-        browser,
-        dir,
-        page,
-        &[
-            "--dump-dom".into(),
-            "--enable-logging=stderr".into(),
-            "--v=0".into(),
-        ],
-    )
-}
-
-/// Whether a page ran cleanly: its status is `rendered` and the console stayed silent.
-///
-/// This Chromium logs every console message of the page, whatever its level, as an
-/// `INFO:CONSOLE...` line on stderr (uncaught errors as `"Uncaught ..."`), so the level of a
-/// `console.error` cannot be told apart from a `console.log`. The viewer writes nothing to the
-/// console, so every console line counts as a problem.
-fn page_problems(run: &BrowserRun) -> Result<(), String> {
-    let mut problems = Vec::new();
-    if !run.stdout.contains(r#"data-status="rendered""#) {
-        let status = run
-            .stdout
-            .split("data-status=\"")
-            .nth(1)
-            .and_then(|rest| rest.split('"').next())
-            .unwrap_or("(no data-status in the dumped DOM)");
-        problems.push(format!("page status is '{status}', not 'rendered'"));
-    }
-    problems.extend(
-        run.stderr
-            .lines()
-            .filter(|line| line.contains("CONSOLE") || line.contains("Uncaught"))
-            .map(|line| format!("console: {line}")),
-    );
-    if problems.is_empty() {
-        Ok(())
-    } else {
-        Err(problems.join("\n"))
-    }
-}
-
-/// The planned page with `script` run after the viewer's own script.
-fn with_extra_script(page: &str, script: &str) -> String {
-    let end = page.rfind("</body>").expect("the page has a body");
-    format!(
-        "{}<script>{script}</script>\n{}",
-        &page[..end],
-        &page[end..]
     )
 }
 
@@ -528,16 +314,6 @@ fn a_motion_of_only_the_seed_renders() {
     }
 }
 
-/// The workspace's shipped data directory.
-fn data_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data")
-}
-
-/// The shipped FR3 robot file.
-fn fr3_path() -> std::path::PathBuf {
-    data_dir().join("robots/fr3_pen.urdf")
-}
-
 /// A classical rollout round a circle of radius 5 cm on the mid-range pose's tool plane, and
 /// its page.
 fn circle_page() -> (Trajectory, String) {
@@ -585,7 +361,7 @@ fn a_path_task_draws_its_path() {
     let (trajectory, page) = circle_page();
     assert_eq!(trajectory.termination, emg_control::Termination::Completed);
     assert!(
-        page.contains(r#""path":{"step_m":0.005"#),
+        page.contains(r#""path":{"length_m":0.31416,"s":[0.0,"#),
         "the page holds the sampled path"
     );
     let Some(browser) = browser() else { return };
@@ -599,4 +375,120 @@ fn a_path_task_draws_its_path() {
     if let Some(problem) = blank_screenshot_problem(&pixels) {
         panic!("{problem} (page in {})", dir.display());
     }
+}
+
+/// The job page of [`synthetic_job`].
+fn job_page() -> (support::job::SyntheticJob, String) {
+    let job = synthetic_job();
+    let page = job.page("two strokes");
+    (job, page)
+}
+
+#[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
+fn a_job_page_renders_and_names_the_segment_under_way() {
+    let Some(browser) = browser() else { return };
+    let tmp = temp_dir("job-dom");
+    let dir = tmp.path();
+    let (job, page) = job_page();
+    if let Err(problems) = page_problems(&dump_dom(&browser, dir, &page)) {
+        panic!("the job page did not run cleanly:\n{problems}");
+    }
+    let count = job.spans.len();
+    let ids = ["r-segment", "r-stroke", "r-angle", "r-time"];
+    // Mid-way through each segment, the read-out names it and says whether the pen is down.
+    for (index, span) in job.spans.iter().enumerate() {
+        let t = 0.5 * (span.start_s + span.end_s);
+        let run = dump_dom(
+            &browser,
+            dir,
+            &with_extra_script(&page, &scrub_and_record(t, &ids)),
+        );
+        if let Err(problems) = page_problems(&run) {
+            panic!("scrubbing to {t} s broke the job page:\n{problems}");
+        }
+        let segment = body_data(&run, "r-segment").expect("the segment is recorded");
+        assert_eq!(
+            segment,
+            format!("{} ({} of {count})", span.kind, index + 1),
+            "at {t} s"
+        );
+        let stroke = body_data(&run, "r-stroke").expect("the stroke read-out is recorded");
+        let angle = body_data(&run, "r-angle").expect("the tool angle is recorded");
+        if span.task.is_some() {
+            assert!(stroke.contains(" m of "), "pen down at {t} s: {stroke}");
+            assert!(
+                angle.contains("limit"),
+                "the cone's limit at {t} s: {angle}"
+            );
+        } else {
+            assert_eq!(stroke, "pen up", "at {t} s");
+            assert_eq!(angle, "free (pen up)", "at {t} s");
+        }
+    }
+}
+
+#[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
+fn a_job_page_lays_ink_as_it_plays() {
+    let Some(browser) = browser() else { return };
+    let tmp = temp_dir("job-ink");
+    let dir = tmp.path();
+    let (_, page) = job_page();
+    // Paused, zoomed in on the work (the view turns and zooms about it).
+    let pause = r#"
+        document.getElementById("play").click();
+        const scene = document.getElementById("scene");
+        for (let k = 0; k < 2; k++) {
+            scene.dispatchEvent(new WheelEvent("wheel", { deltaY: -700, bubbles: true, cancelable: true }));
+        }
+    "#;
+    let (width, height, at_start) = screenshot(&browser, dir, &with_extra_script(&page, pause));
+    assert_eq!((width, height), (1000, 700), "screenshot size");
+    if let Some(problem) = blank_screenshot_problem(&at_start) {
+        panic!(
+            "the job page looks blank: {problem} (page in {})",
+            dir.display()
+        );
+    }
+    let to_end = format!(
+        "{pause}{}",
+        scrub_and_record(1e9, &[]) // clamped to the program's end
+    );
+    let (_, _, at_end) = screenshot(&browser, dir, &with_extra_script(&page, &to_end));
+    // Counted in the scene, above the controls and the legend (which has an ink swatch).
+    let scene = |pixels: &[[u8; 3]]| pixels[..1000 * 590].to_vec();
+    let ink = script_colour("INK_COLOUR");
+    let (before, after) = (
+        pixels_of(&scene(&at_start), ink),
+        pixels_of(&scene(&at_end), ink),
+    );
+    assert!(
+        before < 10 && after > 300,
+        "ink pixels: {before} at the start, {after} at the end (page in {})",
+        dir.display()
+    );
+    let moves = script_colour("MOVE_COLOUR");
+    assert!(
+        pixels_of(&scene(&at_start), moves) > 100,
+        "the pen-up moves are drawn from the start (page in {})",
+        dir.display()
+    );
+}
+
+#[test]
+#[ignore = "needs headless Chromium (`chromium` on PATH or EMG_CHROMIUM): `cargo test -- --include-ignored` runs it, as .ci/run does"]
+fn a_job_page_without_samples_reports_the_error() {
+    let Some(browser) = browser() else { return };
+    let tmp = temp_dir("job-broken");
+    let dir = tmp.path();
+    let (_, page) = job_page();
+    let broken = without_steps(&page);
+    assert_ne!(broken, page, "the data blob holds the steps");
+    let problems = page_problems(&dump_dom(&browser, dir, &broken))
+        .expect_err("a job page whose script throws passed the check");
+    assert!(
+        problems.contains("error: Uncaught Error: the motion data holds no steps"),
+        "{problems}"
+    );
 }
