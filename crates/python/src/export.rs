@@ -56,9 +56,14 @@ pub fn export(
     let text = std::fs::read_to_string(&path)
         .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
     let job = if emg_job::JobFile::is_job(&text) {
-        Some(serde_json::from_str::<emg_job::JobFile>(&text).map_err(|e| {
-            InputError::new_err(format!("{} is not a valid job program: {e}", path.display()))
-        })?)
+        Some(
+            serde_json::from_str::<emg_job::JobFile>(&text).map_err(|e| {
+                InputError::new_err(format!(
+                    "{} is not a valid job program: {e}",
+                    path.display()
+                ))
+            })?,
+        )
     } else {
         None
     };
@@ -85,8 +90,7 @@ pub fn export(
         shipped,
         kinematics: Some(&robot.inner),
     };
-    let export =
-        emg_io::export(points, format, &out, &target, &options).map_err(fail)?;
+    let export = emg_io::export(points, format, &out, &target, &options).map_err(fail)?;
     export
         .write(&[
             ("joint trajectory", path.as_path()),
