@@ -13,8 +13,8 @@ use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec, Task};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
-    FreeSpace, JOB_FORMAT_VERSION, Job, JobSettings, JobSpec, Order, order_strokes, part_surfaces,
-    plan_job, plan_stroke, verify_job,
+    FreeSpace, Job, JobSettings, Order, order_strokes, part_surfaces, plan_job, plan_stroke,
+    verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner};
@@ -131,13 +131,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 origin[2],
                 width
             );
-            jobs.push((name, job_of(drawing.strokes, planner.robot())?));
+            jobs.push((name, Job::from_strokes(drawing.strokes, planner.robot())?));
         }
     }
     for tilt_deg in [0.0, 20.0, 40.0] {
         jobs.push((
             format!("5 seams on a surface tilted {tilt_deg}°"),
-            job_of(seams(tilt_deg), planner.robot())?,
+            Job::from_strokes(seams(tilt_deg), planner.robot())?,
         ));
     }
     let bar = progress::bar(jobs.len() as u64, "jobs");
@@ -200,18 +200,6 @@ fn setup(robot_file: &Path) -> anyhow::Result<(Planner, MotionTiming, emg_verify
         &planner.config().rollout.constraints,
     )?;
     Ok((planner, timing, checker))
-}
-
-fn job_of(strokes: Vec<PathSpec>, robot: &emg_kinematics::Robot) -> anyhow::Result<Job> {
-    Ok(Job::from_spec(
-        JobSpec {
-            version: JOB_FORMAT_VERSION,
-            strokes,
-            settings: JobSettings::default(),
-            home: None,
-        },
-        robot,
-    )?)
 }
 
 /// Five parallel seams 0.2 m long, 3 cm apart, on a surface through (0.45, 0, 0.25) whose

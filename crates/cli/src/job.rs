@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
-use emg_job::{Job, JobSettings, Order, plan_job};
+use emg_job::{Job, Order, plan_job};
 use emg_planner::{ControllerKind, Models, MotionTiming, PlanRequest, Planner, PlannerConfig};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -196,87 +196,22 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         println!("{text}");
     }
     if let Some(path) = &args.html {
-        write_text(path, &job_page(&file, &job, planner.robot(), &args.file))?;
+        write_text(
+            path,
+            &emg_job::viewer_page(
+                &file,
+                &job,
+                planner.robot(),
+                &args
+                    .file
+                    .file_stem()
+                    .unwrap_or(args.file.as_os_str())
+                    .to_string_lossy(),
+            ),
+        )?;
         println!("wrote {}", path.display());
     }
     Ok(())
-}
-
-/// The viewer page of `file`, the program of `job` (read from `source`) on `robot`.
-fn job_page(
-    file: &emg_job::JobFile,
-    job: &Job,
-    robot: &emg_kinematics::Robot,
-    source: &std::path::Path,
-) -> String {
-    // Every stroke as drawn: reversed where the order draws it from its end.
-    let strokes: Vec<emg_control::Path> = job
-        .strokes
-        .iter()
-        .enumerate()
-        .map(|(index, stroke)| {
-            let reversed = file
-                .ordering
-                .sequence
-                .iter()
-                .any(|o| o.stroke == index && o.reversed);
-            reversed
-                .then(|| stroke.reversed())
-                .flatten()
-                .unwrap_or_else(|| stroke.clone())
-        })
-        .collect();
-    let segments: Vec<emg_viewer::JobSegment<'_>> = file
-        .segments
-        .iter()
-        .map(|segment| emg_viewer::JobSegment {
-            kind: match segment.kind {
-                emg_job::SegmentKind::Stroke { stroke, part } => {
-                    emg_viewer::JobSegmentKind::Stroke { stroke, part }
-                }
-                emg_job::SegmentKind::Retreat => emg_viewer::JobSegmentKind::Retreat,
-                emg_job::SegmentKind::Travel => emg_viewer::JobSegmentKind::Travel,
-                emg_job::SegmentKind::Approach => emg_viewer::JobSegmentKind::Approach,
-            },
-            start_s: segment.start_s,
-            end_s: segment.end_s,
-            task: segment.task.as_ref(),
-        })
-        .collect();
-    let samples: Vec<emg_viewer::JobSample> = file
-        .points
-        .iter()
-        .map(|point| emg_viewer::JobSample {
-            time_s: point.time_from_start.seconds(),
-            q: robot.joint_vector(&point.positions),
-        })
-        .collect();
-    let tasks: Vec<emg_control::Task> = file
-        .segments
-        .iter()
-        .filter_map(|s| s.task.clone())
-        .collect();
-    let reached = emg_viewer::drawn_stretches(robot, &strokes, &segments, &samples);
-    let s = &file.summary;
-    let name = source
-        .file_stem()
-        .unwrap_or(source.as_os_str())
-        .to_string_lossy();
-    emg_viewer::render_job_html(&emg_viewer::JobViewerInput {
-        robot,
-        strokes: &strokes,
-        reached: &reached,
-        segments: &segments,
-        samples: &samples,
-        surfaces: &emg_job::part_surfaces(robot, &tasks),
-        constraints: &file.constraints,
-        title: &format!(
-            "{name}: {} strokes, {:.1} % drawn, {:.2} s",
-            file.strokes.len(),
-            100.0 * s.drawn_m / s.total_m.max(f64::MIN_POSITIVE),
-            s.duration_s
-        ),
-    })
 }
 
 /// The job of a job file, or of an SVG drawing placed as the options say.
@@ -296,15 +231,7 @@ fn read_job(args: &JobArgs, robot: &emg_kinematics::Robot) -> Result<Job> {
                 SvgOptions::default().min_stroke_m * 1e3
             );
         }
-        Job::from_spec(
-            emg_job::JobSpec {
-                version: emg_job::JOB_FORMAT_VERSION,
-                strokes: drawing.strokes,
-                settings: JobSettings::default(),
-                home: None,
-            },
-            robot,
-        )?
+        Job::from_strokes(drawing.strokes, robot)?
     } else {
         if [&args.origin, &args.normal, &args.x_axis]
             .iter()

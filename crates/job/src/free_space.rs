@@ -4,8 +4,8 @@
 //! over, the lifted configuration above a point of a stroke, and the collision-free move
 //! between two configurations (the straight edge, else dual RRT-Connect with shortcuts).
 
-use emg_control::{ConstraintConfig, Path, PathSpec, SegmentSpec, Task, first_contact};
-use emg_kinematics::{DampingConfig, JointVector, Robot, Vec3, damped_pseudo_inverse};
+use emg_control::{ConstraintConfig, Path, PathSpec, SegmentSpec, Task};
+use emg_kinematics::{DampingConfig, JointVector, Robot, ToolContact, Vec3, damped_pseudo_inverse};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -131,6 +131,11 @@ impl<'a> FreeSpace<'a> {
         self.robot
     }
 
+    /// The tasks whose work plates the arm keeps off between strokes.
+    pub fn surfaces(&self) -> &[Task] {
+        &self.surfaces
+    }
+
     /// The constraints (plates, scene, margin) the arm keeps.
     pub fn constraints(&self) -> &'a ConstraintConfig {
         self.constraints
@@ -139,6 +144,12 @@ impl<'a> FreeSpace<'a> {
     /// Whether `q` is free: within the joint limits, no link touching another, a plate or an
     /// obstacle, the tool's tip not inside the part.
     pub fn free(&self, q: &JointVector) -> bool {
+        self.free_by(q, 0.0)
+    }
+
+    /// Whether `q` is free with `margin` (m) more clearance than the constraints ask between
+    /// links, from the plates and from the obstacles.
+    fn free_by(&self, q: &JointVector, margin: f64) -> bool {
         if self.robot.limits().first_violation(q, 0.0).is_some() {
             return false;
         }
@@ -149,17 +160,52 @@ impl<'a> FreeSpace<'a> {
             let depth = offset.dot(normal);
             depth > self.constraints.line_tolerance_m && (offset - normal * depth).norm() <= *radius
         });
-        !inside
-            && self.surfaces.iter().all(|task| {
-                first_contact(self.robot, task, &kinematics, self.constraints).is_none()
+        if inside
+            || self
+                .robot
+                .first_collision(&kinematics, self.constraints.collision_margin_m + margin)
+                .is_some()
+        {
+            return false;
+        }
+        let clear_of_plates = self.surfaces.iter().all(|task| {
+            task.work_surface(&self.constraints.work_surface)
+                .shape(&task.p0, &task.d, &task.n)
+                .is_none_or(|plate| {
+                    self.robot
+                        .first_contact(&kinematics, &plate, margin, ToolContact::Allowed)
+                        .is_none()
+                })
+        });
+        clear_of_plates
+            && self.constraints.scene.obstacles.iter().all(|obstacle| {
+                self.robot
+                    .first_contact(
+                        &kinematics,
+                        &obstacle.shape,
+                        obstacle.clearance_m + margin,
+                        ToolContact::Forbidden,
+                    )
+                    .is_none()
             })
     }
 
     /// Whether the straight joint-space edge from `a` to `b` is free at every configuration
-    /// visited, no two of them more than [`MAX_POINT_TRAVEL_M`] apart at any point of the arm.
+    /// visited, no two of them more than [`MAX_POINT_TRAVEL_M`] apart at any point of the arm,
+    /// the ones inside it with half that more clearance: free all along.
     pub fn edge_free(&self, a: &JointVector, b: &JointVector) -> bool {
         let steps = ((b - a).abs().sum() / self.step_l1_rad).ceil().max(1.0) as usize;
-        (0..=steps).all(|k| self.free(&(a + (b - a) * (k as f64 / steps as f64))))
+        // Between two checked configurations no point of the arm moves more than
+        // `MAX_POINT_TRAVEL_M`, so none comes closer than half of it to where it was checked:
+        // the configurations inside the edge keep that much more clearance.
+        self.free(a)
+            && self.free(b)
+            && (1..steps).all(|k| {
+                self.free_by(
+                    &(a + (b - a) * (k as f64 / steps as f64)),
+                    MAX_POINT_TRAVEL_M / 2.0,
+                )
+            })
     }
 
     /// The configuration near `q` whose TCP lies at `target` (Newton steps on the TCP position

@@ -16,6 +16,7 @@
 
 pub mod free_space;
 pub mod order;
+pub mod page;
 pub mod program;
 pub mod spec;
 pub mod stroke;
@@ -30,6 +31,7 @@ use rayon::prelude::*;
 
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, part_surfaces};
 pub use order::{Ordering, Oriented, order_strokes};
+pub use page::viewer_page;
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
 };
@@ -207,6 +209,7 @@ pub fn plan_job(
         ordering,
         strokes: reports,
         summary,
+        surfaces: free.surfaces().to_vec(),
         segments: program.segments().to_vec(),
         points: program.points(dof).ok_or(JobPlanError::TooLong)?,
     })

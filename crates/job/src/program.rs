@@ -133,6 +133,9 @@ pub struct JobFile {
     pub strokes: Vec<StrokeReport>,
     /// The totals.
     pub summary: JobSummary,
+    /// The part the moves keep off: one task per plane of the strokes, whose work plate covers
+    /// them all ([`crate::part_surfaces`]).
+    pub surfaces: Vec<Task>,
     /// The segments in time order.
     pub segments: Vec<Segment>,
     /// The samples of the whole program, from rest to rest.

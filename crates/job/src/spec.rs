@@ -203,6 +203,19 @@ impl Job {
         })
     }
 
+    /// The job of `strokes` (a drawing's) with the default settings and no home.
+    pub fn from_strokes(strokes: Vec<PathSpec>, robot: &Robot) -> Result<Self, JobError> {
+        Self::from_spec(
+            JobSpec {
+                version: JOB_FORMAT_VERSION,
+                strokes,
+                settings: JobSettings::default(),
+                home: None,
+            },
+            robot,
+        )
+    }
+
     /// Reads a job file's text; `origin` names it in errors.
     pub fn from_json(origin: &str, text: &str, robot: &Robot) -> Result<Self, JobError> {
         let spec: JobSpec = serde_json::from_str(text).map_err(|e| JobError::Parse {

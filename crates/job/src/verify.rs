@@ -2,8 +2,8 @@
 //! replayed by the checker (`emg_verify`, which shares no kinematics with the planners), each
 //! from rest to rest within the joint velocity, acceleration and jerk limits; a stroke part's
 //! samples on its stretch of the stroke within the tolerance and the cone, clear of the arm's
-//! own links, its work plate and the scene; a move's samples clear of the arm's own links,
-//! every stroke's work plate and the scene.
+//! own links, its work plate and the scene; a move's samples clear of the arm's own links, the
+//! part's plates the file names (`surfaces`) and the scene.
 
 use emg_control::{ConstraintConfig, task_bounds};
 use emg_verify::{JointSamples, Joints, ReferenceModel, ReplayError, check_replay};
@@ -65,11 +65,6 @@ pub fn verify_job(
         });
     }
     let dynamics = file.limits.dynamics();
-    let tasks: Vec<_> = file
-        .segments
-        .iter()
-        .filter_map(|s| s.task.as_ref())
-        .collect();
     // Between strokes the tool leaves the line and turns freely: only the arm's clearances hold.
     let free = ConstraintConfig {
         line_tolerance_m: f64::INFINITY,
@@ -123,10 +118,10 @@ pub fn verify_job(
                 check.stroke_parts += 1;
             }
             _ => {
-                for task in &tasks {
+                for task in &file.surfaces {
                     check_replay(
                         model,
-                        &(*task).into(),
+                        &task.into(),
                         &task_bounds(task, &free),
                         &samples,
                         None,

@@ -5,9 +5,7 @@
 use std::path::PathBuf;
 
 use emg_io::{Placement, SvgOptions, read_svg_file};
-use emg_job::{
-    JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, SegmentKind, plan_job, verify_job,
-};
+use emg_job::{Job, JobError, SegmentKind, plan_job, verify_job};
 use emg_kinematics::Robot;
 use emg_planner::{
     DEFAULT_RATE_HZ, DataDir, Models, MotionTiming, PlanRequest, Planner, PlannerConfig,
@@ -51,16 +49,7 @@ fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
 
 fn icon_job(robot: &Robot, name: &str, placement: &Placement) -> Job {
     let drawing = read_svg_file(&icon(name), placement, &SvgOptions::default()).expect("icon");
-    Job::from_spec(
-        JobSpec {
-            version: JOB_FORMAT_VERSION,
-            strokes: drawing.strokes,
-            settings: JobSettings::default(),
-            home: None,
-        },
-        robot,
-    )
-    .expect("a valid job")
+    Job::from_strokes(drawing.strokes, robot).expect("a valid job")
 }
 
 fn plans_and_checks_the_pencil_icon(name: &str) {

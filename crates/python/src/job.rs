@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use emg_job::{JOB_FORMAT_VERSION, Job, JobFile, JobSettings, JobSpec};
+use emg_job::{Job, JobFile};
 use emg_planner::{DEFAULT_RATE_HZ, PlanRequest};
 use emg_timing::Scaling;
 use numpy::ndarray::Array2;
@@ -54,13 +54,7 @@ pub(crate) fn read_job(
         };
         let drawing = emg_io::read_svg_file(&path, &placement, &emg_io::SvgOptions::default())
             .map_err(|e| invalid(&e))?;
-        let spec = JobSpec {
-            version: JOB_FORMAT_VERSION,
-            strokes: drawing.strokes,
-            settings: JobSettings::default(),
-            home: None,
-        };
-        return Job::from_spec(spec, robot).map_err(|e| invalid(&e));
+        return Job::from_strokes(drawing.strokes, robot).map_err(|e| invalid(&e));
     }
     if placement.is_some() {
         return Err(InputError::new_err(
