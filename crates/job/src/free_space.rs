@@ -147,8 +147,9 @@ impl<'a> FreeSpace<'a> {
         self.free_by(q, 0.0)
     }
 
-    /// Whether `q` is free with `margin` (m) more clearance than the constraints ask between
-    /// links, from the plates and from the obstacles.
+    /// Whether `q` is free with `margin` (m) more clearance than the constraints ask from the
+    /// plates and from the obstacles (not between the arm's own links, some of which always lie
+    /// closer than that to one another).
     fn free_by(&self, q: &JointVector, margin: f64) -> bool {
         if self.robot.limits().first_violation(q, 0.0).is_some() {
             return false;
@@ -163,7 +164,7 @@ impl<'a> FreeSpace<'a> {
         if inside
             || self
                 .robot
-                .first_collision(&kinematics, self.constraints.collision_margin_m + margin)
+                .first_collision(&kinematics, self.constraints.collision_margin_m)
                 .is_some()
         {
             return false;
@@ -197,7 +198,8 @@ impl<'a> FreeSpace<'a> {
         let steps = ((b - a).abs().sum() / self.step_l1_rad).ceil().max(1.0) as usize;
         // Between two checked configurations no point of the arm moves more than
         // `MAX_POINT_TRAVEL_M`, so none comes closer than half of it to where it was checked:
-        // the configurations inside the edge keep that much more clearance.
+        // the configurations inside the edge keep that much more clearance from the part and the
+        // cell.
         self.free(a)
             && self.free(b)
             && (1..steps).all(|k| {
