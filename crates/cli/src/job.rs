@@ -39,14 +39,14 @@ pub struct JobArgs {
     #[arg(long, value_parser = parse_order)]
     pub order: Option<Order>,
     /// SVG only: where the drawing's centre goes (m, base frame).
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
-    pub origin: Option<Vec<f64>>,
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
+    pub origin: Option<[f64; 3]>,
     /// SVG only: the surface normal the pen points along.
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
-    pub normal: Option<Vec<f64>>,
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
+    pub normal: Option<[f64; 3]>,
     /// SVG only: the drawing's x axis on the surface.
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',', num_args = 3)]
-    pub x_axis: Option<Vec<f64>>,
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
+    pub x_axis: Option<[f64; 3]>,
     /// SVG only: the drawing's width (m).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
@@ -257,15 +257,14 @@ fn read_job(args: &JobArgs, robot: &emg_kinematics::Robot) -> Result<Job> {
 /// The drawing's placement: the default with what the options set.
 fn placement(args: &JobArgs) -> Result<Placement> {
     let mut placement = Placement::default();
-    let vector = |values: &Vec<f64>| [values[0], values[1], values[2]];
-    if let Some(origin) = &args.origin {
-        placement.origin_m = vector(origin);
+    if let Some(origin) = args.origin {
+        placement.origin_m = origin;
     }
-    if let Some(normal) = &args.normal {
-        placement.normal = vector(normal);
+    if let Some(normal) = args.normal {
+        placement.normal = normal;
     }
-    if let Some(x_axis) = &args.x_axis {
-        placement.x_axis = vector(x_axis);
+    if let Some(x_axis) = args.x_axis {
+        placement.x_axis = x_axis;
     }
     if let Some(width) = args.width {
         placement.width_m = Some(width);
