@@ -1,7 +1,9 @@
-//! `cargo xtask readme-picture`: the README's picture. The task of the README's own
+//! `cargo xtask readme-picture`: the README's pictures. The task of the README's own
 //! `emg plan --p0 … --d … --n …` command, planned as `emg plan` plans it (the search, the work
 //! plate, the shipped models), drawn by the viewer and taken as a still by headless Chromium
-//! (`docs/figures/readme-demo.png`).
+//! (`docs/figures/readme-demo.png`); with `--job`, the drawing of the README's `emg job FILE`
+//! command planned as `emg job` plans it, its program drawn by the viewer
+//! (`docs/figures/job-demo.png`).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -19,9 +21,13 @@ pub struct Args {
     /// Share of the motion the still shows (0 = the start, 1 = the end).
     #[arg(long, default_value_t = 0.6)]
     at: f64,
-    /// Output PNG.
-    #[arg(long, default_value_os_t = workspace::root().join("docs/figures/readme-demo.png"))]
-    out: PathBuf,
+    /// Picture the README's `emg job` command instead of its `emg plan` command.
+    #[arg(long)]
+    job: bool,
+    /// Output PNG (default: `docs/figures/readme-demo.png`, with `--job`
+    /// `docs/figures/job-demo.png`).
+    #[arg(long)]
+    out: Option<PathBuf>,
     /// Chromium (default: $EMG_CHROMIUM, else `chromium` on PATH).
     #[arg(long)]
     chromium: Option<PathBuf>,
@@ -37,6 +43,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let readme = workspace::root().join("README.md");
     let text = std::fs::read_to_string(&readme)
         .with_context(|| format!("reading {}", readme.display()))?;
+    let figures = workspace::root().join("docs/figures");
+    if args.job {
+        let out = args
+            .out
+            .clone()
+            .unwrap_or_else(|| figures.join("job-demo.png"));
+        return job_picture(args, &text, &out);
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| figures.join("readme-demo.png"));
     let [p0, d, n] = readme_task(&text)?;
     let robot_path = workspace::default_robot();
     let robot = workspace::load_robot(&robot_path)?;
@@ -56,11 +74,69 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     });
     let html = workspace::root().join("target/readme-picture.html");
     emg_io::write_atomically(&html, page)?;
-    screenshot(args, &html)?;
+    screenshot(args, &html, &out)?;
     println!(
         "planned {:.4} m; wrote {}",
         plan.trajectory.path_length_m,
-        args.out.display()
+        out.display()
+    );
+    Ok(())
+}
+
+/// The README's `emg job FILE` drawing planned as `emg job` plans it (its default placement and
+/// tolerance, the shipped models), its program's page and the still of it at `out`.
+fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
+    let line = readme
+        .lines()
+        .find(|line| line.trim_start().starts_with("emg job "))
+        .context("README.md holds no `emg job …` command")?;
+    let file = line
+        .split_whitespace()
+        .nth(2)
+        .context("the README's `emg job` command names no file")?;
+    let robot_path = workspace::default_robot();
+    let robot = workspace::load_robot(&robot_path)?;
+    let models = Models::shipped(&robot, workspace::data_dir().path())?;
+    let mut config = PlannerConfig::cell();
+    config.rollout.constraints.line_tolerance_m = 5e-4;
+    let timing = emg_planner::MotionTiming::for_robot_file(
+        &robot,
+        &robot_path,
+        None,
+        emg_timing::Scaling::default(),
+        config.rollout.speed_m_per_s,
+        emg_planner::DEFAULT_RATE_HZ,
+        &config.rollout.constraints,
+    )?;
+    let planner = Planner::new(robot, models, config)?;
+    let drawing = emg_io::read_svg_file(
+        &workspace::root().join(file),
+        &emg_io::Placement::default(),
+        &emg_io::SvgOptions::default(),
+    )?;
+    let job = emg_job::Job::from_strokes(drawing.strokes, planner.robot())?;
+    let program = emg_job::plan_job(
+        &planner,
+        &PlanRequest::default(),
+        &job,
+        &timing,
+        &robot_path.display().to_string(),
+        &|_, _| {},
+    )?;
+    let name = Path::new(file).file_stem().map_or_else(
+        || file.to_string(),
+        |stem| stem.to_string_lossy().into_owned(),
+    );
+    let page = emg_job::viewer_page(&program, &job, planner.robot(), &name);
+    let html = workspace::root().join("target/readme-job-picture.html");
+    emg_io::write_atomically(&html, page)?;
+    screenshot(args, &html, out)?;
+    println!(
+        "planned {:.4} m of {:.4} m in {:.2} s; wrote {}",
+        program.summary.drawn_m,
+        program.summary.total_m,
+        program.summary.duration_s,
+        out.display()
     );
     Ok(())
 }
@@ -84,14 +160,14 @@ fn readme_task(readme: &str) -> anyhow::Result<[Vec3; 3]> {
     Ok([vector("--p0")?, vector("--d")?, vector("--n")?])
 }
 
-/// Headless Chromium's still of `html` at `args.at` of the motion, written to `args.out`.
-fn screenshot(args: &Args, html: &Path) -> anyhow::Result<()> {
+/// Headless Chromium's still of `html` at `args.at` of the motion, written to `out`.
+fn screenshot(args: &Args, html: &Path, out: &Path) -> anyhow::Result<()> {
     let chromium = args
         .chromium
         .clone()
         .or_else(|| std::env::var_os("EMG_CHROMIUM").map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from("chromium"));
-    if let Some(parent) = args.out.parent() {
+    if let Some(parent) = out.parent() {
         std::fs::create_dir_all(parent)?;
     }
     let url = format!("file://{}#t={}", html.canonicalize()?.display(), args.at);
@@ -104,7 +180,7 @@ fn screenshot(args: &Args, html: &Path) -> anyhow::Result<()> {
             "--window-size=1100,650",
             "--virtual-time-budget=2000",
         ])
-        .arg(format!("--screenshot={}", args.out.display()))
+        .arg(format!("--screenshot={}", out.display()))
         .arg(url)
         .output()
         .with_context(|| {
@@ -113,7 +189,7 @@ fn screenshot(args: &Args, html: &Path) -> anyhow::Result<()> {
                 chromium.display()
             )
         })?;
-    if !output.status.success() || !args.out.exists() {
+    if !output.status.success() || !out.exists() {
         bail!(
             "{} failed: {}",
             chromium.display(),
