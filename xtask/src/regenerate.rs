@@ -227,6 +227,45 @@ const STAGES: &[Stage] = &[
         writes: &["docs/results/ur5e/paths.json", "docs/results/ur5e/paths.md"],
     },
     Stage {
+        name: "precision-eval",
+        args: &["precision-eval"],
+        writes: &["docs/results/precision.json", "docs/results/precision.md"],
+    },
+    Stage {
+        name: "precision-eval-iiwa14",
+        args: &["precision-eval", "--robot", "iiwa14"],
+        writes: &[
+            "docs/results/iiwa14/precision.json",
+            "docs/results/iiwa14/precision.md",
+        ],
+    },
+    Stage {
+        name: "precision-eval-ur5e",
+        args: &["precision-eval", "--robot", "ur5e"],
+        writes: &[
+            "docs/results/ur5e/precision.json",
+            "docs/results/ur5e/precision.md",
+        ],
+    },
+    Stage {
+        name: "job-eval",
+        args: &["job-eval"],
+        writes: &["docs/results/jobs.json", "docs/results/jobs.md"],
+    },
+    Stage {
+        name: "job-eval-iiwa14",
+        args: &["job-eval", "--robot", "iiwa14"],
+        writes: &[
+            "docs/results/iiwa14/jobs.json",
+            "docs/results/iiwa14/jobs.md",
+        ],
+    },
+    Stage {
+        name: "job-eval-ur5e",
+        args: &["job-eval", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/jobs.json", "docs/results/ur5e/jobs.md"],
+    },
+    Stage {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],
@@ -476,6 +515,11 @@ const STAGES: &[Stage] = &[
         name: "readme-picture",
         args: &["readme-picture"],
         writes: &["docs/figures/readme-demo.png"],
+    },
+    Stage {
+        name: "readme-job-picture",
+        args: &["readme-picture", "--job"],
+        writes: &["docs/figures/job-demo.png"],
     },
     Stage {
         name: "report",
