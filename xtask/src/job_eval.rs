@@ -17,14 +17,11 @@ use emg_job::{
     verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
-use emg_planner::{DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner};
-use emg_timing::{Scaling, time_free_move};
+use emg_planner::{MotionTiming, PlanRequest, Planner};
+use emg_timing::time_free_move;
 use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
-
-/// The line tolerance of the jobs (mm), `emg job`'s default.
-const TOLERANCE_MM: f64 = 0.5;
 
 /// Options of `job-eval`.
 #[derive(clap::Args)]
@@ -187,18 +184,8 @@ fn setup(robot_file: &Path) -> anyhow::Result<(Planner, MotionTiming, emg_verify
         0,
         "job-eval",
     )?;
-    let mut config = emg_planner::PlannerConfig::cell();
-    config.rollout.constraints.line_tolerance_m = TOLERANCE_MM * 1e-3;
-    let planner = planner.with_config(config)?;
-    let timing = MotionTiming::for_robot_file(
-        planner.robot(),
-        robot_file,
-        None,
-        Scaling::default(),
-        planner.config().rollout.speed_m_per_s,
-        DEFAULT_RATE_HZ,
-        &planner.config().rollout.constraints,
-    )?;
+    let planner = planner.with_config(emg_job::job_config(emg_job::JOB_TOLERANCE_M))?;
+    let timing = emg_job::job_timing(planner.robot(), robot_file, planner.config())?;
     Ok((planner, timing, checker))
 }
 

@@ -97,17 +97,8 @@ fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
     let robot_path = workspace::default_robot();
     let robot = workspace::load_robot(&robot_path)?;
     let models = Models::shipped(&robot, workspace::data_dir().path())?;
-    let mut config = PlannerConfig::cell();
-    config.rollout.constraints.line_tolerance_m = 5e-4;
-    let timing = emg_planner::MotionTiming::for_robot_file(
-        &robot,
-        &robot_path,
-        None,
-        emg_timing::Scaling::default(),
-        config.rollout.speed_m_per_s,
-        emg_planner::DEFAULT_RATE_HZ,
-        &config.rollout.constraints,
-    )?;
+    let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
+    let timing = emg_job::job_timing(&robot, &robot_path, &config)?;
     let planner = Planner::new(robot, models, config)?;
     let drawing = emg_io::read_svg_file(
         &workspace::root().join(file),

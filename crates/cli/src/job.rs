@@ -7,14 +7,11 @@ use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, Order, plan_job};
-use emg_planner::{ControllerKind, Models, MotionTiming, PlanRequest, Planner, PlannerConfig};
+use emg_planner::{Models, PlanRequest, Planner};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::output::write_text;
 use crate::robot;
-
-/// The line tolerance of a job unless `--tolerance` says otherwise (mm).
-pub const JOB_TOLERANCE_MM: f64 = 0.5;
 
 /// Options of `emg job`.
 #[derive(Debug, Args)]
@@ -29,7 +26,7 @@ pub struct JobArgs {
     #[arg(long, value_parser = robot::parse_robot, default_value_os_t = robot::default_robot())]
     pub robot: PathBuf,
     /// The strokes' line tolerance (mm).
-    #[arg(long, value_name = "MM", default_value_t = JOB_TOLERANCE_MM)]
+    #[arg(long, value_name = "MM", default_value_t = emg_job::JOB_TOLERANCE_M * 1e3)]
     pub tolerance: f64,
     /// The tool cone's half-angle around the surface normal (degrees).
     #[arg(long, value_name = "DEG", default_value_t = 30.0)]
@@ -90,30 +87,16 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
             .context("--export urscript: nothing was planned or written")?;
     }
     let job = read_job(args, &robot)?;
-    let mut config = PlannerConfig::cell();
-    config.rollout.constraints.line_tolerance_m = args.tolerance * 1e-3;
+    let mut config = emg_job::job_config(args.tolerance * 1e-3);
     config.rollout.constraints.theta_max_deg = args.cone;
     config.validate()?;
     let diffusion = robot::shipped_model(&args.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
     let policy = robot::shipped_model(&args.robot, emg_planner::POLICY_WEIGHTS_FILE);
-    let controller = if policy.is_some() {
-        ControllerKind::Hybrid
-    } else {
-        ControllerKind::Classical
-    };
     let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
-    let timing = MotionTiming::for_robot_file(
-        &robot,
-        &args.robot,
-        None,
-        emg_timing::Scaling::default(),
-        config.rollout.speed_m_per_s,
-        emg_planner::DEFAULT_RATE_HZ,
-        &config.rollout.constraints,
-    )?;
+    let timing = emg_job::job_timing(&robot, &args.robot, &config)?;
     let planner = Planner::new(robot, models, config)?;
     let request = PlanRequest {
-        controller,
+        controller: planner.models().best_controller(),
         ..PlanRequest::default()
     };
     let bar = ProgressBar::new(job.strokes.len() as u64).with_style(

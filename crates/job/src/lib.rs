@@ -26,7 +26,9 @@ use std::time::Instant;
 
 use emg_control::Task;
 use emg_kinematics::JointVector;
-use emg_planner::{MotionTiming, PlanRequest, Planner};
+use emg_planner::{
+    DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
+};
 use rayon::prelude::*;
 
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, part_surfaces};
@@ -38,6 +40,36 @@ pub use program::{
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order};
 pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
+
+/// A job's line tolerance unless it is given another (m): what a pen, a bead or a seam needs.
+pub const JOB_TOLERANCE_M: f64 = 5e-4;
+
+/// The planner configuration a job plans with: `emg plan`'s ([`PlannerConfig::cell`]: the work
+/// plate, the corrected step) at `tolerance_m`.
+pub fn job_config(tolerance_m: f64) -> PlannerConfig {
+    let mut config = PlannerConfig::cell();
+    config.rollout.constraints.line_tolerance_m = tolerance_m;
+    config
+}
+
+/// The timing of a job's program for `robot` read from `robot_file`, as `emg job` times it:
+/// the limits file beside the robot file (else assumed ones), unscaled, the tool at the
+/// configuration's speed, sampled at [`DEFAULT_RATE_HZ`].
+pub fn job_timing(
+    robot: &emg_kinematics::Robot,
+    robot_file: &std::path::Path,
+    config: &PlannerConfig,
+) -> Result<MotionTiming, TimingSetupError> {
+    MotionTiming::for_robot_file(
+        robot,
+        robot_file,
+        None,
+        emg_timing::Scaling::default(),
+        config.rollout.speed_m_per_s,
+        DEFAULT_RATE_HZ,
+        &config.rollout.constraints,
+    )
+}
 
 /// Why a planned job cannot be written.
 #[derive(Debug, thiserror::Error)]

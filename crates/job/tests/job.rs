@@ -7,10 +7,7 @@ use std::path::PathBuf;
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, JobError, SegmentKind, plan_job, verify_job};
 use emg_kinematics::Robot;
-use emg_planner::{
-    DEFAULT_RATE_HZ, DataDir, Models, MotionTiming, PlanRequest, Planner, PlannerConfig,
-    ShippedRobot,
-};
+use emg_planner::{DataDir, Models, MotionTiming, PlanRequest, Planner, ShippedRobot};
 use emg_verify::ReferenceModel;
 
 fn workspace() -> PathBuf {
@@ -31,18 +28,8 @@ fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
     let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
         .expect("checker loads");
     let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
-    let mut config = PlannerConfig::cell();
-    config.rollout.constraints.line_tolerance_m = 5e-4;
-    let timing = MotionTiming::for_robot_file(
-        &robot,
-        &file,
-        None,
-        emg_timing::Scaling::default(),
-        config.rollout.speed_m_per_s,
-        DEFAULT_RATE_HZ,
-        &config.rollout.constraints,
-    )
-    .expect("timing");
+    let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
+    let timing = emg_job::job_timing(&robot, &file, &config).expect("timing");
     let planner = Planner::new(robot, models, config).expect("planner");
     (planner, timing, checker, file)
 }

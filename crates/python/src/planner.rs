@@ -376,7 +376,7 @@ impl Planner {
     /// cannot finish it, the strokes joined by checked free moves; the GIL is released while
     /// planning. A malformed job raises `InputError` naming the field; one of which no stroke
     /// can be drawn raises `PlanningError`.
-    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5))]
+    #[pyo3(signature = (job, placement = None, tolerance_mm = emg_job::JOB_TOLERANCE_M * 1e3))]
     fn plan_job(
         &self,
         py: Python<'_>,
