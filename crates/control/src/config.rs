@@ -23,8 +23,8 @@ pub struct ConstraintConfig {
     /// the default plate.
     #[serde(skip_serializing_if = "WorkSurface::is_off")]
     pub work_surface: WorkSurface,
-    /// Obstacles of the cell; every capsule of the arm, the tool's included, keeps each one's
-    /// clearance.
+    /// Obstacles of the cell; every capsule of the arm, the tool's included unless the obstacle
+    /// is the part the tool works on, keeps each one's clearance.
     #[serde(skip_serializing_if = "Scene::is_empty")]
     pub scene: Scene,
 }

@@ -204,7 +204,7 @@ pub fn first_contact(
                 kin,
                 &obstacle.shape,
                 obstacle.clearance_m,
-                ToolContact::Forbidden,
+                obstacle.tool_contact(),
             )
             .map(|hit| scene_contact(&obstacle.name, hit))
     })

@@ -52,6 +52,7 @@ impl From<&ConstraintConfig> for Bounds {
                     name: obstacle.name.clone(),
                     solid: solid(&obstacle.shape),
                     clearance_m: obstacle.clearance_m,
+                    tool_may_touch: obstacle.tool_may_touch,
                 })
                 .collect(),
         }

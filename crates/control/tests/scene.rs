@@ -76,6 +76,7 @@ fn random_obstacle(rng: &mut rand_chacha::ChaCha8Rng, kind: usize) -> Obstacle {
         name: format!("obstacle {kind}"),
         shape,
         clearance_m: rng.random_range(0.0..0.02),
+        tool_may_touch: rng.random_bool(0.5),
     }
 }
 
@@ -278,6 +279,7 @@ fn an_obstacle_on_the_path_ends_the_rollout_before_it() {
                 radius: 0.015,
             },
             clearance_m: 0.005,
+            tool_may_touch: false,
         }],
     };
     let trajectory = classical(&robot, &task, &blocked);

@@ -1,11 +1,11 @@
-//! The connect stage's geometry: which configurations are free (the joint limits,
-//! self-collision, every stroke's work plate and the scene, the tool's tip never inside the
+//! The connect stage's geometry: the part under a job's strokes, which configurations are free
+//! (the joint limits, self-collision, the part and the scene, the tool's tip never inside the
 //! part), the straight joint-space edges between them checked at a resolution no link can step
 //! over, the lifted configuration above a point of a stroke, and the collision-free move
 //! between two configurations (the straight edge, else dual RRT-Connect with shortcuts).
 
 use emg_control::{ConstraintConfig, Path, PathSpec, SegmentSpec, Task};
-use emg_kinematics::{DampingConfig, JointVector, Robot, ToolContact, Vec3, damped_pseudo_inverse};
+use emg_kinematics::{DampingConfig, JointVector, Obstacle, Robot, Vec3, damped_pseudo_inverse};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -26,10 +26,14 @@ const SHORTCUTS: usize = 200;
 /// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
 const SAME_PLANE: f64 = 1e-6;
 
-/// One task per plane of `tasks` whose path is a rectangle holding all their paths' points
-/// (sampled every centimetre, 1 mm added round): its work plate covers the part those strokes
-/// lie on, so the arm keeps off the whole part between strokes with one check per plane. A
-/// plane whose rectangle makes no task keeps its strokes' own tasks.
+/// Orientations of a plane's rectangle tried (a half turn, in 1° steps).
+const RECTANGLE_ANGLES: usize = 180;
+
+/// One task per plane of `tasks` whose work plate is the part those strokes lie on: its path
+/// runs along the middle of the smallest rectangle (of [`RECTANGLE_ANGLES`] orientations)
+/// holding all the tasks' path points on the plane (sampled every centimetre, 1 mm added round)
+/// and zigzags to its edges, so the plate covers the rectangle with the plate's margins and no
+/// more. A plane whose rectangle makes no task keeps its strokes' own tasks.
 pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
     let mut planes: Vec<(Vec3, Vec3, Vec<&Task>)> = Vec::new();
     for task in tasks {
@@ -44,39 +48,16 @@ pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
     }
     let mut surfaces = Vec::new();
     for (point, normal, members) in planes {
-        let u = members[0].d;
-        let w = normal.cross(&u);
-        let mut low = [f64::INFINITY; 2];
-        let mut high = [f64::NEG_INFINITY; 2];
-        for task in &members {
-            let Some(path) = &task.path else { continue };
-            let samples = (path.length_m() / 0.01).ceil() as usize;
-            for k in 0..=samples {
-                let offset = path.point_at(path.length_m() * k as f64 / samples as f64) - point;
-                for (axis, value) in [offset.dot(&u), offset.dot(&w)].into_iter().enumerate() {
-                    low[axis] = low[axis].min(value - 1e-3);
-                    high[axis] = high[axis].max(value + 1e-3);
-                }
-            }
-        }
-        let corner = |a: f64, b: f64| point + u * a + w * b;
-        let rectangle = PathSpec {
-            version: emg_control::PATH_FORMAT_VERSION,
-            start: corner(low[0], low[1]).into(),
-            normal: normal.into(),
-            blend_radius_m: 0.0,
-            segments: [
-                corner(high[0], low[1]),
-                corner(high[0], high[1]),
-                corner(low[0], high[1]),
-                corner(low[0], low[1]),
-            ]
-            .into_iter()
-            .map(|to| SegmentSpec::Line { to: to.into() })
-            .collect(),
-        };
-        match Path::new(rectangle)
-            .ok()
+        let points: Vec<Vec3> = members
+            .iter()
+            .filter_map(|task| task.path.as_ref())
+            .flat_map(|path| {
+                let samples = (path.length_m() / 0.01).ceil() as usize;
+                (0..=samples)
+                    .map(move |k| path.point_at(path.length_m() * k as f64 / samples as f64))
+            })
+            .collect();
+        match rectangle_path(point, normal, members[0].d, &points)
             .and_then(|path| Task::on_path(robot, path, None).ok())
         {
             Some(task) => surfaces.push(task),
@@ -86,12 +67,94 @@ pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
     surfaces
 }
 
+/// The path along the middle of the smallest rectangle on the plane through `point` with
+/// normal `normal` holding `points` (1 mm added round), its sides turned from `u0` by one of
+/// [`RECTANGLE_ANGLES`] angles: from the middle of one end to the other's, then round the
+/// rectangle's corners, so its extent across its start direction is half the rectangle's width
+/// to each side.
+fn rectangle_path(point: Vec3, normal: Vec3, u0: Vec3, points: &[Vec3]) -> Option<Path> {
+    if points.is_empty() {
+        return None;
+    }
+    let w0 = normal.cross(&u0);
+    let bounds = |u: &Vec3, w: &Vec3| {
+        let mut low = [f64::INFINITY; 2];
+        let mut high = [f64::NEG_INFINITY; 2];
+        for p in points {
+            let offset = p - point;
+            for (axis, value) in [offset.dot(u), offset.dot(w)].into_iter().enumerate() {
+                low[axis] = low[axis].min(value - 1e-3);
+                high[axis] = high[axis].max(value + 1e-3);
+            }
+        }
+        (low, high)
+    };
+    let (u, w, (low, high)) = (0..RECTANGLE_ANGLES)
+        .map(|k| {
+            let angle = std::f64::consts::PI * k as f64 / RECTANGLE_ANGLES as f64;
+            let u = u0 * libm::cos(angle) + w0 * libm::sin(angle);
+            let w = normal.cross(&u);
+            (u, w, bounds(&u, &w))
+        })
+        .min_by(|a, b| area(&a.2).total_cmp(&area(&b.2)))?;
+    let corner = |a: f64, b: f64| point + u * a + w * b;
+    let middle = 0.5 * (low[1] + high[1]);
+    let spec = PathSpec {
+        version: emg_control::PATH_FORMAT_VERSION,
+        start: corner(low[0], middle).into(),
+        normal: normal.into(),
+        blend_radius_m: 0.0,
+        segments: [
+            corner(high[0], middle),
+            corner(high[0], high[1]),
+            corner(low[0], high[1]),
+            corner(low[0], low[1]),
+            corner(high[0], low[1]),
+        ]
+        .into_iter()
+        .map(|to| SegmentSpec::Line { to: to.into() })
+        .collect(),
+    };
+    Path::new(spec).ok()
+}
+
+/// The area of the rectangle `[low, high]`.
+fn area((low, high): &([f64; 2], [f64; 2])) -> f64 {
+    (high[0] - low[0]) * (high[1] - low[1])
+}
+
+/// Name of the obstacles [`with_part`] adds.
+pub const PART: &str = "part";
+
+/// `constraints` with the part the strokes lie on added to the scene: the work plate of each task
+/// of `surfaces` ([`part_surfaces`]) under `constraints.work_surface`, an obstacle the tool may
+/// touch and the rest of the arm keeps off, while drawing as between strokes.
+pub fn with_part(constraints: &ConstraintConfig, surfaces: &[Task]) -> ConstraintConfig {
+    let mut with_part = constraints.clone();
+    with_part
+        .scene
+        .obstacles
+        .extend(surfaces.iter().filter_map(|task| {
+            let plate = task
+                .work_surface(&constraints.work_surface)
+                .shape(&task.p0, &task.d, &task.n)?;
+            Some(Obstacle {
+                name: PART.to_string(),
+                shape: plate,
+                clearance_m: 0.0,
+                tool_may_touch: true,
+            })
+        }));
+    with_part
+}
+
 /// Free space of a job's arm.
 pub struct FreeSpace<'a> {
     robot: &'a Robot,
-    /// Tasks whose work plates the arm keeps off (one per stroke part).
+    /// The tasks whose work plates make the part ([`part_surfaces`]).
     surfaces: Vec<Task>,
-    constraints: &'a ConstraintConfig,
+    /// The constraints, the part in the scene ([`with_part`]).
+    constraints: ConstraintConfig,
     /// Each stroke's plane (a point on it, its normal) and the radius around that point inside
     /// which the tool's tip stays on the near side of it.
     planes: Vec<(Vec3, Vec3, f64)>,
@@ -100,10 +163,10 @@ pub struct FreeSpace<'a> {
 }
 
 impl<'a> FreeSpace<'a> {
-    /// The free space of `robot` around the tasks `surfaces` (their plates, scene and margin as
-    /// `constraints` sets them), the tool's tip kept on the near side of each task's plane within
-    /// its path's extent and 5 cm more.
-    pub fn new(robot: &'a Robot, surfaces: Vec<Task>, constraints: &'a ConstraintConfig) -> Self {
+    /// The free space of `robot` around the part the tasks `surfaces` make ([`with_part`]: their
+    /// plates under `constraints`, with its scene and margin), the tool's tip kept on the near
+    /// side of each task's plane within its path's extent and 5 cm more.
+    pub fn new(robot: &'a Robot, surfaces: Vec<Task>, constraints: &ConstraintConfig) -> Self {
         let planes = surfaces
             .iter()
             .map(|task| {
@@ -119,8 +182,8 @@ impl<'a> FreeSpace<'a> {
         let (_, reach) = robot.reach_sphere();
         Self {
             robot,
+            constraints: with_part(constraints, &surfaces),
             surfaces,
-            constraints,
             planes,
             step_l1_rad: MAX_POINT_TRAVEL_M / (2.0 * reach),
         }
@@ -131,14 +194,14 @@ impl<'a> FreeSpace<'a> {
         self.robot
     }
 
-    /// The tasks whose work plates the arm keeps off between strokes.
+    /// The tasks whose work plates make the part.
     pub fn surfaces(&self) -> &[Task] {
         &self.surfaces
     }
 
-    /// The constraints (plates, scene, margin) the arm keeps.
-    pub fn constraints(&self) -> &'a ConstraintConfig {
-        self.constraints
+    /// The constraints the arm keeps: the scene with the part in it, the margin.
+    pub fn constraints(&self) -> &ConstraintConfig {
+        &self.constraints
     }
 
     /// Whether `q` is free: within the joint limits, no link touching another, a plate or an
@@ -169,23 +232,13 @@ impl<'a> FreeSpace<'a> {
         {
             return false;
         }
-        let clear_of_plates = self.surfaces.iter().all(|task| {
-            task.work_surface(&self.constraints.work_surface)
-                .shape(&task.p0, &task.d, &task.n)
-                .is_none_or(|plate| {
-                    self.robot
-                        .first_contact(&kinematics, &plate, margin, ToolContact::Allowed)
-                        .is_none()
-                })
-        });
-        clear_of_plates
-            && self.constraints.scene.obstacles.iter().all(|obstacle| {
+        self.constraints.scene.obstacles.iter().all(|obstacle| {
                 self.robot
                     .first_contact(
                         &kinematics,
                         &obstacle.shape,
                         obstacle.clearance_m + margin,
-                        ToolContact::Forbidden,
+                        obstacle.tool_contact(),
                     )
                     .is_none()
             })

@@ -102,25 +102,36 @@ pub fn plan_job(
     let settings = &job.settings;
     let robot = planner.robot();
     let dof = robot.dof();
-    let constraints = &planner.config().rollout.constraints;
     let ordering = order_strokes(&job.strokes, settings.order);
+    // The part under the strokes, which the arm keeps off while drawing as between strokes.
+    let stroke_tasks: Vec<Task> = job
+        .strokes
+        .iter()
+        .filter_map(|stroke| Task::on_path(robot, stroke.clone(), None).ok())
+        .collect();
+    let free = FreeSpace::new(
+        robot,
+        part_surfaces(robot, &stroke_tasks),
+        &planner.config().rollout.constraints,
+    );
+    let constraints = &planner.config().rollout.constraints;
+    let mut on_part = planner.config().clone();
+    on_part.rollout.constraints = free.constraints().clone();
+    let on_part = planner
+        .with_config(on_part)
+        .expect("the planner's configuration with obstacles added is valid");
     let done = std::sync::atomic::AtomicUsize::new(0);
     let plans: Vec<StrokePlan> = ordering
         .sequence
         .par_iter()
         .map(|oriented| {
             let path = oriented.path(&job.strokes);
-            let plan = plan_stroke(planner, request, &path, settings);
+            let plan = plan_stroke(&on_part, request, &path, settings);
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(finished, ordering.sequence.len());
             plan
         })
         .collect();
-    let tasks: Vec<Task> = plans
-        .iter()
-        .flat_map(|plan| plan.parts.iter().map(|part| part.task.clone()))
-        .collect();
-    let free = FreeSpace::new(robot, part_surfaces(robot, &tasks), constraints);
     let connector = Connector {
         free: &free,
         timing,
@@ -140,7 +151,7 @@ pub fn plan_job(
             let placed = connector.place(planned, from, seed).or_else(|why| {
                 let from = from.ok_or(why.clone())?;
                 let again = connector
-                    .replanned_nearby(planner, request, planned, &from)
+                    .replanned_nearby(&on_part, request, planned, &from)
                     .ok_or(why.clone())?;
                 connector.place(&again, Some(from), seed).map_err(|_| why)
             });

@@ -2,12 +2,13 @@
 //! replayed by the checker (`emg_verify`, which shares no kinematics with the planners), each
 //! from rest to rest within the joint velocity, acceleration and jerk limits; a stroke part's
 //! samples on its stretch of the stroke within the tolerance and the cone, clear of the arm's
-//! own links, its work plate and the scene; a move's samples clear of the arm's own links, the
-//! part's plates the file names (`surfaces`) and the scene.
+//! own links, its work plate, the part the file's `surfaces` make and the scene; a move's
+//! samples clear of the arm's own links, the part and the scene.
 
 use emg_control::{ConstraintConfig, task_bounds};
 use emg_verify::{JointSamples, Joints, ReferenceModel, ReplayError, check_replay};
 
+use crate::free_space::with_part;
 use crate::program::{JobFile, SegmentKind};
 
 /// What the check verified.
@@ -65,11 +66,12 @@ pub fn verify_job(
         });
     }
     let dynamics = file.limits.dynamics();
+    let on_part = with_part(&file.constraints, &file.surfaces);
     // Between strokes the tool leaves the line and turns freely: only the arm's clearances hold.
     let free = ConstraintConfig {
         line_tolerance_m: f64::INFINITY,
         theta_max_deg: 180.0,
-        ..file.constraints.clone()
+        ..on_part.clone()
     };
     let times: Vec<f64> = file
         .points
@@ -109,7 +111,7 @@ pub fn verify_job(
                 check_replay(
                     model,
                     &task.into(),
-                    &task_bounds(task, &file.constraints),
+                    &task_bounds(task, &on_part),
                     &samples,
                     None,
                     Some(&dynamics),
@@ -118,7 +120,8 @@ pub fn verify_job(
                 check.stroke_parts += 1;
             }
             _ => {
-                for task in &file.surfaces {
+                // The whole part is in `free`'s scene: one surface's task frames the replay.
+                if let Some(task) = file.surfaces.first() {
                     check_replay(
                         model,
                         &task.into(),

@@ -380,6 +380,20 @@ pub struct Obstacle {
     pub shape: Shape,
     /// Smallest surface distance (m) every capsule of the arm keeps from it.
     pub clearance_m: f64,
+    /// Whether the tool's capsules may touch it: the part the tool works on (a pen draws on
+    /// it, a torch welds it), which the rest of the arm keeps clear of. Off by default.
+    pub tool_may_touch: bool,
+}
+
+impl Obstacle {
+    /// Which capsules of the arm the obstacle is checked against.
+    pub fn tool_contact(&self) -> ToolContact {
+        if self.tool_may_touch {
+            ToolContact::Allowed
+        } else {
+            ToolContact::Forbidden
+        }
+    }
 }
 
 /// The obstacles of a cell, read from a scene file (JSON):
@@ -396,7 +410,8 @@ pub struct Obstacle {
 ///
 /// Positions are in the base frame (m); a half-space's `normal` points out of the solid; a box
 /// has its full edge lengths `size` and the URDF roll–pitch–yaw `rpy` of its axes (default 0);
-/// `clearance_m` defaults to 0 (not touching).
+/// `clearance_m` defaults to 0 (not touching); `"tool_may_touch": true` marks the part the tool
+/// works on, which only the rest of the arm keeps clear of.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "SceneFile", into = "SceneFile")]
 pub struct Scene {
@@ -502,6 +517,8 @@ struct ObstacleFile {
     name: Option<String>,
     #[serde(default)]
     clearance_m: f64,
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    tool_may_touch: bool,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     half_space: Option<HalfSpaceFile>,
     #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
@@ -646,6 +663,7 @@ impl ObstacleFile {
             name,
             shape,
             clearance_m,
+            tool_may_touch: file.tool_may_touch,
         })
     }
 }
@@ -656,6 +674,7 @@ impl From<Obstacle> for ObstacleFile {
         let mut file = Self {
             name: Some(obstacle.name),
             clearance_m: obstacle.clearance_m,
+            tool_may_touch: obstacle.tool_may_touch,
             half_space: None,
             cuboid: None,
             sphere: None,

@@ -323,6 +323,7 @@ fn an_obstacle_is_plain_data() {
             radius: 0.05,
         },
         clearance_m: 0.0,
+        tool_may_touch: true,
     };
     let scene = Scene {
         obstacles: vec![obstacle.clone()],
@@ -330,7 +331,7 @@ fn an_obstacle_is_plain_data() {
     let text = serde_json::to_string(&scene).unwrap();
     assert_eq!(
         text,
-        r#"{"obstacles":[{"name":"ball","clearance_m":0.0,"sphere":{"centre":[0.3,0.0,0.4],"radius":0.05}}]}"#
+        r#"{"obstacles":[{"name":"ball","clearance_m":0.0,"tool_may_touch":true,"sphere":{"centre":[0.3,0.0,0.4],"radius":0.05}}]}"#
     );
     assert_eq!(serde_json::from_str::<Scene>(&text).unwrap(), scene);
 }

@@ -376,6 +376,7 @@ fn the_bound_reaches_past_a_stretch_only_the_tolerance_disc_clears() {
         name: "rod".to_string(),
         shape: rod.clone(),
         clearance_m: 0.0,
+        tool_may_touch: false,
     });
     let planner = planner().with_config(config).expect("a scene with a rod");
     let robot = planner.robot();

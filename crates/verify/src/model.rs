@@ -363,7 +363,7 @@ impl ReferenceModel {
         let obstacles = bounds
             .obstacles
             .iter()
-            .map(|o| (&o.solid, o.clearance_m, o.name.as_str(), false));
+            .map(|o| (&o.solid, o.clearance_m, o.name.as_str(), o.tool_may_touch));
         let mut worst: Option<(f64, String, String)> = None;
         for (solid, clearance, name, tool_may_touch) in surface.into_iter().chain(obstacles) {
             for capsule in &self.capsules {

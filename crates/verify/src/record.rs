@@ -337,6 +337,8 @@ pub struct Obstacle {
     pub solid: Solid,
     /// Smallest allowed surface distance (m).
     pub clearance_m: f64,
+    /// Whether the tool's capsules may touch it (the part the tool works on).
+    pub tool_may_touch: bool,
 }
 
 /// One recorded point of a motion, with what the planner says it measured there.
