@@ -10,10 +10,10 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::{PathSpec, SegmentSpec, Task};
+use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
-    FreeSpace, Job, JobSettings, Order, order_strokes, part_surfaces, plan_job, plan_stroke,
+    FreeSpace, Job, JobSettings, Order, job_part, order_strokes, plan_job, plan_stroke,
     verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
@@ -85,6 +85,37 @@ pub struct JobRow {
     pub baseline_colliding_moves: usize,
 }
 
+/// The name of the job of [`grid_of_circles`].
+const GRID: &str = "100 circles 2 cm across in a 10 × 10 grid";
+
+/// A job of 100 strokes: circles of 1 cm radius, 3 cm apart in a 10 × 10 grid pen down round
+/// (0.45, 0, 0.25).
+fn grid_of_circles() -> Vec<PathSpec> {
+    let centre = Vec3::new(0.45, 0.0, 0.25);
+    (0..100)
+        .map(|k| {
+            let middle = centre
+                + Vec3::new(
+                    0.03 * ((k / 10) as f64 - 4.5),
+                    0.03 * ((k % 10) as f64 - 4.5),
+                    0.0,
+                );
+            PathSpec {
+                version: emg_control::PATH_FORMAT_VERSION,
+                start: (middle + Vec3::new(0.01, 0.0, 0.0)).into(),
+                normal: [0.0, 0.0, -1.0],
+                blend_radius_m: 0.0,
+                segments: vec![SegmentSpec::Arc {
+                    centre: Some(middle.into()),
+                    through: None,
+                    to: None,
+                    sweep_deg: Some(360.0),
+                }],
+            }
+        })
+        .collect()
+}
+
 /// The whole record written to `jobs.json`.
 #[derive(Serialize, Deserialize)]
 pub struct Record {
@@ -96,6 +127,10 @@ pub struct Record {
     pub icons: String,
     /// Machine and threads.
     pub machine: String,
+    /// Threads the jobs of `rows` were planned on.
+    pub threads: usize,
+    /// Planning time of the grid job ([`GRID`]) on one thread (s).
+    pub grid_one_thread_s: f64,
     /// Every job.
     pub rows: Vec<JobRow>,
 }
@@ -137,6 +172,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Job::from_strokes(seams(tilt_deg), planner.robot())?,
         ));
     }
+    let grid = Job::from_strokes(grid_of_circles(), planner.robot())?;
+    jobs.push((GRID.to_string(), grid.clone()));
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
     for (name, job) in &jobs {
@@ -151,6 +188,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         bar.inc(1);
     }
     bar.finish();
+    let request = PlanRequest::default();
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let started = Instant::now();
+    one_thread.install(|| plan_job(&planner, &request, &grid, &timing, &robot_name, &|_, _| {}))?;
+    let grid_one_thread_s = started.elapsed().as_secs_f64();
     let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
@@ -161,6 +203,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         },
         icons: workspace::relative(&args.icons),
         machine: workspace::machine(),
+        threads: rayon::current_num_threads(),
+        grid_one_thread_s,
         rows,
     };
     workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
@@ -287,7 +331,7 @@ struct Baseline {
 
 /// Each stroke, in the shortest order, planned alone by the search (one motion, no resumption),
 /// the strokes joined by straight joint moves from one motion's end to the next one's start with
-/// no lift; a move collides where the job's free space (the same plates, self-collision and
+/// no lift; a move collides where the job's free space (the same part, self-collision and
 /// tool-tip test as `emg job`'s moves) refuses its edge.
 fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
     let settings = JobSettings {
@@ -307,12 +351,7 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
                 .map(|part| (part.task, part.trajectory)),
         );
     }
-    let tasks: Vec<Task> = motions.iter().map(|(task, _)| task.clone()).collect();
-    let free = FreeSpace::new(
-        planner.robot(),
-        part_surfaces(planner.robot(), &tasks),
-        constraints,
-    );
+    let free = FreeSpace::new(planner.robot(), job_part(planner.robot(), job), constraints);
     let mut drawn_m = 0.0;
     let mut duration_s = 0.0;
     let (mut moves, mut colliding) = (0, 0);
@@ -345,10 +384,11 @@ fn markdown(record: &Record) -> String {
     let sum = |value: fn(&JobRow) -> f64| rows.iter().map(value).sum::<f64>();
     let count = |value: fn(&JobRow) -> usize| rows.iter().map(value).sum::<usize>();
     let strokes = count(|r| r.strokes);
+    let grid = rows.iter().find(|r| r.job == GRID).unwrap_or(&rows[0]);
     let mut md = format!(
         "# Jobs ({})\n\n\
          Written by `{}` on {}. Every SVG of `{}` placed pen down at {} places in front of the \
-         arm, and five seams on surfaces tilted 0°, 20° and 40°, planned as `emg job` plans \
+         arm, five seams on surfaces tilted 0°, 20° and 40°, and {GRID}, planned as `emg job` plans \
          them (the search per stroke, resumed where one motion cannot finish it, safe moves \
          between strokes, 0.5 mm, 30°); every program re-checked segment by segment by the \
          independent checker. The baseline is what a user scripts today: each stroke planned \
@@ -361,7 +401,8 @@ fn markdown(record: &Record) -> String {
          | moves colliding | 0 of {} (checked) | {} of {} |\n\
          | program duration, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | {:.1} |\n\
          | pen-up time / pen-down time | {:.2} | — |\n\
-         | planning time per stroke, mean (ms) | {:.1} | — |\n\
+         | planning time per stroke, mean (ms, {} threads) | {:.1} | — |\n\
+         | {GRID}: planning (s) on {} threads / on one | {:.2} / {:.2} ({:.1} ms per stroke on one) | — |\n\
          | programs the checker refuses | {} of {} | — |\n\n",
         record.robot,
         record.command,
@@ -384,7 +425,12 @@ fn markdown(record: &Record) -> String {
         sum(|r| r.pen_down_s),
         sum(|r| r.baseline_duration_s),
         sum(|r| r.pen_up_s) / sum(|r| r.pen_down_s).max(f64::MIN_POSITIVE),
+        record.threads,
         1e3 * sum(|r| r.planning_s) / strokes.max(1) as f64,
+        record.threads,
+        grid.planning_s,
+        record.grid_one_thread_s,
+        1e3 * record.grid_one_thread_s / grid.strokes.max(1) as f64,
         rows.iter().filter(|r| r.checker_failure.is_some()).count(),
         rows.len(),
     );

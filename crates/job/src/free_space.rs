@@ -26,6 +26,16 @@ const SHORTCUTS: usize = 200;
 /// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
 const SAME_PLANE: f64 = 1e-6;
 
+/// The part under `job`'s strokes: [`part_surfaces`] of their tasks.
+pub fn job_part(robot: &Robot, job: &crate::Job) -> Vec<Task> {
+    let tasks: Vec<Task> = job
+        .strokes
+        .iter()
+        .filter_map(|stroke| Task::on_path(robot, stroke.clone(), None).ok())
+        .collect();
+    part_surfaces(robot, &tasks)
+}
+
 /// Orientations of a plane's rectangle tried (a half turn, in 1° steps).
 const RECTANGLE_ANGLES: usize = 180;
 

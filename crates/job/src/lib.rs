@@ -24,14 +24,13 @@ pub mod verify;
 
 use std::time::Instant;
 
-use emg_control::Task;
 use emg_kinematics::JointVector;
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
 };
 use rayon::prelude::*;
 
-pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, part_surfaces};
+pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use order::{Ordering, Oriented, order_strokes};
 pub use page::viewer_page;
 pub use program::{
@@ -104,14 +103,9 @@ pub fn plan_job(
     let dof = robot.dof();
     let ordering = order_strokes(&job.strokes, settings.order);
     // The part under the strokes, which the arm keeps off while drawing as between strokes.
-    let stroke_tasks: Vec<Task> = job
-        .strokes
-        .iter()
-        .filter_map(|stroke| Task::on_path(robot, stroke.clone(), None).ok())
-        .collect();
     let free = FreeSpace::new(
         robot,
-        part_surfaces(robot, &stroke_tasks),
+        job_part(robot, job),
         &planner.config().rollout.constraints,
     );
     let constraints = &planner.config().rollout.constraints;
