@@ -13,8 +13,7 @@ use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
-    FreeSpace, Job, JobSettings, Order, job_part, order_strokes, plan_job, plan_stroke,
-    verify_job,
+    FreeSpace, Job, JobSettings, Order, job_part, order_strokes, plan_job, plan_stroke, verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{MotionTiming, PlanRequest, Planner};

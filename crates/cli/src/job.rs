@@ -7,21 +7,18 @@ use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, Order, plan_job};
-use emg_planner::{Models, PlanRequest, Planner};
+use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::output::write_text;
 use crate::robot;
 
-/// Options of `emg job`.
+/// What a job is and how it is planned: the options `emg job` and `emg place` share.
 #[derive(Debug, Args)]
-pub struct JobArgs {
+pub struct JobInput {
     /// The job: a job file (JSON, docs/jobs.md) or an SVG drawing (every subpath a stroke).
     #[arg(value_name = "JOB")]
     pub file: PathBuf,
-    /// The program to write (an emg-job/1 file).
-    #[arg(long, value_name = "FILE", default_value = "job.json")]
-    pub out: PathBuf,
     /// Robot: fr3, iiwa14, ur5e, or a URDF path.
     #[arg(long, value_parser = robot::parse_robot, default_value_os_t = robot::default_robot())]
     pub robot: PathBuf,
@@ -47,6 +44,17 @@ pub struct JobArgs {
     /// SVG only: the drawing's width (m).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
+}
+
+/// Options of `emg job`.
+#[derive(Debug, Args)]
+pub struct JobArgs {
+    /// The job and how it is planned.
+    #[command(flatten)]
+    pub input: JobInput,
+    /// The program to write (an emg-job/1 file).
+    #[arg(long, value_name = "FILE", default_value = "job.json")]
+    pub out: PathBuf,
     /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
     /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
@@ -56,6 +64,45 @@ pub struct JobArgs {
     /// moves dashed, the segment under way named.
     #[arg(long, value_name = "FILE")]
     pub html: Option<PathBuf>,
+}
+
+/// A job ready to plan: the job read, the planner and timing `emg job` plans it with, the
+/// request.
+pub struct Ready {
+    /// The job.
+    pub job: Job,
+    /// The planner at the job's tolerance and cone.
+    pub planner: Planner,
+    /// The program's timing.
+    pub timing: MotionTiming,
+    /// The request (the search with the best shipped controller).
+    pub request: PlanRequest,
+}
+
+impl JobInput {
+    /// The job read and its planner set up.
+    pub fn ready(&self) -> Result<Ready> {
+        let robot = robot::load_robot(&self.robot, None, None)?;
+        let job = read_job(self, &robot)?;
+        let mut config = emg_job::job_config(self.tolerance * 1e-3);
+        config.rollout.constraints.theta_max_deg = self.cone;
+        config.validate()?;
+        let diffusion = robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
+        let policy = robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE);
+        let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
+        let timing = emg_job::job_timing(&robot, &self.robot, &config)?;
+        let planner = Planner::new(robot, models, config)?;
+        let request = PlanRequest {
+            controller: planner.models().best_controller(),
+            ..PlanRequest::default()
+        };
+        Ok(Ready {
+            job,
+            planner,
+            timing,
+            request,
+        })
+    }
 }
 
 fn parse_order(value: &str) -> Result<Order, String> {
@@ -68,7 +115,7 @@ fn parse_order(value: &str) -> Result<Order, String> {
 
 /// Reads the job, plans it, prints its summary and writes its program.
 pub fn run_job(args: &JobArgs) -> Result<()> {
-    let robot = robot::load_robot(&args.robot, None, None)?;
+    let input = &args.input;
     let exported = args
         .export
         .map(|format| args.out.with_extension(format.extension()));
@@ -77,28 +124,22 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(
         &[
-            ("job", args.file.as_path()),
-            ("robot file", args.robot.as_path()),
+            ("job", input.file.as_path()),
+            ("robot file", input.robot.as_path()),
         ],
         &outputs,
     )?;
     if let Some(format) = args.export {
-        crate::export::refuse_format(format, &args.robot, &robot)
+        let robot = robot::load_robot(&input.robot, None, None)?;
+        crate::export::refuse_format(format, &input.robot, &robot)
             .context("--export urscript: nothing was planned or written")?;
     }
-    let job = read_job(args, &robot)?;
-    let mut config = emg_job::job_config(args.tolerance * 1e-3);
-    config.rollout.constraints.theta_max_deg = args.cone;
-    config.validate()?;
-    let diffusion = robot::shipped_model(&args.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
-    let policy = robot::shipped_model(&args.robot, emg_planner::POLICY_WEIGHTS_FILE);
-    let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
-    let timing = emg_job::job_timing(&robot, &args.robot, &config)?;
-    let planner = Planner::new(robot, models, config)?;
-    let request = PlanRequest {
-        controller: planner.models().best_controller(),
-        ..PlanRequest::default()
-    };
+    let Ready {
+        job,
+        planner,
+        timing,
+        request,
+    } = input.ready()?;
     let bar = ProgressBar::new(job.strokes.len() as u64).with_style(
         ProgressStyle::with_template("{msg:>8} [{bar:40}] {pos}/{len} strokes, {elapsed}")
             .expect("a valid template")
@@ -110,10 +151,46 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         &request,
         &job,
         &timing,
-        &args.robot.display().to_string(),
+        &input.robot.display().to_string(),
         &|done, _| bar.set_position(done as u64),
     )?;
     bar.finish_and_clear();
+    print_summary(&file);
+    write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
+    println!("wrote {}", args.out.display());
+    if let (Some(format), Some(path)) = (args.export, &exported) {
+        let text = crate::export::export_to(
+            file.timed_points(),
+            format,
+            path,
+            &input.robot,
+            planner.robot(),
+            &emg_io::ExportOptions::default(),
+            &args.out,
+        )?;
+        println!("{text}");
+    }
+    if let Some(path) = &args.html {
+        write_text(
+            path,
+            &emg_job::viewer_page(
+                &file,
+                &job,
+                planner.robot(),
+                &input
+                    .file
+                    .file_stem()
+                    .unwrap_or(input.file.as_os_str())
+                    .to_string_lossy(),
+            ),
+        )?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// Prints a planned program's summary: strokes, length drawn, travel, times, what was left out.
+pub fn print_summary(file: &emg_job::JobFile) {
     let s = &file.summary;
     println!(
         "{} strokes: {} complete, {} resumed after a reconfiguration, {} short",
@@ -164,41 +241,10 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
             println!("  stroke {}, {why}", stroke.stroke);
         }
     }
-    write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
-    println!("wrote {}", args.out.display());
-    if let (Some(format), Some(path)) = (args.export, &exported) {
-        let text = crate::export::export_to(
-            file.timed_points(),
-            format,
-            path,
-            &args.robot,
-            planner.robot(),
-            &emg_io::ExportOptions::default(),
-            &args.out,
-        )?;
-        println!("{text}");
-    }
-    if let Some(path) = &args.html {
-        write_text(
-            path,
-            &emg_job::viewer_page(
-                &file,
-                &job,
-                planner.robot(),
-                &args
-                    .file
-                    .file_stem()
-                    .unwrap_or(args.file.as_os_str())
-                    .to_string_lossy(),
-            ),
-        )?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
 }
 
 /// The job of a job file, or of an SVG drawing placed as the options say.
-fn read_job(args: &JobArgs, robot: &emg_kinematics::Robot) -> Result<Job> {
+fn read_job(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Job> {
     let is_svg = args
         .file
         .extension()
@@ -238,7 +284,7 @@ fn read_job(args: &JobArgs, robot: &emg_kinematics::Robot) -> Result<Job> {
 }
 
 /// The drawing's placement: the default with what the options set.
-fn placement(args: &JobArgs) -> Result<Placement> {
+fn placement(args: &JobInput) -> Result<Placement> {
     let mut placement = Placement::default();
     if let Some(origin) = args.origin {
         placement.origin_m = origin;

@@ -73,6 +73,54 @@ pub enum SegmentSpec {
     },
 }
 
+impl PathSpec {
+    /// The path moved rigidly by `motion` (points transformed, the normal turned; a signed
+    /// sweep keeps its sense, which turns with the normal).
+    pub fn moved(&self, motion: &nalgebra::Isometry3<f64>) -> Self {
+        let point = |p: &[f64; 3]| -> [f64; 3] {
+            (motion * nalgebra::Point3::from(Vec3::from(*p)))
+                .coords
+                .into()
+        };
+        Self {
+            version: self.version,
+            start: point(&self.start),
+            normal: (motion.rotation * Vec3::from(self.normal)).into(),
+            blend_radius_m: self.blend_radius_m,
+            segments: self
+                .segments
+                .iter()
+                .map(|segment| match segment {
+                    SegmentSpec::Line { to } => SegmentSpec::Line { to: point(to) },
+                    SegmentSpec::Arc {
+                        centre,
+                        through,
+                        to,
+                        sweep_deg,
+                    } => SegmentSpec::Arc {
+                        centre: centre.as_ref().map(point),
+                        through: through.as_ref().map(point),
+                        to: to.as_ref().map(point),
+                        sweep_deg: *sweep_deg,
+                    },
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The arc segment about `centre` of `length_m` on a circle of `radius_m`, turning the way the
+/// sign of `turn` says; a whole circle's sweep, recomputed from its length, may round past 360°
+/// and is held at it.
+fn arc_of_length(centre: Vec3, turn: f64, length_m: f64, radius_m: f64) -> SegmentSpec {
+    SegmentSpec::Arc {
+        centre: Some(centre.into()),
+        through: None,
+        to: None,
+        sweep_deg: Some(turn.signum() * (length_m / radius_m).to_degrees().min(360.0)),
+    }
+}
+
 /// Why a path was refused; names the field and what is wrong.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PathError {
@@ -449,14 +497,7 @@ impl Path {
                     } else {
                         -1.0
                     };
-                    SegmentSpec::Arc {
-                        centre: Some(centre.into()),
-                        through: None,
-                        to: None,
-                        sweep_deg: Some(
-                            turn * ((end - begin) / (from - centre).norm()).to_degrees(),
-                        ),
-                    }
+                    arc_of_length(centre, turn, end - begin, (from - centre).norm())
                 }
             });
         }
@@ -485,14 +526,7 @@ impl Path {
                     } else {
                         1.0
                     };
-                    SegmentSpec::Arc {
-                        centre: Some(centre.into()),
-                        through: None,
-                        to: None,
-                        sweep_deg: Some(
-                            turn * (piece.length_m / (to - centre).norm()).to_degrees(),
-                        ),
-                    }
+                    arc_of_length(centre, turn, piece.length_m, (to - centre).norm())
                 }
             });
         }

@@ -269,6 +269,42 @@ fn unit_circle() -> (Vec3, Vec3, Path) {
     (p, n, Path::new(circle).unwrap())
 }
 
+/// A whole circle's stretch, its reverse and its rigid motions are paths again, of its length,
+/// whatever its radius (the sweep recomputed from the arc length may round past 360°).
+#[test]
+fn whole_circles_stretch_reverse_and_move_as_paths() {
+    let motion = nalgebra::Isometry3::new(Vec3::new(0.1, -0.2, 0.05), Vec3::new(0.3, -0.2, 0.7));
+    for k in 0..200 {
+        let radius = 0.005 + 0.0013 * k as f64;
+        let (p, n) = (Vec3::new(0.45, 0.0, 0.25), -Vec3::z());
+        let centre = p - Vec3::new(radius, 0.0, 0.0);
+        let circle = Path::new(spec(
+            p,
+            n,
+            0.0,
+            vec![arc(Some(centre), None, None, Some(360.0))],
+        ))
+        .unwrap();
+        let length = circle.length_m();
+        let whole = circle
+            .stretch(0.0, length)
+            .unwrap_or_else(|| panic!("radius {radius}: the whole circle is a stretch"));
+        assert!((whole.length_m() - length).abs() < 1e-12, "radius {radius}");
+        let back = circle.reversed().unwrap();
+        assert!((back.length_m() - length).abs() < 1e-12, "radius {radius}");
+        let moved = Path::new(circle.spec().moved(&motion)).unwrap();
+        assert!((moved.length_m() - length).abs() < 1e-12, "radius {radius}");
+        for s in [0.0, 0.3 * length, length] {
+            assert_close(
+                moved.point_at(s),
+                (motion * nalgebra::Point3::from(circle.point_at(s))).coords,
+                1e-12,
+                "a moved point",
+            );
+        }
+    }
+}
+
 #[test]
 fn a_tcp_is_located_near_where_it_was_last() {
     let (p, _, circle) = unit_circle();

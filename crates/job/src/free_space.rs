@@ -243,15 +243,15 @@ impl<'a> FreeSpace<'a> {
             return false;
         }
         self.constraints.scene.obstacles.iter().all(|obstacle| {
-                self.robot
-                    .first_contact(
-                        &kinematics,
-                        &obstacle.shape,
-                        obstacle.clearance_m + margin,
-                        obstacle.tool_contact(),
-                    )
-                    .is_none()
-            })
+            self.robot
+                .first_contact(
+                    &kinematics,
+                    &obstacle.shape,
+                    obstacle.clearance_m + margin,
+                    obstacle.tool_contact(),
+                )
+                .is_none()
+        })
     }
 
     /// Whether the straight joint-space edge from `a` to `b` is free at every configuration

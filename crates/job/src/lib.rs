@@ -17,6 +17,7 @@
 pub mod free_space;
 pub mod order;
 pub mod page;
+pub mod place;
 pub mod program;
 pub mod spec;
 pub mod stroke;
@@ -33,10 +34,14 @@ use rayon::prelude::*;
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use order::{Ordering, Oriented, order_strokes};
 pub use page::viewer_page;
+pub use place::{
+    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, Score, Scored,
+    place_job, place_score,
+};
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
 };
-pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order};
+pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
 pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 

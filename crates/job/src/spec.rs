@@ -2,7 +2,8 @@
 //! into a [`Job`].
 
 use emg_control::{Path, PathError, PathSpec};
-use emg_kinematics::{JointVector, Robot};
+use emg_kinematics::{JointVector, Robot, Vec3, rotation_from_rpy, rpy_of};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
 /// The job file version this build reads.
@@ -23,6 +24,41 @@ pub struct JobSpec {
     /// above its first stroke and ends above its last.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub home: Option<Vec<f64>>,
+    /// A rigid motion applied to every stroke (the place `emg place --export` writes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transform: Option<Transform>,
+}
+
+/// A rigid motion in the base frame: a turn by the URDF roll–pitch–yaw `rpy` (rad, about the
+/// base's fixed x, y, z axes through its origin), then a shift by `translation_m` (m).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    /// The shift (m).
+    pub translation_m: [f64; 3],
+    /// The turn (rad).
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+impl Transform {
+    /// The motion as an isometry.
+    pub fn isometry(&self) -> Isometry3<f64> {
+        let [roll, pitch, yaw] = self.rpy;
+        Isometry3::from_parts(
+            Translation3::from(Vec3::from(self.translation_m)),
+            UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(roll, pitch, yaw)),
+        )
+    }
+
+    /// The transform of `motion`.
+    pub fn of(motion: &Isometry3<f64>) -> Self {
+        let (roll, pitch, yaw) = rpy_of(&motion.rotation.to_rotation_matrix());
+        Self {
+            translation_m: motion.translation.vector.into(),
+            rpy: [roll, pitch, yaw],
+        }
+    }
 }
 
 /// The order the strokes are drawn in.
@@ -125,6 +161,9 @@ pub enum JobError {
     /// The home configuration does not fit the arm.
     #[error("job field 'home': {0}")]
     Home(String),
+    /// The transform holds a number that is not finite.
+    #[error("job field 'transform' must hold finite numbers, got {0:?}")]
+    Transform(Transform),
 }
 
 impl JobSettings {
@@ -187,11 +226,22 @@ impl Job {
             return Err(JobError::NoStrokes);
         }
         spec.settings.validate()?;
+        let motion = match spec.transform {
+            Some(t) if t.translation_m.iter().chain(&t.rpy).all(|v| v.is_finite()) => {
+                Some(t.isometry())
+            }
+            Some(t) => return Err(JobError::Transform(t)),
+            None => None,
+        };
         let strokes = spec
             .strokes
             .into_iter()
             .enumerate()
             .map(|(index, stroke)| {
+                let stroke = match &motion {
+                    Some(motion) => stroke.moved(motion),
+                    None => stroke,
+                };
                 Path::new(stroke).map_err(|source| JobError::Stroke { index, source })
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -211,9 +261,27 @@ impl Job {
                 strokes,
                 settings: JobSettings::default(),
                 home: None,
+                transform: None,
             },
             robot,
         )
+    }
+
+    /// The job with every stroke moved rigidly by `motion`.
+    pub fn moved(&self, motion: &Isometry3<f64>) -> Result<Self, JobError> {
+        let strokes = self
+            .strokes
+            .iter()
+            .enumerate()
+            .map(|(index, stroke)| {
+                Path::new(stroke.spec().moved(motion))
+                    .map_err(|source| JobError::Stroke { index, source })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            strokes,
+            ..self.clone()
+        })
     }
 
     /// Reads a job file's text; `origin` names it in errors.

@@ -62,7 +62,8 @@ pub use parse::ParseError;
 pub use planner::{CONTINUITY_RESTARTS, Plan, PlanError, PlanRequest, Planner, PlannerKind};
 pub use reach::{
     BoundNote, FAR_END_SHARE, MAX_REACH_RESTARTS, Reach, ReachConfig, SHORTFALL_SHARE,
-    StartBlockers, StartContact, far_end_chains, reach, shortfall, start_blockers, witness_chains,
+    StartBlockers, StartContact, far_end_chains, reach, reachable_points, shortfall,
+    start_blockers, witness_chains,
 };
 pub use search::{
     CHAIN_SOURCE, FAR_END_SOURCE, MAX_FAR_END_SHARES, MAX_SEARCH_BUDGET_STEPS, SearchConfig,

@@ -166,6 +166,39 @@ pub fn reach(
     }
 }
 
+/// The score reachability studies give a path, point by point: of the grid points of the
+/// scan of `task`'s path ([`reach`]'s, on the point itself only), how many have a valid
+/// configuration (IK with the tool in its cone, within the limits, free of contact), each
+/// searched on its own: a miss does not end the count, and nothing asks that the
+/// configurations join into a motion. Returns (points with one, points); (0, 0) on a line.
+pub fn reachable_points(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    config: &ReachConfig,
+) -> (usize, usize) {
+    if task.path.is_none() {
+        return (0, 0);
+    }
+    let scan = Scan::new(robot, task, constraints, config);
+    let mut carried: Vec<JointVector> = task.q0_seed.into_iter().collect();
+    let (mut reached, mut points) = (0, 0);
+    for k in 0u64.. {
+        let Some(s) = grid_point(task, k, config.grid_m) else {
+            break;
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+        rng.set_stream(k);
+        points += 1;
+        let found = scan.solutions_at(&task.point_at(s), &carried, &mut rng);
+        if !found.is_empty() {
+            reached += 1;
+            carried = found;
+        }
+    }
+    (reached, points)
+}
+
 /// The arc length of the `k`-th grid point of `task`'s scan: `k · grid_m` along a line; along
 /// a path the same, its last point at the path's end, and `None` past it.
 fn grid_point(task: &Task, k: u64, grid_m: f64) -> Option<f64> {

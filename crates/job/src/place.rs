@@ -1,0 +1,497 @@
+//! The place stage: where to put the part so that the job reaches furthest. A place is the part
+//! shifted in its surface's plane and turned about its normal ([`Place`], in the [`PartFrame`]);
+//! the places of a [`Region`] are
+//!
+//! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
+//!    (the part under the strokes kept off, as the job plans), Σ min(bound, length) / Σ length,
+//!    from a coarse scan ([`PlaceSettings::coarse_grid_m`], fewer restarts);
+//! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
+//!    round the best one, scored again by the full scan;
+//! 3. **certified**: the best [`PlaceSettings::certify`] planned as full jobs ([`plan_job`]) and
+//!    ranked by pen-down length drawn, then by the program's duration.
+//!
+//! Every score and plan is deterministic and independent of the number of threads; ties keep
+//! the grid's order.
+
+use emg_control::Task;
+use emg_kinematics::Vec3;
+use emg_planner::{MotionTiming, PlanRequest, Planner, ReachConfig, reach, reachable_points};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::free_space::{job_part, with_part};
+use crate::program::JobFile;
+use crate::spec::{Job, JobError, Transform};
+use crate::{JobPlanError, plan_job};
+
+/// The places searched: the part's shift along the [`PartFrame`]'s axes (m) and its turn about
+/// the surface normal (degrees), each a closed range `[low, high]`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Region {
+    /// Shift along the frame's x axis (m).
+    pub x_m: [f64; 2],
+    /// Shift along the frame's y axis (m).
+    pub y_m: [f64; 2],
+    /// Turn about the normal (degrees, counter-clockwise seen from the tool's side).
+    pub rotation_deg: [f64; 2],
+}
+
+/// How densely the places are searched.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlaceSettings {
+    /// Grid positions along each of x and y.
+    pub positions: usize,
+    /// Grid turns.
+    pub rotations: usize,
+    /// Best screened places scored again by the full scan.
+    pub refine: usize,
+    /// Best refined places planned as full jobs.
+    pub certify: usize,
+    /// Grid spacing of the screening's scan along each stroke (m).
+    pub coarse_grid_m: f64,
+    /// Random IK restarts of the screening's scan where warm starts fail.
+    pub coarse_restarts: usize,
+}
+
+impl Default for PlaceSettings {
+    /// 10 × 10 positions × 5 turns (500 places), the best 20 refined, the best 5 certified; the
+    /// screening scans every 2 cm with 8 restarts.
+    fn default() -> Self {
+        Self {
+            positions: 10,
+            rotations: 5,
+            refine: 20,
+            certify: 5,
+            coarse_grid_m: 0.02,
+            coarse_restarts: 8,
+        }
+    }
+}
+
+/// Why no place can be chosen.
+#[derive(Debug, thiserror::Error)]
+pub enum PlaceError {
+    /// A range of the region is empty or not finite.
+    #[error(
+        "region field '{field}' must be a finite range [low, high] with low ≤ high, got {value:?}"
+    )]
+    Region {
+        /// The field.
+        field: &'static str,
+        /// Its value.
+        value: [f64; 2],
+    },
+    /// A setting is out of range.
+    #[error("placement setting '{field}' must be {allowed}, got {value}")]
+    Setting {
+        /// The field.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// The allowed range.
+        allowed: &'static str,
+    },
+    /// A place moves a stroke into an invalid path.
+    #[error(transparent)]
+    Job(#[from] JobError),
+    /// No place of the region lets the arm reach any stroke.
+    #[error(
+        "no place of the region lets the arm reach any of the job's strokes (the best screened \
+         score is 0): move the region nearer the arm"
+    )]
+    Unreachable,
+    /// No certified place draws anything.
+    #[error("no certified place draws anything: {0}")]
+    NothingDrawn(JobPlanError),
+}
+
+/// The frame places are measured in: the centre of the strokes' points, the surface normal
+/// pointing to the tool's side (−n of the first stroke), x the base's x axis laid on the
+/// surface (its y axis where x stands along the normal), y = normal × x.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PartFrame {
+    /// Centre of the strokes' points (m).
+    pub centre: [f64; 3],
+    /// Unit normal toward the tool.
+    pub normal: [f64; 3],
+    /// Unit x axis on the surface.
+    pub x: [f64; 3],
+    /// Unit y axis on the surface.
+    pub y: [f64; 3],
+}
+
+impl PartFrame {
+    /// The frame of `job`'s part.
+    pub fn of(job: &Job) -> Self {
+        let points: Vec<Vec3> = job
+            .strokes
+            .iter()
+            .flat_map(|path| {
+                let samples = (path.length_m() / 0.01).ceil().max(1.0) as usize;
+                (0..=samples)
+                    .map(move |k| path.point_at(path.length_m() * k as f64 / samples as f64))
+            })
+            .collect();
+        let centre = points.iter().sum::<Vec3>() / points.len().max(1) as f64;
+        let normal = -job.strokes[0].normal();
+        let on_surface = |axis: Vec3| axis - normal * axis.dot(&normal);
+        let x = [Vec3::x(), Vec3::y()]
+            .into_iter()
+            .map(on_surface)
+            .find(|x| x.norm() > 0.1)
+            .unwrap_or_else(|| on_surface(Vec3::z()))
+            .normalize();
+        Self {
+            centre: centre.into(),
+            normal: normal.into(),
+            x: x.into(),
+            y: normal.cross(&x).into(),
+        }
+    }
+
+    /// The rigid motion that puts the part at `place`: turned about the normal through the
+    /// centre, then shifted along x and y.
+    pub fn motion(&self, place: &Place) -> Isometry3<f64> {
+        let centre = Vec3::from(self.centre);
+        let turn = UnitQuaternion::from_axis_angle(
+            &nalgebra::Unit::new_normalize(Vec3::from(self.normal)),
+            place.rotation_deg.to_radians(),
+        );
+        let shift = Vec3::from(self.x) * place.x_m + Vec3::from(self.y) * place.y_m;
+        Isometry3::from_parts(Translation3::from(centre + shift - turn * centre), turn)
+    }
+}
+
+/// One place of the part: its shift along the frame's axes (m) and its turn (degrees).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Place {
+    /// Shift along x (m).
+    pub x_m: f64,
+    /// Shift along y (m).
+    pub y_m: f64,
+    /// Turn about the normal (degrees).
+    pub rotation_deg: f64,
+}
+
+/// A place and its score: Σ min(bound, length) / Σ length over the strokes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Scored {
+    /// The place.
+    pub place: Place,
+    /// Its score in [0, 1].
+    pub score: f64,
+}
+
+/// A place planned as a full job.
+#[derive(Clone, Debug, Serialize)]
+pub struct Certified {
+    /// The place and its refined score.
+    pub scored: Scored,
+    /// Pen-down length drawn (m), 0 where nothing could be drawn.
+    pub drawn_m: f64,
+    /// Pen-down length in all (m).
+    pub total_m: f64,
+    /// Strokes drawn whole.
+    pub complete: usize,
+    /// Strokes.
+    pub strokes: usize,
+    /// The program's duration (s).
+    pub duration_s: f64,
+    /// The program, where one was planned.
+    #[serde(skip)]
+    pub program: Option<Box<JobFile>>,
+}
+
+/// What the place stage found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Placement {
+    /// The frame places are measured in.
+    pub frame: PartFrame,
+    /// The region searched.
+    pub region: Region,
+    /// Every screened place, in grid order (x slowest, then y, then the turn).
+    pub screened: Vec<Scored>,
+    /// The refined places, best first.
+    pub refined: Vec<Scored>,
+    /// The certified places, best first: the chosen place is the first.
+    pub certified: Vec<Certified>,
+}
+
+impl Placement {
+    /// The chosen place.
+    pub fn best(&self) -> &Certified {
+        &self.certified[0]
+    }
+
+    /// The chosen place as a transform a job file takes (`transform`).
+    pub fn transform(&self) -> Transform {
+        Transform::of(&self.frame.motion(&self.best().scored.place))
+    }
+}
+
+/// The places of the region's grid: `count` values spread evenly over `[low, high]` (the middle
+/// where `count` is 1 or the range a point).
+fn spread(range: [f64; 2], count: usize) -> Vec<f64> {
+    if count <= 1 || range[0] == range[1] {
+        return vec![0.5 * (range[0] + range[1])];
+    }
+    (0..count)
+        .map(|k| range[0] + (range[1] - range[0]) * k as f64 / (count - 1) as f64)
+        .collect()
+}
+
+impl Region {
+    /// Checks every range.
+    pub fn validate(&self) -> Result<(), PlaceError> {
+        for (field, value) in [
+            ("x_m", self.x_m),
+            ("y_m", self.y_m),
+            ("rotation_deg", self.rotation_deg),
+        ] {
+            if !(value[0].is_finite() && value[1].is_finite() && value[0] <= value[1]) {
+                return Err(PlaceError::Region { field, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl PlaceSettings {
+    /// Checks every setting.
+    pub fn validate(&self) -> Result<(), PlaceError> {
+        let require = |field, value: f64, allowed, ok: bool| {
+            if value.is_finite() && ok {
+                Ok(())
+            } else {
+                Err(PlaceError::Setting {
+                    field,
+                    value,
+                    allowed,
+                })
+            }
+        };
+        for (field, value) in [
+            ("positions", self.positions),
+            ("rotations", self.rotations),
+            ("refine", self.refine),
+            ("certify", self.certify),
+        ] {
+            require(
+                field,
+                value as f64,
+                "in [1, 1000]",
+                (1..=1000).contains(&value),
+            )?;
+        }
+        require(
+            "coarse_grid_m",
+            self.coarse_grid_m,
+            "in [0.001, 0.2] m",
+            (0.001..=0.2).contains(&self.coarse_grid_m),
+        )?;
+        require(
+            "coarse_restarts",
+            self.coarse_restarts as f64,
+            "in [0, 10000]",
+            self.coarse_restarts <= 10_000,
+        )
+    }
+}
+
+/// What a place is scored by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Score {
+    /// The reachability bound of each stroke: how far along it one motion could go.
+    Bound,
+    /// The share of the strokes' points that have an IK solution in the cone, each on its own:
+    /// what reachability studies score.
+    PointIk,
+}
+
+/// The score of `job` moved to `place` by `planner`'s constraints with the part under its
+/// strokes, each stroke scanned with `config`: Σ min(bound, length) / Σ length
+/// ([`Score::Bound`]) or the share of scanned points with a configuration ([`Score::PointIk`]).
+pub fn place_score(
+    planner: &Planner,
+    job: &Job,
+    frame: &PartFrame,
+    place: &Place,
+    config: &ReachConfig,
+    score: Score,
+) -> Result<f64, JobError> {
+    let robot = planner.robot();
+    let moved = job.moved(&frame.motion(place))?;
+    let constraints = with_part(
+        &planner.config().rollout.constraints,
+        &job_part(robot, &moved),
+    );
+    let (mut reached, mut total) = (0.0, 0.0);
+    for stroke in &moved.strokes {
+        let Ok(task) = Task::on_path(robot, stroke.clone(), None) else {
+            total += stroke.length_m();
+            continue;
+        };
+        match score {
+            Score::Bound => {
+                let bound = reach(robot, &task, &constraints, config, &[]).reachable_m;
+                reached += bound.min(stroke.length_m());
+                total += stroke.length_m();
+            }
+            Score::PointIk => {
+                let (found, points) = reachable_points(robot, &task, &constraints, config);
+                reached += found as f64;
+                total += points as f64;
+            }
+        }
+    }
+    Ok(if total > 0.0 { reached / total } else { 0.0 })
+}
+
+/// The places of `region` for `job`, screened, refined and certified as the module says, by
+/// `score`; `progress` is told the stage's name, the places done and the places in it.
+#[allow(clippy::too_many_arguments)]
+pub fn place_job(
+    planner: &Planner,
+    request: &PlanRequest,
+    job: &Job,
+    timing: &MotionTiming,
+    robot_file: &str,
+    region: &Region,
+    settings: &PlaceSettings,
+    score: Score,
+    progress: &(dyn Fn(&str, usize, usize) + Sync),
+) -> Result<Placement, PlaceError> {
+    region.validate()?;
+    settings.validate()?;
+    let frame = PartFrame::of(job);
+    let xs = spread(region.x_m, settings.positions);
+    let ys = spread(region.y_m, settings.positions);
+    let turns = spread(region.rotation_deg, settings.rotations);
+    let grid: Vec<Place> = xs
+        .iter()
+        .flat_map(|&x_m| {
+            ys.iter().flat_map({
+                let turns = &turns;
+                move |&y_m| {
+                    turns.iter().map(move |&rotation_deg| Place {
+                        x_m,
+                        y_m,
+                        rotation_deg,
+                    })
+                }
+            })
+        })
+        .collect();
+    let full = planner.config().reach.clone();
+    let coarse = ReachConfig {
+        grid_m: settings.coarse_grid_m.max(full.grid_m),
+        restarts: settings.coarse_restarts.min(full.restarts),
+        ..full.clone()
+    };
+    let scored = |stage: &str, places: &[Place], config: &ReachConfig| {
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        places
+            .par_iter()
+            .map(|place| {
+                let value = place_score(planner, job, &frame, place, config, score)?;
+                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                progress(stage, finished, places.len());
+                Ok(Scored {
+                    place: *place,
+                    score: value,
+                })
+            })
+            .collect::<Result<Vec<Scored>, JobError>>()
+    };
+    let screened = scored("screen", &grid, &coarse)?;
+    let ranked = best_first(&screened);
+    if ranked[0].score <= 0.0 {
+        return Err(PlaceError::Unreachable);
+    }
+    // The best screened places, and the places half a step round the best one.
+    let step = |values: &[f64]| match values {
+        [a, b, ..] => 0.5 * (b - a),
+        _ => 0.0,
+    };
+    let top = ranked[0].place;
+    let mut refine: Vec<Place> = ranked
+        .iter()
+        .take(settings.refine)
+        .map(|s| s.place)
+        .collect();
+    for dx in [-1.0, 0.0, 1.0] {
+        for dy in [-1.0, 0.0, 1.0] {
+            for dr in [-1.0, 0.0, 1.0] {
+                let near = Place {
+                    x_m: (top.x_m + dx * step(&xs)).clamp(region.x_m[0], region.x_m[1]),
+                    y_m: (top.y_m + dy * step(&ys)).clamp(region.y_m[0], region.y_m[1]),
+                    rotation_deg: (top.rotation_deg + dr * step(&turns))
+                        .clamp(region.rotation_deg[0], region.rotation_deg[1]),
+                };
+                if !refine.contains(&near) {
+                    refine.push(near);
+                }
+            }
+        }
+    }
+    let refined = best_first(&scored("refine", &refine, &full)?);
+    let mut certified = Vec::new();
+    let mut first_failure = None;
+    let candidates: Vec<Scored> = refined.iter().take(settings.certify).copied().collect();
+    for (index, candidate) in candidates.iter().enumerate() {
+        let moved = job.moved(&frame.motion(&candidate.place))?;
+        let total_m = moved.strokes.iter().map(|s| s.length_m()).sum();
+        let planned = plan_job(planner, request, &moved, timing, robot_file, &|_, _| {});
+        progress("certify", index + 1, candidates.len());
+        certified.push(match planned {
+            Ok(program) => Certified {
+                scored: *candidate,
+                drawn_m: program.summary.drawn_m,
+                total_m,
+                complete: program.summary.complete,
+                strokes: moved.strokes.len(),
+                duration_s: program.summary.duration_s,
+                program: Some(Box::new(program)),
+            },
+            Err(why) => {
+                first_failure.get_or_insert(why);
+                Certified {
+                    scored: *candidate,
+                    drawn_m: 0.0,
+                    total_m,
+                    complete: 0,
+                    strokes: moved.strokes.len(),
+                    duration_s: 0.0,
+                    program: None,
+                }
+            }
+        });
+    }
+    // Most drawn first, then the shortest program; ties keep the refined order (stable sort).
+    certified.sort_by(|a, b| {
+        b.drawn_m
+            .total_cmp(&a.drawn_m)
+            .then(a.duration_s.total_cmp(&b.duration_s))
+    });
+    if certified[0].program.is_none() {
+        return Err(PlaceError::NothingDrawn(
+            first_failure.expect("a place without a program failed to plan"),
+        ));
+    }
+    Ok(Placement {
+        frame,
+        region: *region,
+        screened,
+        refined,
+        certified,
+    })
+}
+
+/// `scored` best first; equal scores keep their order.
+fn best_first(scored: &[Scored]) -> Vec<Scored> {
+    let mut ranked = scored.to_vec();
+    ranked.sort_by(|a, b| b.score.total_cmp(&a.score));
+    ranked
+}
