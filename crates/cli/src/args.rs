@@ -43,6 +43,11 @@ pub enum Command {
     /// reconfiguration where one motion cannot finish it), safe moves between strokes, one timed
     /// program written as an emg-job/1 file (see docs/jobs.md).
     Job(crate::job::JobArgs),
+    /// Find where to put a job's part (shifted on its surface, turned about its normal) so the
+    /// arm draws the most of it: places screened by the strokes' reachability bounds, the best
+    /// planned as full jobs; writes the program at the chosen place, and on request the heat
+    /// map and the job file with the place as its transform (see docs/placement.md).
+    Place(crate::place::PlaceArgs),
 }
 
 /// Options of `emg import-robot`.

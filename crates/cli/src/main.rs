@@ -70,6 +70,7 @@ mod import;
 mod interrupt;
 mod job;
 mod output;
+mod place;
 mod refusal;
 mod report;
 mod robot;
@@ -99,6 +100,7 @@ fn main() -> ExitCode {
         Command::ImportRobot(args) => import::run_import(&args),
         Command::Export(args) => export::run_export(&args),
         Command::Job(args) => job::run_job(&args),
+        Command::Place(args) => place::run_place(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

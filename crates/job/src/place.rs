@@ -25,6 +25,13 @@ use crate::program::JobFile;
 use crate::spec::{Job, JobError, Transform};
 use crate::{JobPlanError, plan_job};
 
+/// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
+/// first.
+pub const SAME_SCORE: f64 = 1e-3;
+
+/// The step (m) pen-down lengths are ranked in: within one, the shorter program goes first.
+pub const SAME_LENGTH_M: f64 = 1e-3;
+
 /// The places searched: the part's shift along the [`PartFrame`]'s axes (m) and its turn about
 /// the surface normal (degrees), each a closed range `[low, high]`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -181,6 +188,10 @@ pub struct Scored {
     pub place: Place,
     /// Its score in [0, 1].
     pub score: f64,
+    /// How deep inside the sphere the arm reaches the strokes lie: the smallest distance of
+    /// their points from its surface (m), which breaks ties between equal scores (a bound
+    /// reads full well before the arm's reach ends).
+    pub depth_m: f64,
 }
 
 /// A place planned as a full job.
@@ -320,9 +331,19 @@ pub fn place_score(
     place: &Place,
     config: &ReachConfig,
     score: Score,
-) -> Result<f64, JobError> {
+) -> Result<Scored, JobError> {
     let robot = planner.robot();
     let moved = job.moved(&frame.motion(place))?;
+    let (centre, radius) = robot.reach_sphere();
+    let depth_m = moved
+        .strokes
+        .iter()
+        .flat_map(|path| {
+            let samples = (path.length_m() / 0.01).ceil().max(1.0) as usize;
+            (0..=samples).map(move |k| path.point_at(path.length_m() * k as f64 / samples as f64))
+        })
+        .map(|point| radius - (point - centre).norm())
+        .fold(f64::INFINITY, f64::min);
     let constraints = with_part(
         &planner.config().rollout.constraints,
         &job_part(robot, &moved),
@@ -346,7 +367,11 @@ pub fn place_score(
             }
         }
     }
-    Ok(if total > 0.0 { reached / total } else { 0.0 })
+    Ok(Scored {
+        place: *place,
+        score: if total > 0.0 { reached / total } else { 0.0 },
+        depth_m,
+    })
 }
 
 /// The places of `region` for `job`, screened, refined and certified as the module says, by
@@ -395,13 +420,10 @@ pub fn place_job(
         places
             .par_iter()
             .map(|place| {
-                let value = place_score(planner, job, &frame, place, config, score)?;
+                let scored = place_score(planner, job, &frame, place, config, score)?;
                 let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 progress(stage, finished, places.len());
-                Ok(Scored {
-                    place: *place,
-                    score: value,
-                })
+                Ok(scored)
             })
             .collect::<Result<Vec<Scored>, JobError>>()
     };
@@ -469,10 +491,12 @@ pub fn place_job(
             }
         });
     }
-    // Most drawn first, then the shortest program; ties keep the refined order (stable sort).
+    // Most drawn first (counted in steps of [`SAME_LENGTH_M`]), then the shortest program;
+    // ties keep the refined order (stable sort).
+    let steps = |c: &Certified| (c.drawn_m / SAME_LENGTH_M).round();
     certified.sort_by(|a, b| {
-        b.drawn_m
-            .total_cmp(&a.drawn_m)
+        steps(b)
+            .total_cmp(&steps(a))
             .then(a.duration_s.total_cmp(&b.duration_s))
     });
     if certified[0].program.is_none() {
@@ -489,9 +513,15 @@ pub fn place_job(
     })
 }
 
-/// `scored` best first; equal scores keep their order.
+/// `scored` best first: by score (in steps of [`SAME_SCORE`]), then deeper inside the arm's
+/// reach; equal ones keep their order.
 fn best_first(scored: &[Scored]) -> Vec<Scored> {
+    let steps = |s: &Scored| (s.score / SAME_SCORE).round();
     let mut ranked = scored.to_vec();
-    ranked.sort_by(|a, b| b.score.total_cmp(&a.score));
+    ranked.sort_by(|a, b| {
+        steps(b)
+            .total_cmp(&steps(a))
+            .then(b.depth_m.total_cmp(&a.depth_m))
+    });
     ranked
 }

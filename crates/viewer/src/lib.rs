@@ -1,5 +1,6 @@
 //! A self-contained HTML motion viewer: one page that animates a planned motion along a line or
-//! a path ([`render_html`]), or a whole job's program ([`render_job_html`]).
+//! a path ([`render_html`]), or a whole job's program ([`render_job_html`]); and the placement
+//! map of `emg place` ([`placement_map_svg`]).
 //!
 //! [`render_html`] turns a robot, its task, the rollout and the constraints it was planned under
 //! into a single HTML document with inline CSS, inline JavaScript and the motion as an inline
@@ -56,6 +57,7 @@
 
 mod job;
 mod page;
+mod placement_map;
 mod scene;
 
 pub use job::{
@@ -63,6 +65,7 @@ pub use job::{
     MOVE_POINT_SPACING_M, drawn_stretches,
 };
 pub use page::{render_html, render_job_html};
+pub use placement_map::{MapCell, MapMark, placement_map_svg};
 
 use emg_control::{ConstraintConfig, Task, Trajectory};
 use emg_kinematics::Robot;

@@ -1,0 +1,245 @@
+//! `emg place`: where to put a job's part so the arm draws the most of it (`emg_job::place_job`):
+//! progress bars per stage, the certified places as a table, the program at the chosen place,
+//! the heat map and the chosen place as a job file's transform.
+
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use emg_job::{JOB_FORMAT_VERSION, JobSpec, PlaceSettings, Placement, Region, Score, place_job};
+use emg_viewer::{MapCell, MapMark, placement_map_svg};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::job::{JobInput, Ready, print_summary};
+use crate::output::write_text;
+
+/// Options of `emg place`.
+#[derive(Debug, Args)]
+pub struct PlaceArgs {
+    /// The job and how it is planned.
+    #[command(flatten)]
+    pub input: JobInput,
+    /// The part's shifts searched along its x axis (the base's x laid on the surface): MIN,MAX
+    /// (m).
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.15,0.15")]
+    pub x: [f64; 2],
+    /// The part's shifts searched along its y axis (normal × x): MIN,MAX (m).
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.15,0.15")]
+    pub y: [f64; 2],
+    /// The part's turns searched about the surface normal through its centre: MIN,MAX
+    /// (degrees).
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-90,90")]
+    pub rotation: [f64; 2],
+    /// Grid positions along each of x and y.
+    #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().positions)]
+    pub positions: usize,
+    /// Grid turns.
+    #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().rotations)]
+    pub rotations: usize,
+    /// Best refined places planned as full jobs.
+    #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().certify)]
+    pub certify: usize,
+    /// What screens a place: `bound` (default: each stroke's reachability bound, how far one
+    /// motion could go along it) or `point-ik` (the share of stroke points with an IK solution
+    /// in the cone, each on its own, as reachability studies score).
+    #[arg(long, value_parser = parse_score, default_value = "bound")]
+    pub score: Score,
+    /// The program planned at the chosen place (an emg-job/1 file).
+    #[arg(long, value_name = "FILE", default_value = "placed.json")]
+    pub out: PathBuf,
+    /// Also write the heat map (SVG): each position's best score over the turns, the certified
+    /// places ranked.
+    #[arg(long, value_name = "FILE")]
+    pub map: Option<PathBuf>,
+    /// Also write the job at the chosen place: a job file (docs/jobs.md) with the strokes as
+    /// read and the place as its `transform`, for `emg job`.
+    #[arg(long, value_name = "FILE")]
+    pub export: Option<PathBuf>,
+}
+
+fn parse_range(value: &str) -> Result<[f64; 2], String> {
+    let numbers: Vec<f64> = value
+        .split(',')
+        .map(|part| part.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("'{value}' is not MIN,MAX (two numbers)"))?;
+    match numbers[..] {
+        [low, high] => Ok([low, high]),
+        _ => Err(format!("'{value}' is not MIN,MAX (two numbers)")),
+    }
+}
+
+fn parse_score(value: &str) -> Result<Score, String> {
+    match value {
+        "bound" => Ok(Score::Bound),
+        "point-ik" => Ok(Score::PointIk),
+        other => Err(format!("'{other}' is not a score: bound or point-ik")),
+    }
+}
+
+/// Searches the region, prints the certified places and writes the outputs.
+pub fn run_place(args: &PlaceArgs) -> Result<()> {
+    let input = &args.input;
+    let mut outputs = vec![("--out", args.out.as_path())];
+    outputs.extend(args.map.as_deref().map(|path| ("--map", path)));
+    outputs.extend(args.export.as_deref().map(|path| ("--export", path)));
+    emg_io::refuse_overwriting(
+        &[
+            ("job", input.file.as_path()),
+            ("robot file", input.robot.as_path()),
+        ],
+        &outputs,
+    )?;
+    let region = Region {
+        x_m: args.x,
+        y_m: args.y,
+        rotation_deg: args.rotation,
+    };
+    let settings = PlaceSettings {
+        positions: args.positions,
+        rotations: args.rotations,
+        certify: args.certify,
+        ..PlaceSettings::default()
+    };
+    region.validate()?;
+    settings.validate()?;
+    let Ready {
+        job,
+        planner,
+        timing,
+        request,
+    } = input.ready()?;
+    let bar = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("{msg:>8} [{bar:40}] {pos}/{len} places, {elapsed}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    let placement = place_job(
+        &planner,
+        &request,
+        &job,
+        &timing,
+        &input.robot.display().to_string(),
+        &region,
+        &settings,
+        args.score,
+        &|stage, done, of| {
+            bar.set_message(stage.to_string());
+            bar.set_length(of as u64);
+            bar.set_position(done as u64);
+        },
+    )?;
+    bar.finish_and_clear();
+    print_places(&placement);
+    let best = placement.best();
+    let program = best
+        .program
+        .as_deref()
+        .expect("the chosen place was planned");
+    print_summary(program);
+    write_text(&args.out, &(serde_json::to_string(program)? + "\n"))?;
+    println!("wrote {}", args.out.display());
+    if let Some(path) = &args.map {
+        write_text(path, &map(&placement, args.score))?;
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.export {
+        let spec = JobSpec {
+            version: JOB_FORMAT_VERSION,
+            strokes: job.strokes.iter().map(|s| s.spec().clone()).collect(),
+            settings: job.settings.clone(),
+            home: job
+                .home
+                .map(|q| q.as_slice()[..planner.robot().dof()].to_vec()),
+            transform: Some(placement.transform()),
+        };
+        write_text(path, &(serde_json::to_string_pretty(&spec)? + "\n"))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// The table of certified places and the chosen one's transform.
+fn print_places(placement: &Placement) {
+    println!(
+        "screened {} places, refined {}, planned {}",
+        placement.screened.len(),
+        placement.refined.len(),
+        placement.certified.len()
+    );
+    println!("rank  x (m)   y (m)   turn (°)  score  drawn (m)  of (m)  complete  program (s)");
+    for (rank, place) in placement.certified.iter().enumerate() {
+        let p = &place.scored.place;
+        println!(
+            "{:>4}  {:>6.3}  {:>6.3}  {:>8.1}  {:>5.3}  {:>9.4}  {:>6.4}  {:>4} / {:<3}  {:>10.2}",
+            rank + 1,
+            p.x_m,
+            p.y_m,
+            p.rotation_deg,
+            place.scored.score,
+            place.drawn_m,
+            place.total_m,
+            place.complete,
+            place.strokes,
+            place.duration_s
+        );
+    }
+    let t = placement.transform();
+    println!(
+        "chosen: shift ({:.3}, {:.3}) m, turn {:.1}° about the normal: transform translation_m \
+         [{:.4}, {:.4}, {:.4}], rpy [{:.4}, {:.4}, {:.4}]",
+        placement.best().scored.place.x_m,
+        placement.best().scored.place.y_m,
+        placement.best().scored.place.rotation_deg,
+        t.translation_m[0],
+        t.translation_m[1],
+        t.translation_m[2],
+        t.rpy[0],
+        t.rpy[1],
+        t.rpy[2]
+    );
+}
+
+/// The heat map of the screened places: per position the best score over the turns.
+fn map(placement: &Placement, score: Score) -> String {
+    let mut cells: Vec<MapCell> = Vec::new();
+    for scored in &placement.screened {
+        let p = &scored.place;
+        match cells.iter_mut().find(|c| c.x_m == p.x_m && c.y_m == p.y_m) {
+            Some(cell) if cell.score >= scored.score => {}
+            Some(cell) => {
+                cell.score = scored.score;
+                cell.rotation_deg = p.rotation_deg;
+            }
+            None => cells.push(MapCell {
+                x_m: p.x_m,
+                y_m: p.y_m,
+                score: scored.score,
+                rotation_deg: p.rotation_deg,
+            }),
+        }
+    }
+    let mut marks: Vec<MapMark> = Vec::new();
+    for (rank, c) in placement.certified.iter().enumerate() {
+        let (x_m, y_m) = (c.scored.place.x_m, c.scored.place.y_m);
+        match marks.iter_mut().find(|m| m.x_m == x_m && m.y_m == y_m) {
+            Some(mark) => mark.ranks.push_str(&format!(", {}", rank + 1)),
+            None => marks.push(MapMark {
+                x_m,
+                y_m,
+                ranks: (rank + 1).to_string(),
+            }),
+        }
+    }
+    let what = match score {
+        Score::Bound => "Σ min(bound, length) / Σ length",
+        Score::PointIk => "share of stroke points with an IK solution",
+    };
+    placement_map_svg(
+        &cells,
+        &marks,
+        &format!(
+            "best screened score per position ({what}); the turn below it; planned places ranked"
+        ),
+    )
+}
