@@ -1,0 +1,112 @@
+//! `emg place`: an icon placed where the arm draws little of it is moved to where the planner
+//! draws all of it, the program there passed by `emg check`, the place written as a job file's
+//! transform that `emg job` plans the same; wrong regions refused naming what is wrong, nothing
+//! written.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{emg, read_json, temp_dir, text};
+
+fn pencil() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/data/icons/pencil.svg")
+}
+
+/// lucide's pencil 0.3 m wide, pen down at 0.78 m in front of the FR3: near the edge of its
+/// reach.
+const FAR: [&str; 4] = ["--origin", "0.78,0,0.25", "--width", "0.3"];
+
+/// The pen-down length drawn and in all of a program file.
+fn drawn(program: &serde_json::Value) -> (f64, f64) {
+    let summary = &program["summary"];
+    (
+        summary["drawn_m"].as_f64().unwrap(),
+        summary["total_m"].as_f64().unwrap(),
+    )
+}
+
+#[test]
+fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
+    let dir = temp_dir("place");
+    let pencil = pencil();
+    let file = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let mut job = vec!["job", pencil.to_str().unwrap()];
+    job.extend(FAR);
+    let far = file("far.json");
+    let output = emg(&[&job[..], &["--out", &far]].concat());
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let (far_drawn, total) = drawn(&read_json(Path::new(&far)));
+    assert!(far_drawn < 0.5 * total, "{far_drawn} of {total} m drawn where it stands");
+
+    let (placed, map, export) = (file("placed.json"), file("map.svg"), file("placed-job.json"));
+    let mut place = vec!["place", pencil.to_str().unwrap()];
+    place.extend(FAR);
+    place.extend([
+        "--x=-0.3,0",
+        "--y=-0.1,0.1",
+        "--rotation=-45,45",
+        "--positions",
+        "3",
+        "--rotations",
+        "2",
+        "--certify",
+        "2",
+        "--out",
+        &placed,
+        "--map",
+        &map,
+        "--export",
+        &export,
+    ]);
+    let output = emg(&place);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    assert!(stdout.contains("screened 18 places"), "{stdout}");
+    let (placed_drawn, placed_total) = drawn(&read_json(Path::new(&placed)));
+    assert!((placed_total - total).abs() < 1e-9);
+    assert!(
+        placed_drawn > total - 1e-3,
+        "{placed_drawn} of {total} m drawn at the chosen place:\n{stdout}"
+    );
+    let check = emg(&["check", &placed]);
+    assert!(check.status.success(), "{}", text(&check.stdout));
+    let svg = std::fs::read_to_string(&map).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("planned places ranked"));
+
+    // The exported job file plans the same program.
+    let again = file("again.json");
+    let output = emg(&["job", &export, "--out", &again]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    assert_eq!(drawn(&read_json(Path::new(&again))), drawn(&read_json(Path::new(&placed))));
+}
+
+#[test]
+fn wrong_regions_are_refused_and_nothing_is_written() {
+    let dir = temp_dir("place-refused");
+    let out = dir.path().join("placed.json");
+    let pencil = pencil();
+    let refused = |extra: &[&str], expected: &str| {
+        let mut args = vec![
+            "place",
+            pencil.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--positions",
+            "2",
+            "--rotations",
+            "1",
+        ];
+        args.extend(extra);
+        let output = emg(&args);
+        assert!(!output.status.success(), "{extra:?} was accepted");
+        let stderr = text(&output.stderr);
+        assert!(stderr.contains(expected), "{extra:?}: {stderr}");
+        assert!(!out.exists(), "{extra:?} wrote {}", out.display());
+    };
+    refused(&["--x=0.2,-0.2"], "region field 'x_m'");
+    refused(&["--rotation=10,nan"], "region field 'rotation_deg'");
+    refused(&["--y=0.1"], "is not MIN,MAX");
+    // Two metres beyond the arm's reach.
+    refused(&["--x=2,2.5"], "no place of the region lets the arm reach");
+}
