@@ -84,19 +84,19 @@ pub struct JobRow {
     pub baseline_colliding_moves: usize,
 }
 
-/// The name of the job of [`grid_of_circles`].
+/// The name of the job of [`grid_of_circles`]`(10, 10, …)`.
 const GRID: &str = "100 circles 2 cm across in a 10 × 10 grid";
 
-/// A job of 100 strokes: circles of 1 cm radius, 3 cm apart in a 10 × 10 grid pen down round
-/// (0.45, 0, 0.25).
-fn grid_of_circles() -> Vec<PathSpec> {
-    let centre = Vec3::new(0.45, 0.0, 0.25);
-    (0..100)
+/// A job of `rows × columns` strokes: circles of 1 cm radius, 3 cm apart in a grid pen down
+/// round `centre` (m), rows along the base's x.
+pub fn grid_of_circles(rows: usize, columns: usize, centre: [f64; 3]) -> Vec<PathSpec> {
+    let centre = Vec3::from(centre);
+    (0..rows * columns)
         .map(|k| {
             let middle = centre
                 + Vec3::new(
-                    0.03 * ((k / 10) as f64 - 4.5),
-                    0.03 * ((k % 10) as f64 - 4.5),
+                    0.03 * ((k / columns) as f64 - 0.5 * (rows - 1) as f64),
+                    0.03 * ((k % columns) as f64 - 0.5 * (columns - 1) as f64),
                     0.0,
                 );
             PathSpec {
@@ -171,7 +171,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Job::from_strokes(seams(tilt_deg), planner.robot())?,
         ));
     }
-    let grid = Job::from_strokes(grid_of_circles(), planner.robot())?;
+    let grid = Job::from_strokes(grid_of_circles(10, 10, [0.45, 0.0, 0.25]), planner.robot())?;
     jobs.push((GRID.to_string(), grid.clone()));
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
@@ -218,7 +218,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// The planner `emg job` plans with (the cell's plate, the corrected step, 0.5 mm), its timing
 /// and the checker.
-fn setup(robot_file: &Path) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
+pub fn setup(robot_file: &Path) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
     let workspace::PlannerSetup {
         planner, checker, ..
     } = workspace::planner_setup(

@@ -18,6 +18,7 @@ mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
 mod job_eval;
+mod place_eval;
 mod label_seeds;
 mod limit;
 mod make_tasks;
@@ -93,6 +94,9 @@ enum Command {
     /// Jobs on line-art icons and tilted seams planned as `emg job` plans them, checked, beside
     /// the baseline of strokes planned alone and joined straight (docs/results/jobs.*).
     JobEval(job_eval::Args),
+    /// `emg place` on icons near the edge of the arm's reach and a 20-stroke job, beside the
+    /// usual point-by-point IK score; the screening timed (docs/results/placement.*).
+    PlaceEval(place_eval::Args),
     /// The search at 20 mm, 0.5 mm and 0.1 mm with the paper's and the corrected step, on lines
     /// and paths, checked and timed (docs/results/precision.*).
     PrecisionEval(precision_eval::Args),
@@ -123,6 +127,7 @@ fn main() -> anyhow::Result<()> {
         Command::PathEval(args) => path_eval::run(&args),
         Command::PrecisionEval(args) => precision_eval::run(&args),
         Command::JobEval(args) => job_eval::run(&args),
+        Command::PlaceEval(args) => place_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
     }
 }

@@ -266,6 +266,15 @@ const STAGES: &[Stage] = &[
         writes: &["docs/results/ur5e/jobs.json", "docs/results/ur5e/jobs.md"],
     },
     Stage {
+        name: "place-eval",
+        args: &["place-eval"],
+        writes: &[
+            "docs/results/placement.json",
+            "docs/results/placement.md",
+            "docs/figures/placement-map.svg",
+        ],
+    },
+    Stage {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],

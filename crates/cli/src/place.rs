@@ -6,8 +6,9 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use emg_job::{JOB_FORMAT_VERSION, JobSpec, PlaceSettings, Placement, Region, Score, place_job};
-use emg_viewer::{MapCell, MapMark, placement_map_svg};
+use emg_job::{
+    JOB_FORMAT_VERSION, JobSpec, PlaceSettings, Placement, Region, Score, place_job, placement_map,
+};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::job::{JobInput, Ready, print_summary};
@@ -140,7 +141,7 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
     write_text(&args.out, &(serde_json::to_string(program)? + "\n"))?;
     println!("wrote {}", args.out.display());
     if let Some(path) = &args.map {
-        write_text(path, &map(&placement, args.score))?;
+        write_text(path, &placement_map(&placement, args.score))?;
         println!("wrote {}", path.display());
     }
     if let Some(path) = &args.export {
@@ -198,48 +199,4 @@ fn print_places(placement: &Placement) {
         t.rpy[1],
         t.rpy[2]
     );
-}
-
-/// The heat map of the screened places: per position the best score over the turns.
-fn map(placement: &Placement, score: Score) -> String {
-    let mut cells: Vec<MapCell> = Vec::new();
-    for scored in &placement.screened {
-        let p = &scored.place;
-        match cells.iter_mut().find(|c| c.x_m == p.x_m && c.y_m == p.y_m) {
-            Some(cell) if cell.score >= scored.score => {}
-            Some(cell) => {
-                cell.score = scored.score;
-                cell.rotation_deg = p.rotation_deg;
-            }
-            None => cells.push(MapCell {
-                x_m: p.x_m,
-                y_m: p.y_m,
-                score: scored.score,
-                rotation_deg: p.rotation_deg,
-            }),
-        }
-    }
-    let mut marks: Vec<MapMark> = Vec::new();
-    for (rank, c) in placement.certified.iter().enumerate() {
-        let (x_m, y_m) = (c.scored.place.x_m, c.scored.place.y_m);
-        match marks.iter_mut().find(|m| m.x_m == x_m && m.y_m == y_m) {
-            Some(mark) => mark.ranks.push_str(&format!(", {}", rank + 1)),
-            None => marks.push(MapMark {
-                x_m,
-                y_m,
-                ranks: (rank + 1).to_string(),
-            }),
-        }
-    }
-    let what = match score {
-        Score::Bound => "Σ min(bound, length) / Σ length",
-        Score::PointIk => "share of stroke points with an IK solution",
-    };
-    placement_map_svg(
-        &cells,
-        &marks,
-        &format!(
-            "best screened score per position ({what}); the turn below it; planned places ranked"
-        ),
-    )
 }

@@ -33,10 +33,10 @@ use rayon::prelude::*;
 
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use order::{Ordering, Oriented, order_strokes};
-pub use page::viewer_page;
+pub use page::{placement_map, viewer_page};
 pub use place::{
-    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, Score, Scored,
-    place_job, place_score,
+    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, SAME_LENGTH_M,
+    SAME_SCORE, Score, Scored, place_job, place_score,
 };
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,

@@ -1,9 +1,13 @@
 //! A job's program as the viewer draws it (`emg_viewer::render_job_html`): what `emg job --html`
-//! and the README's picture show.
+//! and the README's picture show; and the heat map of a job's places
+//! (`emg_viewer::placement_map_svg`).
 
 use emg_control::Path;
 use emg_kinematics::Robot;
 
+use emg_viewer::{MapCell, MapMark, placement_map_svg};
+
+use crate::place::{Placement, Score};
 use crate::program::{JobFile, SegmentKind};
 use crate::spec::Job;
 
@@ -56,4 +60,49 @@ pub fn viewer_page(file: &JobFile, job: &Job, robot: &Robot, name: &str) -> Stri
             s.duration_s
         ),
     })
+}
+
+/// The heat map of `placement`'s screened places ([`placement_map_svg`]): per position the
+/// best `score` over the turns, the certified places ranked: what `emg place --map` writes.
+pub fn placement_map(placement: &Placement, score: Score) -> String {
+    let mut cells: Vec<MapCell> = Vec::new();
+    for scored in &placement.screened {
+        let p = &scored.place;
+        match cells.iter_mut().find(|c| c.x_m == p.x_m && c.y_m == p.y_m) {
+            Some(cell) if cell.score >= scored.score => {}
+            Some(cell) => {
+                cell.score = scored.score;
+                cell.rotation_deg = p.rotation_deg;
+            }
+            None => cells.push(MapCell {
+                x_m: p.x_m,
+                y_m: p.y_m,
+                score: scored.score,
+                rotation_deg: p.rotation_deg,
+            }),
+        }
+    }
+    let mut marks: Vec<MapMark> = Vec::new();
+    for (rank, c) in placement.certified.iter().enumerate() {
+        let (x_m, y_m) = (c.scored.place.x_m, c.scored.place.y_m);
+        match marks.iter_mut().find(|m| m.x_m == x_m && m.y_m == y_m) {
+            Some(mark) => mark.ranks.push_str(&format!(", {}", rank + 1)),
+            None => marks.push(MapMark {
+                x_m,
+                y_m,
+                ranks: (rank + 1).to_string(),
+            }),
+        }
+    }
+    let what = match score {
+        Score::Bound => "Σ min(bound, length) / Σ length",
+        Score::PointIk => "share of stroke points with an IK solution",
+    };
+    placement_map_svg(
+        &cells,
+        &marks,
+        &format!(
+            "best screened score per position ({what}); the turn below it; planned places ranked"
+        ),
+    )
 }

@@ -227,6 +227,8 @@ pub struct Placement {
     pub refined: Vec<Scored>,
     /// The certified places, best first: the chosen place is the first.
     pub certified: Vec<Certified>,
+    /// Wall time of the screening on this machine (s): reported, never decided on.
+    pub screening_s: f64,
 }
 
 impl Placement {
@@ -427,7 +429,9 @@ pub fn place_job(
             })
             .collect::<Result<Vec<Scored>, JobError>>()
     };
+    let started = std::time::Instant::now();
     let screened = scored("screen", &grid, &coarse)?;
+    let screening_s = started.elapsed().as_secs_f64();
     let ranked = best_first(&screened);
     if ranked[0].score <= 0.0 {
         return Err(PlaceError::Unreachable);
@@ -510,6 +514,7 @@ pub fn place_job(
         screened,
         refined,
         certified,
+        screening_s,
     })
 }
 

@@ -1,0 +1,391 @@
+//! `cargo xtask place-eval`: `emg place` on jobs whose part stands where the arm draws little of
+//! it (every icon of the SVG reader's vendored lucide-static 1.62.0 set, 0.3 m wide, near the
+//! edge of the arm's reach) and on a 20-stroke job, beside the usual approach (the place whose
+//! stroke points most often have an IK solution in the cone, planned as it is); the 20-stroke
+//! job's screening timed, its best places checked against the top 20 planned, and its places
+//! found again on one thread: `docs/results/placement.{json,md}` and the heat map
+//! `docs/figures/placement-map.svg`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
+use emg_job::{
+    Job, PartFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, Score, place_job, plan_job,
+    verify_job,
+};
+use emg_planner::{MotionTiming, PlanRequest, Planner};
+use serde::{Deserialize, Serialize};
+
+use crate::job_eval::{grid_of_circles, setup};
+use crate::{progress, workspace};
+
+/// Options of `place-eval`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory of SVG icons (every `*.svg` in it, in name order).
+    #[arg(long, default_value_os_t = workspace::root().join("crates/io/tests/data/icons"))]
+    icons: PathBuf,
+    /// Robot file.
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
+    robot: PathBuf,
+    /// Output directory of placement.{json,md}.
+    #[arg(long, default_value_os_t = workspace::results_dir())]
+    out_dir: PathBuf,
+    /// The heat map of the 20-stroke job.
+    #[arg(long, default_value_os_t = workspace::root().join("docs/figures/placement-map.svg"))]
+    map: PathBuf,
+}
+
+/// The region every job is placed in: shifts along the part's x and y axes (m), turns (°).
+const REGION: Region = Region {
+    x_m: [-0.35, 0.05],
+    y_m: [-0.2, 0.2],
+    rotation_deg: [-90.0, 90.0],
+};
+
+/// Where each icon stands before it is placed: its centre (m) and width (m).
+const FAR: ([f64; 3], f64) = ([0.78, 0.0, 0.25], 0.3);
+
+/// One job's places, found by the bound and by the usual point-by-point score.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PlaceRow {
+    /// The job.
+    pub job: String,
+    /// Its strokes and pen-down length (m).
+    pub strokes: usize,
+    /// See `strokes`.
+    pub total_m: f64,
+    /// Drawn where it stands (m).
+    pub as_given_m: f64,
+    /// `emg place`'s chosen place: drawn (m), strokes complete, program (s).
+    pub chosen_m: f64,
+    /// See `chosen_m`.
+    pub chosen_complete: usize,
+    /// See `chosen_m`.
+    pub chosen_s: f64,
+    /// Whether the independent checker passed the chosen place's program.
+    pub chosen_checked: bool,
+    /// The place the point-by-point score ranks first, planned: drawn (m), strokes complete.
+    pub point_ik_m: f64,
+    /// See `point_ik_m`.
+    pub point_ik_complete: usize,
+    /// Places screened, and the screening's wall time (s).
+    pub screened: usize,
+    /// See `screened`.
+    pub screening_s: f64,
+}
+
+/// The 20-stroke job's checks.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct TopTwenty {
+    /// The most any of the 20 best refined places draws when planned (m).
+    pub best_of_top_m: f64,
+    /// What the chosen place draws (m).
+    pub chosen_m: f64,
+    /// Whether the places found on one thread are the same (every score and the chosen place).
+    pub same_on_one_thread: bool,
+}
+
+/// The whole record written to `placement.json`.
+#[derive(Serialize, Deserialize)]
+pub struct Record {
+    /// Robot name.
+    pub robot: String,
+    /// The command that wrote it.
+    pub command: String,
+    /// Machine and threads.
+    pub machine: String,
+    /// Threads.
+    pub threads: usize,
+    /// The region.
+    pub region: Region,
+    /// The settings.
+    pub settings: PlaceSettings,
+    /// Every job.
+    pub rows: Vec<PlaceRow>,
+    /// The 20-stroke job's checks.
+    pub top_twenty: TopTwenty,
+}
+
+/// Name of the 20-stroke job.
+const TWENTY: &str = "20 circles 2 cm across in a 4 × 5 grid round (0.75, 0, 0.25)";
+
+/// Places every job, compares, checks, writes the record, its table and the heat map.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let (planner, timing, checker) = setup(&args.robot)?;
+    let robot_name = args.robot.display().to_string();
+    let mut icons: Vec<PathBuf> = std::fs::read_dir(&args.icons)
+        .with_context(|| format!("reading {}", args.icons.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "svg"))
+        .collect();
+    icons.sort();
+    let mut jobs: Vec<(String, Job)> = Vec::new();
+    for icon in &icons {
+        let placement = SvgPlacement {
+            origin_m: FAR.0,
+            width_m: Some(FAR.1),
+            ..SvgPlacement::default()
+        };
+        let drawing = read_svg_file(icon, &placement, &SvgOptions::default())?;
+        jobs.push((
+            format!(
+                "{} at ({}, {}, {}), {} m wide",
+                icon.file_name().unwrap_or_default().to_string_lossy(),
+                FAR.0[0],
+                FAR.0[1],
+                FAR.0[2],
+                FAR.1
+            ),
+            Job::from_strokes(drawing.strokes, planner.robot())?,
+        ));
+    }
+    let twenty = Job::from_strokes(grid_of_circles(4, 5, [0.75, 0.0, 0.25]), planner.robot())?;
+    jobs.push((TWENTY.to_string(), twenty.clone()));
+    let settings = PlaceSettings::default();
+    let request = PlanRequest::default();
+    let bar = progress::bar(jobs.len() as u64, "jobs");
+    let mut rows = Vec::new();
+    let mut twenty_placement = None;
+    for (name, job) in &jobs {
+        let (row, placement) = evaluate(
+            &planner,
+            &timing,
+            &checker,
+            &robot_name,
+            name,
+            job,
+            &settings,
+        )?;
+        rows.push(row);
+        if name == TWENTY {
+            twenty_placement = Some(placement);
+        }
+        bar.inc(1);
+    }
+    bar.finish();
+    let placement = twenty_placement.expect("the 20-stroke job was placed");
+    // Every one of the 20 best refined places planned.
+    let frame = PartFrame::of(&twenty);
+    let best_of_top_m = placement
+        .refined
+        .iter()
+        .take(20)
+        .map(|scored| {
+            let moved = twenty.moved(&frame.motion(&scored.place))?;
+            Ok(
+                plan_job(&planner, &request, &moved, &timing, &robot_name, &|_, _| {})
+                    .map_or(0.0, |program| program.summary.drawn_m),
+            )
+        })
+        .collect::<anyhow::Result<Vec<f64>>>()?
+        .into_iter()
+        .fold(0.0, f64::max);
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let again = one_thread.install(|| {
+        place_job(
+            &planner,
+            &request,
+            &twenty,
+            &timing,
+            &robot_name,
+            &REGION,
+            &settings,
+            Score::Bound,
+            &|_, _, _| {},
+        )
+    })?;
+    let same_on_one_thread = again.screened == placement.screened
+        && again.refined == placement.refined
+        && again.best().scored == placement.best().scored;
+    let top_twenty = TopTwenty {
+        best_of_top_m,
+        chosen_m: placement.best().drawn_m,
+        same_on_one_thread,
+    };
+    write_map(&args.map, &placement)?;
+    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
+    let record = Record {
+        robot: planner.robot().name().to_string(),
+        command: match shipped.map(|robot| robot.name) {
+            Some("fr3") => "cargo xtask place-eval".to_string(),
+            Some(name) => format!("cargo xtask place-eval --robot {name}"),
+            None => format!("cargo xtask place-eval --robot {}", args.robot.display()),
+        },
+        machine: workspace::machine(),
+        threads: rayon::current_num_threads(),
+        region: REGION,
+        settings,
+        rows,
+        top_twenty,
+    };
+    workspace::write_results(&args.out_dir, "placement", &record, &markdown(&record))?;
+    anyhow::ensure!(
+        record.rows.iter().all(|r| r.chosen_checked),
+        "a chosen place's program fails the checker"
+    );
+    anyhow::ensure!(same_on_one_thread, "the places differ on one thread");
+    Ok(())
+}
+
+/// `job` as it stands, placed by `emg place` and by the point-by-point score.
+fn evaluate(
+    planner: &Planner,
+    timing: &MotionTiming,
+    checker: &emg_verify::ReferenceModel,
+    robot_name: &str,
+    name: &str,
+    job: &Job,
+    settings: &PlaceSettings,
+) -> anyhow::Result<(PlaceRow, Placement)> {
+    let request = PlanRequest::default();
+    let plan = |job: &Job| plan_job(planner, &request, job, timing, robot_name, &|_, _| {}).ok();
+    let as_given_m = plan(job).map_or(0.0, |program| program.summary.drawn_m);
+    let placed = |score| {
+        place_job(
+            planner,
+            &request,
+            job,
+            timing,
+            robot_name,
+            &REGION,
+            settings,
+            score,
+            &|_, _, _| {},
+        )
+    };
+    let ours = placed(Score::Bound)?;
+    let chosen = ours.best();
+    let program = chosen.program.as_deref().expect("the chosen place was planned");
+    let chosen_checked = verify_job(program, checker, planner.robot().joint_names()).is_ok();
+    // The usual approach takes the place its score ranks first and plans it as it is.
+    let usual = placed(Score::PointIk)?;
+    let frame = PartFrame::of(job);
+    let first = job.moved(&frame.motion(&usual.refined[0].place))?;
+    let (point_ik_m, point_ik_complete) = plan(&first).map_or((0.0, 0), |program| {
+        (program.summary.drawn_m, program.summary.complete)
+    });
+    let row = PlaceRow {
+        job: name.to_string(),
+        strokes: job.strokes.len(),
+        total_m: job.strokes.iter().map(|s| s.length_m()).sum(),
+        as_given_m,
+        chosen_m: chosen.drawn_m,
+        chosen_complete: chosen.complete,
+        chosen_s: chosen.duration_s,
+        chosen_checked,
+        point_ik_m,
+        point_ik_complete,
+        screened: ours.screened.len(),
+        screening_s: ours.screening_s,
+    };
+    Ok((row, ours))
+}
+
+/// The heat map of `placement`, as `emg place --map` draws it.
+fn write_map(path: &Path, placement: &Placement) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    emg_io::write_atomically(path, &emg_job::placement_map(placement, Score::Bound))?;
+    Ok(())
+}
+
+fn markdown(record: &Record) -> String {
+    let rows = &record.rows;
+    let unfinished = |complete: usize, row: &PlaceRow| complete < row.strokes;
+    let ours_short = rows
+        .iter()
+        .filter(|r| unfinished(r.chosen_complete, r))
+        .count();
+    let usual_short = rows
+        .iter()
+        .filter(|r| unfinished(r.point_ik_complete, r))
+        .count();
+    let sum = |value: fn(&PlaceRow) -> f64| rows.iter().map(value).sum::<f64>();
+    let twenty = rows.iter().find(|r| r.job == TWENTY);
+    let mut md = format!(
+        "# Placement ({})\n\n\
+         Written by `{}` on {} ({} threads). Each job's part is searched over shifts x in \
+         [{}, {}] m and y in [{}, {}] m along its axes and turns in [{}°, {}°] about its \
+         normal: {} × {} positions × {} turns screened by the strokes' bounds (a {} m scan, {} \
+         restarts), the best {} and the places round the best refined by the full scan, the \
+         best {} planned as full jobs (`emg place`'s defaults). The usual approach scores a \
+         place by the share of stroke points with an IK solution in the cone, each on its own, \
+         and takes the place it ranks first.\n\n\
+         | | `emg place` | usual approach |\n|---|---|---|\n\
+         | pen-down length drawn (Σ of {:.3} m; {:.3} m where the parts stand) | {:.3} ({:.1} %) | {:.3} ({:.1} %) |\n\
+         | jobs with strokes left unfinished (of {}) | {} | {} |\n\n",
+        record.robot,
+        record.command,
+        record.machine,
+        record.threads,
+        record.region.x_m[0],
+        record.region.x_m[1],
+        record.region.y_m[0],
+        record.region.y_m[1],
+        record.region.rotation_deg[0],
+        record.region.rotation_deg[1],
+        record.settings.positions,
+        record.settings.positions,
+        record.settings.rotations,
+        record.settings.coarse_grid_m,
+        record.settings.coarse_restarts,
+        record.settings.refine,
+        record.settings.certify,
+        sum(|r| r.total_m),
+        sum(|r| r.as_given_m),
+        sum(|r| r.chosen_m),
+        100.0 * sum(|r| r.chosen_m) / sum(|r| r.total_m),
+        sum(|r| r.point_ik_m),
+        100.0 * sum(|r| r.point_ik_m) / sum(|r| r.total_m),
+        rows.len(),
+        ours_short,
+        usual_short,
+    );
+    if let Some(twenty) = twenty {
+        let t = &record.top_twenty;
+        md.push_str(&format!(
+            "{TWENTY}: {} places screened in {:.1} s; the chosen place draws {:.3} m, the best \
+             of the 20 best refined places, each planned, {:.3} m ({}); the places found on one \
+             thread are {}.\n\n",
+            twenty.screened,
+            twenty.screening_s,
+            t.chosen_m,
+            t.best_of_top_m,
+            if t.chosen_m >= t.best_of_top_m - SAME_LENGTH_M {
+                "the chosen place draws as much as any"
+            } else {
+                "one of them draws more"
+            },
+            if t.same_on_one_thread {
+                "the same"
+            } else {
+                "different"
+            },
+        ));
+    }
+    md.push_str(
+        "| job | strokes | of (m) | where it stands (m) | `emg place` (m) | complete | program (s) | usual approach (m) | complete | screened | screening (s) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        md.push_str(&format!(
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.2} | {:.3} | {} | {} | {:.1} |\n",
+            r.job,
+            r.strokes,
+            r.total_m,
+            r.as_given_m,
+            r.chosen_m,
+            r.chosen_complete,
+            r.chosen_s,
+            r.point_ik_m,
+            r.point_ik_complete,
+            r.screened,
+            r.screening_s
+        ));
+    }
+    md.push_str("\n![heat map of the 20-stroke job](../figures/placement-map.svg)\n");
+    md
+}
