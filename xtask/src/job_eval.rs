@@ -218,7 +218,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// The planner `emg job` plans with (the cell's plate, the corrected step, 0.5 mm), its timing
 /// and the checker.
-pub fn setup(robot_file: &Path) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
+pub fn setup(
+    robot_file: &Path,
+) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
     let workspace::PlannerSetup {
         planner, checker, ..
     } = workspace::planner_setup(

@@ -257,7 +257,10 @@ fn evaluate(
     };
     let ours = placed(Score::Bound)?;
     let chosen = ours.best();
-    let program = chosen.program.as_deref().expect("the chosen place was planned");
+    let program = chosen
+        .program
+        .as_deref()
+        .expect("the chosen place was planned");
     let chosen_checked = verify_job(program, checker, planner.robot().joint_names()).is_ok();
     // The usual approach takes the place its score ranks first and plans it as it is.
     let usual = placed(Score::PointIk)?;

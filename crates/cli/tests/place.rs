@@ -37,9 +37,16 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let output = emg(&[&job[..], &["--out", &far]].concat());
     assert!(output.status.success(), "{}", text(&output.stderr));
     let (far_drawn, total) = drawn(&read_json(Path::new(&far)));
-    assert!(far_drawn < 0.5 * total, "{far_drawn} of {total} m drawn where it stands");
+    assert!(
+        far_drawn < 0.5 * total,
+        "{far_drawn} of {total} m drawn where it stands"
+    );
 
-    let (placed, map, export) = (file("placed.json"), file("map.svg"), file("placed-job.json"));
+    let (placed, map, export) = (
+        file("placed.json"),
+        file("map.svg"),
+        file("placed-job.json"),
+    );
     let mut place = vec!["place", pencil.to_str().unwrap()];
     place.extend(FAR);
     place.extend([
@@ -78,7 +85,10 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let again = file("again.json");
     let output = emg(&["job", &export, "--out", &again]);
     assert!(output.status.success(), "{}", text(&output.stderr));
-    assert_eq!(drawn(&read_json(Path::new(&again))), drawn(&read_json(Path::new(&placed))));
+    assert_eq!(
+        drawn(&read_json(Path::new(&again))),
+        drawn(&read_json(Path::new(&placed)))
+    );
 }
 
 #[test]

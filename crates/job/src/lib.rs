@@ -35,8 +35,8 @@ pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surface
 pub use order::{Ordering, Oriented, order_strokes};
 pub use page::{placement_map, viewer_page};
 pub use place::{
-    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, SAME_LENGTH_M,
-    SAME_SCORE, Score, Scored, place_job, place_score,
+    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, SAME_SCORE, Score,
+    Scored, place_job, place_score,
 };
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
@@ -44,6 +44,10 @@ pub use program::{
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
 pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
+
+/// Pen-down lengths closer than this (m) count as the same: of two starts of a stroke that draw
+/// as far, the nearer one to the arm is taken; places that draw as much rank by duration.
+pub const SAME_LENGTH_M: f64 = 1e-3;
 
 /// A job's line tolerance unless it is given another (m): what a pen, a bead or a seam needs.
 pub const JOB_TOLERANCE_M: f64 = 5e-4;
@@ -145,14 +149,28 @@ pub fn plan_job(
         for (index, planned) in plan.parts.iter().enumerate() {
             let from = program.last().or(job.home);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
-            // Where the searched start cannot be reached, the part is planned again from the
-            // configuration the arm is in, moved above the part's start and set down there.
-            let placed = connector.place(planned, from, seed).or_else(|why| {
-                let from = from.ok_or(why.clone())?;
-                let again = connector
-                    .replanned_nearby(&on_part, request, planned, &from)
-                    .ok_or(why.clone())?;
-                connector.place(&again, Some(from), seed).map_err(|_| why)
+            // The part planned again from the configuration the arm is in, moved above the
+            // part's start and set down there: taken first where it draws as far from a start
+            // nearer the arm, and where the searched start cannot be reached.
+            let nearby =
+                from.and_then(|from| connector.replanned_nearby(&on_part, request, planned, &from));
+            let as_far =
+                |part: &StrokePart| part.reached_s() >= planned.reached_s() - SAME_LENGTH_M;
+            let nearer = |part: &StrokePart| {
+                from.is_some_and(|from| {
+                    let start = |p: &StrokePart| p.trajectory.steps[0].q;
+                    (start(part) - from).norm() < (start(planned) - from).norm()
+                })
+            };
+            let (first, fallback) = match &nearby {
+                Some(again) if as_far(again) && nearer(again) => (again, Some(planned)),
+                Some(again) => (planned, Some(again)),
+                None => (planned, None),
+            };
+            let placed = connector.place(first, from, seed).or_else(|why| {
+                fallback
+                    .ok_or(why.clone())
+                    .and_then(|part| connector.place(part, from, seed).map_err(|_| why))
             });
             let (part, placed) = match placed {
                 Ok(placed) => placed,

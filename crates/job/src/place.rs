@@ -23,18 +23,16 @@ use serde::{Deserialize, Serialize};
 use crate::free_space::{job_part, with_part};
 use crate::program::JobFile;
 use crate::spec::{Job, JobError, Transform};
-use crate::{JobPlanError, plan_job};
+use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
 
 /// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
 /// first.
 pub const SAME_SCORE: f64 = 1e-3;
 
-/// The step (m) pen-down lengths are ranked in: within one, the shorter program goes first.
-pub const SAME_LENGTH_M: f64 = 1e-3;
-
 /// The places searched: the part's shift along the [`PartFrame`]'s axes (m) and its turn about
 /// the surface normal (degrees), each a closed range `[low, high]`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Region {
     /// Shift along the frame's x axis (m).
     pub x_m: [f64; 2],

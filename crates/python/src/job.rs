@@ -66,14 +66,13 @@ pub(crate) fn read_job(
     Job::from_json(&path.display().to_string(), &text, robot).map_err(|e| invalid(&e))
 }
 
-/// Plans `job` with `planner` at `tolerance_mm`; the GIL is released while planning.
-pub(crate) fn plan(
-    py: Python<'_>,
+/// What a job plans with at `tolerance_mm`: `planner` at that tolerance, its timing and the
+/// request (the search, the best shipped controller), as `emg job` plans.
+fn job_planner(
     planner: &emg_planner::Planner,
     robot_file: &std::path::Path,
-    job: &Job,
     tolerance_mm: f64,
-) -> PyResult<JobPlan> {
+) -> PyResult<(emg_planner::Planner, emg_planner::MotionTiming, PlanRequest)> {
     if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
         return Err(InputError::new_err(format!(
             "tolerance_mm: must be a positive number, got {tolerance_mm}"
@@ -96,6 +95,18 @@ pub(crate) fn plan(
         controller: planner.models().best_controller(),
         ..PlanRequest::default()
     };
+    Ok((planner, timing, request))
+}
+
+/// Plans `job` with `planner` at `tolerance_mm`; the GIL is released while planning.
+pub(crate) fn plan(
+    py: Python<'_>,
+    planner: &emg_planner::Planner,
+    robot_file: &std::path::Path,
+    job: &Job,
+    tolerance_mm: f64,
+) -> PyResult<JobPlan> {
+    let (planner, timing, request) = job_planner(planner, robot_file, tolerance_mm)?;
     let file = py
         .detach(|| {
             emg_job::plan_job(
@@ -231,5 +242,135 @@ impl JobPlan {
         Array2::from_shape_vec((points.len(), joints), flat)
             .expect("one value per joint")
             .into_pyarray(py)
+    }
+}
+
+/// Where to put a job's part (`emg_job::place_job`, docs/placement.md): the places planned, the
+/// chosen one as a transform, its program, and the heat map.
+#[pyclass(frozen, module = "extreme_line_motion")]
+pub struct JobPlacement {
+    placement: emg_job::Placement,
+    score: emg_job::Score,
+}
+
+/// The region of `region`, a dict of `x_m`, `y_m` (shifts, m) and `rotation_deg` (turns), each
+/// `[low, high]`.
+fn read_region(py: Python<'_>, region: &Bound<'_, PyDict>) -> PyResult<emg_job::Region> {
+    let text: String = py
+        .import("json")?
+        .call_method1("dumps", (region,))?
+        .extract()?;
+    let region: emg_job::Region =
+        serde_json::from_str(&text).map_err(|e| InputError::new_err(format!("region: {e}")))?;
+    region
+        .validate()
+        .map_err(|e| InputError::new_err(message(&e)))?;
+    Ok(region)
+}
+
+/// Places `job` over `region` with `planner` at `tolerance_mm`, screening `positions² ×
+/// rotations` places by `score` (`"bound"` or `"point_ik"`) and planning the best `certify`; the
+/// GIL is released meanwhile.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn place(
+    py: Python<'_>,
+    planner: &emg_planner::Planner,
+    robot_file: &std::path::Path,
+    job: &Job,
+    region: &Bound<'_, PyDict>,
+    tolerance_mm: f64,
+    (positions, rotations, certify): (usize, usize, usize),
+    score: &str,
+) -> PyResult<JobPlacement> {
+    let region = read_region(py, region)?;
+    let score = match score {
+        "bound" => emg_job::Score::Bound,
+        "point_ik" => emg_job::Score::PointIk,
+        other => {
+            return Err(InputError::new_err(format!(
+                "score: '{other}' is not a score: bound or point_ik"
+            )));
+        }
+    };
+    let settings = emg_job::PlaceSettings {
+        positions,
+        rotations,
+        certify,
+        ..emg_job::PlaceSettings::default()
+    };
+    settings
+        .validate()
+        .map_err(|e| InputError::new_err(message(&e)))?;
+    let (planner, timing, request) = job_planner(planner, robot_file, tolerance_mm)?;
+    let placement = py
+        .detach(|| {
+            emg_job::place_job(
+                &planner,
+                &request,
+                job,
+                &timing,
+                &robot_file.display().to_string(),
+                &region,
+                &settings,
+                score,
+                &|_, _, _| {},
+            )
+        })
+        .map_err(|e| PlanningError::new_err(message(&e)))?;
+    Ok(JobPlacement { placement, score })
+}
+
+#[pymethods]
+impl JobPlacement {
+    /// The places planned as full jobs, best first (dicts: `place` with `x_m`, `y_m`,
+    /// `rotation_deg`; `score`, `depth_m`, `drawn_m`, `total_m`, `complete`, `strokes`,
+    /// `duration_s`); the first is the chosen place.
+    #[getter]
+    fn certified<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        python(py, &self.placement.certified)
+    }
+
+    /// Every screened place in grid order (dicts: `place`, `score`, `depth_m`).
+    #[getter]
+    fn screened<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        python(py, &self.placement.screened)
+    }
+
+    /// The chosen place as a job file's `transform` (`translation_m`, `rpy`).
+    #[getter]
+    fn transform<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        python(py, &self.placement.transform())
+    }
+
+    /// The program planned at the chosen place.
+    #[getter]
+    fn program(&self) -> JobPlan {
+        JobPlan {
+            file: (**self
+                .placement
+                .best()
+                .program
+                .as_ref()
+                .expect("the chosen place was planned"))
+            .clone(),
+        }
+    }
+
+    /// The heat map as SVG text (what `emg place --map` writes).
+    fn map_svg(&self) -> String {
+        emg_job::placement_map(&self.placement, self.score)
+    }
+
+    fn __repr__(&self) -> String {
+        let best = self.placement.best();
+        format!(
+            "JobPlacement({} places screened; chosen shift ({:.3}, {:.3}) m, turn {:.1}°: {:.4} m of {:.4} m drawn)",
+            self.placement.screened.len(),
+            best.scored.place.x_m,
+            best.scored.place.y_m,
+            best.scored.place.rotation_deg,
+            best.drawn_m,
+            best.total_m
+        )
     }
 }

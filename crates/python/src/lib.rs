@@ -108,6 +108,7 @@ fn extreme_line_motion(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("CheckFailed", py.get_type::<CheckFailed>())?;
     module.add_class::<planner::Planner>()?;
     module.add_class::<job::JobPlan>()?;
+    module.add_class::<job::JobPlacement>()?;
     module.add_class::<planner::Plan>()?;
     module.add_class::<planner::Task>()?;
     module.add_class::<timing::Motion>()?;

@@ -389,6 +389,41 @@ impl Planner {
         crate::job::plan(py, &self.inner, &robot.file, &job, tolerance_mm)
     }
 
+    /// Finds where to put a job's part (docs/placement.md): `job` and `placement` as for
+    /// `plan_job`; `region` a dict of `x_m`, `y_m` (shifts along the part's axes, m) and
+    /// `rotation_deg` (turns about its normal), each `[low, high]`; `positions² × rotations`
+    /// places screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
+    /// the share of stroke points with an IK solution), the best `certify` planned as full jobs.
+    /// Returns a `JobPlacement`; a bad region or setting raises `InputError` naming it, a
+    /// region the arm cannot reach `PlanningError`.
+    #[pyo3(signature = (job, region, placement = None, tolerance_mm = emg_job::JOB_TOLERANCE_M * 1e3, positions = 10, rotations = 5, certify = 5, score = "bound"))]
+    #[allow(clippy::too_many_arguments)]
+    fn place_job(
+        &self,
+        py: Python<'_>,
+        job: &Bound<'_, PyAny>,
+        region: &Bound<'_, PyDict>,
+        placement: Option<&Bound<'_, PyDict>>,
+        tolerance_mm: f64,
+        positions: usize,
+        rotations: usize,
+        certify: usize,
+        score: &str,
+    ) -> PyResult<crate::job::JobPlacement> {
+        let robot = self.robot.get();
+        let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        crate::job::place(
+            py,
+            &self.inner,
+            &robot.file,
+            &job,
+            region,
+            tolerance_mm,
+            (positions, rotations, certify),
+            score,
+        )
+    }
+
     /// Plans every task of `tasks` (`Task` objects, e.g. from `load_tasks`, or `(p0, d, n)`
     /// triples) in parallel on all cores with the GIL released; the plans come in task order
     /// and do not depend on the number of threads. Arguments as for `plan`; the first task
