@@ -47,9 +47,8 @@ pub(crate) fn read_job(
         .extension()
         .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"))
     {
-        let placement: emg_io::Placement = match placement {
-            Some(dict) => serde_json::from_str(&dumps(dict.as_any())?)
-                .map_err(|e| InputError::new_err(format!("placement: {e}")))?,
+        let placement = match placement {
+            Some(dict) => placement_of(&dumps(dict.as_any())?)?,
             None => emg_io::Placement::default(),
         };
         let drawing = emg_io::read_svg_file(&path, &placement, &emg_io::SvgOptions::default())
@@ -96,6 +95,24 @@ fn job_planner(
         ..PlanRequest::default()
     };
     Ok((planner, timing, request))
+}
+
+/// The placement a dict's JSON `text` gives: the default's fields with the dict's over them (a
+/// `scale_m_per_unit` given without `width_m` replaces the default width).
+fn placement_of(text: &str) -> PyResult<emg_io::Placement> {
+    let invalid = |e: serde_json::Error| InputError::new_err(format!("placement: {e}"));
+    let given: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(text).map_err(invalid)?;
+    let serde_json::Value::Object(mut fields) =
+        serde_json::to_value(emg_io::Placement::default()).expect("a placement serialises")
+    else {
+        unreachable!("a placement serialises to an object")
+    };
+    if given.contains_key("scale_m_per_unit") && !given.contains_key("width_m") {
+        fields.remove("width_m");
+    }
+    fields.extend(given);
+    serde_json::from_value(serde_json::Value::Object(fields)).map_err(invalid)
 }
 
 /// Plans `job` with `planner` at `tolerance_mm`; the GIL is released while planning.
