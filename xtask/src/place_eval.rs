@@ -291,7 +291,7 @@ fn write_map(path: &Path, placement: &Placement) -> anyhow::Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    emg_io::write_atomically(path, &emg_job::placement_map(placement, Score::Bound))?;
+    emg_io::write_atomically(path, emg_job::placement_map(placement, Score::Bound))?;
     Ok(())
 }
 

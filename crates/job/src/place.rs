@@ -14,7 +14,7 @@
 //! the grid's order.
 
 use emg_control::Task;
-use emg_kinematics::Vec3;
+use emg_kinematics::{Vec3, rotation_about};
 use emg_planner::{MotionTiming, PlanRequest, Planner, ReachConfig, reach, reachable_points};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use rayon::prelude::*;
@@ -159,10 +159,10 @@ impl PartFrame {
     /// centre, then shifted along x and y.
     pub fn motion(&self, place: &Place) -> Isometry3<f64> {
         let centre = Vec3::from(self.centre);
-        let turn = UnitQuaternion::from_axis_angle(
-            &nalgebra::Unit::new_normalize(Vec3::from(self.normal)),
+        let turn = UnitQuaternion::from_rotation_matrix(&rotation_about(
+            &Vec3::from(self.normal),
             place.rotation_deg.to_radians(),
-        );
+        ));
         let shift = Vec3::from(self.x) * place.x_m + Vec3::from(self.y) * place.y_m;
         Isometry3::from_parts(Translation3::from(centre + shift - turn * centre), turn)
     }
