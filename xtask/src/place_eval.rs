@@ -11,8 +11,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
 use emg_job::{
-    Job, PartFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, Score, place_job, plan_job,
-    verify_job,
+    Job, PartFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE, Score, place_job,
+    plan_job, verify_job,
 };
 use emg_planner::{MotionTiming, PlanRequest, Planner};
 use serde::{Deserialize, Serialize};
@@ -37,10 +37,11 @@ pub struct Args {
     map: PathBuf,
 }
 
-/// The region every job is placed in: shifts along the part's x and y axes (m), turns (°).
+/// The region every job is placed in: shifts along the part's x and y axes (m), turns (°),
+/// across the edge of the arm's reach.
 const REGION: Region = Region {
-    x_m: [-0.35, 0.05],
-    y_m: [-0.2, 0.2],
+    x_m: [-0.2, 0.15],
+    y_m: [-0.3, 0.3],
     rotation_deg: [-90.0, 90.0],
 };
 
@@ -66,15 +67,40 @@ pub struct PlaceRow {
     pub chosen_s: f64,
     /// Whether the independent checker passed the chosen place's program.
     pub chosen_checked: bool,
-    /// The place the point-by-point score ranks first, planned: drawn (m), strokes complete.
+    /// The place the point-by-point score ranks first (ties deepest inside the arm's reach
+    /// first, as `emg place` breaks them), planned: drawn (m), strokes complete.
     pub point_ik_m: f64,
     /// See `point_ik_m`.
     pub point_ik_complete: usize,
+    /// The screened places at the point-by-point score's top (every one of them best to that
+    /// score), and of up to [`TIED_PLANNED`] of them, spread over the grid and planned, those
+    /// that leave strokes unfinished.
+    pub point_ik_top: TopPlaces,
+    /// The same for the screening bound's top places.
+    pub bound_top: TopPlaces,
     /// Places screened, and the screening's wall time (s).
     pub screened: usize,
     /// See `screened`.
     pub screening_s: f64,
 }
+
+/// Places at a score's top, some of them planned.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct TopPlaces {
+    /// Screened places at the top score (within `SAME_SCORE`).
+    pub places: usize,
+    /// Of them planned.
+    pub planned: usize,
+    /// Of those planned, those that leave strokes unfinished.
+    pub unfinished: usize,
+    /// Pen-down length the planned ones draw, Σ, and in all (m).
+    pub drawn_m: f64,
+    /// See `drawn_m`.
+    pub total_m: f64,
+}
+
+/// Places at a score's top planned per job at most, spread evenly over the grid's order.
+const TIED_PLANNED: usize = 20;
 
 /// The 20-stroke job's checks.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -269,6 +295,38 @@ fn evaluate(
     let (point_ik_m, point_ik_complete) = plan(&first).map_or((0.0, 0), |program| {
         (program.summary.drawn_m, program.summary.complete)
     });
+    let top_places = |placement: &Placement| -> anyhow::Result<TopPlaces> {
+        let top = placement
+            .screened
+            .iter()
+            .map(|s| s.score)
+            .fold(0.0, f64::max);
+        let tied: Vec<_> = placement
+            .screened
+            .iter()
+            .filter(|s| s.score >= top - SAME_SCORE)
+            .collect();
+        let planned = TIED_PLANNED.min(tied.len());
+        let mut counted = TopPlaces {
+            places: tied.len(),
+            planned,
+            unfinished: 0,
+            drawn_m: 0.0,
+            total_m: 0.0,
+        };
+        for k in 0..planned {
+            let moved = job.moved(&frame.motion(&tied[k * tied.len() / planned].place))?;
+            let (drawn, complete) = plan(&moved).map_or((0.0, 0), |program| {
+                (program.summary.drawn_m, program.summary.complete)
+            });
+            counted.unfinished += usize::from(complete < job.strokes.len());
+            counted.drawn_m += drawn;
+            counted.total_m += moved.strokes.iter().map(|s| s.length_m()).sum::<f64>();
+        }
+        Ok(counted)
+    };
+    let point_ik_top = top_places(&usual)?;
+    let bound_top = top_places(&ours)?;
     let row = PlaceRow {
         job: name.to_string(),
         strokes: job.strokes.len(),
@@ -280,6 +338,8 @@ fn evaluate(
         chosen_checked,
         point_ik_m,
         point_ik_complete,
+        point_ik_top,
+        bound_top,
         screened: ours.screened.len(),
         screening_s: ours.screening_s,
     };
@@ -307,6 +367,7 @@ fn markdown(record: &Record) -> String {
         .filter(|r| unfinished(r.point_ik_complete, r))
         .count();
     let sum = |value: fn(&PlaceRow) -> f64| rows.iter().map(value).sum::<f64>();
+    let count = |value: fn(&PlaceRow) -> usize| rows.iter().map(value).sum::<usize>();
     let twenty = rows.iter().find(|r| r.job == TWENTY);
     let mut md = format!(
         "# Placement ({})\n\n\
@@ -319,7 +380,13 @@ fn markdown(record: &Record) -> String {
          and takes the place it ranks first.\n\n\
          | | `emg place` | usual approach |\n|---|---|---|\n\
          | pen-down length drawn (Σ of {:.3} m; {:.3} m where the parts stand) | {:.3} ({:.1} %) | {:.3} ({:.1} %) |\n\
-         | jobs with strokes left unfinished (of {}) | {} | {} |\n\n",
+         | jobs with strokes left unfinished (of {}) | {} | {} |\n\n\
+         A score ranks many places first where the whole job lies in reach. Of the places each \
+         score ranks at its top (up to {TIED_PLANNED} per job, spread over the grid, each \
+         planned as a job): the point-by-point IK score's leave strokes unfinished at {} of {} \
+         ({:.1} % of their pen-down length drawn); the screening bound's at {} of {} ({:.1} %). \
+         Neither score alone says where the arm draws the job: `emg place` plans its best \
+         places before it chooses.\n\n",
         record.robot,
         record.command,
         record.machine,
@@ -346,6 +413,13 @@ fn markdown(record: &Record) -> String {
         rows.len(),
         ours_short,
         usual_short,
+        count(|r| r.point_ik_top.unfinished),
+        count(|r| r.point_ik_top.planned),
+        100.0 * sum(|r| r.point_ik_top.drawn_m)
+            / sum(|r| r.point_ik_top.total_m).max(f64::MIN_POSITIVE),
+        count(|r| r.bound_top.unfinished),
+        count(|r| r.bound_top.planned),
+        100.0 * sum(|r| r.bound_top.drawn_m) / sum(|r| r.bound_top.total_m).max(f64::MIN_POSITIVE),
     );
     if let Some(twenty) = twenty {
         let t = &record.top_twenty;
@@ -370,12 +444,12 @@ fn markdown(record: &Record) -> String {
         ));
     }
     md.push_str(
-        "| job | strokes | of (m) | where it stands (m) | `emg place` (m) | complete | program (s) | usual approach (m) | complete | screened | screening (s) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| job | strokes | of (m) | where it stands (m) | `emg place` (m) | complete | program (s) | usual approach (m) | complete | IK score's top places: unfinished / planned (of) | bound's top places: unfinished / planned (of) | screened | screening (s) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         md.push_str(&format!(
-            "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.2} | {:.3} | {} | {} | {:.1} |\n",
+            "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.2} | {:.3} | {} | {} / {} ({}) | {} / {} ({}) | {} | {:.1} |\n",
             r.job,
             r.strokes,
             r.total_m,
@@ -385,6 +459,12 @@ fn markdown(record: &Record) -> String {
             r.chosen_s,
             r.point_ik_m,
             r.point_ik_complete,
+            r.point_ik_top.unfinished,
+            r.point_ik_top.planned,
+            r.point_ik_top.places,
+            r.bound_top.unfinished,
+            r.bound_top.planned,
+            r.bound_top.places,
             r.screened,
             r.screening_s
         ));
