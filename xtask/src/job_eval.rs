@@ -139,13 +139,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let (planner, timing, checker) = setup(&args.robot)?;
     let robot_name = args.robot.display().to_string();
     let mut jobs: Vec<(String, Job)> = Vec::new();
-    let mut icons: Vec<PathBuf> = std::fs::read_dir(&args.icons)
-        .with_context(|| format!("reading {}", args.icons.display()))?
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|path| path.extension().is_some_and(|ext| ext == "svg"))
-        .collect();
-    icons.sort();
-    anyhow::ensure!(!icons.is_empty(), "no SVG in {}", args.icons.display());
+    let icons = icon_files(&args.icons)?;
     for icon in &icons {
         for (origin, width) in PLACES {
             let placement = Placement {
@@ -192,14 +186,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     one_thread.install(|| plan_job(&planner, &request, &grid, &timing, &robot_name, &|_, _| {}))?;
     let grid_one_thread_s = started.elapsed().as_secs_f64();
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: match shipped.map(|robot| robot.name) {
-            Some("fr3") => "cargo xtask job-eval".to_string(),
-            Some(name) => format!("cargo xtask job-eval --robot {name}"),
-            None => format!("cargo xtask job-eval --robot {}", args.robot.display()),
-        },
+        command: workspace::command_for("job-eval", &args.robot),
         icons: workspace::relative(&args.icons),
         machine: workspace::machine(),
         threads: rayon::current_num_threads(),
@@ -214,6 +203,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .count();
     anyhow::ensure!(failures == 0, "{failures} programs fail the checker");
     Ok(())
+}
+
+/// Every `*.svg` of `dir`, in name order (at least one).
+pub fn icon_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let mut icons: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "svg"))
+        .collect();
+    icons.sort();
+    anyhow::ensure!(!icons.is_empty(), "no SVG in {}", dir.display());
+    Ok(icons)
 }
 
 /// The planner `emg job` plans with (the cell's plate, the corrected step, 0.5 mm), its timing

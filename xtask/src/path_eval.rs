@@ -292,14 +292,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
     let (rows, failures): (Vec<PathRow>, Vec<Vec<String>>) = outcomes.into_iter().unzip();
     let failures: Vec<String> = failures.into_iter().flatten().collect();
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: match shipped.map(|robot| robot.name) {
-            Some("fr3") => "cargo xtask path-eval".to_string(),
-            Some(name) => format!("cargo xtask path-eval --robot {name}"),
-            None => format!("cargo xtask path-eval --robot {}", args.robot.display()),
-        },
+        command: workspace::command_for("path-eval", &args.robot),
         tasks: workspace::relative(&args.task_file),
         seed: args.seed,
         machine: workspace::machine(),

@@ -8,7 +8,6 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
 use emg_job::{
     Job, PartFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE, Score, place_job,
@@ -17,7 +16,7 @@ use emg_job::{
 use emg_planner::{MotionTiming, PlanRequest, Planner};
 use serde::{Deserialize, Serialize};
 
-use crate::job_eval::{grid_of_circles, setup};
+use crate::job_eval::{grid_of_circles, icon_files, setup};
 use crate::{progress, workspace};
 
 /// Options of `place-eval`.
@@ -141,12 +140,7 @@ const TWENTY: &str = "20 circles 2 cm across in a 4 × 5 grid round (0.75, 0, 0.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let (planner, timing, checker) = setup(&args.robot)?;
     let robot_name = args.robot.display().to_string();
-    let mut icons: Vec<PathBuf> = std::fs::read_dir(&args.icons)
-        .with_context(|| format!("reading {}", args.icons.display()))?
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|path| path.extension().is_some_and(|ext| ext == "svg"))
-        .collect();
-    icons.sort();
+    let icons = icon_files(&args.icons)?;
     let mut jobs: Vec<(String, Job)> = Vec::new();
     for icon in &icons {
         let placement = SvgPlacement {
@@ -231,14 +225,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         same_on_one_thread,
     };
     write_map(&args.map, &placement)?;
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: match shipped.map(|robot| robot.name) {
-            Some("fr3") => "cargo xtask place-eval".to_string(),
-            Some(name) => format!("cargo xtask place-eval --robot {name}"),
-            None => format!("cargo xtask place-eval --robot {}", args.robot.display()),
-        },
+        command: workspace::command_for("place-eval", &args.robot),
         machine: workspace::machine(),
         threads: rayon::current_num_threads(),
         region: REGION,

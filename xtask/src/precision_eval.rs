@@ -323,17 +323,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let [line_bounds_m, path_bounds_m] = bounds;
     let unfinished_at_tightest = unfinished(&rows, &paths, &path_bounds_m);
-    let shipped = emg_planner::ShippedRobot::by_path(&args.robot, &workspace::data_dir());
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: match shipped.map(|robot| robot.name) {
-            Some("fr3") => "cargo xtask precision-eval".to_string(),
-            Some(name) => format!("cargo xtask precision-eval --robot {name}"),
-            None => format!(
-                "cargo xtask precision-eval --robot {}",
-                args.robot.display()
-            ),
-        },
+        command: workspace::command_for("precision-eval", &args.robot),
         tasks: workspace::relative(&args.task_file),
         line_count: args.tasks,
         path_count: args.paths,

@@ -277,3 +277,13 @@ mod tests {
         assert_eq!(custom.urdf, PathBuf::from("arms/my_arm.urdf"));
     }
 }
+
+/// The command line of `cargo xtask SUBCOMMAND` for `robot`: no `--robot` for the FR3, the
+/// shipped arm's name for another, else the file.
+pub fn command_for(subcommand: &str, robot: &Path) -> String {
+    match emg_planner::ShippedRobot::by_path(robot, &data_dir()).map(|shipped| shipped.name) {
+        Some("fr3") => format!("cargo xtask {subcommand}"),
+        Some(name) => format!("cargo xtask {subcommand} --robot {name}"),
+        None => format!("cargo xtask {subcommand} --robot {}", robot.display()),
+    }
+}

@@ -8,9 +8,8 @@ use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, Order, plan_job};
 use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
-use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::output::write_text;
+use crate::output::{progress_bar, write_text};
 use crate::robot;
 
 /// What a job is and how it is planned: the options `emg job` and `emg place` share.
@@ -140,11 +139,7 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         timing,
         request,
     } = input.ready()?;
-    let bar = ProgressBar::new(job.strokes.len() as u64).with_style(
-        ProgressStyle::with_template("{msg:>8} [{bar:40}] {pos}/{len} strokes, {elapsed}")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
+    let bar = progress_bar(job.strokes.len() as u64, "strokes");
     bar.set_message("planning");
     let file = plan_job(
         &planner,

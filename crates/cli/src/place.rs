@@ -9,10 +9,9 @@ use clap::Args;
 use emg_job::{
     JOB_FORMAT_VERSION, JobSpec, PlaceSettings, Placement, Region, Score, place_job, placement_map,
 };
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::job::{JobInput, Ready, print_summary};
-use crate::output::write_text;
+use crate::output::{progress_bar, write_text};
 
 /// Options of `emg place`.
 #[derive(Debug, Args)]
@@ -110,11 +109,7 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
         timing,
         request,
     } = input.ready()?;
-    let bar = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("{msg:>8} [{bar:40}] {pos}/{len} places, {elapsed}")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
+    let bar = progress_bar(0, "places");
     let placement = place_job(
         &planner,
         &request,
