@@ -247,6 +247,16 @@ pub fn replace_readme_section(start: &str, end: &str, text: &str) -> anyhow::Res
     Ok(())
 }
 
+/// The command line of `cargo xtask SUBCOMMAND` for `robot`: no `--robot` for the FR3, the
+/// shipped arm's name for another, else the file.
+pub fn command_for(subcommand: &str, robot: &Path) -> String {
+    match emg_planner::ShippedRobot::by_path(robot, &data_dir()).map(|shipped| shipped.name) {
+        Some("fr3") => format!("cargo xtask {subcommand}"),
+        Some(name) => format!("cargo xtask {subcommand} --robot {name}"),
+        None => format!("cargo xtask {subcommand} --robot {}", robot.display()),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,15 +285,5 @@ mod tests {
         let custom = layout_of("arms/my_arm.urdf");
         assert_eq!(custom.subdir, "custom/my_arm");
         assert_eq!(custom.urdf, PathBuf::from("arms/my_arm.urdf"));
-    }
-}
-
-/// The command line of `cargo xtask SUBCOMMAND` for `robot`: no `--robot` for the FR3, the
-/// shipped arm's name for another, else the file.
-pub fn command_for(subcommand: &str, robot: &Path) -> String {
-    match emg_planner::ShippedRobot::by_path(robot, &data_dir()).map(|shipped| shipped.name) {
-        Some("fr3") => format!("cargo xtask {subcommand}"),
-        Some(name) => format!("cargo xtask {subcommand} --robot {name}"),
-        None => format!("cargo xtask {subcommand} --robot {}", robot.display()),
     }
 }
