@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 
 use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
 use emg_job::{
-    Job, PartFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE, Score, place_job,
-    plan_job, verify_job,
+    Job, Moving, PlaceFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE, Score,
+    place_job, plan_job, verify_job,
 };
 use emg_planner::{MotionTiming, PlanRequest, Planner};
 use serde::{Deserialize, Serialize};
@@ -39,6 +39,7 @@ pub struct Args {
 /// The region every job is placed in: shifts along the part's x and y axes (m), turns (°),
 /// across the edge of the arm's reach.
 const REGION: Region = Region {
+    moving: Moving::Part,
     x_m: [-0.2, 0.15],
     y_m: [-0.3, 0.3],
     rotation_deg: [-90.0, 90.0],
@@ -187,13 +188,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
     let placement = twenty_placement.expect("the 20-stroke job was placed");
     // Every one of the 20 best refined places planned.
-    let frame = PartFrame::of(&twenty);
+    let frame = PlaceFrame::of(&twenty, REGION.moving);
     let best_of_top_m = placement
         .refined
         .iter()
         .take(20)
         .map(|scored| {
-            let moved = twenty.moved(&frame.motion(&scored.place))?;
+            let moved = twenty.moved(&frame.job_motion(&scored.place))?;
             Ok(
                 plan_job(&planner, &request, &moved, &timing, &robot_name, &|_, _| {})
                     .map_or(0.0, |program| program.summary.drawn_m),
@@ -279,8 +280,8 @@ fn evaluate(
     let chosen_checked = verify_job(program, checker, planner.robot().joint_names()).is_ok();
     // The usual approach takes the place its score ranks first and plans it as it is.
     let usual = placed(Score::PointIk)?;
-    let frame = PartFrame::of(job);
-    let first = job.moved(&frame.motion(&usual.refined[0].place))?;
+    let frame = PlaceFrame::of(job, REGION.moving);
+    let first = job.moved(&frame.job_motion(&usual.refined[0].place))?;
     let (point_ik_m, point_ik_complete) = plan(&first).map_or((0.0, 0), |program| {
         (program.summary.drawn_m, program.summary.complete)
     });
@@ -304,7 +305,7 @@ fn evaluate(
             total_m: 0.0,
         };
         for k in 0..planned {
-            let moved = job.moved(&frame.motion(&tied[k * tied.len() / planned].place))?;
+            let moved = job.moved(&frame.job_motion(&tied[k * tied.len() / planned].place))?;
             let (drawn, complete) = plan(&moved).map_or((0.0, 0), |program| {
                 (program.summary.drawn_m, program.summary.complete)
             });

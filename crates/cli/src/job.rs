@@ -43,6 +43,10 @@ pub struct JobInput {
     /// SVG only: the drawing's width (m).
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
+    /// The cell's obstacles (a scene file, docs/scene.md), which the arm keeps clear of while
+    /// drawing and between strokes.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 /// Options of `emg job`.
@@ -79,12 +83,25 @@ pub struct Ready {
 }
 
 impl JobInput {
+    /// The files the job is read from, named as an overwrite refusal names them.
+    pub fn files(&self) -> Vec<(&'static str, &std::path::Path)> {
+        let mut files = vec![
+            ("job", self.file.as_path()),
+            ("robot file", self.robot.as_path()),
+        ];
+        files.extend(self.scene.as_deref().map(|path| ("--scene", path)));
+        files
+    }
+
     /// The job read and its planner set up.
     pub fn ready(&self) -> Result<Ready> {
         let robot = robot::load_robot(&self.robot, None, None)?;
         let job = read_job(self, &robot)?;
         let mut config = emg_job::job_config(self.tolerance * 1e-3);
         config.rollout.constraints.theta_max_deg = self.cone;
+        if let Some(path) = &self.scene {
+            config.rollout.constraints.scene = emg_io::read_scene(path)?;
+        }
         config.validate()?;
         let diffusion = robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
         let policy = robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE);
@@ -121,13 +138,7 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
-    emg_io::refuse_overwriting(
-        &[
-            ("job", input.file.as_path()),
-            ("robot file", input.robot.as_path()),
-        ],
-        &outputs,
-    )?;
+    emg_io::refuse_overwriting(&input.files(), &outputs)?;
     if let Some(format) = args.export {
         let robot = robot::load_robot(&input.robot, None, None)?;
         crate::export::refuse_format(format, &input.robot, &robot)

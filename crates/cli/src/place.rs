@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use emg_job::{
-    JOB_FORMAT_VERSION, JobSpec, PlaceSettings, Placement, Region, Score, place_job, placement_map,
+    JOB_FORMAT_VERSION, JobSpec, Moving, PlaceSettings, Placement, Region, Score, place_job,
+    placement_map,
 };
 
 use crate::job::{JobInput, Ready, print_summary};
@@ -19,15 +20,20 @@ pub struct PlaceArgs {
     /// The job and how it is planned.
     #[command(flatten)]
     pub input: JobInput,
-    /// The part's shifts searched along its x axis (the base's x laid on the surface): MIN,MAX
-    /// (m).
+    /// What moves: `part` (default: the part on its surface, turned about its normal through
+    /// its centre) or `base` (the robot's base on its mount, turned about its z axis; the part
+    /// and the cell stay).
+    #[arg(long = "move", value_name = "WHAT", value_parser = parse_moving, default_value = "part")]
+    pub moving: Moving,
+    /// The shifts searched along x (the part's: the base's x laid on the surface; the base's
+    /// own): MIN,MAX (m).
     #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.15,0.15")]
     pub x: [f64; 2],
-    /// The part's shifts searched along its y axis (normal × x): MIN,MAX (m).
+    /// The shifts searched along y (the part's: normal × x; the base's own): MIN,MAX (m).
     #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.15,0.15")]
     pub y: [f64; 2],
-    /// The part's turns searched about the surface normal through its centre: MIN,MAX
-    /// (degrees).
+    /// The turns searched (the part's about its surface normal through its centre, the base's
+    /// about its z axis): MIN,MAX (degrees).
     #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-90,90")]
     pub rotation: [f64; 2],
     /// Grid positions along each of x and y.
@@ -69,6 +75,14 @@ fn parse_range(value: &str) -> Result<[f64; 2], String> {
     }
 }
 
+fn parse_moving(value: &str) -> Result<Moving, String> {
+    match value {
+        "part" => Ok(Moving::Part),
+        "base" => Ok(Moving::Base),
+        other => Err(format!("'{other}' is not what moves: part or base")),
+    }
+}
+
 fn parse_score(value: &str) -> Result<Score, String> {
     match value {
         "bound" => Ok(Score::Bound),
@@ -83,14 +97,9 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(args.map.as_deref().map(|path| ("--map", path)));
     outputs.extend(args.export.as_deref().map(|path| ("--export", path)));
-    emg_io::refuse_overwriting(
-        &[
-            ("job", input.file.as_path()),
-            ("robot file", input.robot.as_path()),
-        ],
-        &outputs,
-    )?;
+    emg_io::refuse_overwriting(&input.files(), &outputs)?;
     let region = Region {
+        moving: args.moving,
         x_m: args.x,
         y_m: args.y,
         rotation_deg: args.rotation,
@@ -180,18 +189,36 @@ fn print_places(placement: &Placement) {
             place.duration_s
         );
     }
-    let t = placement.transform();
+    let place = &placement.best().scored.place;
+    let what = match placement.frame.moving {
+        Moving::Part => "the part",
+        Moving::Base => "the base",
+    };
     println!(
-        "chosen: shift ({:.3}, {:.3}) m, turn {:.1}° about the normal: transform translation_m \
-         [{:.4}, {:.4}, {:.4}], rpy [{:.4}, {:.4}, {:.4}]",
-        placement.best().scored.place.x_m,
-        placement.best().scored.place.y_m,
-        placement.best().scored.place.rotation_deg,
-        t.translation_m[0],
-        t.translation_m[1],
-        t.translation_m[2],
-        t.rpy[0],
-        t.rpy[1],
-        t.rpy[2]
+        "chosen: {what} shifted ({:.3}, {:.3}) m, turned {:.1}°",
+        place.x_m, place.y_m, place.rotation_deg
     );
+    let written = |t: &emg_job::Transform| {
+        format!(
+            "translation_m [{:.4}, {:.4}, {:.4}], rpy [{:.4}, {:.4}, {:.4}]",
+            t.translation_m[0],
+            t.translation_m[1],
+            t.translation_m[2],
+            t.rpy[0],
+            t.rpy[1],
+            t.rpy[2]
+        )
+    };
+    if let Some(pose) = placement.base_pose() {
+        println!(
+            "  the base's new pose in its present frame: {}",
+            written(&pose)
+        );
+        println!(
+            "  the job's and the scene's transform in the moved base's frame: {}",
+            written(&placement.transform())
+        );
+    } else {
+        println!("  the job's transform: {}", written(&placement.transform()));
+    }
 }

@@ -1,7 +1,8 @@
 //! `emg place`: an icon placed where the arm draws little of it is moved to where the planner
 //! draws all of it, the program there passed by `emg check`, the place written as a job file's
-//! transform that `emg job` plans the same; wrong regions refused naming what is wrong, nothing
-//! written.
+//! transform that `emg job` plans to the same program; the same by moving the robot's base in a
+//! cell, the cell read back with the same transform; wrong regions refused naming what is wrong,
+//! nothing written.
 
 mod common;
 
@@ -86,9 +87,62 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let output = emg(&["job", &export, "--out", &again]);
     assert!(output.status.success(), "{}", text(&output.stderr));
     assert_eq!(
-        drawn(&read_json(Path::new(&again))),
-        drawn(&read_json(Path::new(&placed)))
+        read_json(Path::new(&again))["points"],
+        read_json(Path::new(&placed))["points"]
     );
+}
+
+#[test]
+fn the_base_is_moved_in_its_cell_to_where_the_icon_is_drawn_whole() {
+    let dir = temp_dir("place-base");
+    let pencil = pencil();
+    let cell = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/cell.json");
+    let file = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (placed, export) = (file("placed.json"), file("placed-job.json"));
+    let mut place = vec!["place", pencil.to_str().unwrap()];
+    place.extend(FAR);
+    place.extend([
+        "--scene",
+        cell.to_str().unwrap(),
+        "--move",
+        "base",
+        "--x=0,0.3",
+        "--y=-0.1,0.1",
+        "--rotation=-30,30",
+        "--positions",
+        "3",
+        "--rotations",
+        "2",
+        "--certify",
+        "2",
+        "--out",
+        &placed,
+        "--export",
+        &export,
+    ]);
+    let output = emg(&place);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    assert!(stdout.contains("the base's new pose"), "{stdout}");
+    let program = read_json(Path::new(&placed));
+    let (drawn_m, total_m) = drawn(&program);
+    assert!(
+        drawn_m > total_m - 1e-3,
+        "{drawn_m} of {total_m} m:\n{stdout}"
+    );
+    let check = emg(&["check", &placed]);
+    assert!(check.status.success(), "{}", text(&check.stdout));
+    // In the moved base's frame the cell moves as the job does: the cell file with the job's
+    // transform plans the same program.
+    let job = read_json(Path::new(&export));
+    let mut scene = read_json(&cell);
+    scene["transform"] = job["transform"].clone();
+    let moved_cell = file("cell-moved.json");
+    std::fs::write(&moved_cell, scene.to_string()).unwrap();
+    let again = file("again.json");
+    let output = emg(&["job", &export, "--scene", &moved_cell, "--out", &again]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    assert_eq!(read_json(Path::new(&again))["points"], program["points"]);
 }
 
 #[test]

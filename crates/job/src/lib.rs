@@ -35,8 +35,8 @@ pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surface
 pub use order::{Ordering, Oriented, order_strokes};
 pub use page::{placement_map, viewer_page};
 pub use place::{
-    Certified, PartFrame, Place, PlaceError, PlaceSettings, Placement, Region, SAME_SCORE, Score,
-    Scored, place_job, place_score,
+    Certified, Moving, Place, PlaceError, PlaceFrame, PlaceSettings, Placement, Region, SAME_SCORE,
+    Score, Scored, place_job, place_score,
 };
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
@@ -275,6 +275,10 @@ pub fn plan_job(
     })
 }
 
+/// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
+/// into free space (near an obstacle, say).
+const LIFT_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
+
 /// A stroke part made ready to join the program: timed, with its free configurations above
 /// its start and end and the free move to the first from where the arm was.
 struct Placed {
@@ -308,13 +312,18 @@ impl Connector<'_> {
             .map_err(|e| format!("cannot be timed: {e}"))?;
         let start = timed.samples[0].q;
         let end = timed.samples[timed.samples.len() - 1].q;
-        let lift = -part.task.n * self.settings.lift_m;
+        // The tool lifts the job's height where that is free, else half or a quarter of it.
         let above = |q: &JointVector, what: &str| {
-            self.free
-                .reach_point(q, &(robot.forward(q).tcp() + lift))
+            LIFT_SHARES
+                .iter()
+                .find_map(|share| {
+                    let lift = -part.task.n * (self.settings.lift_m * share);
+                    self.free.reach_point(q, &(robot.forward(q).tcp() + lift))
+                })
                 .ok_or_else(|| {
                     format!(
-                        "the tool cannot lift {} m off its {what} into free space",
+                        "the tool cannot lift {} m (or a quarter of it) off its {what} into free \
+                         space",
                         self.settings.lift_m
                     )
                 })

@@ -1,6 +1,7 @@
-//! The place stage: where to put the part so that the job reaches furthest. A place is the part
-//! shifted in its surface's plane and turned about its normal ([`Place`], in the [`PartFrame`]);
-//! the places of a [`Region`] are
+//! The place stage: where to put the part, or the robot's base, so that the job reaches
+//! furthest. A place is the part shifted in its surface's plane and turned about its normal, or
+//! the base shifted on its mount and turned about its vertical axis ([`Place`], in the
+//! [`PlaceFrame`], [`Moving`]); the places of a [`Region`] are
 //!
 //! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
 //!    (the part under the strokes kept off, as the job plans), Σ min(bound, length) / Σ length,
@@ -13,7 +14,7 @@
 //! Every score and plan is deterministic and independent of the number of threads; ties keep
 //! the grid's order.
 
-use emg_control::Task;
+use emg_control::{ConstraintConfig, Task};
 use emg_kinematics::{Vec3, rotation_about};
 use emg_planner::{MotionTiming, PlanRequest, Planner, ReachConfig, reach, reachable_points};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -29,11 +30,27 @@ use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
 /// first.
 pub const SAME_SCORE: f64 = 1e-3;
 
-/// The places searched: the part's shift along the [`PartFrame`]'s axes (m) and its turn about
-/// the surface normal (degrees), each a closed range `[low, high]`.
+/// What a placement moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Moving {
+    /// The part, with the strokes on it: shifted on its surface, turned about its normal through
+    /// the strokes' centre. The cell stays.
+    #[default]
+    Part,
+    /// The robot's base on its mount: shifted along the base's x and y, turned about its z axis
+    /// through its origin. The part and the cell stay, so in the base's frame both move back.
+    Base,
+}
+
+/// The places searched: the shift along the [`PlaceFrame`]'s axes (m) and the turn about its
+/// normal (degrees), each a closed range `[low, high]`, of the part or the base.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
+    /// What moves.
+    #[serde(default)]
+    pub moving: Moving,
     /// Shift along the frame's x axis (m).
     pub x_m: [f64; 2],
     /// Shift along the frame's y axis (m).
@@ -111,11 +128,14 @@ pub enum PlaceError {
     NothingDrawn(JobPlanError),
 }
 
-/// The frame places are measured in: the centre of the strokes' points, the surface normal
-/// pointing to the tool's side (−n of the first stroke), x the base's x axis laid on the
-/// surface (its y axis where x stands along the normal), y = normal × x.
+/// The frame places are measured in. Moving the part: the centre of the strokes' points, the
+/// surface normal pointing to the tool's side (−n of the first stroke), x the base's x axis laid
+/// on the surface (its y axis where x stands along the normal), y = normal × x. Moving the base:
+/// the base's own origin and axes (normal z).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PartFrame {
+pub struct PlaceFrame {
+    /// What moves.
+    pub moving: Moving,
     /// Centre of the strokes' points (m).
     pub centre: [f64; 3],
     /// Unit normal toward the tool.
@@ -126,9 +146,18 @@ pub struct PartFrame {
     pub y: [f64; 3],
 }
 
-impl PartFrame {
-    /// The frame of `job`'s part.
-    pub fn of(job: &Job) -> Self {
+impl PlaceFrame {
+    /// The frame of `job`'s part, or of the base, as `moving` says.
+    pub fn of(job: &Job, moving: Moving) -> Self {
+        if moving == Moving::Base {
+            return Self {
+                moving,
+                centre: [0.0; 3],
+                normal: Vec3::z().into(),
+                x: Vec3::x().into(),
+                y: Vec3::y().into(),
+            };
+        }
         let points: Vec<Vec3> = job
             .strokes
             .iter()
@@ -148,6 +177,7 @@ impl PartFrame {
             .unwrap_or_else(|| on_surface(Vec3::z()))
             .normalize();
         Self {
+            moving,
             centre: centre.into(),
             normal: normal.into(),
             x: x.into(),
@@ -155,7 +185,19 @@ impl PartFrame {
         }
     }
 
-    /// The rigid motion that puts the part at `place`: turned about the normal through the
+    /// The motion of the job and of the cell in the base's frame at `place`: the part's
+    /// [`PlaceFrame::motion`] moving the part (the cell stays), its inverse moving the base;
+    /// rounded through the [`Transform`] a file writes, so that a job (and a scene) read back
+    /// with the exported transform is bit for bit the one planned.
+    pub fn job_motion(&self, place: &Place) -> Isometry3<f64> {
+        let motion = match self.moving {
+            Moving::Part => self.motion(place),
+            Moving::Base => self.motion(place).inverse(),
+        };
+        Transform::of(&motion).isometry()
+    }
+
+    /// The rigid motion that puts what moves at `place`: turned about the normal through the
     /// centre, then shifted along x and y.
     pub fn motion(&self, place: &Place) -> Isometry3<f64> {
         let centre = Vec3::from(self.centre);
@@ -216,7 +258,7 @@ pub struct Certified {
 #[derive(Clone, Debug, Serialize)]
 pub struct Placement {
     /// The frame places are measured in.
-    pub frame: PartFrame,
+    pub frame: PlaceFrame,
     /// The region searched.
     pub region: Region,
     /// Every screened place, in grid order (x slowest, then y, then the turn).
@@ -235,9 +277,16 @@ impl Placement {
         &self.certified[0]
     }
 
-    /// The chosen place as a transform a job file takes (`transform`).
+    /// The chosen place as the transform a job file (and, moving the base, a scene file)
+    /// takes: the motion of the job and the cell in the base's frame.
     pub fn transform(&self) -> Transform {
-        Transform::of(&self.frame.motion(&self.best().scored.place))
+        Transform::of(&self.frame.job_motion(&self.best().scored.place))
+    }
+
+    /// Moving the base: where the chosen place puts it, in its present frame.
+    pub fn base_pose(&self) -> Option<Transform> {
+        (self.frame.moving == Moving::Base)
+            .then(|| Transform::of(&self.frame.motion(&self.best().scored.place)))
     }
 }
 
@@ -327,13 +376,14 @@ pub enum Score {
 pub fn place_score(
     planner: &Planner,
     job: &Job,
-    frame: &PartFrame,
+    frame: &PlaceFrame,
     place: &Place,
     config: &ReachConfig,
     score: Score,
 ) -> Result<Scored, JobError> {
     let robot = planner.robot();
-    let moved = job.moved(&frame.motion(place))?;
+    let motion = frame.job_motion(place);
+    let moved = job.moved(&motion)?;
     let (centre, radius) = robot.reach_sphere();
     let depth_m = moved
         .strokes
@@ -345,7 +395,7 @@ pub fn place_score(
         .map(|point| radius - (point - centre).norm())
         .fold(f64::INFINITY, f64::min);
     let constraints = with_part(
-        &planner.config().rollout.constraints,
+        &cell_at(&planner.config().rollout.constraints, frame, &motion),
         &job_part(robot, &moved),
     );
     let (mut reached, mut total) = (0.0, 0.0);
@@ -390,7 +440,7 @@ pub fn place_job(
 ) -> Result<Placement, PlaceError> {
     region.validate()?;
     settings.validate()?;
-    let frame = PartFrame::of(job);
+    let frame = PlaceFrame::of(job, region.moving);
     let xs = spread(region.x_m, settings.positions);
     let ys = spread(region.y_m, settings.positions);
     let turns = spread(region.rotation_deg, settings.rotations);
@@ -465,9 +515,15 @@ pub fn place_job(
     let mut first_failure = None;
     let candidates: Vec<Scored> = refined.iter().take(settings.certify).copied().collect();
     for (index, candidate) in candidates.iter().enumerate() {
-        let moved = job.moved(&frame.motion(&candidate.place))?;
+        let motion = frame.job_motion(&candidate.place);
+        let moved = job.moved(&motion)?;
         let total_m = moved.strokes.iter().map(|s| s.length_m()).sum();
-        let planned = plan_job(planner, request, &moved, timing, robot_file, &|_, _| {});
+        let mut config = planner.config().clone();
+        config.rollout.constraints = cell_at(&config.rollout.constraints, &frame, &motion);
+        let at_place = planner
+            .with_config(config)
+            .expect("the planner's configuration with its cell moved is valid");
+        let planned = plan_job(&at_place, request, &moved, timing, robot_file, &|_, _| {});
         progress("certify", index + 1, candidates.len());
         certified.push(match planned {
             Ok(program) => Certified {
@@ -514,6 +570,22 @@ pub fn place_job(
         certified,
         screening_s,
     })
+}
+
+/// `constraints` with the cell where the place puts it relative to the base: moved by `motion`
+/// when the base moves, as they are when the part does.
+fn cell_at(
+    constraints: &ConstraintConfig,
+    frame: &PlaceFrame,
+    motion: &Isometry3<f64>,
+) -> ConstraintConfig {
+    match frame.moving {
+        Moving::Part => constraints.clone(),
+        Moving::Base => ConstraintConfig {
+            scene: constraints.scene.moved(motion),
+            ..constraints.clone()
+        },
+    }
 }
 
 /// `scored` best first: by score (in steps of [`SAME_SCORE`]), then deeper inside the arm's

@@ -2,8 +2,9 @@
 //! into a [`Job`].
 
 use emg_control::{Path, PathError, PathSpec};
-use emg_kinematics::{JointVector, Robot, Vec3, rotation_from_rpy, rpy_of};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+pub use emg_kinematics::Transform;
+use emg_kinematics::{JointVector, Robot};
+use nalgebra::Isometry3;
 use serde::{Deserialize, Serialize};
 
 /// The job file version this build reads.
@@ -27,38 +28,6 @@ pub struct JobSpec {
     /// A rigid motion applied to every stroke (the place `emg place --export` writes).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub transform: Option<Transform>,
-}
-
-/// A rigid motion in the base frame: a turn by the URDF roll–pitch–yaw `rpy` (rad, about the
-/// base's fixed x, y, z axes through its origin), then a shift by `translation_m` (m).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Transform {
-    /// The shift (m).
-    pub translation_m: [f64; 3],
-    /// The turn (rad).
-    #[serde(default)]
-    pub rpy: [f64; 3],
-}
-
-impl Transform {
-    /// The motion as an isometry.
-    pub fn isometry(&self) -> Isometry3<f64> {
-        let [roll, pitch, yaw] = self.rpy;
-        Isometry3::from_parts(
-            Translation3::from(Vec3::from(self.translation_m)),
-            UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(roll, pitch, yaw)),
-        )
-    }
-
-    /// The transform of `motion`.
-    pub fn of(motion: &Isometry3<f64>) -> Self {
-        let (roll, pitch, yaw) = rpy_of(&motion.rotation.to_rotation_matrix());
-        Self {
-            translation_m: motion.translation.vector.into(),
-            rpy: [roll, pitch, yaw],
-        }
-    }
 }
 
 /// The order the strokes are drawn in.
@@ -161,9 +130,6 @@ pub enum JobError {
     /// The home configuration does not fit the arm.
     #[error("job field 'home': {0}")]
     Home(String),
-    /// The transform holds a number that is not finite.
-    #[error("job field 'transform' must hold finite numbers, got {0:?}")]
-    Transform(Transform),
 }
 
 impl JobSettings {
@@ -226,13 +192,7 @@ impl Job {
             return Err(JobError::NoStrokes);
         }
         spec.settings.validate()?;
-        let motion = match spec.transform {
-            Some(t) if t.translation_m.iter().chain(&t.rpy).all(|v| v.is_finite()) => {
-                Some(t.isometry())
-            }
-            Some(t) => return Err(JobError::Transform(t)),
-            None => None,
-        };
+        let motion = spec.transform.map(|t| t.isometry());
         let strokes = spec
             .strokes
             .into_iter()

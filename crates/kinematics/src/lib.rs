@@ -56,7 +56,7 @@ pub use projection::{
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
-pub use rotation::{rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
+pub use rotation::{Transform, rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
 pub use scene::{
     ContactHit, Obstacle, ObstacleError, Plate, Scene, Shape, ToolContact, WorkSurface,
     capsule_ray_entry,

@@ -4,9 +4,11 @@
 //! library, whose last bits differ between platforms (and, with glibc, between CPUs with and
 //! without fused multiply-adds). These take them from the `libm` crate, pure Rust and the same
 //! arithmetic everywhere, so a robot file, a scene or a task turns into the same numbers on
-//! every machine (the workspace's `clippy.toml` forbids the others).
+//! every machine (the workspace's `clippy.toml` forbids the others); and [`Transform`], a rigid
+//! motion as files write it.
 
-use nalgebra::{Matrix3, Rotation3};
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
+use serde::{Deserialize, Serialize};
 
 use crate::Vec3;
 
@@ -128,6 +130,38 @@ mod tests {
             let m = rotation.matrix();
             assert!((m * m.transpose() - Matrix3::identity()).amax() < 1e-12);
             assert!((m.determinant() - 1.0).abs() < 1e-12);
+        }
+    }
+}
+
+/// A rigid motion in the base frame: a turn by the URDF roll–pitch–yaw `rpy` (rad, about the
+/// base's fixed x, y, z axes through its origin), then a shift by `translation_m` (m).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    /// The shift (m).
+    pub translation_m: [f64; 3],
+    /// The turn (rad).
+    #[serde(default)]
+    pub rpy: [f64; 3],
+}
+
+impl Transform {
+    /// The motion as an isometry.
+    pub fn isometry(&self) -> Isometry3<f64> {
+        let [roll, pitch, yaw] = self.rpy;
+        Isometry3::from_parts(
+            Translation3::from(Vec3::from(self.translation_m)),
+            UnitQuaternion::from_rotation_matrix(&rotation_from_rpy(roll, pitch, yaw)),
+        )
+    }
+
+    /// The transform of `motion`.
+    pub fn of(motion: &Isometry3<f64>) -> Self {
+        let (roll, pitch, yaw) = rpy_of(&motion.rotation.to_rotation_matrix());
+        Self {
+            translation_m: motion.translation.vector.into(),
+            rpy: [roll, pitch, yaw],
         }
     }
 }

@@ -1,14 +1,14 @@
 //! The cell around the arm: obstacles (half-spaces, boxes, spheres, capsules in the base frame,
 //! each with the clearance it asks for) and the clearance of the arm's capsules from them.
 
-use nalgebra::Rotation3;
+use nalgebra::{Isometry3, Rotation3};
 use serde::{Deserialize, Serialize};
 
 use crate::Vec3;
 use crate::collision::segment_distance;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
-use crate::rotation::{rotation_from_rpy, rpy_of};
+use crate::rotation::{Transform, rotation_from_rpy, rpy_of};
 
 /// A solid the arm keeps clear of, in the base frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -50,6 +50,35 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// The solid moved rigidly by `motion`.
+    pub fn moved(&self, motion: &Isometry3<f64>) -> Self {
+        let point = |p: &Vec3| (motion * nalgebra::Point3::from(*p)).coords;
+        match self {
+            Self::HalfSpace { point: p, normal } => Self::HalfSpace {
+                point: point(p),
+                normal: motion.rotation * normal,
+            },
+            Self::Cuboid {
+                centre,
+                rotation,
+                half_extents,
+            } => Self::Cuboid {
+                centre: point(centre),
+                rotation: motion.rotation.to_rotation_matrix() * rotation,
+                half_extents: *half_extents,
+            },
+            Self::Sphere { centre, radius } => Self::Sphere {
+                centre: point(centre),
+                radius: *radius,
+            },
+            Self::Capsule { start, end, radius } => Self::Capsule {
+                start: point(start),
+                end: point(end),
+                radius: *radius,
+            },
+        }
+    }
+
     /// The work surface of a task (SPEC §9): the plane through `p0` with normal `n`, the
     /// material on the side `(x − p0)·n > 0` (`n` points from the tool into the surface).
     pub fn work_surface(p0: &Vec3, n: &Vec3) -> Self {
@@ -424,6 +453,20 @@ impl Scene {
     pub fn is_empty(&self) -> bool {
         self.obstacles.is_empty()
     }
+
+    /// The scene with every obstacle moved rigidly by `motion`.
+    pub fn moved(&self, motion: &Isometry3<f64>) -> Self {
+        Self {
+            obstacles: self
+                .obstacles
+                .iter()
+                .map(|obstacle| Obstacle {
+                    shape: obstacle.shape.moved(motion),
+                    ..obstacle.clone()
+                })
+                .collect(),
+        }
+    }
 }
 
 /// Which capsules of the arm an obstacle may touch.
@@ -480,6 +523,10 @@ impl Robot {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SceneFile {
+    /// A rigid motion applied to every obstacle as it is read (not written: a scene writes its
+    /// obstacles where they are).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    transform: Option<Transform>,
     obstacles: Vec<ObstacleFile>,
 }
 
@@ -493,13 +540,19 @@ impl TryFrom<SceneFile> for Scene {
             .enumerate()
             .map(|(index, obstacle)| obstacle.into_obstacle(index))
             .collect::<Result<_, _>>()?;
-        Ok(Self { obstacles })
+        let scene = Self { obstacles };
+        // JSON numbers are finite, so a transform read is one.
+        Ok(match file.transform {
+            Some(transform) => scene.moved(&transform.isometry()),
+            None => scene,
+        })
     }
 }
 
 impl From<Scene> for SceneFile {
     fn from(scene: Scene) -> Self {
         Self {
+            transform: None,
             obstacles: scene
                 .obstacles
                 .into_iter()

@@ -110,6 +110,43 @@ fn segment_distance_matches_a_dense_sampling_of_every_shape() {
     );
 }
 
+/// A rigid motion moves a segment and every shape together: their distance is unchanged; a scene
+/// file's `transform` moves its obstacles as `Scene::moved` does.
+#[test]
+fn moved_shapes_keep_their_distances_and_scene_files_move_theirs() {
+    let mut rng = rng(12);
+    for case in 0..2_000 {
+        let shape = random_shape(&mut rng, case % 4);
+        let (a, b) = (random_point(&mut rng, 0.5), random_point(&mut rng, 0.5));
+        let motion = nalgebra::Isometry3::from_parts(
+            nalgebra::Translation3::from(random_point(&mut rng, 0.5)),
+            nalgebra::UnitQuaternion::from_rotation_matrix(&rotation_about(
+                &random_unit(&mut rng),
+                rng.random_range(-3.0..3.0),
+            )),
+        );
+        let moved = |p: &Vec3| (motion * nalgebra::Point3::from(*p)).coords;
+        let before = shape.segment_distance(&a, &b);
+        let after = shape
+            .moved(&motion)
+            .segment_distance(&moved(&a), &moved(&b));
+        assert!(
+            (before - after).abs() < 1e-9,
+            "case {case}: {before} vs {after}"
+        );
+    }
+    let text = r#"{"transform": {"translation_m": [0.1, -0.2, 0.3], "rpy": [0, 0, 1.5707963267948966]},
+        "obstacles": [{"sphere": {"centre": [0.5, 0, 0], "radius": 0.05}}]}"#;
+    let scene: Scene = serde_json::from_str(text).unwrap();
+    let Shape::Sphere { centre, .. } = &scene.obstacles[0].shape else {
+        panic!("a sphere")
+    };
+    assert!(
+        (centre - Vec3::new(0.1, 0.3, 0.3)).norm() < 1e-12,
+        "{centre}"
+    );
+}
+
 #[test]
 fn box_distances_known_answers() {
     let unit_box = Shape::Cuboid {
