@@ -353,7 +353,17 @@ impl JobPlacement {
         python(py, &self.placement.screened)
     }
 
-    /// The chosen place as a job file's `transform` (`translation_m`, `rpy`).
+    /// Moving the base: its new pose in its present frame (`translation_m`, `rpy`); else `None`.
+    #[getter]
+    fn base_pose<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.placement
+            .base_pose()
+            .map(|pose| python(py, &pose))
+            .transpose()
+    }
+
+    /// The chosen place as a job file's (and, moving the base, a scene file's) `transform`
+    /// (`translation_m`, `rpy`).
     #[getter]
     fn transform<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         python(py, &self.placement.transform())

@@ -391,7 +391,8 @@ impl Planner {
 
     /// Finds where to put a job's part (docs/placement.md): `job` and `placement` as for
     /// `plan_job`; `region` a dict of `x_m`, `y_m` (shifts along the part's axes, m) and
-    /// `rotation_deg` (turns about its normal), each `[low, high]`; `positions² × rotations`
+    /// `rotation_deg` (turns about its normal), each `[low, high]`, and `moving` (`"part"`, the
+    /// default, or `"base"`: the robot's base on its mount); `positions² × rotations`
     /// places screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
     /// the share of stroke points with an IK solution), the best `certify` planned as full jobs.
     /// Returns a `JobPlacement`; a bad region or setting raises `InputError` naming it, a

@@ -1,6 +1,7 @@
 """Placement from Python: `Planner.place_job` moves lucide's pencil from the edge of the FR3's
 reach to where the arm draws it whole, the same place as `emg place`, its program passing
-`emg check`; a bad region is refused naming the field.
+`emg check`; or the robot's base to where it draws it; a bad region is refused naming the
+field.
 
 EMG_CLI names the `emg` binary to compare with (default: target/debug/emg of this checkout).
 """
@@ -51,6 +52,20 @@ def test_the_pencil_is_moved_where_it_is_drawn_whole_as_emg_place_moves_it(tmp_p
     ours = tmp_path / "python.json"
     placement.program.write(ours)
     run_cli("check", ours)
+
+
+def test_the_base_moves_instead_of_the_part():
+    placement = elm.Planner("fr3").place_job(
+        PENCIL,
+        {"moving": "base", "x_m": [0.0, 0.3], "y_m": [-0.1, 0.1], "rotation_deg": [-30, 30]},
+        placement=FAR, positions=3, rotations=2, certify=2,
+    )
+    best = placement.certified[0]
+    assert best["drawn_m"] == pytest.approx(best["total_m"], abs=1e-3)
+    pose = placement.base_pose
+    assert pose["translation_m"][0] == pytest.approx(best["scored"]["place"]["x_m"])
+    # The job moves back as the base moves forward.
+    assert placement.transform["rpy"][2] == pytest.approx(-pose["rpy"][2])
 
 
 def test_a_bad_region_is_refused_naming_the_field():
