@@ -133,8 +133,8 @@ pub struct JobFile {
     pub strokes: Vec<StrokeReport>,
     /// The totals.
     pub summary: JobSummary,
-    /// The part the moves keep off: one task per plane of the strokes, whose work plate covers
-    /// them all ([`crate::part_surfaces`]).
+    /// The part the arm keeps off while drawing and moving: one task per plane of the strokes,
+    /// whose work plate covers them all ([`crate::part_surfaces`]).
     pub surfaces: Vec<Task>,
     /// The segments in time order.
     pub segments: Vec<Segment>,

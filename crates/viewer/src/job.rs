@@ -114,7 +114,7 @@ pub struct JobViewerInput<'a> {
     /// [`JOB_PAGE_RATE_HZ`] of them, at their times).
     pub samples: &'a [JobSample],
     /// The tasks whose work surfaces are drawn (for a job, `emg_job::part_surfaces` of its
-    /// stroke parts' tasks: one plate per plane the strokes lie on).
+    /// strokes: the part, one plate per plane the strokes lie on).
     pub surfaces: &'a [Task],
     /// The constraints the job was planned under (tool cone, work surface, obstacles).
     pub constraints: &'a ConstraintConfig,
