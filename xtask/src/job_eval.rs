@@ -87,6 +87,26 @@ pub struct JobRow {
 /// The name of the job of [`grid_of_circles`]`(10, 10, …)`.
 const GRID: &str = "100 circles 2 cm across in a 10 × 10 grid";
 
+/// The name of the job of [`hatch`].
+const HATCH: &str = "100 parallel seams 0.2 m long, 3 mm apart";
+
+/// A job of 100 strokes: seams 0.2 m long along the base's y, 3 mm apart along its x from
+/// (0.3, −0.1, 0.25), pen down.
+fn hatch() -> Vec<PathSpec> {
+    (0..100)
+        .map(|k| {
+            let x = 0.3 + 0.003 * k as f64;
+            PathSpec {
+                version: emg_control::PATH_FORMAT_VERSION,
+                start: [x, -0.1, 0.25],
+                normal: [0.0, 0.0, -1.0],
+                blend_radius_m: 0.0,
+                segments: vec![SegmentSpec::Line { to: [x, 0.1, 0.25] }],
+            }
+        })
+        .collect()
+}
+
 /// A job of `rows × columns` strokes: circles of 1 cm radius, 3 cm apart in a grid pen down
 /// round `centre` (m), rows along the base's x.
 pub fn grid_of_circles(rows: usize, columns: usize, centre: [f64; 3]) -> Vec<PathSpec> {
@@ -128,8 +148,8 @@ pub struct Record {
     pub machine: String,
     /// Threads the jobs of `rows` were planned on.
     pub threads: usize,
-    /// Planning time of the grid job ([`GRID`]) on one thread (s).
-    pub grid_one_thread_s: f64,
+    /// Planning time of each 100-stroke job ([`GRID`], [`HATCH`]) on one thread (s).
+    pub one_thread_s: Vec<(String, f64)>,
     /// Every job.
     pub rows: Vec<JobRow>,
 }
@@ -165,8 +185,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             Job::from_strokes(seams(tilt_deg), planner.robot())?,
         ));
     }
-    let grid = Job::from_strokes(grid_of_circles(10, 10, [0.45, 0.0, 0.25]), planner.robot())?;
-    jobs.push((GRID.to_string(), grid.clone()));
+    let hundreds = [
+        (GRID, grid_of_circles(10, 10, [0.45, 0.0, 0.25])),
+        (HATCH, hatch()),
+    ];
+    for (name, strokes) in &hundreds {
+        jobs.push((
+            name.to_string(),
+            Job::from_strokes(strokes.clone(), planner.robot())?,
+        ));
+    }
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
     for (name, job) in &jobs {
@@ -183,16 +211,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
     let request = PlanRequest::default();
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let started = Instant::now();
-    one_thread.install(|| plan_job(&planner, &request, &grid, &timing, &robot_name, &|_, _| {}))?;
-    let grid_one_thread_s = started.elapsed().as_secs_f64();
+    let mut one_thread_s = Vec::new();
+    for (name, job) in jobs
+        .iter()
+        .filter(|(name, _)| [GRID, HATCH].contains(&name.as_str()))
+    {
+        let started = Instant::now();
+        one_thread
+            .install(|| plan_job(&planner, &request, job, &timing, &robot_name, &|_, _| {}))?;
+        one_thread_s.push((name.clone(), started.elapsed().as_secs_f64()));
+    }
     let record = Record {
         robot: planner.robot().name().to_string(),
         command: workspace::command_for("job-eval", &args.robot),
         icons: workspace::relative(&args.icons),
         machine: workspace::machine(),
         threads: rayon::current_num_threads(),
-        grid_one_thread_s,
+        one_thread_s,
         rows,
     };
     workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
@@ -386,11 +421,10 @@ fn markdown(record: &Record) -> String {
     let sum = |value: fn(&JobRow) -> f64| rows.iter().map(value).sum::<f64>();
     let count = |value: fn(&JobRow) -> usize| rows.iter().map(value).sum::<usize>();
     let strokes = count(|r| r.strokes);
-    let grid = rows.iter().find(|r| r.job == GRID).unwrap_or(&rows[0]);
     let mut md = format!(
         "# Jobs ({})\n\n\
          Written by `{}` on {}. Every SVG of `{}` placed pen down at {} places in front of the \
-         arm, five seams on surfaces tilted 0°, 20° and 40°, and {GRID}, planned as `emg job` plans \
+         arm, five seams on surfaces tilted 0°, 20° and 40°, {GRID} and {HATCH}, planned as `emg job` plans \
          them (the search per stroke, resumed where one motion cannot finish it, safe moves \
          between strokes, 0.5 mm, 30°); every program re-checked segment by segment by the \
          independent checker. The baseline is what a user scripts today: each stroke planned \
@@ -404,8 +438,7 @@ fn markdown(record: &Record) -> String {
          | program duration, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | {:.1} |\n\
          | pen-up time / pen-down time | {:.2} | — |\n\
          | planning time per stroke, mean (ms, {} threads) | {:.1} | — |\n\
-         | {GRID}: planning (s) on {} threads / on one | {:.2} / {:.2} ({:.1} ms per stroke on one) | — |\n\
-         | programs the checker refuses | {} of {} | — |\n\n",
+         | programs the checker refuses | {} of {} | — |\n",
         record.robot,
         record.command,
         record.machine,
@@ -429,13 +462,21 @@ fn markdown(record: &Record) -> String {
         sum(|r| r.pen_up_s) / sum(|r| r.pen_down_s).max(f64::MIN_POSITIVE),
         record.threads,
         1e3 * sum(|r| r.planning_s) / strokes.max(1) as f64,
-        record.threads,
-        grid.planning_s,
-        record.grid_one_thread_s,
-        1e3 * record.grid_one_thread_s / grid.strokes.max(1) as f64,
         rows.iter().filter(|r| r.checker_failure.is_some()).count(),
         rows.len(),
     );
+    for (name, one_thread_s) in &record.one_thread_s {
+        if let Some(row) = rows.iter().find(|r| &r.job == name) {
+            md.push_str(&format!(
+                "| {name}: planning (s) on {} threads / on one | {:.2} / {:.2} ({:.1} ms per stroke on one) | — |\n",
+                record.threads,
+                row.planning_s,
+                one_thread_s,
+                1e3 * one_thread_s / row.strokes.max(1) as f64,
+            ));
+        }
+    }
+    md.push('\n');
     md.push_str(
         "| job | strokes | complete / resumed / short | drawn (m) | of (m) | pen down (s) | pen up (s) | \
          moves straight / sampled | planning (s) | baseline drawn (m) | baseline colliding moves |\n\
