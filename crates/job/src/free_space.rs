@@ -273,6 +273,37 @@ impl<'a> FreeSpace<'a> {
             })
     }
 
+    /// Whether the motion through `path` (a timed motion's samples, close together) is free:
+    /// its ends, and the configurations along the polyline of its samples every
+    /// [`FreeSpace::edge_free`] step of joint-space length (`Σ|Δq_i|`), those with half
+    /// [`MAX_POINT_TRAVEL_M`] more clearance, as an edge is checked.
+    pub fn path_free(&self, path: &[JointVector]) -> bool {
+        let (Some(first), Some(last)) = (path.first(), path.last()) else {
+            return true;
+        };
+        if !(self.free(first) && self.free(last)) {
+            return false;
+        }
+        // Joint-space length walked since the last configuration checked.
+        let mut since = 0.0;
+        for pair in path.windows(2) {
+            let chord = pair[1] - pair[0];
+            let length = chord.abs().sum();
+            let mut along = self.step_l1_rad - since;
+            while along < length {
+                if !self.free_by(
+                    &(pair[0] + chord * (along / length)),
+                    MAX_POINT_TRAVEL_M / 2.0,
+                ) {
+                    return false;
+                }
+                along += self.step_l1_rad;
+            }
+            since = length - (along - self.step_l1_rad);
+        }
+        true
+    }
+
     /// The configuration near `q` whose TCP lies at `target` (Newton steps on the TCP position
     /// with the damped pseudo-inverse), if they converge to a free configuration joined to `q`
     /// by a free edge.

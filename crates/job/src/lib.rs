@@ -29,6 +29,7 @@ use emg_kinematics::JointVector;
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
 };
+use emg_timing::time_blended_move;
 use rayon::prelude::*;
 
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
@@ -143,11 +144,16 @@ pub fn plan_job(
     let mut program = Program::default();
     let mut reports = Vec::new();
     let (mut straight_moves, mut sampled_moves) = (0, 0);
+    // The last part's lift, joined to the move after it.
+    let mut retreat: Option<[JointVector; 2]> = None;
     for (oriented, plan) in ordering.sequence.iter().zip(&plans) {
         let mut parts_left_out = Vec::new();
         let mut drawn_parts = Vec::new();
         for (index, planned) in plan.parts.iter().enumerate() {
-            let from = program.last().or(job.home);
+            let from = retreat
+                .map(|[_, above]| above)
+                .or(program.last())
+                .or(job.home);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
             // The part planned again from the configuration the arm is in, moved above the
             // part's start and set down there: taken first where it draws as far from a start
@@ -192,10 +198,13 @@ pub fn plan_job(
                 _ => sampled_moves += 1,
             }
             // Without a home the program begins above the first stroke.
-            if !travel.is_empty() {
-                program.append_move(SegmentKind::Travel, &travel, timing, dof);
-            }
-            program.append_move(SegmentKind::Approach, &[above_start, start], timing, dof);
+            connector.join(
+                &mut program,
+                retreat.take(),
+                &travel,
+                Some([above_start, start]),
+                dof,
+            );
             program.append(
                 SegmentKind::Stroke {
                     stroke: oriented.stroke,
@@ -206,7 +215,7 @@ pub fn plan_job(
                 Some(&part.task),
                 dof,
             );
-            program.append_move(SegmentKind::Retreat, &[end, above_end], timing, dof);
+            retreat = Some([end, above_end]);
             drawn_parts.push(part);
         }
         let drawn = StrokePlan {
@@ -228,19 +237,23 @@ pub fn plan_job(
             parts_left_out,
         });
     }
-    let mut ends_at_home = job.home.is_none();
-    if let Some(home) = job.home
-        && let Some(last) = program.last()
-        && let Some(vertices) = free.connect(
+    let last = retreat.map(|[_, above]| above).or(program.last());
+    let home_travel = job.home.zip(last).and_then(|(home, last)| {
+        free.connect(
             &last,
             &home,
             settings.seed.wrapping_add(u64::MAX / 2),
             settings.rrt_max_samples,
         )
-    {
-        program.append_move(SegmentKind::Travel, &vertices, timing, dof);
-        ends_at_home = true;
-    }
+    });
+    let ends_at_home = job.home.is_none() || home_travel.is_some();
+    connector.join(
+        &mut program,
+        retreat.take(),
+        home_travel.as_deref().unwrap_or_default(),
+        None,
+        dof,
+    );
     if program.segments().is_empty() {
         let why = reports
             .iter()
@@ -274,6 +287,10 @@ pub fn plan_job(
         points: program.points(dof).ok_or(JobPlanError::TooLong)?,
     })
 }
+
+/// How far before a pen-up move's corner its rounding starts: this share of the shorter of the
+/// corner's edges (half: the tool has risen half its lift before it moves aside).
+pub const BLEND_SHARE: f64 = 0.5;
 
 /// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
 /// into free space (near an obstacle, say).
@@ -351,6 +368,55 @@ impl Connector<'_> {
                 travel,
             },
         ))
+    }
+
+    /// Appends the pen-up move between two parts (or after the last): `retreat` (the lift off
+    /// the last part), `travel` (the free move from above it, or from the program's start) and
+    /// `approach` (the set-down onto the next part) as one motion through their vertices with
+    /// its corners rounded ([`time_blended_move`], each corner's arc starting
+    /// [`BLEND_SHARE`] of the shorter edge before it), where that motion is free
+    /// ([`FreeSpace::path_free`]) and holds the limits: one `travel` segment, at rest only where
+    /// the tool leaves and meets the part. Else each of them rest to rest, at rest at every
+    /// vertex.
+    fn join(
+        &self,
+        program: &mut Program,
+        retreat: Option<[JointVector; 2]>,
+        travel: &[JointVector],
+        approach: Option<[JointVector; 2]>,
+        dof: usize,
+    ) {
+        let mut vertices: Vec<JointVector> = Vec::new();
+        for q in retreat
+            .iter()
+            .flatten()
+            .chain(travel)
+            .chain(approach.iter().flatten())
+        {
+            if vertices.last().is_none_or(|last| (q - last).norm() > 1e-12) {
+                vertices.push(*q);
+            }
+        }
+        let request = self.timing.request();
+        if retreat.is_some()
+            && vertices.len() > 2
+            && let Some(samples) = time_blended_move(&vertices, request, BLEND_SHARE)
+            && self
+                .free
+                .path_free(&samples.iter().map(|s| s.q).collect::<Vec<_>>())
+        {
+            program.append(SegmentKind::Travel, &samples, &vertices, None, dof);
+            return;
+        }
+        if let Some(retreat) = retreat {
+            program.append_move(SegmentKind::Retreat, &retreat, self.timing, dof);
+        }
+        if !travel.is_empty() {
+            program.append_move(SegmentKind::Travel, travel, self.timing, dof);
+        }
+        if let Some(approach) = approach {
+            program.append_move(SegmentKind::Approach, &approach, self.timing, dof);
+        }
     }
 
     /// `part`'s stretch planned again by one rollout from the configuration reached from

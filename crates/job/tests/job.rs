@@ -59,18 +59,29 @@ fn plans_and_checks_the_pencil_icon(name: &str) {
         summary.drawn_m,
         summary.total_m
     );
-    // Pen down, lifted between strokes: every stroke part has a retreat after it.
+    // Pen down, lifted between strokes: every stroke part has a retreat after it and an
+    // approach before it, or a pen-up move blended from one part to the next (lift, move and
+    // set-down: three vertices or more) between them; the pencil's two strokes are joined so.
     let kinds: Vec<SegmentKind> = program.segments.iter().map(|s| s.kind).collect();
+    let blended = |k: usize| {
+        program.segments[k].kind == SegmentKind::Travel && program.segments[k].vertices.len() >= 3
+    };
     for (k, kind) in kinds.iter().enumerate() {
         if matches!(kind, SegmentKind::Stroke { .. }) {
-            assert_eq!(
-                kinds.get(k + 1),
-                Some(&SegmentKind::Retreat),
+            assert!(
+                kinds[k + 1] == SegmentKind::Retreat || blended(k + 1),
                 "{name}: {kinds:?}"
             );
-            assert_eq!(kinds[k - 1], SegmentKind::Approach, "{name}: {kinds:?}");
+            assert!(
+                kinds[k - 1] == SegmentKind::Approach || blended(k - 1),
+                "{name}: {kinds:?}"
+            );
         }
     }
+    assert!(
+        (0..kinds.len()).any(blended),
+        "{name}: no blended move in {kinds:?}"
+    );
     for pair in program.segments.windows(2) {
         assert_eq!(
             pair[0].end_s, pair[1].start_s,
@@ -80,7 +91,7 @@ fn plans_and_checks_the_pencil_icon(name: &str) {
     let check = verify_job(&program, &checker, planner.robot().joint_names())
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     assert_eq!(check.points, program.points.len());
-    assert!(check.moves >= 2 * check.stroke_parts - 1);
+    assert!(check.moves > check.stroke_parts);
     // A program moved off its stroke is refused.
     let mut moved = program.clone();
     let stroke = moved

@@ -32,7 +32,6 @@ pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<
     }];
     // Every sample lies on the grid `k / rate`; an edge's last sample, on the first grid time at
     // or after its end, holds its end vertex at rest.
-    let period_ns = 1e9 / request.rate_hz;
     let mut elapsed = 0u64;
     for edge in vertices.windows(2) {
         let chord = edge[1] - edge[0];
@@ -42,35 +41,54 @@ pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<
         }
         let direction = chord / length;
         let profile = edge_profile(&direction, length, request);
-        let duration = profile.duration();
-        let last = ((duration * request.rate_hz).ceil() as u64).max(1);
-        let mut hints = [0, 0];
-        for k in 1..=last {
-            let local = (k as f64 / request.rate_hz).min(duration);
-            let state = profile.state_from(local, &mut hints);
-            let end = k == last;
-            samples.push(TimedSample {
-                time_ns: ((elapsed + k) as f64 * period_ns).round() as u64,
-                q: if end {
-                    edge[1]
-                } else {
-                    edge[0] + direction * state.s
-                },
-                qd: if end {
-                    JointVector::zeros()
-                } else {
-                    direction * state.sd
-                },
-                qdd: if end {
-                    JointVector::zeros()
-                } else {
-                    direction * state.sdd
-                },
-            });
-        }
-        elapsed += last;
+        elapsed = push_samples(
+            &profile,
+            request.rate_hz,
+            elapsed,
+            &edge[1],
+            &mut samples,
+            |s| (edge[0] + direction * s, direction, JointVector::zeros()),
+        );
     }
     samples
+}
+
+/// Appends the samples of `profile` along a joint path, `path(s)` its point, first and second
+/// derivatives by the path parameter, every `1 / rate_hz` from `elapsed` periods on (the last
+/// at `end`, at rest); returns the periods elapsed after them.
+pub(crate) fn push_samples(
+    profile: &SmoothedProfile,
+    rate_hz: f64,
+    elapsed: u64,
+    end: &JointVector,
+    samples: &mut Vec<TimedSample>,
+    path: impl Fn(f64) -> (JointVector, JointVector, JointVector),
+) -> u64 {
+    let period_ns = 1e9 / rate_hz;
+    let duration = profile.duration();
+    let last = ((duration * rate_hz).ceil() as u64).max(1);
+    let mut hints = [0, 0];
+    for k in 1..=last {
+        let time_ns = ((elapsed + k) as f64 * period_ns).round() as u64;
+        if k == last {
+            samples.push(TimedSample {
+                time_ns,
+                q: *end,
+                qd: JointVector::zeros(),
+                qdd: JointVector::zeros(),
+            });
+            break;
+        }
+        let state = profile.state_from(k as f64 / rate_hz, &mut hints);
+        let (q, dq, ddq) = path(state.s);
+        samples.push(TimedSample {
+            time_ns,
+            q,
+            qd: dq * state.sd,
+            qdd: dq * state.sdd + ddq * (state.sd * state.sd),
+        });
+    }
+    elapsed + last
 }
 
 /// The jerk-limited rest-to-rest profile along a straight edge of `length` rad in the unit

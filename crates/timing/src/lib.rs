@@ -13,8 +13,13 @@
 //!    still breaks a limit ([`first_breach`]); a path task's motion comes to rest at every corner
 //!    its path does not blend ([`rest_waypoints`]), each stretch between rests timed on its own.
 //!
+//! A move through free space between strokes is a joint polyline: [`time_free_move`] keeps to
+//! its edges, at rest at every vertex; [`time_blended_move`] rounds its corners and passes them
+//! without stopping.
+//!
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
+mod blend;
 mod dynamics;
 mod free;
 mod inset;
@@ -25,6 +30,7 @@ mod retime;
 mod spline;
 mod topp;
 
+pub use blend::{MAX_BLEND_TURN_DEG, time_blended_move};
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
 pub use free::{FREE_GRID_PER_RAD, time_free_move};
 pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};

@@ -125,6 +125,11 @@ impl SmoothedProfile {
         self.profile.duration + self.window
     }
 
+    /// The averaging window (s).
+    pub fn window(&self) -> f64 {
+        self.window
+    }
+
     /// `s` and its derivatives at `t`; exactly the path's end and at rest from the end of the
     /// motion on.
     pub fn state(&self, t: f64) -> PathState {

@@ -415,24 +415,44 @@ fn time_stretch(
         if slowdowns == MAX_SLOWDOWNS {
             return Err(TimingError::LimitsNotMet(first.clone()));
         }
-        // Lower the bounds on the stretches of path the breaching samples' windows cover.
-        let margin = 2.0 * window + 3.0 / request.rate_hz;
-        let mut lowered = vec![false; grid.len()];
-        for breach in &found {
-            let t = samples[breach.sample].time_s();
-            let from = profile.state(t - margin).s;
-            let to = profile.state(t + margin).s;
-            let first = grid.partition_point(|g| g.s < from).saturating_sub(2);
-            let last = (grid.partition_point(|g| g.s <= to) + 2).min(grid.len());
-            lowered[first..last].fill(true);
-        }
-        for (f, lowered) in factor.iter_mut().zip(lowered) {
-            if lowered {
-                *f *= SLOWDOWN;
-            }
-        }
+        slow_down(
+            &mut factor,
+            &grid,
+            &profile,
+            &samples,
+            &found,
+            request.rate_hz,
+        );
     }
     unreachable!("the loop returns by its last round")
+}
+
+/// Lowers `factor` by [`SLOWDOWN`] on the stretches of path that the windows of the samples
+/// `found` breaching a limit cover (the profile's averaging window and three samples to each
+/// side), once per round however many breaches cover a grid point.
+pub(crate) fn slow_down(
+    factor: &mut [f64],
+    grid: &[GridPoint],
+    profile: &SmoothedProfile,
+    samples: &[TimedSample],
+    found: &[LimitBreach],
+    rate_hz: f64,
+) {
+    let margin = 2.0 * profile.window() + 3.0 / rate_hz;
+    let mut lowered = vec![false; grid.len()];
+    for breach in found {
+        let t = samples[breach.sample].time_s();
+        let from = profile.state(t - margin).s;
+        let to = profile.state(t + margin).s;
+        let first = grid.partition_point(|g| g.s < from).saturating_sub(2);
+        let last = (grid.partition_point(|g| g.s <= to) + 2).min(grid.len());
+        lowered[first..last].fill(true);
+    }
+    for (f, lowered) in factor.iter_mut().zip(lowered) {
+        if lowered {
+            *f *= SLOWDOWN;
+        }
+    }
 }
 
 /// The motion sampled at `k / rate_hz` (rounded to whole nanoseconds) for `k = 0, 1, …` up to

@@ -1,0 +1,352 @@
+//! A move through free space that does not stop at its inner vertices: each corner of the joint
+//! polyline rounded by a circular arc in joint space, tangent to both edges and starting at most
+//! a given share of the shorter edge before the vertex, the whole path timed at once from rest to
+//! rest (TOPP-RA within the joint velocity and acceleration limits, averaged over the window the
+//! jerk limits need and slowed down locally where a sample still breaks a limit, as a stroke is
+//! timed). The path leaves the checked polyline, so whoever uses it checks its samples again.
+
+use emg_kinematics::JointVector;
+
+use crate::dynamics::{TimedSample, breaches};
+use crate::free::{FREE_GRID_PER_RAD, push_samples};
+use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::retime::{ACCELERATION_MARGIN, MAX_SLOWDOWNS, TimingRequest, slow_down};
+use crate::topp::{GridPoint, topp_ra};
+
+/// Largest turn (degrees) at a vertex that a blend rounds: a sharper corner (the path nearly
+/// turning back) gives no blended move.
+pub const MAX_BLEND_TURN_DEG: f64 = 170.0;
+
+/// Grid intervals along a blend at least.
+const GRID_PER_BLEND: f64 = 40.0;
+
+/// One piece of a blended path, parameterised by its joint-space arc length from 0.
+#[derive(Clone, Debug)]
+enum Piece {
+    /// `from + direction·s`.
+    Line {
+        from: JointVector,
+        direction: JointVector,
+        length: f64,
+    },
+    /// The quintic from `from` (leaving along `incoming`) to `to` (arriving along `outgoing`)
+    /// with no second derivative at either end, parameterised by `s = t·length`, `t ∈ [0, 1]`:
+    /// its first and second derivatives by `s` meet the lines' (unit, zero) at both ends, so the
+    /// path's curvature is continuous and a motion along it has finite jerk.
+    Blend {
+        from: JointVector,
+        to: JointVector,
+        incoming: JointVector,
+        outgoing: JointVector,
+        length: f64,
+    },
+}
+
+impl Piece {
+    fn length(&self) -> f64 {
+        match self {
+            Self::Line { length, .. } => *length,
+            Self::Blend { length, .. } => *length,
+        }
+    }
+
+    /// The point, its first and its second derivative by arc length at `s`.
+    fn eval(&self, s: f64) -> (JointVector, JointVector, JointVector) {
+        match self {
+            Self::Line {
+                from, direction, ..
+            } => (from + direction * s, *direction, JointVector::zeros()),
+            Self::Blend {
+                from,
+                to,
+                incoming,
+                outgoing,
+                length,
+            } => {
+                // Quintic Hermite basis (end accelerations zero): weights of `from`, of the
+                // incoming velocity `length·incoming`, of the outgoing one and of `to`, with
+                // their first and second derivatives by `t`.
+                let t = s / length;
+                let (t2, t3, t4, t5) = (t * t, t * t * t, t * t * t * t, t * t * t * t * t);
+                let h = [
+                    1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5,
+                    t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5,
+                    -4.0 * t3 + 7.0 * t4 - 3.0 * t5,
+                    10.0 * t3 - 15.0 * t4 + 6.0 * t5,
+                ];
+                let dh = [
+                    -30.0 * t2 + 60.0 * t3 - 30.0 * t4,
+                    1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4,
+                    -12.0 * t2 + 28.0 * t3 - 15.0 * t4,
+                    30.0 * t2 - 60.0 * t3 + 30.0 * t4,
+                ];
+                let ddh = [
+                    -60.0 * t + 180.0 * t2 - 120.0 * t3,
+                    -36.0 * t + 96.0 * t2 - 60.0 * t3,
+                    -24.0 * t + 84.0 * t2 - 60.0 * t3,
+                    60.0 * t - 180.0 * t2 + 120.0 * t3,
+                ];
+                let (vin, vout) = (incoming * *length, outgoing * *length);
+                let combine = |w: &[f64; 4]| from * w[0] + vin * w[1] + vout * w[2] + to * w[3];
+                (
+                    combine(&h),
+                    combine(&dh) / *length,
+                    combine(&ddh) / (length * length),
+                )
+            }
+        }
+    }
+}
+
+/// The polyline `vertices` with its corners rounded, each arc starting `share` of the shorter
+/// of its two edges before its vertex; `None` where a corner turns by more than
+/// [`MAX_BLEND_TURN_DEG`].
+fn blended_pieces(vertices: &[JointVector], share: f64) -> Option<Vec<Piece>> {
+    let mut points: Vec<JointVector> = Vec::with_capacity(vertices.len());
+    for v in vertices {
+        if points.last().is_none_or(|last| (v - last).norm() > 1e-9) {
+            points.push(*v);
+        }
+    }
+    let edges: Vec<(JointVector, f64)> = points
+        .windows(2)
+        .map(|pair| {
+            let chord = pair[1] - pair[0];
+            (chord / chord.norm(), chord.norm())
+        })
+        .collect();
+    // Each inner vertex's blend: how far before it the arc starts, and the arc.
+    let mut cut = vec![0.0; points.len()];
+    let mut arcs: Vec<Option<Piece>> = vec![None; points.len()];
+    for k in 1..points.len().saturating_sub(1) {
+        let (incoming, before) = edges[k - 1];
+        let (outgoing, after) = edges[k];
+        let turn = libm::acos(incoming.dot(&outgoing).clamp(-1.0, 1.0));
+        if turn.to_degrees() > MAX_BLEND_TURN_DEG {
+            return None;
+        }
+        if turn < 1e-6 {
+            continue;
+        }
+        let distance = share * before.min(after);
+        cut[k] = distance;
+        arcs[k] = Some(Piece::Blend {
+            from: points[k] - incoming * distance,
+            to: points[k] + outgoing * distance,
+            incoming,
+            outgoing,
+            length: 2.0 * distance,
+        });
+    }
+    let mut pieces = Vec::new();
+    for (k, &(direction, length)) in edges.iter().enumerate() {
+        let straight = length - cut[k] - cut[k + 1];
+        if straight > 1e-12 {
+            pieces.push(Piece::Line {
+                from: points[k] + direction * cut[k],
+                direction,
+                length: straight,
+            });
+        }
+        if let Some(arc) = arcs[k + 1].take() {
+            pieces.push(arc);
+        }
+    }
+    Some(pieces)
+}
+
+/// Samples at `request.rate_hz` of the rest-to-rest motion along the polyline `vertices` with
+/// every corner rounded (each arc starting `share` ≤ ½ of the shorter of its edges before its
+/// vertex), not stopping at any inner vertex; `None` where a corner turns back (more than
+/// [`MAX_BLEND_TURN_DEG`]) or the samples break a limit after
+/// [`MAX_SLOWDOWNS`] local slow-downs.
+///
+/// # Panics
+///
+/// If `vertices` is empty.
+pub fn time_blended_move(
+    vertices: &[JointVector],
+    request: &TimingRequest,
+    share: f64,
+) -> Option<Vec<TimedSample>> {
+    let first = *vertices.first().expect("a move has a vertex");
+    let end = *vertices.last().expect("a move has a vertex");
+    let pieces = blended_pieces(vertices, share.clamp(0.0, 0.5))?;
+    let mut starts = Vec::with_capacity(pieces.len());
+    let mut grid = Vec::new();
+    let mut at = 0.0;
+    let limits = &request.limits;
+    let (velocity, jerk) = (&limits.velocity, &limits.jerk);
+    for piece in &pieces {
+        starts.push(at);
+        let length = piece.length();
+        let per_m = match piece {
+            Piece::Line { .. } => FREE_GRID_PER_RAD,
+            Piece::Blend { length, .. } => FREE_GRID_PER_RAD.max(GRID_PER_BLEND / length),
+        };
+        let intervals = ((length * per_m).ceil() as usize).max(2);
+        let skip = usize::from(!grid.is_empty());
+        for i in skip..=intervals {
+            let local = length * i as f64 / intervals as f64;
+            let (_, dq, ddq) = piece.eval(local);
+            // The path's third derivative (by central differences on a blend): the jerk
+            // `q'''·ṡ³` it adds stays within half the limit.
+            let dddq = match piece {
+                Piece::Line { .. } => JointVector::zeros(),
+                Piece::Blend { length, .. } => {
+                    let h = 1e-4 * length;
+                    let ahead = piece.eval((local + h).min(*length)).2;
+                    let behind = piece.eval((local - h).max(0.0)).2;
+                    (ahead - behind) / ((local + h).min(*length) - (local - h).max(0.0))
+                }
+            };
+            let speed_bound = (0..dq.len())
+                .filter(|&j| dq[j].abs() > 1e-12)
+                .map(|j| velocity[j] / dq[j].abs())
+                .chain(
+                    (0..dq.len())
+                        .filter(|&j| dddq[j].abs() > 1e-12)
+                        .map(|j| libm::cbrt(0.5 * jerk[j] / dddq[j].abs())),
+                )
+                .fold(f64::INFINITY, f64::min);
+            grid.push(GridPoint {
+                s: at + local,
+                dq,
+                ddq,
+                x_max: speed_bound * speed_bound,
+            });
+        }
+        at += length;
+    }
+    if grid.len() < 2 {
+        return None;
+    }
+    let path = |s: f64| {
+        let index = starts.partition_point(|start| *start <= s).max(1) - 1;
+        pieces[index].eval(s - starts[index])
+    };
+    // As a stroke is timed: averaged over the window the jerk limits need at full acceleration,
+    // slowed down locally wherever a sample still breaks a limit.
+    let window = 2.0
+        * limits
+            .acceleration
+            .iter()
+            .zip(limits.jerk.iter())
+            .filter(|(_, j)| **j > 0.0)
+            .map(|(a, j)| a / j)
+            .fold(0.0, f64::max);
+    let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
+    let mut factor = vec![1.0; grid.len()];
+    for _ in 0..=MAX_SLOWDOWNS {
+        let x = topp_ra(&grid, &planned_acceleration, &factor);
+        let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
+        let mut samples = vec![TimedSample {
+            time_ns: 0,
+            q: first,
+            qd: JointVector::zeros(),
+            qdd: JointVector::zeros(),
+        }];
+        push_samples(&profile, request.rate_hz, 0, &end, &mut samples, path);
+        let found = breaches(&samples, limits);
+        if found.is_empty() {
+            return Some(samples);
+        }
+        slow_down(
+            &mut factor,
+            &grid,
+            &profile,
+            &samples,
+            &found,
+            request.rate_hz,
+        );
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::DynamicLimits;
+    use crate::{first_breach, time_free_move};
+
+    fn request() -> TimingRequest {
+        let mut velocity = JointVector::zeros();
+        let mut acceleration = JointVector::zeros();
+        let mut jerk = JointVector::zeros();
+        for j in 0..7 {
+            velocity[j] = 1.0 + 0.1 * j as f64;
+            acceleration[j] = 3.0;
+            jerk[j] = 30.0;
+        }
+        TimingRequest {
+            limits: DynamicLimits {
+                velocity,
+                acceleration,
+                jerk,
+            },
+            tool_speed_m_per_s: 0.2,
+            rate_hz: 1000.0,
+        }
+    }
+
+    /// Distance of `q` from the polyline `vertices`.
+    fn off_polyline(q: &JointVector, vertices: &[JointVector]) -> f64 {
+        vertices
+            .windows(2)
+            .map(|edge| {
+                let chord = edge[1] - edge[0];
+                let t = ((q - edge[0]).dot(&chord) / chord.norm_squared()).clamp(0.0, 1.0);
+                (q - (edge[0] + chord * t)).norm()
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn a_blended_move_rounds_its_corners_without_stopping_and_holds_the_limits() {
+        let request = request();
+        let a = JointVector::zeros();
+        let mut b = a;
+        b[2] = 0.1;
+        let mut c = b;
+        c[0] = 1.0;
+        c[3] = -0.5;
+        let mut d = c;
+        d[2] = 0.0;
+        let vertices = [a, b, c, d];
+        let share = 0.5;
+        let samples = time_blended_move(&vertices, &request, share).expect("a blended move");
+        let (first, last) = (samples[0], samples[samples.len() - 1]);
+        assert_eq!((first.q, last.q), (a, d));
+        assert_eq!(
+            (first.qd, last.qd),
+            (JointVector::zeros(), JointVector::zeros())
+        );
+        assert_eq!(first_breach(&samples, &request.limits), None);
+        // It keeps near the polyline: within the largest corner cut of it, and it never comes
+        // to rest between its ends.
+        for sample in &samples[1..samples.len() - 1] {
+            assert!(off_polyline(&sample.q, &vertices) <= share * 0.1 + 1e-9);
+            assert!(sample.qd.norm() > 0.0);
+        }
+        // The velocity matches the positions' finite differences.
+        for pair in samples.windows(2) {
+            let dt = (pair[1].time_ns - pair[0].time_ns) as f64 * 1e-9;
+            let mean = (pair[1].q - pair[0].q) / dt;
+            let average = (pair[1].qd + pair[0].qd) / 2.0;
+            assert!((mean - average).norm() < 5e-3, "{mean:?} vs {average:?}");
+        }
+        // Faster than stopping at every vertex.
+        let stopping = time_free_move(&vertices, &request);
+        assert!(last.time_ns < stopping[stopping.len() - 1].time_ns);
+    }
+
+    #[test]
+    fn a_move_that_turns_back_is_not_blended() {
+        let a = JointVector::zeros();
+        let mut b = a;
+        b[0] = 0.5;
+        let mut c = a;
+        c[1] = 0.01;
+        assert!(time_blended_move(&[a, b, c], &request(), 0.5).is_none());
+    }
+}
