@@ -266,28 +266,8 @@ pub fn time_blended_move(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::DynamicLimits;
+    use crate::free::tests::{assert_velocities_match_positions, request};
     use crate::{first_breach, time_free_move};
-
-    fn request() -> TimingRequest {
-        let mut velocity = JointVector::zeros();
-        let mut acceleration = JointVector::zeros();
-        let mut jerk = JointVector::zeros();
-        for j in 0..7 {
-            velocity[j] = 1.0 + 0.1 * j as f64;
-            acceleration[j] = 3.0;
-            jerk[j] = 30.0;
-        }
-        TimingRequest {
-            limits: DynamicLimits {
-                velocity,
-                acceleration,
-                jerk,
-            },
-            tool_speed_m_per_s: 0.2,
-            rate_hz: 1000.0,
-        }
-    }
 
     /// Distance of `q` from the polyline `vertices`.
     fn off_polyline(q: &JointVector, vertices: &[JointVector]) -> f64 {
@@ -328,13 +308,7 @@ mod tests {
             assert!(off_polyline(&sample.q, &vertices) <= share * 0.1 + 1e-9);
             assert!(sample.qd.norm() > 0.0);
         }
-        // The velocity matches the positions' finite differences.
-        for pair in samples.windows(2) {
-            let dt = (pair[1].time_ns - pair[0].time_ns) as f64 * 1e-9;
-            let mean = (pair[1].q - pair[0].q) / dt;
-            let average = (pair[1].qd + pair[0].qd) / 2.0;
-            assert!((mean - average).norm() < 5e-3, "{mean:?} vs {average:?}");
-        }
+        assert_velocities_match_positions(&samples);
         // Faster than stopping at every vertex.
         let stopping = time_free_move(&vertices, &request);
         assert!(last.time_ns < stopping[stopping.len() - 1].time_ns);

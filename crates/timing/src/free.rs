@@ -124,11 +124,12 @@ fn edge_profile(direction: &JointVector, length: f64, request: &TimingRequest) -
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::DynamicLimits;
 
-    fn request() -> TimingRequest {
+    /// Limits of a seven-joint arm for the free moves' tests, at 1 kHz.
+    pub(crate) fn request() -> TimingRequest {
         let mut velocity = JointVector::zeros();
         let mut acceleration = JointVector::zeros();
         let mut jerk = JointVector::zeros();
@@ -179,7 +180,11 @@ mod tests {
             let on_bc = ((q - b).norm() + (c - q).norm() - (c - b).norm()).abs() < 1e-9;
             assert!(on_ab || on_bc, "{q:?} off the polyline");
         }
-        // The velocity matches the positions' finite differences.
+        assert_velocities_match_positions(&samples);
+    }
+
+    /// Asserts that every pair of samples' mean velocity is their positions' finite difference.
+    pub(crate) fn assert_velocities_match_positions(samples: &[TimedSample]) {
         for pair in samples.windows(2) {
             let dt = (pair[1].time_ns - pair[0].time_ns) as f64 * 1e-9;
             let mean = (pair[1].q - pair[0].q) / dt;
