@@ -37,7 +37,7 @@ pub fn job_part(robot: &Robot, job: &crate::Job) -> Vec<Task> {
 }
 
 /// Orientations of a plane's rectangle tried (a half turn, in 1° steps).
-const RECTANGLE_ANGLES: usize = 180;
+pub const RECTANGLE_ANGLES: usize = 180;
 
 /// One task per plane of `tasks` whose work plate is the part those strokes lie on: its path
 /// runs along the middle of the smallest rectangle (of [`RECTANGLE_ANGLES`] orientations)

@@ -7,12 +7,13 @@
 //!    reconfiguration where one motion cannot finish it;
 //! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
 //!    approach along n;
-//! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory, every segment
-//!    with its time span, as an `emg-job/1` file;
+//! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
+//!    blended through its corners where that stays free), every segment with its time span, as
+//!    an `emg-job/1` file;
 //!
 //! and [`verify_job`] re-checks a written program with the independent checker.
 //!
-//! [`plan_job`] runs them in order.
+//! [`plan_job`] runs them in order; [`place_job`] runs it at the best places for the part.
 
 pub mod free_space;
 pub mod order;

@@ -29,7 +29,8 @@ pub enum SegmentKind {
     },
     /// The tool lifted off the surface along −n.
     Retreat,
-    /// A free joint-space move between two lifted configurations (or home).
+    /// A free joint-space move between two lifted configurations (or home); a blended pen-up
+    /// move (the lift, the move and the set-down in one motion) is one of these.
     Travel,
     /// The tool set down along n.
     Approach,

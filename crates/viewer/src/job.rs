@@ -44,7 +44,8 @@ pub enum JobSegmentKind {
     },
     /// The tool lifted off the surface.
     Retreat,
-    /// A free move between two lifted configurations (or home).
+    /// A free move between two lifted configurations (or home), or a whole pen-up move blended
+    /// from one stroke part to the next.
     Travel,
     /// The tool set down on the surface.
     Approach,
