@@ -149,6 +149,10 @@ pub struct Row {
     pub bound_shares: Vec<BoundShare>,
     /// Motions that the line tolerance ended.
     pub ended_by_line_tolerance: usize,
+    /// Of those, the motions that ended more than one grid step of the scan (its resolution)
+    /// short of the bound: where the step's own tracking ended them, not the end of the arm's
+    /// reach along the line or path.
+    pub ended_by_line_tolerance_short: usize,
     /// Paths planned to their end (lines: 0).
     pub completed: usize,
     /// Plans, timed motions or files the independent checker rejected.
@@ -202,6 +206,8 @@ pub struct Record {
     pub path_bounds_m: Vec<Vec<f64>>,
     /// Paths the corrected step completes at 20 mm and not at 0.1 mm.
     pub unfinished_at_tightest: Vec<Unfinished>,
+    /// The grid step of the reachability scan (m), its resolution.
+    pub grid_m: f64,
     /// The first few checker failures.
     pub failure_examples: Vec<String>,
 }
@@ -235,6 +241,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let limits_file = limits_file_beside(&args.robot);
     let robot_name = args.robot.display().to_string();
 
+    let grid_m = planner.config().reach.grid_m;
     let mut rows = Vec::new();
     let mut bounds = [Vec::new(), Vec::new()];
     let mut failures = Vec::new();
@@ -312,6 +319,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .iter()
                     .filter(|o| o.ended_by_line_tolerance)
                     .count(),
+                ended_by_line_tolerance_short: planned
+                    .iter()
+                    .zip(&kind_bounds[tolerance])
+                    .filter(|(o, bound)| o.ended_by_line_tolerance && *bound - o.length_m > grid_m)
+                    .count(),
                 completed: planned.iter().filter(|o| o.completed).count(),
                 checker_failures: planned.iter().map(|o| o.failures.len()).sum(),
                 plan_ms_mean: planned.iter().map(|o| o.plan_ms).sum::<f64>()
@@ -336,6 +348,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         line_bounds_m,
         path_bounds_m,
         unfinished_at_tightest,
+        grid_m,
         failure_examples: failures.iter().take(5).cloned().collect(),
     };
     workspace::write_results(&args.out_dir, "precision", &record, &markdown(&record))?;
@@ -494,7 +507,10 @@ fn markdown(record: &Record) -> String {
         });
         md.push_str(
             "Σ plan / Σ bound per bucket of the bound at the row's tolerance (tasks in the \
-             bucket in brackets), the motions the line tolerance ended",
+             bucket in brackets), the motions the line tolerance ended and, of them, those it \
+             ended more than one grid step of the scan (1 cm) short of the bound (the others \
+             end where the scan found no valid configuration one grid step further: the end of \
+             the arm's reach along the line or path)",
         );
         md.push_str(match kind {
             Kind::Lines => ", and the mean plan time on its thread.\n\n",
@@ -504,12 +520,12 @@ fn markdown(record: &Record) -> String {
         for bucket in &buckets {
             md.push_str(&format!(" {bucket} |"));
         }
-        md.push_str(" ended by the tolerance |");
+        md.push_str(" ended by the tolerance | of them short of the bound |");
         if kind == Kind::Paths {
             md.push_str(" completed |");
         }
         md.push_str(" ms per plan | checker failures |\n|---|---|");
-        md.push_str(&"---|".repeat(buckets.len() + 3 + usize::from(kind == Kind::Paths)));
+        md.push_str(&"---|".repeat(buckets.len() + 4 + usize::from(kind == Kind::Paths)));
         md.push('\n');
         for row in rows {
             let total = row.lengths_m.len().max(1);
@@ -521,11 +537,15 @@ fn markdown(record: &Record) -> String {
             for share in &row.bound_shares {
                 md.push_str(&format!(" {:.3} ({}) |", share.share, share.tasks));
             }
-            md.push_str(&format!(
-                " {} ({:.1} %) |",
+            for ended in [
                 row.ended_by_line_tolerance,
-                100.0 * row.ended_by_line_tolerance as f64 / total as f64
-            ));
+                row.ended_by_line_tolerance_short,
+            ] {
+                md.push_str(&format!(
+                    " {ended} ({:.1} %) |",
+                    100.0 * ended as f64 / total as f64
+                ));
+            }
             if kind == Kind::Paths {
                 md.push_str(&format!(" {} of {} |", row.completed, row.lengths_m.len()));
             }
@@ -543,17 +563,26 @@ fn markdown(record: &Record) -> String {
         );
     } else {
         md.push_str(
-            "| path | shape | length (m) | reached at 0.1 mm (m) | bound at 0.1 mm (m) |\n\
-             |---|---|---|---|---|\n",
+            "The bound at 0.1 mm says whether the path can be finished at all: where it lies \
+             within one grid step of the scan (1 cm) of what was reached, no valid configuration \
+             was found further along.\n\n\
+             | path | shape | length (m) | reached at 0.1 mm (m) | bound at 0.1 mm (m) | the \
+             bound says |\n\
+             |---|---|---|---|---|---|\n",
         );
         for path in &record.unfinished_at_tightest {
             md.push_str(&format!(
-                "| {} | {} | {:.4} | {:.4} | {:.4} |\n",
+                "| {} | {} | {:.4} | {:.4} | {:.4} | {} |\n",
                 path.index,
                 path.shape.name(),
                 path.length_m,
                 path.reached_m,
-                path.bound_m
+                path.bound_m,
+                if path.bound_m - path.reached_m > record.grid_m {
+                    "reachable further"
+                } else {
+                    "cannot"
+                }
             ));
         }
     }
@@ -566,8 +595,9 @@ fn markdown(record: &Record) -> String {
 pub fn readme_table(results: &std::path::Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | step | lines: Σ plan / Σ bound | lines ended by the tolerance | \
-         paths: Σ plan / Σ bound | paths completed | checker failures |\n\
-         |---|---|---|---|---|---|---|---|\n",
+         of them short of the bound | paths: Σ plan / Σ bound | paths completed | checker \
+         failures |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
     );
     for (shipped, record) in crate::report::shipped_results::<Record>(results, "precision.json")? {
         let rows_of = |kind: Kind| record.rows.iter().filter(move |r| r.kind == kind);
@@ -580,12 +610,14 @@ pub fn readme_table(results: &std::path::Path) -> anyhow::Result<String> {
                     .map_or(f64::NAN, |b| b.share)
             };
             md.push_str(&format!(
-                "| {} | {} mm | {} | {:.3} | {:.1} % | {} | {} | {} |\n",
+                "| {} | {} mm | {} | {:.3} | {:.1} % | {:.1} % | {} | {} | {} |\n",
                 shipped.name,
                 line.setting.tolerance_mm,
                 line.setting.step_name(),
                 all(line),
                 100.0 * line.ended_by_line_tolerance as f64 / line.lengths_m.len().max(1) as f64,
+                100.0 * line.ended_by_line_tolerance_short as f64
+                    / line.lengths_m.len().max(1) as f64,
                 path.map_or("—".to_string(), |p| format!("{:.3}", all(p))),
                 path.map_or("—".to_string(), |p| format!(
                     "{} of {}",

@@ -159,7 +159,9 @@ pub enum Tracking {
     /// The paper's step, corrected where its TCP lands more than
     /// [`CORRECTION_TRIGGER`](crate::CORRECTION_TRIGGER) of the tolerance off the line or path:
     /// the end configuration is moved back onto it by Newton corrections `Δq = J⁺ e` (the
-    /// step's pseudo-inverse, `e` the offset to the nearest line or path point, up to
+    /// pseudo-inverse at each corrected configuration, lightly damped,
+    /// [`CORRECTION_DAMPING`](crate::CORRECTION_DAMPING); `e` the offset to the nearest line or
+    /// path point; up to
     /// [`MAX_CORRECTIONS`](crate::MAX_CORRECTIONS)); where those leave it off, the step is
     /// taken again with no null-space motion (the damping near a singularity does not buy
     /// self-motion with task error). Steps that track well are the paper's, bit for bit; what

@@ -58,5 +58,7 @@ pub use task::{
     ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task,
     TaskError,
 };
-pub use tracking::{CORRECTION_TRIGGER, MAX_CORRECTIONS, correct_onto_task, onto_task};
+pub use tracking::{
+    CORRECTION_DAMPING, CORRECTION_TRIGGER, MAX_CORRECTIONS, correct_onto_task, onto_task,
+};
 pub use verification::{CheckRollout, task_bounds};
