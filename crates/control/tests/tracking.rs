@@ -9,15 +9,19 @@
 //!   corrected step is the paper's, bit for bit.
 //! - On lines at 0.1 mm, the tolerance ends most motions of the paper's step and at most a
 //!   quarter as many of the corrected step's, every one of them checked, and they go further.
+//! - Near a singularity, where the step's own damping would leave most of an offset in place,
+//!   the corrections (the Jacobian at each corrected configuration, lightly damped) still bring
+//!   the TCP onto the line.
 
 mod common;
 
 use emg_control::{
-    CORRECTION_TRIGGER, CheckRollout, Path, PathSpec, RolloutConfig, SegmentSpec, Task,
-    Termination, Tracking, Trajectory,
+    CORRECTION_TRIGGER, CheckRollout, MAX_CORRECTIONS, Path, PathSpec, RolloutConfig, SegmentSpec,
+    Task, Termination, Tracking, Trajectory, correct_onto_task,
 };
+use emg_kinematics::{DampingConfig, damped_pseudo_inverse};
 
-use common::{checker, classical, robot, tasks};
+use common::{checker, classical, random_q, rng, robot, tasks};
 
 const RADIUS_M: f64 = 0.1;
 
@@ -153,4 +157,64 @@ fn on_lines_at_a_tenth_of_a_millimetre_the_tolerance_ends_few_corrected_motions(
         "the corrected step: {corrected_ended} ended by the tolerance, the paper's {paper_ended}"
     );
     assert!(longer > 0.0);
+}
+
+#[test]
+fn near_a_singularity_the_corrections_converge_where_the_steps_damping_would_not() {
+    let robot = robot();
+    let damping = DampingConfig::default();
+    // The first of a seeded draw of configurations whose Jacobian's smallest singular value
+    // lies well inside the step's damped band, `σ_min < σ_0`.
+    let mut draw = rng(54);
+    let (q, eigen) = std::iter::repeat_with(|| random_q(&mut draw, &robot))
+        .take(1_000_000)
+        .map(|q| (q, robot.forward(&q).jacobian_gram().symmetric_eigen()))
+        .find(|(_, eigen)| {
+            let sigma_min = eigen.eigenvalues.min().max(0.0).sqrt();
+            (0.2 * damping.sigma_threshold..0.4 * damping.sigma_threshold).contains(&sigma_min)
+        })
+        .expect("a configuration near a singularity");
+    let kinematics = robot.forward(&q);
+    let weakest = eigen.eigenvalues.imin();
+    // Lines 1 mm from the TCP on either side, along the direction the arm moves it least.
+    let weak = eigen.eigenvectors.column(weakest).into_owned();
+    let n = kinematics.tool_axis();
+    let d = n.cross(&weak).normalize();
+    let offset_m = 1e-3;
+    // Half of a 0.1 mm tolerance, where the corrected step stops correcting.
+    let target_m = CORRECTION_TRIGGER * 1e-4;
+    let step_inverse = damped_pseudo_inverse(kinematics.jacobian(), &damping);
+    for side in [1.0, -1.0] {
+        let task = Task::new(
+            &robot,
+            kinematics.tcp() + weak * side * offset_m,
+            d,
+            n,
+            None,
+        )
+        .unwrap();
+        assert!((task.distance(&kinematics.tcp()) - offset_m).abs() < 1e-9);
+
+        let mut corrected = q;
+        let mut at = kinematics.clone();
+        assert!(correct_onto_task(
+            &robot,
+            &task,
+            0.0,
+            target_m,
+            &mut corrected,
+            &mut at
+        ));
+        assert!(task.distance(&at.tcp()) <= target_m);
+        let moved = (corrected - q).amax();
+        assert!(moved < 0.15, "the corrections moved a joint {moved} rad");
+
+        // The step's own pseudo-inverse, as many times, leaves most of the offset.
+        let mut chord = q;
+        for _ in 0..MAX_CORRECTIONS {
+            chord += step_inverse.matrix * task.offset(&robot.forward(&chord).tcp());
+        }
+        let left = task.distance(&robot.forward(&chord).tcp());
+        assert!(left > 0.5 * offset_m, "the step's damping left {left} m");
+    }
 }
