@@ -14,8 +14,8 @@ use emg_control::{CheckRollout, PathShape, Task, Termination, Tracking, path_tas
 use emg_eval::{BoundShare, bound_shares};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    ControllerKind, DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner,
-    PlannerConfig, limits_file_beside,
+    ControllerKind, DEFAULT_RATE_HZ, FAR_END_SHARE, MotionTiming, PlanFiles, PlanRecord,
+    PlanRequest, Planner, PlannerConfig, SHORTFALL_SHARE, limits_file_beside,
 };
 use emg_timing::Scaling;
 use rayon::prelude::*;
@@ -153,6 +153,12 @@ pub struct Row {
     /// short of the bound: where the step's own tracking ended them, not the end of the arm's
     /// reach along the line or path.
     pub ended_by_line_tolerance_short: usize,
+    /// Tasks whose plan ends below the shortfall share of its bound with no chain of valid
+    /// configurations joining `p0` to near the bound's end (the bound's continuity test,
+    /// `emg_planner::BoundNote::likely_loose`: the bound is likely loose there), in task order;
+    /// tested on the rows whose plans are written as `emg plan` writes them (the corrected step
+    /// with learned parts), empty on the others.
+    pub bound_likely_loose: Vec<usize>,
     /// Paths planned to their end (lines: 0).
     pub completed: usize,
     /// Plans, timed motions or files the independent checker rejected.
@@ -217,6 +223,7 @@ struct Outcome {
     length_m: f64,
     bound_m: f64,
     ended_by_line_tolerance: bool,
+    bound_likely_loose: bool,
     completed: bool,
     plan_ms: f64,
     failures: Vec<String>,
@@ -324,6 +331,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     .zip(&kind_bounds[tolerance])
                     .filter(|(o, bound)| o.ended_by_line_tolerance && *bound - o.length_m > grid_m)
                     .count(),
+                bound_likely_loose: (0..planned.len())
+                    .filter(|&i| planned[i].bound_likely_loose)
+                    .collect(),
                 completed: planned.iter().filter(|o| o.completed).count(),
                 checker_failures: planned.iter().map(|o| o.failures.len()).sum(),
                 plan_ms_mean: planned.iter().map(|o| o.plan_ms).sum::<f64>()
@@ -386,8 +396,10 @@ fn plan_one(
     if let Err(problem) = checker.check(task, &plan.trajectory, constraints) {
         failures.push(format!("{what}: {problem}"));
     }
+    let mut bound_likely_loose = false;
     if setting.tracking == Tracking::Corrected && setting.learned {
         let bound = planner.bound_note(task, &plan);
+        bound_likely_loose = bound.likely_loose;
         let record = PlanRecord {
             robot: robot_name,
             request: &request,
@@ -419,6 +431,7 @@ fn plan_one(
         length_m: plan.trajectory.path_length_m,
         bound_m: reach.reachable_m,
         ended_by_line_tolerance: plan.trajectory.termination.label() == "line_tolerance",
+        bound_likely_loose,
         completed: plan.trajectory.termination == Termination::Completed,
         plan_ms,
         failures,
@@ -555,6 +568,7 @@ fn markdown(record: &Record) -> String {
             ));
         }
         md.push('\n');
+        md.push_str(&loose_bounds(record, kind));
     }
     md.push_str("## Paths completed at 20 mm and not at 0.1 mm (corrected step)\n\n");
     if record.unfinished_at_tightest.is_empty() {
@@ -585,6 +599,61 @@ fn markdown(record: &Record) -> String {
                 }
             ));
         }
+    }
+    md
+}
+
+/// What the bound's continuity test says of the rows that ran it: the tasks whose plan ends
+/// short of a bound no chain of valid configurations joins (likely loose), and `Σ plan / Σ
+/// bound` over the other tasks.
+fn loose_bounds(record: &Record, kind: Kind) -> String {
+    let bounds = match kind {
+        Kind::Lines => &record.line_bounds_m,
+        Kind::Paths => &record.path_bounds_m,
+    };
+    let mut md = String::new();
+    for row in record.rows.iter().filter(|r| {
+        r.kind == kind && r.setting.tracking == Tracking::Corrected && r.setting.learned
+    }) {
+        let Some(tolerance) = TOLERANCES_MM
+            .iter()
+            .position(|&t| t == row.setting.tolerance_mm)
+        else {
+            continue;
+        };
+        let bound = &bounds[tolerance];
+        let others: Vec<usize> = (0..row.lengths_m.len())
+            .filter(|i| !row.bound_likely_loose.contains(i))
+            .collect();
+        let sum = |values: &[f64], tasks: &mut dyn Iterator<Item = usize>| {
+            tasks.map(|i| values[i]).sum::<f64>()
+        };
+        if row.bound_likely_loose.is_empty() {
+            md.push_str(&format!(
+                "At {} mm with the corrected step, the bound's continuity test (`emg plan`'s \
+                 note on a plan below {SHORTFALL_SHARE} × its bound) finds a chain of valid \
+                 configurations joining `p0` to {:.0} % of the bound on every task that ends \
+                 short of it.\n\n",
+                row.setting.tolerance_mm,
+                100.0 * FAR_END_SHARE,
+            ));
+            continue;
+        }
+        let loose_bound = sum(bound, &mut row.bound_likely_loose.iter().copied());
+        let loose_plan = sum(&row.lengths_m, &mut row.bound_likely_loose.iter().copied());
+        let share = sum(&row.lengths_m, &mut others.iter().copied())
+            / sum(bound, &mut others.iter().copied());
+        md.push_str(&format!(
+            "At {} mm with the corrected step, the bound's continuity test (`emg plan`'s note \
+             on a plan below {SHORTFALL_SHARE} × its bound) finds no chain of valid \
+             configurations joining `p0` to {:.0} % of the bound on {} of {} tasks (the bound \
+             likely loose there): {loose_plan:.2} m planned of their Σ {loose_bound:.2} m bound. \
+             Σ plan / Σ bound over the other tasks: {share:.3}.\n\n",
+            row.setting.tolerance_mm,
+            100.0 * FAR_END_SHARE,
+            row.bound_likely_loose.len(),
+            row.lengths_m.len(),
+        ));
     }
     md
 }

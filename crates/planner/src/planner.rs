@@ -269,22 +269,22 @@ impl Planner {
     pub fn bound_note(&self, task: &Task, plan: &Plan) -> BoundNote {
         let reach = self.reach_of(task, plan);
         let trajectory = &plan.trajectory;
-        let shortfall =
-            (trajectory.path_length_m < SHORTFALL_SHARE * reach.reachable_m).then(|| {
-                let chains = far_end_chains(
-                    &self.robot,
-                    task,
-                    &self.config.rollout.constraints,
-                    &self.config.reach,
-                    &reach,
-                    self.config.search.chain_jump_rad,
-                    CONTINUITY_RESTARTS,
-                );
-                shortfall(trajectory, reach.reachable_m, !chains.is_empty())
-            });
+        let joined = (trajectory.path_length_m < SHORTFALL_SHARE * reach.reachable_m).then(|| {
+            !far_end_chains(
+                &self.robot,
+                task,
+                &self.config.rollout.constraints,
+                &self.config.reach,
+                &reach,
+                self.config.search.chain_jump_rad,
+                CONTINUITY_RESTARTS,
+            )
+            .is_empty()
+        });
         BoundNote {
             reachable_m: reach.reachable_m,
-            shortfall,
+            shortfall: joined.map(|joined| shortfall(trajectory, reach.reachable_m, joined)),
+            likely_loose: joined == Some(false),
         }
     }
 

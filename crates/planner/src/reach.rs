@@ -226,6 +226,10 @@ pub struct BoundNote {
     pub reachable_m: f64,
     /// Why the plan ends below [`SHORTFALL_SHARE`] of the bound, when it does ([`shortfall`]).
     pub shortfall: Option<String>,
+    /// Whether the plan ends below [`SHORTFALL_SHARE`] of the bound and no chain of valid
+    /// configurations ([`far_end_chains`]) joins `p0` to [`FAR_END_SHARE`] of it: the bound is
+    /// likely loose there, its points on self-motion branches no motion joins.
+    pub likely_loose: bool,
 }
 
 /// Why `trajectory` ends below [`SHORTFALL_SHARE`] of the bound `reachable_m`: how far it got,

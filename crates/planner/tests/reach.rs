@@ -205,6 +205,7 @@ fn a_plan_short_of_its_bound_says_whether_the_bound_joins_p0() {
         let length = plan.trajectory.path_length_m;
         if length >= SHORTFALL_SHARE * reach.reachable_m {
             assert_eq!(note.shortfall, None, "{length} m of {}", reach.reachable_m);
+            assert!(!note.likely_loose);
             continue;
         }
         short += 1;
@@ -218,6 +219,7 @@ fn a_plan_short_of_its_bound_says_whether_the_bound_joins_p0() {
             CONTINUITY_RESTARTS,
         )
         .is_empty();
+        assert_eq!(note.likely_loose, !joined);
         let text = note.shortfall.expect("a short plan says so");
         assert!(text.contains(&format!("ends at {length:.2} m")), "{text}");
         assert!(
