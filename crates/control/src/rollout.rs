@@ -264,9 +264,9 @@ impl<'a> Episode<'a> {
     /// The corrected step of [`Tracking::Corrected`] from the current configuration, whose
     /// paper step of `step_s` seconds with `action` ended at `paper_end` (the kinematics in the
     /// context): Newton corrections `Δq = J⁺ e` toward the nearest line or path point
-    /// ([`correct_onto_task`]); then the same without the null-space motion. The end configuration and the action it applied, with
-    /// the context's kinematics at it; `None`, the kinematics back at `paper_end`, where neither
-    /// comes within [`CORRECTION_TRIGGER`] of the tolerance. Shortening the step as well (a
+    /// ([`correct_onto_task`]); then the same without the null-space motion. The end
+    /// configuration and the action it applied, with the context's kinematics at it; `None`, the
+    /// kinematics back at `paper_end`, where neither comes within [`CORRECTION_TRIGGER`] of the tolerance. Shortening the step as well (a
     /// half, a quarter) was measured and left out: `cargo xtask precision-eval` found the same
     /// shares of the bound at 0.5 mm, the step cap ending what the tolerance had, and lower
     /// ones at 20 mm.

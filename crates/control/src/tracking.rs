@@ -10,11 +10,11 @@ use crate::task::Task;
 /// timing lays between the steps.
 pub const CORRECTION_TRIGGER: f64 = 0.5;
 
-/// Damping of the corrections' pseudo-inverse: a tenth of the step's `λ_max` at most. Near a
-/// singularity, where the step's damping (`λ_max` = 0.05) would leave most of a millimetre
-/// uncorrected after every correction, the corrections still converge; a few millimetres of
-/// offset there move the joints a few hundredths of a radian. (`cargo xtask precision-eval`
-/// measured 0.01 and 0.005 finishing fewer paths at 0.1 mm, 0.0005 no more than 0.002.)
+/// Damping of the corrections' pseudo-inverse: `λ_max` a twenty-fifth of the step's. Near a
+/// singularity, where the step's damping would leave most of an offset in place after every
+/// correction, the corrections still converge, moving the joints by about the offset over
+/// `σ_min`. (On the FR3's 200 paths of `cargo xtask precision-eval`, `λ_max` 0.01 and 0.005
+/// finished fewer at 0.1 mm, 0.0005 no more than 0.002.)
 pub const CORRECTION_DAMPING: DampingConfig = DampingConfig {
     sigma_threshold: 0.05,
     lambda_max: 0.002,
