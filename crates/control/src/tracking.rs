@@ -13,8 +13,8 @@ pub const CORRECTION_TRIGGER: f64 = 0.5;
 /// Damping of the corrections' pseudo-inverse: `λ_max` a twenty-fifth of the step's. Near a
 /// singularity, where the step's damping would leave most of an offset in place after every
 /// correction, the corrections still converge, moving the joints by about the offset over
-/// `σ_min`. (On the FR3's 200 paths of `cargo xtask precision-eval`, `λ_max` 0.01 and 0.005
-/// finished fewer at 0.1 mm, 0.0005 no more than 0.002.)
+/// `σ_min`. (On the FR3's 200 paths of `cargo xtask precision-eval`, `λ_max` 0.01 finished
+/// one fewer at 0.1 mm, 0.005 one fewer at 20 mm, 0.0005 as many as 0.002.)
 pub const CORRECTION_DAMPING: DampingConfig = DampingConfig {
     sigma_threshold: 0.05,
     lambda_max: 0.002,
