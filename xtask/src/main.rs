@@ -17,6 +17,7 @@ mod cartesian_eval;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
+mod gap_eval;
 mod job_eval;
 mod label_seeds;
 mod limit;
@@ -100,6 +101,9 @@ enum Command {
     /// The search at 20 mm, 0.5 mm and 0.1 mm with the paper's and the corrected step, on lines
     /// and paths, checked and timed (docs/results/precision.*).
     PrecisionEval(precision_eval::Args),
+    /// The lines whose bound is likely loose, planned back from beyond the plan's end, with
+    /// motions in place tried between the branches (docs/results/gaps.*).
+    GapEval(gap_eval::Args),
     /// Every shipped task set, label file, model and result, each pipeline in dependency order
     /// (resumable: finished stages are journaled in target/regenerate/; --list, --from STAGE).
     Regenerate(regenerate::Args),
@@ -128,6 +132,7 @@ fn main() -> anyhow::Result<()> {
         Command::PrecisionEval(args) => precision_eval::run(&args),
         Command::JobEval(args) => job_eval::run(&args),
         Command::PlaceEval(args) => place_eval::run(&args),
+        Command::GapEval(args) => gap_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
     }
 }

@@ -97,7 +97,7 @@ impl Setting {
     }
 
     /// The paper's protocol (no work surface) at this setting.
-    fn config(&self) -> PlannerConfig {
+    pub(crate) fn config(&self) -> PlannerConfig {
         let mut config = PlannerConfig::default();
         config.rollout.constraints.line_tolerance_m = self.tolerance_mm * 1e-3;
         config.rollout.tracking = self.tracking;
@@ -108,7 +108,7 @@ impl Setting {
     }
 
     /// `emg plan`'s default request, or its classical controller without the learned parts.
-    fn request(&self) -> PlanRequest {
+    pub(crate) fn request(&self) -> PlanRequest {
         PlanRequest {
             controller: if self.learned {
                 PlanRequest::default().controller

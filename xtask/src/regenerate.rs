@@ -248,6 +248,24 @@ const STAGES: &[Stage] = &[
         ],
     },
     Stage {
+        name: "gap-eval",
+        args: &["gap-eval"],
+        writes: &["docs/results/gaps.json", "docs/results/gaps.md"],
+    },
+    Stage {
+        name: "gap-eval-iiwa14",
+        args: &["gap-eval", "--robot", "iiwa14"],
+        writes: &[
+            "docs/results/iiwa14/gaps.json",
+            "docs/results/iiwa14/gaps.md",
+        ],
+    },
+    Stage {
+        name: "gap-eval-ur5e",
+        args: &["gap-eval", "--robot", "ur5e"],
+        writes: &["docs/results/ur5e/gaps.json", "docs/results/ur5e/gaps.md"],
+    },
+    Stage {
         name: "job-eval",
         args: &["job-eval"],
         writes: &["docs/results/jobs.json", "docs/results/jobs.md"],

@@ -37,6 +37,8 @@ mod demo;
 pub mod embedded;
 mod far_end;
 mod files;
+mod gap;
+mod in_place;
 mod models;
 pub mod parse;
 mod planner;
@@ -54,6 +56,8 @@ pub use config::{ConfigError, PlannerConfig};
 pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
 pub use demo::demo_task;
 pub use files::{PlanFiles, PlanFilesError, PlanRecord};
+pub use gap::{GapProbe, GapProbeOutcome, gap_probes};
+pub use in_place::{InPlaceConfig, in_place_motion};
 pub use models::{
     DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
     robot_stamp,

@@ -1,0 +1,273 @@
+//! Motion in place: whether the arm can move from one configuration to another while its TCP
+//! stays on one point of the line, every constraint held on the way.
+//!
+//! Two motions along a line may cover the same point on different self-motion branches: one
+//! from `p0` that ends there, another that goes on from there to the end of the bound. They join
+//! into one motion only if the arm can change from one branch to the other somewhere, and where
+//! it cannot do so on the move it could still stop and reconfigure with the TCP held still
+//! (the tool axis free inside its cone). The configurations that put the TCP on a point form a
+//! manifold (of dimension `dof − 3`); [`in_place_motion`] searches it with a bidirectional
+//! rapidly-exploring random tree (RRT-Connect): random configurations projected onto the point
+//! by Newton steps on the position Jacobian, trees grown toward them in short joint steps, each
+//! step's end and midpoint projected and held to every constraint
+//! ([`emg_control::first_violation`]). A motion found is a witness that the configurations
+//! join; none found within the budget is evidence, not proof, that they do not.
+
+use emg_control::{ConstraintConfig, OutOfRange, Task, first_violation};
+use emg_kinematics::{JointVector, Robot, Vec3};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+/// Settings of [`in_place_motion`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct InPlaceConfig {
+    /// Random configurations drawn (the budget: it counts draws, not time).
+    pub samples: usize,
+    /// Longest joint step of a tree's edge (rad, Euclidean over the joints).
+    pub step_rad: f64,
+    /// Seed of the random draws.
+    pub seed: u64,
+}
+
+impl Default for InPlaceConfig {
+    fn default() -> Self {
+        Self {
+            samples: 20_000,
+            step_rad: 0.1,
+            seed: 20_261_128,
+        }
+    }
+}
+
+impl InPlaceConfig {
+    /// Checks every value against its allowed range.
+    pub fn validate(&self) -> Result<(), OutOfRange> {
+        OutOfRange::require(
+            "in_place.samples",
+            self.samples as f64,
+            "[1, 1000000]",
+            |n| (1.0..=1e6).contains(&n),
+        )?;
+        OutOfRange::require("in_place.step_rad", self.step_rad, "[0.001, 1]", |s| {
+            (1e-3..=1.0).contains(&s)
+        })
+    }
+}
+
+/// Distance (m) within which a projection counts as on the point.
+const ON_POINT_M: f64 = 1e-7;
+
+/// Newton steps a projection onto the point may take.
+const PROJECTION_STEPS: usize = 30;
+
+/// Damping of the projection's Newton steps (added to `J Jᵀ`, m²).
+const PROJECTION_DAMPING: f64 = 1e-6;
+
+/// Steps a tree grows toward one draw before the next draw.
+const STEPS_PER_DRAW: usize = 50;
+
+/// Steps the other tree grows toward a newly reached node to meet it.
+const STEPS_PER_CONNECT: usize = 100;
+
+/// Joint distance (rad) at which two trees' nodes are the same configuration: a step toward a
+/// configuration on the point within `step_rad` lands on it.
+const MET_RAD: f64 = 1e-9;
+
+/// A motion from `from` to `to` (both with the TCP on `point`) along which the TCP stays on
+/// `point` and every configuration holds `constraints` on `task`, each configuration within
+/// twice `config.step_rad` (Euclidean) of the one before; `None` where the search finds none within
+/// its budget, or where `from` or `to` is not a valid configuration on the point (module
+/// documentation). Deterministic for a given `config.seed`.
+pub fn in_place_motion(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    point: &Vec3,
+    from: &JointVector,
+    to: &JointVector,
+    config: &InPlaceConfig,
+) -> Option<Vec<JointVector>> {
+    let manifold = PointManifold {
+        robot,
+        task,
+        constraints,
+        point: *point,
+        step_rad: config.step_rad,
+    };
+    for end in [from, to] {
+        let on_point = (robot.forward(end).tcp() - point).norm() < 1e3 * ON_POINT_M;
+        if !on_point || !manifold.valid(end) {
+            return None;
+        }
+    }
+    if manifold
+        .step(from, to)
+        .is_some_and(|q| (q - to).norm() < MET_RAD)
+    {
+        return Some(vec![*from, *to]);
+    }
+    let mut trees = [Tree::rooted(*from), Tree::rooted(*to)];
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    let limits = robot.limits();
+    for draw in 0..config.samples {
+        let guess = robot.configuration_from_fn(|i| {
+            limits.lower[i] + rng.random::<f64>() * (limits.upper[i] - limits.lower[i])
+        });
+        let Some(sample) = manifold.project(&guess) else {
+            continue;
+        };
+        let (growing, other) = if draw % 2 == 0 { (0, 1) } else { (1, 0) };
+        let Some(reached) = trees[growing].grow_toward(&manifold, &sample, STEPS_PER_DRAW) else {
+            continue;
+        };
+        let reached_q = trees[growing].nodes[reached].q;
+        if let Some(met) = trees[other].grow_toward(&manifold, &reached_q, STEPS_PER_CONNECT)
+            && (trees[other].nodes[met].q - reached_q).norm() < MET_RAD
+        {
+            let (from_end, to_end) = if growing == 0 {
+                (reached, met)
+            } else {
+                (met, reached)
+            };
+            let mut motion = trees[0].path_to(from_end);
+            motion.reverse();
+            motion.extend(trees[1].path_to(to_end));
+            return Some(motion);
+        }
+    }
+    None
+}
+
+/// `q` moved so that the TCP is on `point`, by damped Newton steps on the position Jacobian
+/// (the least-norm correction each step); `None` where they do not converge.
+pub(crate) fn onto_point(robot: &Robot, q: &JointVector, point: &Vec3) -> Option<JointVector> {
+    let mut q = *q;
+    for _ in 0..PROJECTION_STEPS {
+        let kinematics = robot.forward(&q);
+        let error = point - kinematics.tcp();
+        if error.norm() < ON_POINT_M {
+            return Some(q);
+        }
+        let jacobian = kinematics.jacobian();
+        let mut gram = jacobian * jacobian.transpose();
+        for k in 0..3 {
+            gram[(k, k)] += PROJECTION_DAMPING;
+        }
+        q += jacobian.transpose() * gram.cholesky()?.solve(&error);
+    }
+    None
+}
+
+/// The configurations that put the TCP on one point and hold every constraint.
+struct PointManifold<'a> {
+    robot: &'a Robot,
+    task: &'a Task,
+    constraints: &'a ConstraintConfig,
+    point: Vec3,
+    step_rad: f64,
+}
+
+impl PointManifold<'_> {
+    fn project(&self, q: &JointVector) -> Option<JointVector> {
+        onto_point(self.robot, q, &self.point)
+    }
+
+    /// Whether `q` holds every constraint.
+    fn valid(&self, q: &JointVector) -> bool {
+        first_violation(
+            self.robot,
+            self.task,
+            &self.robot.forward(q),
+            self.constraints,
+        )
+        .is_none()
+    }
+
+    /// One step from `from` toward `toward`: at most `step_rad` along the straight joint
+    /// path, projected onto the point; `None` where the projection moves it more than twice
+    /// that (it jumped to another sheet) or it or the midpoint of the step breaks a constraint.
+    fn step(&self, from: &JointVector, toward: &JointVector) -> Option<JointVector> {
+        let offset = toward - from;
+        let length = offset.norm();
+        let scale = if length > self.step_rad {
+            self.step_rad / length
+        } else {
+            1.0
+        };
+        let next = self.project(&(from + offset * scale))?;
+        if (next - from).norm() > 2.0 * self.step_rad || !self.valid(&next) {
+            return None;
+        }
+        let midpoint = self.project(&((from + next) * 0.5))?;
+        self.valid(&midpoint).then_some(next)
+    }
+}
+
+/// A tree of configurations on the point, each node knowing its parent.
+struct Tree {
+    nodes: Vec<Node>,
+}
+
+struct Node {
+    q: JointVector,
+    parent: Option<usize>,
+}
+
+impl Tree {
+    fn rooted(q: JointVector) -> Self {
+        Self {
+            nodes: vec![Node { q, parent: None }],
+        }
+    }
+
+    /// Grows from the node nearest `target` toward it for at most `steps` steps; the last node
+    /// added, `None` where not even one step was possible.
+    fn grow_toward(
+        &mut self,
+        manifold: &PointManifold,
+        target: &JointVector,
+        steps: usize,
+    ) -> Option<usize> {
+        let mut at = self.nearest(target);
+        let mut added = None;
+        for _ in 0..steps {
+            let current = self.nodes[at].q;
+            if (target - current).norm() < ON_POINT_M {
+                break;
+            }
+            let Some(next) = manifold.step(&current, target) else {
+                break;
+            };
+            self.nodes.push(Node {
+                q: next,
+                parent: Some(at),
+            });
+            at = self.nodes.len() - 1;
+            added = Some(at);
+        }
+        added
+    }
+
+    fn nearest(&self, target: &JointVector) -> usize {
+        (0..self.nodes.len())
+            .min_by(|&a, &b| {
+                (self.nodes[a].q - target)
+                    .norm_squared()
+                    .total_cmp(&(self.nodes[b].q - target).norm_squared())
+            })
+            .expect("a tree has its root")
+    }
+
+    /// The configurations from node `index` back to the root.
+    fn path_to(&self, index: usize) -> Vec<JointVector> {
+        let mut path = Vec::new();
+        let mut at = Some(index);
+        while let Some(i) = at {
+            path.push(self.nodes[i].q);
+            at = self.nodes[i].parent;
+        }
+        path
+    }
+}

@@ -1,0 +1,195 @@
+//! Motion in place (`emg_planner::in_place_motion`) on the shipped UR5e: it joins two
+//! configurations that a walk in place joins, every configuration of its motion on the point and
+//! valid, and it finds nothing between configurations with opposite elbows at a point too near
+//! the shoulder for the elbow to straighten (the only way between them, since the elbow joint's
+//! limits are ±π).
+
+use emg_control::{ConstraintConfig, Task, first_violation};
+use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_planner::{DataDir, InPlaceConfig, SHIPPED_ROBOTS, in_place_motion};
+use emg_seeding::{IkConfig, cone_ik_solutions};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// The elbow joint (0-based).
+const ELBOW: usize = 2;
+
+struct Setup {
+    robot: Robot,
+    task: Task,
+    constraints: ConstraintConfig,
+    point: Vec3,
+    /// Valid configurations with the TCP on `point` (within 1 nm).
+    solutions: Vec<JointVector>,
+}
+
+/// The UR5e, a point 0.35 m from its shoulder (its upper arm and forearm reach 0.817 m, its
+/// wrist and pen well under 0.47 m), a line through it, and IK solutions there with the tool
+/// axis within 5° of the line's normal.
+fn setup() -> Setup {
+    let data = DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"));
+    let arm = SHIPPED_ROBOTS
+        .into_iter()
+        .find(|arm| arm.name == "ur5e")
+        .expect("the UR5e is shipped");
+    let robot = Robot::from_chain_file(arm.path(&data)).expect("robot loads");
+    let point = Vec3::new(0.3, 0.15, 0.25);
+    let normal = Vec3::new(0.0, 0.0, 1.0);
+    let task = Task::new(&robot, point, Vec3::new(0.0, 1.0, 0.0), normal, None).expect("a task");
+    let constraints = ConstraintConfig::default();
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    let solutions: Vec<JointVector> =
+        cone_ik_solutions(&robot, &point, &normal, &IkConfig::default(), &mut rng)
+            .into_iter()
+            .filter_map(|q| projected(&robot, &point, &q))
+            .filter(|q| first_violation(&robot, &task, &robot.forward(q), &constraints).is_none())
+            .collect();
+    Setup {
+        robot,
+        task,
+        constraints,
+        point,
+        solutions,
+    }
+}
+
+/// Every configuration of `motion` is on the point and valid, each within twice the step of
+/// the one before, and it runs from `from` to `to`.
+fn assert_in_place(setup: &Setup, motion: &[JointVector], from: &JointVector, to: &JointVector) {
+    let step_rad = InPlaceConfig::default().step_rad;
+    assert_eq!(motion.first(), Some(from));
+    assert_eq!(motion.last(), Some(to));
+    for (i, q) in motion.iter().enumerate() {
+        let kinematics = setup.robot.forward(q);
+        let off = (kinematics.tcp() - setup.point).norm();
+        assert!(
+            off < 1e-6,
+            "configuration {i}: the TCP is {off} m off the point"
+        );
+        let violation = first_violation(&setup.robot, &setup.task, &kinematics, &setup.constraints);
+        assert!(violation.is_none(), "configuration {i}: {violation:?}");
+    }
+    for (i, pair) in motion.windows(2).enumerate() {
+        let jump = (pair[1] - pair[0]).norm();
+        assert!(jump <= 2.0 * step_rad + 1e-12, "step {i} moves {jump} rad");
+    }
+}
+
+#[test]
+fn a_motion_in_place_joins_what_a_walk_in_place_joins() {
+    let setup = setup();
+    let from = *setup.solutions.first().expect("a solution at the point");
+    // A walk in place: steps along one joint-space direction with a little noise, each put back
+    // on the point and kept when a one-step motion in place takes it.
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let heading = setup
+        .robot
+        .configuration_from_fn(|i| [0.0, 0.0, 0.0, 0.3, 0.3, 1.0][i]);
+    let one_step = InPlaceConfig {
+        samples: 1,
+        ..InPlaceConfig::default()
+    };
+    let mut to = from;
+    for _ in 0..60 {
+        let noise = setup
+            .robot
+            .configuration_from_fn(|_| 0.01 * (rng.random::<f64>() - 0.5));
+        let Some(guess) = projected(&setup.robot, &setup.point, &(to + heading * 0.03 + noise))
+        else {
+            continue;
+        };
+        let moved = in_place_motion(
+            &setup.robot,
+            &setup.task,
+            &setup.constraints,
+            &setup.point,
+            &to,
+            &guess,
+            &one_step,
+        );
+        if let Some(moved) = moved {
+            to = *moved.last().expect("a motion ends");
+        }
+    }
+    assert!(
+        (to - from).norm() > 0.3,
+        "the walk moved {} rad",
+        (to - from).norm()
+    );
+    let motion = in_place_motion(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        &setup.point,
+        &from,
+        &to,
+        &InPlaceConfig::default(),
+    )
+    .expect("a motion in place");
+    assert_in_place(&setup, &motion, &from, &to);
+    assert!(motion.len() > 2, "more than one step apart");
+}
+
+#[test]
+fn no_motion_in_place_flips_an_elbow_that_cannot_straighten() {
+    let setup = setup();
+    let up = setup.solutions.iter().find(|q| q[ELBOW] > 0.2);
+    let down = setup.solutions.iter().find(|q| q[ELBOW] < -0.2);
+    let (Some(up), Some(down)) = (up, down) else {
+        panic!("solutions with both elbows: {:?}", setup.solutions);
+    };
+    let motion = in_place_motion(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        &setup.point,
+        up,
+        down,
+        &InPlaceConfig {
+            samples: 3000,
+            ..InPlaceConfig::default()
+        },
+    );
+    assert!(
+        motion.is_none(),
+        "{} configurations",
+        motion.map_or(0, |m| m.len())
+    );
+}
+
+#[test]
+fn a_configuration_off_the_point_is_refused() {
+    let setup = setup();
+    let on = setup.solutions[0];
+    let off = on
+        + setup
+            .robot
+            .configuration_from_fn(|i| if i == 0 { 0.2 } else { 0.0 });
+    let motion = in_place_motion(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        &setup.point,
+        &on,
+        &off,
+        &InPlaceConfig::default(),
+    );
+    assert!(motion.is_none());
+}
+
+/// `q` moved so that the TCP is on the point: Newton steps on the position (the tests' own;
+/// the crate's is internal).
+fn projected(robot: &Robot, point: &Vec3, q: &JointVector) -> Option<JointVector> {
+    let mut q = *q;
+    for _ in 0..30 {
+        let kinematics = robot.forward(&q);
+        let error = point - kinematics.tcp();
+        if error.norm() < 1e-9 {
+            return Some(q);
+        }
+        let jacobian = kinematics.jacobian();
+        let gram = jacobian * jacobian.transpose();
+        q += jacobian.transpose() * gram.try_inverse()? * error;
+    }
+    None
+}

@@ -1,0 +1,293 @@
+//! `cargo xtask gap-eval`: the lines whose bound is likely loose (`emg plan`'s continuity test,
+//! `emg_planner::BoundNote::likely_loose`), asked from the far side
+//! (`emg_planner::gap_probes`): motions planned back from points between the plan's end and
+//! the bound, where each gets back to, and whether the arm can change in place from the
+//! plan's branch to theirs (`docs/results/gaps.{json,md}`).
+
+use std::path::PathBuf;
+
+use emg_control::{Task, Tracking};
+use emg_planner::{GapProbe, GapProbeOutcome, InPlaceConfig, Planner, gap_probes};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::precision_eval::Setting;
+use crate::{progress, workspace};
+
+/// Options of `gap-eval`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Lines: the first this many tasks of the task set (`precision-eval`'s).
+    #[arg(long, default_value_t = 400)]
+    tasks: usize,
+    /// The line tolerance (mm).
+    #[arg(long, default_value_t = 0.5)]
+    tolerance_mm: f64,
+    /// Random configurations each motion in place may draw (its budget).
+    #[arg(long, default_value_t = InPlaceConfig::default().samples)]
+    samples: usize,
+    /// Worker threads (0 = one per core); the results do not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Task set.
+    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
+    task_file: PathBuf,
+    /// Robot file.
+    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
+    robot: PathBuf,
+    /// Output directory of gaps.{json,md}.
+    #[arg(long, default_value_os_t = workspace::results_dir())]
+    out_dir: PathBuf,
+}
+
+/// A line whose bound is likely loose, and its probes.
+#[derive(Serialize, Deserialize)]
+pub struct LooseLine {
+    /// Index in the task set.
+    pub task: usize,
+    /// The plan's length (m).
+    pub planned_m: f64,
+    /// The bound (m).
+    pub bound_m: f64,
+    /// The motions planned back from beyond the plan's end.
+    pub probes: Vec<GapProbe>,
+}
+
+impl LooseLine {
+    /// The longest motion from `p0` shown: the plan, or a motion back that passes `p0`.
+    pub fn longest_shown_m(&self) -> f64 {
+        self.probes
+            .iter()
+            .filter(|probe| probe.outcome == GapProbeOutcome::PassesP0)
+            .map(|probe| probe.from_m)
+            .fold(self.planned_m, f64::max)
+    }
+
+    /// The longest motion from `p0` shown with one stop to reconfigure in place: the plan to
+    /// where a motion back is joined to it in place, then that motion read forwards to where
+    /// it started; at least [`LooseLine::longest_shown_m`].
+    pub fn longest_with_one_stop_m(&self) -> f64 {
+        self.probes
+            .iter()
+            .filter(|probe| {
+                matches!(
+                    probe.outcome,
+                    GapProbeOutcome::Overlaps {
+                        joined_in_place: Some(true),
+                        ..
+                    }
+                )
+            })
+            .map(|probe| probe.from_m)
+            .fold(self.longest_shown_m(), f64::max)
+    }
+}
+
+/// The whole record written to `gaps.json`.
+#[derive(Serialize, Deserialize)]
+pub struct Record {
+    /// Robot name.
+    pub robot: String,
+    /// The command that wrote the record.
+    pub command: String,
+    /// Task set.
+    pub tasks: String,
+    /// Lines planned (the first of the set).
+    pub line_count: usize,
+    /// The line tolerance (mm).
+    pub tolerance_mm: f64,
+    /// The motion in place's settings.
+    pub in_place: InPlaceConfig,
+    /// Σ plan and Σ bound over every line (m).
+    pub planned_m: f64,
+    /// See `planned_m`.
+    pub bound_m: f64,
+    /// The lines whose bound is likely loose, in task order.
+    pub loose: Vec<LooseLine>,
+    /// Machine and worker threads.
+    pub machine: String,
+    /// See `machine`.
+    pub threads: usize,
+}
+
+/// Plans every line, probes those whose bound is likely loose, writes the record and its table.
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let workspace::PlannerSetup { planner, tasks, .. } =
+        workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "gap-eval")?;
+    let setting = Setting {
+        tolerance_mm: args.tolerance_mm,
+        tracking: Tracking::Corrected,
+        learned: true,
+    };
+    let planner = planner.with_config(setting.config())?;
+    let in_place = InPlaceConfig {
+        samples: args.samples,
+        ..InPlaceConfig::default()
+    };
+    in_place.validate()?;
+    let pool = workspace::thread_pool(args.threads)?;
+    let bar = progress::bar(tasks.len() as u64, "lines");
+    let lines: Vec<(f64, f64, Option<LooseLine>)> = pool.install(|| {
+        tasks
+            .par_iter()
+            .enumerate()
+            .map(|(index, task)| {
+                let line = probe_line(&planner, &setting, &in_place, index, task);
+                bar.inc(1);
+                line
+            })
+            .collect::<anyhow::Result<_>>()
+    })?;
+    bar.finish();
+    let record = Record {
+        robot: planner.robot().name().to_string(),
+        command: workspace::command_for("gap-eval", &args.robot),
+        tasks: workspace::relative(&args.task_file),
+        line_count: tasks.len(),
+        tolerance_mm: args.tolerance_mm,
+        in_place,
+        planned_m: lines.iter().map(|(planned, _, _)| planned).sum(),
+        bound_m: lines.iter().map(|(_, bound, _)| bound).sum(),
+        loose: lines
+            .into_iter()
+            .filter_map(|(_, _, loose)| loose)
+            .collect(),
+        machine: workspace::machine(),
+        threads: pool.current_num_threads(),
+    };
+    workspace::write_results(&args.out_dir, "gaps", &record, &markdown(&record))
+}
+
+/// The plan's length and bound of one line, with its probes when its bound is likely loose.
+fn probe_line(
+    planner: &Planner,
+    setting: &Setting,
+    in_place: &InPlaceConfig,
+    index: usize,
+    task: &Task,
+) -> anyhow::Result<(f64, f64, Option<LooseLine>)> {
+    let plan = planner.plan(task, &setting.request())?;
+    let note = planner.bound_note(task, &plan);
+    let planned_m = plan.trajectory.path_length_m;
+    let loose = note.likely_loose.then(|| LooseLine {
+        task: index,
+        planned_m,
+        bound_m: note.reachable_m,
+        probes: gap_probes(planner, task, &plan, in_place),
+    });
+    Ok((planned_m, note.reachable_m, loose))
+}
+
+/// What one probe found, in words for the table.
+fn outcome_words(probe: &GapProbe) -> String {
+    match &probe.outcome {
+        GapProbeOutcome::NoStart => "no motion starts there".into(),
+        GapProbeOutcome::PassesP0 => "passes p0: a longer motion".into(),
+        GapProbeOutcome::StopsShort => "stops before the plan's end".into(),
+        GapProbeOutcome::Overlaps {
+            at_m,
+            joined_in_place,
+            joint_gap_rad,
+        } => match (joined_in_place, joint_gap_rad) {
+            (Some(joined), Some(gap)) => format!(
+                "overlaps; at {at_m:.3} m {} in place ({gap:.2} rad apart)",
+                if *joined { "joined" } else { "not joined" }
+            ),
+            _ => format!("overlaps; at {at_m:.3} m not compared (not a valid configuration)"),
+        },
+    }
+}
+
+fn markdown(record: &Record) -> String {
+    let loose = &record.loose;
+    let probes: Vec<&GapProbe> = loose.iter().flat_map(|line| &line.probes).collect();
+    let count = |matches: &dyn Fn(&GapProbeOutcome) -> bool| {
+        probes
+            .iter()
+            .filter(|probe| matches(&probe.outcome))
+            .count()
+    };
+    let joined = |wanted: bool| move |outcome: &GapProbeOutcome| matches!(outcome, GapProbeOutcome::Overlaps { joined_in_place: Some(j), .. } if *j == wanted);
+    let loose_planned: f64 = loose.iter().map(|line| line.planned_m).sum();
+    let loose_bound: f64 = loose.iter().map(|line| line.bound_m).sum();
+    let loose_shown: f64 = loose.iter().map(LooseLine::longest_shown_m).sum();
+    let loose_shown_with_stop: f64 = loose.iter().map(LooseLine::longest_with_one_stop_m).sum();
+    let mut md = format!(
+        "# Lines whose bound is likely loose, asked from the far side ({})\n\n\
+         Generated by `{}` on {} ({} threads). The first {} tasks of `{}` planned as \
+         `precision-eval`'s corrected step at {} mm plans them (`emg plan`'s default search, \
+         no work surface, 30° cone); Σ plan / Σ bound over all of them: {:.3}. On {} of them the \
+         plan ends below 0.9 of its bound and the bound's continuity test finds no chain of \
+         valid configurations joining `p0` to 95 % of it (`emg plan`'s note \"the bound is \
+         likely loose here\"): {:.2} m planned of their Σ {:.2} m bound. Each is asked from the \
+         far side (`emg_planner::gap_probes`): the same search plans the line backwards from 3 \
+         and 10 grid steps past the plan's end, from halfway to the bound and from half a grid \
+         step before it, and where a motion back passes the plan's end without reaching `p0`, \
+         a motion in place (`emg_planner::in_place_motion`, RRT-Connect on the configurations \
+         that hold the TCP on one point, {} draws, seed {}) tries to join the plan's \
+         configuration there to the motion back's.\n\n\
+         Of {} motions planned back: {} pass `p0` (read forwards, a motion from `p0` longer \
+         than the plan: the search missed it), {} pass the plan's end and are joined to it in \
+         place, {} pass it and are not, {} pass it where a configuration could not be \
+         compared, {} stop before the plan's end, {} have no start. The longest motion from \
+         `p0` shown on these lines (the plan or a motion back past `p0`) sums to {:.2} m of \
+         their {:.2} m bound, {:.2} m with one stop to reconfigure in place (the plan to where \
+         a motion back is joined to it, then that motion). A motion back that covers the \
+         plan's end on another branch, not joined to it in place, and one that stops before \
+         it, are what the continuity test suspected: the bound's configurations there lie on \
+         branches no motion from `p0` that was found reaches. Σ plan / Σ bound over the other \
+         lines: {:.3}.\n\n",
+        record.robot,
+        record.command,
+        record.machine,
+        record.threads,
+        record.line_count,
+        record.tasks,
+        record.tolerance_mm,
+        record.planned_m / record.bound_m,
+        loose.len(),
+        loose_planned,
+        loose_bound,
+        record.in_place.samples,
+        record.in_place.seed,
+        probes.len(),
+        count(&|o| *o == GapProbeOutcome::PassesP0),
+        count(&joined(true)),
+        count(&joined(false)),
+        count(&|o| matches!(
+            o,
+            GapProbeOutcome::Overlaps {
+                joined_in_place: None,
+                ..
+            }
+        )),
+        count(&|o| *o == GapProbeOutcome::StopsShort),
+        count(&|o| *o == GapProbeOutcome::NoStart),
+        loose_shown,
+        loose_bound,
+        loose_shown_with_stop,
+        (record.planned_m - loose_planned) / (record.bound_m - loose_bound),
+    );
+    md.push_str("| task | plan (m) | bound (m) | from (m) | back to (m) | what it shows |\n");
+    md.push_str("|---|---|---|---|---|---|\n");
+    for line in loose {
+        for (i, probe) in line.probes.iter().enumerate() {
+            let (task, planned, bound) = if i == 0 {
+                (
+                    line.task.to_string(),
+                    format!("{:.3}", line.planned_m),
+                    format!("{:.3}", line.bound_m),
+                )
+            } else {
+                Default::default()
+            };
+            md.push_str(&format!(
+                "| {task} | {planned} | {bound} | {:.3} | {:.3} | {} |\n",
+                probe.from_m,
+                probe.back_to_m,
+                outcome_words(probe)
+            ));
+        }
+    }
+    md
+}
