@@ -34,13 +34,20 @@ fn a_loose_bounds_motions_back_do_not_join_the_plan() {
     let plan = planner.plan(task, &PlanRequest::default()).expect("a plan");
     let note = planner.bound_note(task, &plan);
     let end_m = plan.trajectory.path_length_m;
-    assert!(note.likely_loose, "plan {end_m} m of {} m", note.reachable_m);
+    assert!(
+        note.likely_loose,
+        "plan {end_m} m of {} m",
+        note.reachable_m
+    );
 
     let probes = gap_probes(&planner, task, &plan, &InPlaceConfig::default());
     assert!(!probes.is_empty());
     let mut not_joined = 0;
     for probe in &probes {
-        assert!(probe.from_m > end_m && probe.from_m < note.reachable_m, "{probe:?}");
+        assert!(
+            probe.from_m > end_m && probe.from_m < note.reachable_m,
+            "{probe:?}"
+        );
         match probe.outcome {
             GapProbeOutcome::NoStart => assert_eq!(probe.back_to_m, probe.from_m),
             GapProbeOutcome::PassesP0 => assert!(probe.back_to_m <= 0.0, "{probe:?}"),
@@ -51,7 +58,10 @@ fn a_loose_bounds_motions_back_do_not_join_the_plan() {
                 ..
             } => {
                 assert!(at_m >= probe.back_to_m && at_m <= end_m, "{probe:?}");
-                assert!(probe.back_to_m > 0.0 && probe.back_to_m < end_m, "{probe:?}");
+                assert!(
+                    probe.back_to_m > 0.0 && probe.back_to_m < end_m,
+                    "{probe:?}"
+                );
                 not_joined += usize::from(joined_in_place == Some(false));
             }
         }
