@@ -14,6 +14,11 @@ use serde::{Deserialize, Serialize};
 use crate::precision_eval::Setting;
 use crate::{progress, workspace};
 
+/// The README's markers around the table of [`report_table`].
+pub const README_START: &str = "<!-- gaps:start -->";
+/// See [`README_START`].
+pub const README_END: &str = "<!-- gaps:end -->";
+
 /// Options of `gap-eval`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -198,20 +203,104 @@ fn outcome_words(probe: &GapProbe) -> String {
     }
 }
 
-fn markdown(record: &Record) -> String {
-    let loose = &record.loose;
-    let probes: Vec<&GapProbe> = loose.iter().flat_map(|line| &line.probes).collect();
-    let count = |matches: &dyn Fn(&GapProbeOutcome) -> bool| {
-        probes
+/// What a record's probes add up to.
+struct Summary {
+    /// Σ plan and Σ bound over the lines whose bound is likely loose (m).
+    loose_planned_m: f64,
+    /// See `loose_planned_m`.
+    loose_bound_m: f64,
+    /// Σ of their longest motions from `p0` shown, without and with one stop (m).
+    shown_m: f64,
+    /// See `shown_m`.
+    shown_with_stop_m: f64,
+    /// Motions planned back, and of them: passing `p0`, joined in place, not joined, not
+    /// compared, stopping before the plan's end, without a start.
+    probes: usize,
+    /// See `probes`.
+    passes_p0: usize,
+    /// See `probes`.
+    joined: usize,
+    /// See `probes`.
+    not_joined: usize,
+    /// See `probes`.
+    not_compared: usize,
+    /// See `probes`.
+    stops_short: usize,
+    /// See `probes`.
+    no_start: usize,
+    /// Σ plan / Σ bound over all lines, and over the lines whose bound is not likely loose.
+    share: f64,
+    /// See `share`.
+    share_of_others: f64,
+}
+
+impl Summary {
+    fn of(record: &Record) -> Self {
+        let loose = &record.loose;
+        let outcomes: Vec<&GapProbeOutcome> = loose
             .iter()
-            .filter(|probe| matches(&probe.outcome))
-            .count()
-    };
-    let joined = |wanted: bool| move |outcome: &GapProbeOutcome| matches!(outcome, GapProbeOutcome::Overlaps { joined_in_place: Some(j), .. } if *j == wanted);
-    let loose_planned: f64 = loose.iter().map(|line| line.planned_m).sum();
-    let loose_bound: f64 = loose.iter().map(|line| line.bound_m).sum();
-    let loose_shown: f64 = loose.iter().map(LooseLine::longest_shown_m).sum();
-    let loose_shown_with_stop: f64 = loose.iter().map(LooseLine::longest_with_one_stop_m).sum();
+            .flat_map(|line| line.probes.iter().map(|probe| &probe.outcome))
+            .collect();
+        let count = |wanted: &dyn Fn(&GapProbeOutcome) -> bool| {
+            outcomes.iter().filter(|outcome| wanted(outcome)).count()
+        };
+        let joined = |wanted: Option<bool>| move |outcome: &GapProbeOutcome| matches!(outcome, GapProbeOutcome::Overlaps { joined_in_place, .. } if *joined_in_place == wanted);
+        let loose_planned_m: f64 = loose.iter().map(|line| line.planned_m).sum();
+        let loose_bound_m: f64 = loose.iter().map(|line| line.bound_m).sum();
+        Self {
+            loose_planned_m,
+            loose_bound_m,
+            shown_m: loose.iter().map(LooseLine::longest_shown_m).sum(),
+            shown_with_stop_m: loose.iter().map(LooseLine::longest_with_one_stop_m).sum(),
+            probes: outcomes.len(),
+            passes_p0: count(&|o| *o == GapProbeOutcome::PassesP0),
+            joined: count(&joined(Some(true))),
+            not_joined: count(&joined(Some(false))),
+            not_compared: count(&joined(None)),
+            stops_short: count(&|o| *o == GapProbeOutcome::StopsShort),
+            no_start: count(&|o| *o == GapProbeOutcome::NoStart),
+            share: record.planned_m / record.bound_m,
+            share_of_others: (record.planned_m - loose_planned_m)
+                / (record.bound_m - loose_bound_m),
+        }
+    }
+}
+
+/// The report's table: one row per shipped arm with a `gaps.json`.
+pub fn report_table(results: &std::path::Path) -> anyhow::Result<String> {
+    let mut md = String::from(
+        "| arm | tolerance | lines: Σ plan / Σ bound | likely loose | their Σ plan / Σ bound (m) \
+         | longest shown from `p0` (m) | with one stop in place (m) | motions back: past `p0` / \
+         joined in place / not joined / stop short / no start | Σ plan / Σ bound over the others \
+         |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for (shipped, record) in crate::report::shipped_results::<Record>(results, "gaps.json")? {
+        let summary = Summary::of(&record);
+        md.push_str(&format!(
+            "| {} | {} mm | {:.3} | {} of {} | {:.2} / {:.2} | {:.2} | {:.2} | {} / {} / {} / {} / {} \
+             | {:.3} |\n",
+            shipped.name,
+            record.tolerance_mm,
+            summary.share,
+            record.loose.len(),
+            record.line_count,
+            summary.loose_planned_m,
+            summary.loose_bound_m,
+            summary.shown_m,
+            summary.shown_with_stop_m,
+            summary.passes_p0,
+            summary.joined,
+            summary.not_joined,
+            summary.stops_short,
+            summary.no_start,
+            summary.share_of_others,
+        ));
+    }
+    Ok(md)
+}
+
+fn markdown(record: &Record) -> String {
+    let summary = Summary::of(record);
     let mut md = format!(
         "# Lines whose bound is likely loose, asked from the far side ({})\n\n\
          Generated by `{}` on {} ({} threads). The first {} tasks of `{}` planned as \
@@ -244,33 +333,27 @@ fn markdown(record: &Record) -> String {
         record.line_count,
         record.tasks,
         record.tolerance_mm,
-        record.planned_m / record.bound_m,
-        loose.len(),
-        loose_planned,
-        loose_bound,
+        summary.share,
+        record.loose.len(),
+        summary.loose_planned_m,
+        summary.loose_bound_m,
         record.in_place.samples,
         record.in_place.seed,
-        probes.len(),
-        count(&|o| *o == GapProbeOutcome::PassesP0),
-        count(&joined(true)),
-        count(&joined(false)),
-        count(&|o| matches!(
-            o,
-            GapProbeOutcome::Overlaps {
-                joined_in_place: None,
-                ..
-            }
-        )),
-        count(&|o| *o == GapProbeOutcome::StopsShort),
-        count(&|o| *o == GapProbeOutcome::NoStart),
-        loose_shown,
-        loose_bound,
-        loose_shown_with_stop,
-        (record.planned_m - loose_planned) / (record.bound_m - loose_bound),
+        summary.probes,
+        summary.passes_p0,
+        summary.joined,
+        summary.not_joined,
+        summary.not_compared,
+        summary.stops_short,
+        summary.no_start,
+        summary.shown_m,
+        summary.loose_bound_m,
+        summary.shown_with_stop_m,
+        summary.share_of_others,
     );
     md.push_str("| task | plan (m) | bound (m) | from (m) | back to (m) | what it shows |\n");
     md.push_str("|---|---|---|---|---|---|\n");
-    for line in loose {
+    for line in &record.loose {
         for (i, probe) in line.probes.iter().enumerate() {
             let (task, planned, bound) = if i == 0 {
                 (

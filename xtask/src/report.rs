@@ -194,6 +194,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
          corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
          `docs/results/precision.md` per arm):\n\n{precision}\n"
     );
+    let gaps = crate::gap_eval::report_table(&args.results)?;
+    md += &format!(
+        "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
+         step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
+         the far side: motions planned back from beyond the plan's end, and motions in place \
+         between their branches and the plan's (`cargo xtask gap-eval`; `docs/results/gaps.md` \
+         per arm):\n\n{gaps}\n"
+    );
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     if args.results == workspace::root().join("docs/results") {
@@ -212,7 +220,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             crate::precision_eval::README_END,
             &precision,
         )?;
-        println!("wrote the README's tables of search shares, plan times and precision");
+        workspace::replace_readme_section(
+            crate::gap_eval::README_START,
+            crate::gap_eval::README_END,
+            &gaps,
+        )?;
+        println!(
+            "wrote the README's tables of search shares, plan times, precision and loose bounds"
+        );
     }
     Ok(())
 }
