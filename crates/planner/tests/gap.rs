@@ -9,7 +9,7 @@ use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
     DataDir, GapProbeOutcome, InPlaceConfig, Models, PlanRequest, Planner, PlannerConfig,
-    SHIPPED_ROBOTS, gap_probes,
+    ShippedRobot, gap_probes,
 };
 
 /// The line: task 22 of the UR5e's evaluation set.
@@ -18,10 +18,7 @@ const TASK: usize = 22;
 #[test]
 fn a_loose_bounds_motions_back_do_not_join_the_plan() {
     let data = DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"));
-    let arm = SHIPPED_ROBOTS
-        .into_iter()
-        .find(|arm| arm.name == "ur5e")
-        .expect("the UR5e is shipped");
+    let arm = ShippedRobot::by_name("ur5e").expect("the UR5e is shipped");
     let robot = Robot::from_chain_file(arm.path(&data)).expect("robot loads");
     let models = Models::shipped(&robot, &arm.data_dir(&data)).expect("shipped models");
     let tasks = read_tasks(&arm.data_dir(&data).join("tasks/eval-v1.tasks"), &robot)

@@ -6,7 +6,7 @@
 
 use emg_control::{ConstraintConfig, Task, first_violation};
 use emg_kinematics::{JointVector, Robot, Vec3};
-use emg_planner::{DataDir, InPlaceConfig, SHIPPED_ROBOTS, in_place_motion};
+use emg_planner::{DataDir, InPlaceConfig, ShippedRobot, in_place_motion};
 use emg_seeding::{IkConfig, cone_ik_solutions};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -28,10 +28,7 @@ struct Setup {
 /// axis within 5° of the line's normal.
 fn setup() -> Setup {
     let data = DataDir::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data"));
-    let arm = SHIPPED_ROBOTS
-        .into_iter()
-        .find(|arm| arm.name == "ur5e")
-        .expect("the UR5e is shipped");
+    let arm = ShippedRobot::by_name("ur5e").expect("the UR5e is shipped");
     let robot = Robot::from_chain_file(arm.path(&data)).expect("robot loads");
     let point = Vec3::new(0.3, 0.15, 0.25);
     let normal = Vec3::new(0.0, 0.0, 1.0);
