@@ -244,7 +244,14 @@ impl Summary {
         let count = |wanted: &dyn Fn(&GapProbeOutcome) -> bool| {
             outcomes.iter().filter(|outcome| wanted(outcome)).count()
         };
-        let joined = |wanted: Option<bool>| move |outcome: &GapProbeOutcome| matches!(outcome, GapProbeOutcome::Overlaps { joined_in_place, .. } if *joined_in_place == wanted);
+        let joined = |wanted: Option<bool>| {
+            move |outcome: &GapProbeOutcome| match outcome {
+                GapProbeOutcome::Overlaps {
+                    joined_in_place, ..
+                } => *joined_in_place == wanted,
+                _ => false,
+            }
+        };
         let loose_planned_m: f64 = loose.iter().map(|line| line.planned_m).sum();
         let loose_bound_m: f64 = loose.iter().map(|line| line.bound_m).sum();
         Self {

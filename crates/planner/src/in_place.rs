@@ -59,6 +59,10 @@ impl InPlaceConfig {
 /// Distance (m) within which a projection counts as on the point.
 const ON_POINT_M: f64 = 1e-7;
 
+/// Distance (m) from the point within which [`in_place_motion`] takes the configurations it
+/// joins (they come from elsewhere: a plan, an IK solution put on the point).
+pub const END_ON_POINT_M: f64 = 1e-6;
+
 /// Newton steps a projection onto the point may take.
 const PROJECTION_STEPS: usize = 30;
 
@@ -75,11 +79,11 @@ const STEPS_PER_CONNECT: usize = 100;
 /// configuration on the point within `step_rad` lands on it.
 const MET_RAD: f64 = 1e-9;
 
-/// A motion from `from` to `to` (both with the TCP on `point`) along which the TCP stays on
-/// `point` and every configuration holds `constraints` on `task`, each configuration within
-/// twice `config.step_rad` (Euclidean) of the one before; `None` where the search finds none within
-/// its budget, or where `from` or `to` is not a valid configuration on the point (module
-/// documentation). Deterministic for a given `config.seed`.
+/// A motion from `from` to `to` (both with the TCP within [`END_ON_POINT_M`] of `point`) along
+/// which the TCP stays on `point` and every configuration holds `constraints` on `task`, each
+/// configuration within twice `config.step_rad` (Euclidean) of the one before; `None` where the
+/// search finds none within its budget, or where `from` or `to` is not a valid configuration on
+/// the point (module documentation). Deterministic for a given `config.seed`.
 pub fn in_place_motion(
     robot: &Robot,
     task: &Task,
@@ -97,7 +101,7 @@ pub fn in_place_motion(
         step_rad: config.step_rad,
     };
     for end in [from, to] {
-        let on_point = (robot.forward(end).tcp() - point).norm() < 1e3 * ON_POINT_M;
+        let on_point = (robot.forward(end).tcp() - point).norm() < END_ON_POINT_M;
         if !on_point || !manifold.valid(end) {
             return None;
         }
@@ -234,7 +238,7 @@ impl Tree {
         let mut added = None;
         for _ in 0..steps {
             let current = self.nodes[at].q;
-            if (target - current).norm() < ON_POINT_M {
+            if (target - current).norm() < MET_RAD {
                 break;
             }
             let Some(next) = manifold.step(&current, target) else {
