@@ -252,13 +252,15 @@ impl Summary {
                 _ => false,
             }
         };
-        let loose_planned_m: f64 = loose.iter().map(|line| line.planned_m).sum();
-        let loose_bound_m: f64 = loose.iter().map(|line| line.bound_m).sum();
+        // Sums from +0, not the empty sum's −0, which prints as "-0.00" when no line is loose.
+        let total = |of: fn(&LooseLine) -> f64| loose.iter().map(of).fold(0.0, |a, b| a + b);
+        let loose_planned_m = total(|line| line.planned_m);
+        let loose_bound_m = total(|line| line.bound_m);
         Self {
             loose_planned_m,
             loose_bound_m,
-            shown_m: loose.iter().map(LooseLine::longest_shown_m).sum(),
-            shown_with_stop_m: loose.iter().map(LooseLine::longest_with_one_stop_m).sum(),
+            shown_m: total(LooseLine::longest_shown_m),
+            shown_with_stop_m: total(LooseLine::longest_with_one_stop_m),
             probes: outcomes.len(),
             passes_p0: count(&|o| *o == GapProbeOutcome::PassesP0),
             joined: count(&joined(Some(true))),

@@ -95,12 +95,13 @@ pub fn order_strokes(strokes: &[Path], order: Order) -> Ordering {
     }
 }
 
-/// Σ distance from each stroke's end to the next one's start.
+/// Σ distance from each stroke's end to the next one's start (0, not the empty sum's −0, for a
+/// single stroke).
 fn travel(sequence: &[Oriented], ends: &[Ends]) -> f64 {
     sequence
         .windows(2)
         .map(|pair| (Ends::of(pair[1], ends).0 - Ends::of(pair[0], ends).1).norm())
-        .sum()
+        .fold(0.0, |total, leg| total + leg)
 }
 
 /// From the first stroke, always the nearest start (or end, drawn reversed) not yet drawn.
@@ -208,5 +209,17 @@ mod tests {
             vec![0, 2, 1]
         );
         assert!(shortest.sequence[1].reversed && !shortest.sequence[2].reversed);
+    }
+
+    #[test]
+    fn a_single_stroke_travels_a_positive_zero() {
+        let strokes = vec![line([0.4, 0.0, 0.2], [0.5, 0.0, 0.2])];
+        for order in [Order::Given, Order::Shortest] {
+            let ordering = order_strokes(&strokes, order);
+            for travel in [ordering.travel_m, ordering.travel_given_m] {
+                // `{:.3}` prints −0 as "-0.000".
+                assert_eq!(format!("{travel:.3}"), "0.000", "{order:?}");
+            }
+        }
     }
 }
