@@ -266,8 +266,8 @@ impl<'a> Episode<'a> {
     /// context): Newton corrections `Δq = J⁺ e` toward the nearest line or path point
     /// ([`correct_onto_task`]); then the same without the null-space motion. The end
     /// configuration and the action it applied, with the context's kinematics at it; `None`, the
-    /// kinematics back at `paper_end`, where neither comes within [`CORRECTION_TRIGGER`] of the tolerance. Shortening the step as well (a
-    /// half, a quarter) was measured and left out: `cargo xtask precision-eval` found the same
+    /// kinematics back at `paper_end`, where neither comes within [`CORRECTION_TRIGGER`] of the
+    /// tolerance. Shortening the step as well (a half, a quarter) was measured and left out: `cargo xtask precision-eval` found the same
     /// shares of the bound at 0.5 mm, the step cap ending what the tolerance had, and lower
     /// ones at 20 mm.
     fn corrected_step(

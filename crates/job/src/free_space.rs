@@ -5,17 +5,13 @@
 //! between two configurations (the straight edge, else dual RRT-Connect with shortcuts).
 
 use emg_control::{ConstraintConfig, Path, PathSpec, SegmentSpec, Task};
-use emg_kinematics::{DampingConfig, JointVector, Obstacle, Robot, Vec3, damped_pseudo_inverse};
+use emg_kinematics::{JointVector, Obstacle, Robot, Vec3, project_to_point};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The farthest any point of the arm moves between two configurations an edge check visits
 /// (m): far less than the radius of any link's capsule.
 pub const MAX_POINT_TRAVEL_M: f64 = 0.005;
-
-/// Newton iterations of the lift's inverse kinematics, and the TCP error they stop within (m).
-const LIFT_ITERATIONS: usize = 50;
-const LIFT_TOLERANCE_M: f64 = 1e-6;
 
 /// Step of the sampling planner's trees (rad, joint-space distance).
 const RRT_EXTEND_RAD: f64 = 0.1;
@@ -304,22 +300,11 @@ impl<'a> FreeSpace<'a> {
         true
     }
 
-    /// The configuration near `q` whose TCP lies at `target` (Newton steps on the TCP position
-    /// with the damped pseudo-inverse), if they converge to a free configuration joined to `q`
-    /// by a free edge.
+    /// The configuration near `q` whose TCP lies at `target` ([`project_to_point`]), if the
+    /// Newton steps converge to a free configuration joined to `q` by a free edge.
     pub fn reach_point(&self, q: &JointVector, target: &Vec3) -> Option<JointVector> {
-        let mut current = *q;
-        for _ in 0..LIFT_ITERATIONS {
-            let kinematics = self.robot.forward(&current);
-            let error = target - kinematics.tcp();
-            if error.norm() <= LIFT_TOLERANCE_M {
-                return (self.free(&current) && self.edge_free(q, &current)).then_some(current);
-            }
-            let pseudo_inverse =
-                damped_pseudo_inverse(kinematics.jacobian(), &DampingConfig::default());
-            current += pseudo_inverse.matrix * error;
-        }
-        None
+        project_to_point(self.robot, q, target)
+            .filter(|reached| self.free(reached) && self.edge_free(q, reached))
     }
 
     /// A free move from `a` to `b`: the straight edge where it is free, else a path of dual

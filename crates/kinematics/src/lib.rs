@@ -52,7 +52,8 @@ pub use fk::{Kinematics, PositionJacobian};
 pub use manipulability::{directional_manipulability, tool_alignment_gradient};
 pub use nullspace::{BasisConfig, NullSpaceBasis, TaskBasis, null_space_basis, task_aligned_basis};
 pub use projection::{
-    PoseTarget, ProjectionConfig, ProjectionError, pose_residual, project_to_pose,
+    POINT_ITERATIONS, POINT_TOLERANCE_M, PoseTarget, ProjectionConfig, ProjectionError,
+    pose_residual, project_to_point, project_to_pose,
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
 pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};

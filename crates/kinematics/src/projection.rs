@@ -1,8 +1,10 @@
-//! Newton projection of a configuration onto an exact TCP pose within the joint limits.
+//! Newton projection of a configuration onto an exact TCP pose within the joint limits, and
+//! onto a TCP position alone.
 
 use nalgebra::{Matrix3, SMatrix, SVector};
 use serde::{Deserialize, Serialize};
 
+use crate::pseudo_inverse::{DampingConfig, damped_pseudo_inverse};
 use crate::robot::Robot;
 use crate::{JointVector, MAX_DOF, Vec3};
 
@@ -93,6 +95,31 @@ pub enum ProjectionError {
         /// What is wrong with it.
         problem: &'static str,
     },
+}
+
+/// Newton steps [`project_to_point`] takes at most.
+pub const POINT_ITERATIONS: usize = 50;
+
+/// TCP distance (m) from the point within which [`project_to_point`] has converged.
+pub const POINT_TOLERANCE_M: f64 = 1e-6;
+
+/// The configuration near `q` whose TCP lies within [`POINT_TOLERANCE_M`] of `point`, the tool
+/// axis free: Newton steps `q ← q + J⁺ e` on the TCP position (`J⁺` the pseudo-inverse at each
+/// step, damped as [`DampingConfig::default`]; the joint limits not held), at most
+/// [`POINT_ITERATIONS`]; `None` where they do not converge.
+pub fn project_to_point(robot: &Robot, q: &JointVector, point: &Vec3) -> Option<JointVector> {
+    let mut current = *q;
+    for _ in 0..POINT_ITERATIONS {
+        let kinematics = robot.forward(&current);
+        let error = point - kinematics.tcp();
+        if error.norm() <= POINT_TOLERANCE_M {
+            return Some(current);
+        }
+        let pseudo_inverse =
+            damped_pseudo_inverse(kinematics.jacobian(), &DampingConfig::default());
+        current += pseudo_inverse.matrix * error;
+    }
+    None
 }
 
 /// Projects `start` onto the exact pose `target` by Levenberg–Marquardt steps, keeping every

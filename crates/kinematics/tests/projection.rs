@@ -1,13 +1,16 @@
 //! Newton projection onto an exact pose: from random reachable poses `FK(q*)` and starts
 //! `q* + U(−0.2, 0.2)` rad per joint, the projection reaches the position and the tool axis to
 //! 1e-9 (and the TCP x-axis with a roll target), inside the limits (and margin); bad targets
-//! are rejected by field; an unreachable target is an honest `NotConverged`, not a panic.
+//! are rejected by field; an unreachable target is an honest `NotConverged`, not a panic. The
+//! projection onto a TCP position alone reaches it from the same starts, and not a point out of
+//! reach.
 
 mod common;
 
 use common::{angle_between, random_q, random_unit, rng, robot};
 use emg_kinematics::{
-    JointVector, PoseTarget, ProjectionConfig, ProjectionError, Vec3, project_to_pose,
+    JointVector, POINT_TOLERANCE_M, PoseTarget, ProjectionConfig, ProjectionError, Vec3,
+    project_to_point, project_to_pose,
 };
 use rand::RngExt;
 
@@ -206,4 +209,24 @@ fn unreachable_target_fails_honestly() {
             other => panic!("expected NotConverged, got {other:?}"),
         }
     }
+}
+
+#[test]
+fn a_point_is_reached_from_perturbed_starts_and_an_unreachable_one_is_not() {
+    let robot = robot();
+    let mut rng = rng(31);
+    let mut converged = 0;
+    for _ in 0..TRIALS {
+        let q_star = random_q(&mut rng, &robot);
+        let point = robot.forward(&q_star).tcp();
+        let start = q_star + robot.configuration_from_fn(|_| rng.random_range(-0.2..0.2));
+        if let Some(q) = project_to_point(&robot, &start, &point) {
+            converged += 1;
+            let off = (robot.forward(&q).tcp() - point).norm();
+            assert!(off <= POINT_TOLERANCE_M, "{off} m off the point");
+        }
+    }
+    assert!(converged >= TRIALS * 95 / 100, "{converged} of {TRIALS}");
+    let far = Vec3::new(3.0, 0.0, 0.5);
+    assert_eq!(project_to_point(&robot, &robot.mid_range(), &far), None);
 }

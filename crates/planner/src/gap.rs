@@ -14,11 +14,11 @@
 //! - not back to the plan's end: no motion found from either side covers the points between.
 
 use emg_control::{Task, Trajectory};
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
 use serde::{Deserialize, Serialize};
 
 use crate::far_end::{reversed_surface, reversed_task};
-use crate::in_place::{InPlaceConfig, in_place_motion, onto_point};
+use crate::in_place::{InPlaceConfig, in_place_motion};
 use crate::planner::{Plan, PlanRequest, Planner};
 
 /// Where a motion planned back from a point beyond a plan's end got to.
@@ -170,7 +170,7 @@ fn probe_from(
 }
 
 /// The configuration of `trajectory` nearest `at_m` along `task`'s line, moved onto `point`
-/// ([`onto_point`]).
+/// ([`project_to_point`]).
 fn on_point(
     robot: &Robot,
     task: &Task,
@@ -183,5 +183,5 @@ fn on_point(
             .abs()
             .total_cmp(&(task.progress(&b.tcp) - at_m).abs())
     })?;
-    onto_point(robot, &nearest.q, point)
+    project_to_point(robot, &nearest.q, point)
 }

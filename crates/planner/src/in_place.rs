@@ -8,13 +8,13 @@
 //! (the tool axis free inside its cone). The configurations that put the TCP on a point form a
 //! manifold (of dimension `dof − 3`); [`in_place_motion`] searches it with a bidirectional
 //! rapidly-exploring random tree (RRT-Connect): random configurations projected onto the point
-//! by Newton steps on the position Jacobian, trees grown toward them in short joint steps, each
+//! ([`emg_kinematics::project_to_point`]), trees grown toward them in short joint steps, each
 //! step's end and midpoint projected and held to every constraint
 //! ([`emg_control::first_violation`]). A motion found is a witness that the configurations
 //! join; none found within the budget is evidence, not proof, that they do not.
 
 use emg_control::{ConstraintConfig, OutOfRange, Task, first_violation};
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, POINT_TOLERANCE_M, Robot, Vec3, project_to_point};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -56,19 +56,6 @@ impl InPlaceConfig {
     }
 }
 
-/// Distance (m) within which a projection counts as on the point.
-const ON_POINT_M: f64 = 1e-7;
-
-/// Distance (m) from the point within which [`in_place_motion`] takes the configurations it
-/// joins (they come from elsewhere: a plan, an IK solution put on the point).
-pub const END_ON_POINT_M: f64 = 1e-6;
-
-/// Newton steps a projection onto the point may take.
-const PROJECTION_STEPS: usize = 30;
-
-/// Damping of the projection's Newton steps (added to `J Jᵀ`, m²).
-const PROJECTION_DAMPING: f64 = 1e-6;
-
 /// Steps a tree grows toward one draw before the next draw.
 const STEPS_PER_DRAW: usize = 50;
 
@@ -79,7 +66,8 @@ const STEPS_PER_CONNECT: usize = 100;
 /// configuration on the point within `step_rad` lands on it.
 const MET_RAD: f64 = 1e-9;
 
-/// A motion from `from` to `to` (both with the TCP within [`END_ON_POINT_M`] of `point`) along
+/// A motion from `from` to `to` (both with the TCP within
+/// [`POINT_TOLERANCE_M`] of `point`, as [`project_to_point`] puts them) along
 /// which the TCP stays on `point` and every configuration holds `constraints` on `task`, each
 /// configuration within twice `config.step_rad` (Euclidean) of the one before; `None` where the
 /// search finds none within its budget, or where `from` or `to` is not a valid configuration on
@@ -101,7 +89,7 @@ pub fn in_place_motion(
         step_rad: config.step_rad,
     };
     for end in [from, to] {
-        let on_point = (robot.forward(end).tcp() - point).norm() < END_ON_POINT_M;
+        let on_point = (robot.forward(end).tcp() - point).norm() <= POINT_TOLERANCE_M;
         if !on_point || !manifold.valid(end) {
             return None;
         }
@@ -144,26 +132,6 @@ pub fn in_place_motion(
     None
 }
 
-/// `q` moved so that the TCP is on `point`, by damped Newton steps on the position Jacobian
-/// (the least-norm correction each step); `None` where they do not converge.
-pub(crate) fn onto_point(robot: &Robot, q: &JointVector, point: &Vec3) -> Option<JointVector> {
-    let mut q = *q;
-    for _ in 0..PROJECTION_STEPS {
-        let kinematics = robot.forward(&q);
-        let error = point - kinematics.tcp();
-        if error.norm() < ON_POINT_M {
-            return Some(q);
-        }
-        let jacobian = kinematics.jacobian();
-        let mut gram = jacobian * jacobian.transpose();
-        for k in 0..3 {
-            gram[(k, k)] += PROJECTION_DAMPING;
-        }
-        q += jacobian.transpose() * gram.cholesky()?.solve(&error);
-    }
-    None
-}
-
 /// The configurations that put the TCP on one point and hold every constraint.
 struct PointManifold<'a> {
     robot: &'a Robot,
@@ -175,7 +143,7 @@ struct PointManifold<'a> {
 
 impl PointManifold<'_> {
     fn project(&self, q: &JointVector) -> Option<JointVector> {
-        onto_point(self.robot, q, &self.point)
+        project_to_point(self.robot, q, &self.point)
     }
 
     /// Whether `q` holds every constraint.

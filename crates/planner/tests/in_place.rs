@@ -5,7 +5,7 @@
 //! limits are ±π).
 
 use emg_control::{ConstraintConfig, Task, first_violation};
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
 use emg_planner::{DataDir, InPlaceConfig, ShippedRobot, in_place_motion};
 use emg_seeding::{IkConfig, cone_ik_solutions};
 use rand::{RngExt, SeedableRng};
@@ -19,7 +19,7 @@ struct Setup {
     task: Task,
     constraints: ConstraintConfig,
     point: Vec3,
-    /// Valid configurations with the TCP on `point` (within 1 nm).
+    /// Valid configurations with the TCP on `point` (within `POINT_TOLERANCE_M`).
     solutions: Vec<JointVector>,
 }
 
@@ -38,7 +38,7 @@ fn setup() -> Setup {
     let solutions: Vec<JointVector> =
         cone_ik_solutions(&robot, &point, &normal, &IkConfig::default(), &mut rng)
             .into_iter()
-            .filter_map(|q| projected(&robot, &point, &q))
+            .filter_map(|q| project_to_point(&robot, &q, &point))
             .filter(|q| first_violation(&robot, &task, &robot.forward(q), &constraints).is_none())
             .collect();
     Setup {
@@ -91,7 +91,8 @@ fn a_motion_in_place_joins_what_a_walk_in_place_joins() {
         let noise = setup
             .robot
             .configuration_from_fn(|_| 0.01 * (rng.random::<f64>() - 0.5));
-        let Some(guess) = projected(&setup.robot, &setup.point, &(to + heading * 0.03 + noise))
+        let Some(guess) =
+            project_to_point(&setup.robot, &(to + heading * 0.03 + noise), &setup.point)
         else {
             continue;
         };
@@ -172,21 +173,4 @@ fn a_configuration_off_the_point_is_refused() {
         &InPlaceConfig::default(),
     );
     assert!(motion.is_none());
-}
-
-/// `q` moved so that the TCP is on the point: Newton steps on the position (the tests' own;
-/// the crate's is internal).
-fn projected(robot: &Robot, point: &Vec3, q: &JointVector) -> Option<JointVector> {
-    let mut q = *q;
-    for _ in 0..30 {
-        let kinematics = robot.forward(&q);
-        let error = point - kinematics.tcp();
-        if error.norm() < 1e-9 {
-            return Some(q);
-        }
-        let jacobian = kinematics.jacobian();
-        let gram = jacobian * jacobian.transpose();
-        q += jacobian.transpose() * gram.try_inverse()? * error;
-    }
-    None
 }
