@@ -1,8 +1,8 @@
 //! `cargo xtask gap-eval`: the lines whose bound is likely loose (`emg plan`'s continuity test,
 //! `emg_planner::BoundNote::likely_loose`), asked from the far side
 //! (`emg_planner::gap_probes`): motions planned back from points between the plan's end and
-//! the bound, where each gets back to, and whether the arm can change in place from the
-//! plan's branch to theirs (`docs/results/gaps.{json,md}`).
+//! the bound, where each gets back to, and whether the arm can change from the plan's branch to
+//! theirs in place or going back and forth along the line (`docs/results/gaps.{json,md}`).
 
 use std::path::PathBuf;
 
@@ -28,7 +28,8 @@ pub struct Args {
     /// The line tolerance (mm).
     #[arg(long, default_value_t = 0.5)]
     tolerance_mm: f64,
-    /// Random configurations each motion in place may draw (its budget).
+    /// Random configurations each motion in place, and each motion along the line, may draw
+    /// (its budget).
     #[arg(long, default_value_t = InPlaceConfig::default().samples)]
     samples: usize,
     /// Worker threads (0 = one per core); the results do not depend on it.
@@ -86,6 +87,17 @@ impl LooseLine {
             .map(|probe| probe.from_m)
             .fold(self.longest_shown_m(), f64::max)
     }
+
+    /// The longest motion from `p0` shown going back and forth along the line: the plan joined
+    /// along the line to a motion back ([`GapProbe::joined_along_line`]), then that motion read
+    /// forwards to where it started; at least [`LooseLine::longest_with_one_stop_m`].
+    pub fn longest_back_and_forth_m(&self) -> f64 {
+        self.probes
+            .iter()
+            .filter(|probe| probe.joined_along_line == Some(true))
+            .map(|probe| probe.from_m)
+            .fold(self.longest_with_one_stop_m(), f64::max)
+    }
 }
 
 /// The whole record written to `gaps.json`.
@@ -101,7 +113,7 @@ pub struct Record {
     pub line_count: usize,
     /// The line tolerance (mm).
     pub tolerance_mm: f64,
-    /// The motion in place's settings.
+    /// The settings of the motions in place and along the line.
     pub in_place: InPlaceConfig,
     /// Σ plan and Σ bound over every line (m).
     pub planned_m: f64,
@@ -185,7 +197,12 @@ fn probe_line(
 
 /// What one probe found, in words for the table.
 fn outcome_words(probe: &GapProbe) -> String {
-    match &probe.outcome {
+    let along = match probe.joined_along_line {
+        Some(true) => "; joined along the line",
+        Some(false) => "; not joined along the line",
+        None => "",
+    };
+    let outcome = match &probe.outcome {
         GapProbeOutcome::NoStart => "no motion starts there".into(),
         GapProbeOutcome::PassesP0 => "passes p0: a longer motion".into(),
         GapProbeOutcome::StopsShort => "stops before the plan's end".into(),
@@ -200,7 +217,8 @@ fn outcome_words(probe: &GapProbe) -> String {
             ),
             _ => format!("overlaps; at {at_m:.3} m not compared (not a valid configuration)"),
         },
-    }
+    };
+    outcome + along
 }
 
 /// What a record's probes add up to.
@@ -209,10 +227,13 @@ struct Summary {
     loose_planned_m: f64,
     /// See `loose_planned_m`.
     loose_bound_m: f64,
-    /// Σ of their longest motions from `p0` shown, without and with one stop (m).
+    /// Σ of their longest motions from `p0` shown: without a stop, with one stop in place, and
+    /// going back and forth along the line (m).
     shown_m: f64,
     /// See `shown_m`.
     shown_with_stop_m: f64,
+    /// See `shown_m`.
+    shown_back_and_forth_m: f64,
     /// Motions planned back, and of them: passing `p0`, joined in place, not joined, not
     /// compared, stopping before the plan's end, without a start.
     probes: usize,
@@ -228,6 +249,11 @@ struct Summary {
     stops_short: usize,
     /// See `probes`.
     no_start: usize,
+    /// Motions back that do not pass `p0` (with a start), and of them those joined to the plan
+    /// along the line.
+    asked_along_line: usize,
+    /// See `asked_along_line`.
+    joined_along_line: usize,
     /// Σ plan / Σ bound over all lines, and over the lines whose bound is not likely loose.
     share: f64,
     /// See `share`.
@@ -252,6 +278,13 @@ impl Summary {
                 _ => false,
             }
         };
+        let along_line = |wanted: fn(Option<bool>) -> bool| {
+            loose
+                .iter()
+                .flat_map(|line| &line.probes)
+                .filter(|probe| wanted(probe.joined_along_line))
+                .count()
+        };
         // Sums from +0, not the empty sum's −0, which prints as "-0.00" when no line is loose.
         let total = |of: fn(&LooseLine) -> f64| loose.iter().map(of).fold(0.0, |a, b| a + b);
         let loose_planned_m = total(|line| line.planned_m);
@@ -261,6 +294,7 @@ impl Summary {
             loose_bound_m,
             shown_m: total(LooseLine::longest_shown_m),
             shown_with_stop_m: total(LooseLine::longest_with_one_stop_m),
+            shown_back_and_forth_m: total(LooseLine::longest_back_and_forth_m),
             probes: outcomes.len(),
             passes_p0: count(&|o| *o == GapProbeOutcome::PassesP0),
             joined: count(&joined(Some(true))),
@@ -268,6 +302,8 @@ impl Summary {
             not_compared: count(&joined(None)),
             stops_short: count(&|o| *o == GapProbeOutcome::StopsShort),
             no_start: count(&|o| *o == GapProbeOutcome::NoStart),
+            asked_along_line: along_line(|joined| joined.is_some()),
+            joined_along_line: along_line(|joined| joined == Some(true)),
             share: record.planned_m / record.bound_m,
             share_of_others: (record.planned_m - loose_planned_m)
                 / (record.bound_m - loose_bound_m),
@@ -279,15 +315,16 @@ impl Summary {
 pub fn report_table(results: &std::path::Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | lines: Σ plan / Σ bound | likely loose | their Σ plan / Σ bound (m) \
-         | longest shown from `p0` (m) | with one stop in place (m) | motions back: past `p0` / \
-         joined in place / not joined / stop short / no start | Σ plan / Σ bound over the others \
-         |\n|---|---|---|---|---|---|---|---|---|\n",
+         | longest shown from `p0` (m) | with one stop in place (m) | back and forth along the \
+         line (m) | motions back: past `p0` / joined in place / not joined / stop short / no start \
+         | joined along the line | Σ plan / Σ bound over the others |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for (shipped, record) in crate::report::shipped_results::<Record>(results, "gaps.json")? {
         let summary = Summary::of(&record);
         md.push_str(&format!(
-            "| {} | {} mm | {:.3} | {} of {} | {:.2} / {:.2} | {:.2} | {:.2} | {} / {} / {} / {} / {} \
-             | {:.3} |\n",
+            "| {} | {} mm | {:.3} | {} of {} | {:.2} / {:.2} | {:.2} | {:.2} | {:.2} | {} / {} / {} / \
+             {} / {} | {} of {} | {:.3} |\n",
             shipped.name,
             record.tolerance_mm,
             summary.share,
@@ -297,11 +334,14 @@ pub fn report_table(results: &std::path::Path) -> anyhow::Result<String> {
             summary.loose_bound_m,
             summary.shown_m,
             summary.shown_with_stop_m,
+            summary.shown_back_and_forth_m,
             summary.passes_p0,
             summary.joined,
             summary.not_joined,
             summary.stops_short,
             summary.no_start,
+            summary.joined_along_line,
+            summary.asked_along_line,
             summary.share_of_others,
         ));
     }
@@ -323,18 +363,24 @@ fn markdown(record: &Record) -> String {
          step before it, and where a motion back passes the plan's end without reaching `p0`, \
          a motion in place (`emg_planner::in_place_motion`, RRT-Connect on the configurations \
          that hold the TCP on one point, {} draws, seed {}) tries to join the plan's \
-         configuration there to the motion back's.\n\n\
+         configuration there to the motion back's. Where a motion back does not pass `p0`, a \
+         motion along the line (`emg_planner::motion_along_line`, the same search on the \
+         configurations that hold the TCP anywhere on the line up to where the motion back \
+         starts, going back and forth as it needs) tries to join the plan's configurations to \
+         the motion back's.\n\n\
          Of {} motions planned back: {} pass `p0` (read forwards, a motion from `p0` longer \
          than the plan: the search missed it), {} pass the plan's end and are joined to it in \
          place, {} pass it and are not, {} pass it where a configuration could not be \
          compared, {} stop before the plan's end, {} have no start. The longest motion from \
          `p0` shown on these lines (the plan or a motion back past `p0`) sums to {:.2} m of \
          their {:.2} m bound, {:.2} m with one stop to reconfigure in place (the plan to where \
-         a motion back is joined to it, then that motion). A motion back that covers the \
-         plan's end on another branch, not joined to it in place, and one that stops before \
-         it, are what the continuity test suspected: the bound's configurations there lie on \
-         branches no motion from `p0` that was found reaches. Σ plan / Σ bound over the other \
-         lines: {:.3}.\n\n",
+         a motion back is joined to it, then that motion), {:.2} m going back and forth along \
+         the line ({} of the {} motions back that do not pass `p0` are joined to the plan along \
+         it: the plan, back along the line while the arm changes over, then that motion). A \
+         motion back joined to the plan by neither is what the continuity test suspected: the \
+         bound's configurations there lie on branches no motion from `p0` that was found \
+         reaches, even one that retraces the line. Σ plan / Σ bound over the other lines: \
+         {:.3}.\n\n",
         record.robot,
         record.command,
         record.machine,
@@ -358,6 +404,9 @@ fn markdown(record: &Record) -> String {
         summary.shown_m,
         summary.loose_bound_m,
         summary.shown_with_stop_m,
+        summary.shown_back_and_forth_m,
+        summary.joined_along_line,
+        summary.asked_along_line,
         summary.share_of_others,
     );
     md.push_str("| task | plan (m) | bound (m) | from (m) | back to (m) | what it shows |\n");

@@ -199,8 +199,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
          step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
          the far side: motions planned back from beyond the plan's end, and motions in place \
-         between their branches and the plan's (`cargo xtask gap-eval`; `docs/results/gaps.md` \
-         per arm):\n\n{gaps}\n"
+         and along the line between their branches and the plan's (`cargo xtask gap-eval`; \
+         `docs/results/gaps.md` per arm):\n\n{gaps}\n"
     );
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());

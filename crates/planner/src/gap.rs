@@ -12,13 +12,18 @@
 //!   back's with the TCP held still: joined, the two motions make one (with a stop to
 //!   reconfigure);
 //! - not back to the plan's end: no motion found from either side covers the points between.
+//!
+//! Where a motion back does not pass `p0`, [`motion_along_line`] also tries to join the plan's
+//! configurations to the motion back's with the TCP anywhere on the line up to where the motion
+//! back starts, going back and forth along it as it needs: joined, a motion from `p0` reaches
+//! that start (retracing part of the line on the way).
 
 use emg_control::{Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
 use serde::{Deserialize, Serialize};
 
 use crate::far_end::{reversed_surface, reversed_task};
-use crate::in_place::{InPlaceConfig, in_place_motion};
+use crate::in_place::{InPlaceConfig, in_place_motion, motion_along_line};
 use crate::planner::{Plan, PlanRequest, Planner};
 
 /// Where a motion planned back from a point beyond a plan's end got to.
@@ -52,6 +57,10 @@ pub struct GapProbe {
     pub from_m: f64,
     /// Where it ends (m along the line; negative past `p0`).
     pub back_to_m: f64,
+    /// Whether a motion along the line up to `from_m` ([`motion_along_line`]) joins the plan's
+    /// configurations to the motion back's; `None` where there is no motion back or it passes
+    /// `p0`.
+    pub joined_along_line: Option<bool>,
     /// What that means for the plan.
     #[serde(flatten)]
     pub outcome: GapProbeOutcome,
@@ -107,6 +116,7 @@ fn probe_from(
     let no_start = GapProbe {
         from_m,
         back_to_m: from_m,
+        joined_along_line: None,
         outcome: GapProbeOutcome::NoStart,
     };
     let robot = planner.robot();
@@ -162,9 +172,30 @@ fn probe_from(
             joint_gap_rad,
         }
     };
+    let joined_along_line = (outcome != GapProbeOutcome::PassesP0).then(|| {
+        let configurations = |trajectory: &Trajectory| {
+            trajectory
+                .steps
+                .iter()
+                .map(|step| step.q)
+                .collect::<Vec<_>>()
+        };
+        motion_along_line(
+            robot,
+            task,
+            &planner.config().rollout.constraints,
+            0.0,
+            from_m,
+            &configurations(forward),
+            &configurations(&back.trajectory),
+            in_place,
+        )
+        .is_some()
+    });
     GapProbe {
         from_m,
         back_to_m,
+        joined_along_line,
         outcome,
     }
 }

@@ -1,17 +1,19 @@
-//! Motion in place: whether the arm can move from one configuration to another while its TCP
-//! stays on one point of the line, every constraint held on the way.
+//! Motions that hold the TCP on the line: in place on one point, or back and forth along a
+//! stretch of it, every constraint held on the way.
 //!
 //! Two motions along a line may cover the same point on different self-motion branches: one
 //! from `p0` that ends there, another that goes on from there to the end of the bound. They join
 //! into one motion only if the arm can change from one branch to the other somewhere, and where
 //! it cannot do so on the move it could still stop and reconfigure with the TCP held still
-//! (the tool axis free inside its cone). The configurations that put the TCP on a point form a
-//! manifold (of dimension `dof − 3`); [`in_place_motion`] searches it with a bidirectional
+//! (the tool axis free inside its cone), or go back along the line it has drawn while it
+//! changes over. The configurations that put the TCP on a point form a manifold (of dimension
+//! `dof − 3`), those that put it on a stretch of the line one of dimension `dof − 2`;
+//! [`in_place_motion`] and [`motion_along_line`] search them with a bidirectional
 //! rapidly-exploring random tree (RRT-Connect): random configurations projected onto the point
-//! ([`emg_kinematics::project_to_point`]), trees grown toward them in short joint steps, each
-//! step's end and midpoint projected and held to every constraint
-//! ([`emg_control::first_violation`]). A motion found is a witness that the configurations
-//! join; none found within the budget is evidence, not proof, that they do not.
+//! (or the nearest point of the stretch; [`emg_kinematics::project_to_point`]), trees grown
+//! toward them in short joint steps, each step's end and midpoint projected and held to every
+//! constraint ([`emg_control::first_violation`]). A motion found is a witness that the
+//! configurations join; none found within the budget is evidence, not proof, that they do not.
 
 use emg_control::{ConstraintConfig, OutOfRange, Task, first_violation};
 use emg_kinematics::{JointVector, POINT_TOLERANCE_M, Robot, Vec3, project_to_point};
@@ -19,7 +21,7 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-/// Settings of [`in_place_motion`].
+/// Settings of [`in_place_motion`] and [`motion_along_line`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct InPlaceConfig {
@@ -63,7 +65,7 @@ const STEPS_PER_DRAW: usize = 50;
 const STEPS_PER_CONNECT: usize = 100;
 
 /// Joint distance (rad) at which two trees' nodes are the same configuration: a step toward a
-/// configuration on the point within `step_rad` lands on it.
+/// configuration on the manifold within `step_rad` lands on it.
 const MET_RAD: f64 = 1e-9;
 
 /// A motion from `from` to `to` (both with the TCP within
@@ -81,11 +83,11 @@ pub fn in_place_motion(
     to: &JointVector,
     config: &InPlaceConfig,
 ) -> Option<Vec<JointVector>> {
-    let manifold = PointManifold {
+    let manifold = Manifold {
         robot,
         task,
         constraints,
-        point: *point,
+        hold: Hold::Point(*point),
         step_rad: config.step_rad,
     };
     for end in [from, to] {
@@ -94,14 +96,77 @@ pub fn in_place_motion(
             return None;
         }
     }
-    if manifold
-        .step(from, to)
-        .is_some_and(|q| (q - to).norm() < MET_RAD)
-    {
-        return Some(vec![*from, *to]);
+    connect(&manifold, &[*from], &[*to], config)
+}
+
+/// A motion from one of `from` to one of `to` along which the TCP stays on `task`'s line
+/// between `from_m` and `to_m` along it (going back and forth as it needs) and every
+/// configuration holds `constraints`, each within twice `config.step_rad` (Euclidean) of the
+/// one before; every configuration but the first and last has its TCP within
+/// [`POINT_TOLERANCE_M`] of the line. `from` and `to` are each configurations already joined to
+/// one another (a motion's, say): the trees grow from all of them. Those that break a
+/// constraint or whose TCP is not on the stretch (within the line tolerance) are left out;
+/// `None` where none is left on a side, on a path task, or where the search finds no motion
+/// within its budget (module documentation). Deterministic for a given `config.seed`.
+#[allow(clippy::too_many_arguments)]
+pub fn motion_along_line(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    from_m: f64,
+    to_m: f64,
+    from: &[JointVector],
+    to: &[JointVector],
+    config: &InPlaceConfig,
+) -> Option<Vec<JointVector>> {
+    // False as well where either end is not a number.
+    let ordered = from_m <= to_m;
+    if task.path.is_some() || !ordered {
+        return None;
     }
-    let mut trees = [Tree::rooted(*from), Tree::rooted(*to)];
+    let manifold = Manifold {
+        robot,
+        task,
+        constraints,
+        hold: Hold::Stretch { from_m, to_m },
+        step_rad: config.step_rad,
+    };
+    let tolerance = constraints.line_tolerance_m;
+    let on_stretch = |q: &&JointVector| {
+        let along = task.progress(&robot.forward(q).tcp());
+        (from_m - tolerance..=to_m + tolerance).contains(&along) && manifold.valid(q)
+    };
+    let [from, to] =
+        [from, to].map(|ends| ends.iter().filter(on_stretch).copied().collect::<Vec<_>>());
+    if from.is_empty() || to.is_empty() {
+        return None;
+    }
+    connect(&manifold, &from, &to, config)
+}
+
+/// RRT-Connect on `manifold` between trees rooted at every one of `from` and of `to`: the
+/// motion from a root of `from` to a root of `to`, `None` where none is found within
+/// `config.samples` draws.
+fn connect(
+    manifold: &Manifold,
+    from: &[JointVector],
+    to: &[JointVector],
+    config: &InPlaceConfig,
+) -> Option<Vec<JointVector>> {
+    for start in from {
+        for end in to {
+            if (start - end).norm() <= manifold.step_rad
+                && manifold
+                    .step(start, end)
+                    .is_some_and(|q| (q - end).norm() < MET_RAD)
+            {
+                return Some(vec![*start, *end]);
+            }
+        }
+    }
+    let mut trees = [Tree::rooted(from), Tree::rooted(to)];
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
+    let robot = manifold.robot;
     let limits = robot.limits();
     for draw in 0..config.samples {
         let guess = robot.configuration_from_fn(|i| {
@@ -111,11 +176,11 @@ pub fn in_place_motion(
             continue;
         };
         let (growing, other) = if draw % 2 == 0 { (0, 1) } else { (1, 0) };
-        let Some(reached) = trees[growing].grow_toward(&manifold, &sample, STEPS_PER_DRAW) else {
+        let Some(reached) = trees[growing].grow_toward(manifold, &sample, STEPS_PER_DRAW) else {
             continue;
         };
         let reached_q = trees[growing].nodes[reached].q;
-        if let Some(met) = trees[other].grow_toward(&manifold, &reached_q, STEPS_PER_CONNECT)
+        if let Some(met) = trees[other].grow_toward(manifold, &reached_q, STEPS_PER_CONNECT)
             && (trees[other].nodes[met].q - reached_q).norm() < MET_RAD
         {
             let (from_end, to_end) = if growing == 0 {
@@ -132,18 +197,35 @@ pub fn in_place_motion(
     None
 }
 
-/// The configurations that put the TCP on one point and hold every constraint.
-struct PointManifold<'a> {
+/// Where a [`Manifold`]'s configurations hold the TCP.
+enum Hold {
+    /// On one point.
+    Point(Vec3),
+    /// On the task's line, between these distances along it (m).
+    Stretch { from_m: f64, to_m: f64 },
+}
+
+/// The configurations that put the TCP where [`Hold`] says and hold every constraint.
+struct Manifold<'a> {
     robot: &'a Robot,
     task: &'a Task,
     constraints: &'a ConstraintConfig,
-    point: Vec3,
+    hold: Hold,
     step_rad: f64,
 }
 
-impl PointManifold<'_> {
+impl Manifold<'_> {
+    /// The configuration near `q` with the TCP on the point, or on the stretch's point nearest
+    /// `q`'s TCP.
     fn project(&self, q: &JointVector) -> Option<JointVector> {
-        project_to_point(self.robot, q, &self.point)
+        let target = match self.hold {
+            Hold::Point(point) => point,
+            Hold::Stretch { from_m, to_m } => {
+                let along = self.task.progress(&self.robot.forward(q).tcp());
+                self.task.point_at(along.clamp(from_m, to_m))
+            }
+        };
+        project_to_point(self.robot, q, &target)
     }
 
     /// Whether `q` holds every constraint.
@@ -158,7 +240,7 @@ impl PointManifold<'_> {
     }
 
     /// One step from `from` toward `toward`: at most `step_rad` along the straight joint
-    /// path, projected onto the point; `None` where the projection moves it more than twice
+    /// path, projected onto the manifold; `None` where the projection moves it more than twice
     /// that (it jumped to another sheet) or it or the midpoint of the step breaks a constraint.
     fn step(&self, from: &JointVector, toward: &JointVector) -> Option<JointVector> {
         let offset = toward - from;
@@ -177,7 +259,7 @@ impl PointManifold<'_> {
     }
 }
 
-/// A tree of configurations on the point, each node knowing its parent.
+/// A tree of configurations on the manifold, each node knowing its parent (roots none).
 struct Tree {
     nodes: Vec<Node>,
 }
@@ -188,9 +270,10 @@ struct Node {
 }
 
 impl Tree {
-    fn rooted(q: JointVector) -> Self {
+    /// A tree of the configurations `roots`, each a root.
+    fn rooted(roots: &[JointVector]) -> Self {
         Self {
-            nodes: vec![Node { q, parent: None }],
+            nodes: roots.iter().map(|&q| Node { q, parent: None }).collect(),
         }
     }
 
@@ -198,7 +281,7 @@ impl Tree {
     /// added, `None` where not even one step was possible.
     fn grow_toward(
         &mut self,
-        manifold: &PointManifold,
+        manifold: &Manifold,
         target: &JointVector,
         steps: usize,
     ) -> Option<usize> {

@@ -57,7 +57,7 @@ pub use controller::{ControllerKind, Executor, ExecutorConfig, ExecutorError};
 pub use demo::demo_task;
 pub use files::{PlanFiles, PlanFilesError, PlanRecord};
 pub use gap::{GapProbe, GapProbeOutcome, gap_probes};
-pub use in_place::{InPlaceConfig, in_place_motion};
+pub use in_place::{InPlaceConfig, in_place_motion, motion_along_line};
 pub use models::{
     DIFFUSION_WEIGHTS_FILE, Models, ModelsError, POLICY_WEIGHTS_FILE, load_policy, load_seeder,
     robot_stamp,

@@ -2,7 +2,8 @@
 //! evaluation set whose plan ends at 0.31 m of a 1.42 m bound: every probe starts between the
 //! plan's end and the bound, says where its motion back got to consistently with its outcome,
 //! and the motions back that cover the plan's end lie on branches the plan's configuration is
-//! not joined to in place (the gap the continuity test suspected).
+//! not joined to in place, nor the plan to them along the line (the gap the continuity test
+//! suspected); only a motion back with a start that does not pass `p0` is asked along the line.
 
 use emg_control::Tracking;
 use emg_io::read_tasks;
@@ -39,8 +40,14 @@ fn a_loose_bounds_motions_back_do_not_join_the_plan() {
 
     let probes = gap_probes(&planner, task, &plan, &InPlaceConfig::default());
     assert!(!probes.is_empty());
-    let mut not_joined = 0;
+    let (mut not_joined, mut not_joined_along_line) = (0, 0);
     for probe in &probes {
+        let asked = !matches!(
+            probe.outcome,
+            GapProbeOutcome::NoStart | GapProbeOutcome::PassesP0
+        );
+        assert_eq!(probe.joined_along_line.is_some(), asked, "{probe:?}");
+        not_joined_along_line += usize::from(probe.joined_along_line == Some(false));
         assert!(
             probe.from_m > end_m && probe.from_m < note.reachable_m,
             "{probe:?}"
@@ -63,5 +70,5 @@ fn a_loose_bounds_motions_back_do_not_join_the_plan() {
             }
         }
     }
-    assert!(not_joined > 0, "{probes:?}");
+    assert!(not_joined > 0 && not_joined_along_line > 0, "{probes:?}");
 }

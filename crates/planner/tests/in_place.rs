@@ -1,18 +1,24 @@
-//! Motion in place (`emg_planner::in_place_motion`) on the shipped UR5e: it joins two
-//! configurations that a walk in place joins, every configuration of its motion on the point and
-//! valid, and it finds nothing between configurations with opposite elbows at a point too near
-//! the shoulder for the elbow to straighten (the only way between them, since the elbow joint's
-//! limits are ±π).
+//! Motions that hold the TCP on the line (`emg_planner::in_place_motion`,
+//! `emg_planner::motion_along_line`) on the shipped UR5e: in place, one joins two configurations
+//! that a walk in place joins, every configuration of its motion on the point and valid; along
+//! the line, one joins configurations at the two ends of a stretch, every configuration on the
+//! stretch and valid; and neither finds anything between configurations with opposite elbows
+//! where every point is too near the shoulder for the elbow to straighten (the only way between
+//! them, since the elbow joint's limits are ±π).
 
 use emg_control::{ConstraintConfig, Task, first_violation};
 use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
-use emg_planner::{DataDir, InPlaceConfig, ShippedRobot, in_place_motion};
+use emg_planner::{DataDir, InPlaceConfig, ShippedRobot, in_place_motion, motion_along_line};
 use emg_seeding::{IkConfig, cone_ik_solutions};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// The elbow joint (0-based).
 const ELBOW: usize = 2;
+
+/// The stretch of the setup's line, from its point, that motions along it may use (m): all of
+/// it under 0.41 m from the shoulder, still too near for the elbow to straighten.
+const STRETCH_M: f64 = 0.1;
 
 struct Setup {
     robot: Robot,
@@ -170,6 +176,114 @@ fn a_configuration_off_the_point_is_refused() {
         &setup.point,
         &on,
         &off,
+        &InPlaceConfig::default(),
+    );
+    assert!(motion.is_none());
+}
+
+/// Every configuration of `motion` is valid with its TCP on the line's first `STRETCH_M`
+/// (within 1 µm; the ends as given), each within twice the step of the one before.
+fn assert_along_line(setup: &Setup, motion: &[JointVector]) {
+    let step_rad = InPlaceConfig::default().step_rad;
+    for (i, q) in motion.iter().enumerate() {
+        let kinematics = setup.robot.forward(q);
+        let along = setup.task.progress(&kinematics.tcp());
+        let off = setup.task.lateral_error(&kinematics.tcp()).norm();
+        assert!(
+            (-1e-6..=STRETCH_M + 1e-6).contains(&along) && off < 1e-6,
+            "configuration {i}: the TCP is {along} m along the line, {off} m off it"
+        );
+        let violation = first_violation(&setup.robot, &setup.task, &kinematics, &setup.constraints);
+        assert!(violation.is_none(), "configuration {i}: {violation:?}");
+    }
+    for (i, pair) in motion.windows(2).enumerate() {
+        let jump = (pair[1] - pair[0]).norm();
+        assert!(jump <= 2.0 * step_rad + 1e-12, "step {i} moves {jump} rad");
+    }
+}
+
+#[test]
+fn a_motion_along_the_line_joins_its_two_ends() {
+    let setup = setup();
+    let from = setup.solutions[0];
+    let far_point = setup.task.point_at(STRETCH_M);
+    let to = project_to_point(&setup.robot, &from, &far_point).expect("the far point is reached");
+    assert!(
+        first_violation(
+            &setup.robot,
+            &setup.task,
+            &setup.robot.forward(&to),
+            &setup.constraints
+        )
+        .is_none()
+    );
+    let motion = motion_along_line(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        0.0,
+        STRETCH_M,
+        &[from],
+        &[to],
+        &InPlaceConfig::default(),
+    )
+    .expect("a motion along the line");
+    assert_eq!(motion.first(), Some(&from));
+    assert_eq!(motion.last(), Some(&to));
+    assert!(motion.len() > 2, "more than one step apart");
+    assert_along_line(&setup, &motion);
+}
+
+#[test]
+fn no_motion_along_the_line_flips_an_elbow_that_cannot_straighten() {
+    let setup = setup();
+    let up: Vec<JointVector> = setup
+        .solutions
+        .iter()
+        .filter(|q| q[ELBOW] > 0.2)
+        .copied()
+        .collect();
+    let down: Vec<JointVector> = setup
+        .solutions
+        .iter()
+        .filter(|q| q[ELBOW] < -0.2)
+        .copied()
+        .collect();
+    assert!(!up.is_empty() && !down.is_empty(), "{:?}", setup.solutions);
+    let motion = motion_along_line(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        0.0,
+        STRETCH_M,
+        &up,
+        &down,
+        &InPlaceConfig {
+            samples: 3000,
+            ..InPlaceConfig::default()
+        },
+    );
+    assert!(
+        motion.is_none(),
+        "{} configurations",
+        motion.map_or(0, |m| m.len())
+    );
+}
+
+#[test]
+fn configurations_off_the_stretch_are_left_out() {
+    let setup = setup();
+    let on = setup.solutions[0];
+    let beyond = project_to_point(&setup.robot, &on, &setup.task.point_at(2.0 * STRETCH_M))
+        .expect("a point beyond the stretch is reached");
+    let motion = motion_along_line(
+        &setup.robot,
+        &setup.task,
+        &setup.constraints,
+        0.0,
+        STRETCH_M,
+        &[on],
+        &[beyond],
         &InPlaceConfig::default(),
     );
     assert!(motion.is_none());
