@@ -56,19 +56,24 @@ fn setup() -> Setup {
     }
 }
 
-/// Every configuration of `motion` is on the point and valid, each within twice the step of
-/// the one before, and it runs from `from` to `to`.
-fn assert_in_place(setup: &Setup, motion: &[JointVector], from: &JointVector, to: &JointVector) {
+/// `motion` runs from `from` to `to`, every configuration of it valid with its TCP where
+/// `misplaced` finds nothing wrong (it says what is, else), each within twice the step of the
+/// one before.
+fn assert_motion(
+    setup: &Setup,
+    motion: &[JointVector],
+    from: &JointVector,
+    to: &JointVector,
+    misplaced: impl Fn(&Vec3) -> Option<String>,
+) {
     let step_rad = InPlaceConfig::default().step_rad;
     assert_eq!(motion.first(), Some(from));
     assert_eq!(motion.last(), Some(to));
     for (i, q) in motion.iter().enumerate() {
         let kinematics = setup.robot.forward(q);
-        let off = (kinematics.tcp() - setup.point).norm();
-        assert!(
-            off < 1e-6,
-            "configuration {i}: the TCP is {off} m off the point"
-        );
+        if let Some(wrong) = misplaced(&kinematics.tcp()) {
+            panic!("configuration {i}: {wrong}");
+        }
         let violation = first_violation(&setup.robot, &setup.task, &kinematics, &setup.constraints);
         assert!(violation.is_none(), "configuration {i}: {violation:?}");
     }
@@ -76,6 +81,14 @@ fn assert_in_place(setup: &Setup, motion: &[JointVector], from: &JointVector, to
         let jump = (pair[1] - pair[0]).norm();
         assert!(jump <= 2.0 * step_rad + 1e-12, "step {i} moves {jump} rad");
     }
+}
+
+/// [`assert_motion`] with every TCP on the point (within 1 µm).
+fn assert_in_place(setup: &Setup, motion: &[JointVector], from: &JointVector, to: &JointVector) {
+    assert_motion(setup, motion, from, to, |tcp| {
+        let off = (tcp - setup.point).norm();
+        (off >= 1e-6).then(|| format!("the TCP is {off} m off the point"))
+    });
 }
 
 #[test]
@@ -137,23 +150,47 @@ fn a_motion_in_place_joins_what_a_walk_in_place_joins() {
 #[test]
 fn no_motion_in_place_flips_an_elbow_that_cannot_straighten() {
     let setup = setup();
-    let up = setup.solutions.iter().find(|q| q[ELBOW] > 0.2);
-    let down = setup.solutions.iter().find(|q| q[ELBOW] < -0.2);
-    let (Some(up), Some(down)) = (up, down) else {
-        panic!("solutions with both elbows: {:?}", setup.solutions);
-    };
+    let (up, down) = elbows(&setup);
     let motion = in_place_motion(
         &setup.robot,
         &setup.task,
         &setup.constraints,
         &setup.point,
-        up,
-        down,
-        &InPlaceConfig {
-            samples: 3000,
-            ..InPlaceConfig::default()
-        },
+        &up[0],
+        &down[0],
+        &flip_budget(),
     );
+    assert_none(motion);
+}
+
+/// The setup's solutions with the elbow up and with it down, neither side empty.
+fn elbows(setup: &Setup) -> (Vec<JointVector>, Vec<JointVector>) {
+    let side = |up: bool| -> Vec<JointVector> {
+        let solutions = setup.solutions.iter();
+        solutions
+            .filter(|q| if up { q[ELBOW] > 0.2 } else { q[ELBOW] < -0.2 })
+            .copied()
+            .collect()
+    };
+    let (up, down) = (side(true), side(false));
+    assert!(
+        !up.is_empty() && !down.is_empty(),
+        "solutions with both elbows: {:?}",
+        setup.solutions
+    );
+    (up, down)
+}
+
+/// The settings of a search for an elbow flip that cannot exist: the default's, 3000 draws.
+fn flip_budget() -> InPlaceConfig {
+    InPlaceConfig {
+        samples: 3000,
+        ..InPlaceConfig::default()
+    }
+}
+
+/// The search found no motion.
+fn assert_none(motion: Option<Vec<JointVector>>) {
     assert!(
         motion.is_none(),
         "{} configurations",
@@ -181,25 +218,14 @@ fn a_configuration_off_the_point_is_refused() {
     assert!(motion.is_none());
 }
 
-/// Every configuration of `motion` is valid with its TCP on the line's first `STRETCH_M`
-/// (within 1 µm; the ends as given), each within twice the step of the one before.
-fn assert_along_line(setup: &Setup, motion: &[JointVector]) {
-    let step_rad = InPlaceConfig::default().step_rad;
-    for (i, q) in motion.iter().enumerate() {
-        let kinematics = setup.robot.forward(q);
-        let along = setup.task.progress(&kinematics.tcp());
-        let off = setup.task.lateral_error(&kinematics.tcp()).norm();
-        assert!(
-            (-1e-6..=STRETCH_M + 1e-6).contains(&along) && off < 1e-6,
-            "configuration {i}: the TCP is {along} m along the line, {off} m off it"
-        );
-        let violation = first_violation(&setup.robot, &setup.task, &kinematics, &setup.constraints);
-        assert!(violation.is_none(), "configuration {i}: {violation:?}");
-    }
-    for (i, pair) in motion.windows(2).enumerate() {
-        let jump = (pair[1] - pair[0]).norm();
-        assert!(jump <= 2.0 * step_rad + 1e-12, "step {i} moves {jump} rad");
-    }
+/// [`assert_motion`] with every TCP on the line's first `STRETCH_M` (within 1 µm).
+fn assert_along_line(setup: &Setup, motion: &[JointVector], from: &JointVector, to: &JointVector) {
+    assert_motion(setup, motion, from, to, |tcp| {
+        let along = setup.task.progress(tcp);
+        let off = setup.task.lateral_error(tcp).norm();
+        let on = (-1e-6..=STRETCH_M + 1e-6).contains(&along) && off < 1e-6;
+        (!on).then(|| format!("the TCP is {along} m along the line, {off} m off it"))
+    });
 }
 
 #[test]
@@ -228,28 +254,14 @@ fn a_motion_along_the_line_joins_its_two_ends() {
         &InPlaceConfig::default(),
     )
     .expect("a motion along the line");
-    assert_eq!(motion.first(), Some(&from));
-    assert_eq!(motion.last(), Some(&to));
+    assert_along_line(&setup, &motion, &from, &to);
     assert!(motion.len() > 2, "more than one step apart");
-    assert_along_line(&setup, &motion);
 }
 
 #[test]
 fn no_motion_along_the_line_flips_an_elbow_that_cannot_straighten() {
     let setup = setup();
-    let up: Vec<JointVector> = setup
-        .solutions
-        .iter()
-        .filter(|q| q[ELBOW] > 0.2)
-        .copied()
-        .collect();
-    let down: Vec<JointVector> = setup
-        .solutions
-        .iter()
-        .filter(|q| q[ELBOW] < -0.2)
-        .copied()
-        .collect();
-    assert!(!up.is_empty() && !down.is_empty(), "{:?}", setup.solutions);
+    let (up, down) = elbows(&setup);
     let motion = motion_along_line(
         &setup.robot,
         &setup.task,
@@ -258,16 +270,9 @@ fn no_motion_along_the_line_flips_an_elbow_that_cannot_straighten() {
         STRETCH_M,
         &up,
         &down,
-        &InPlaceConfig {
-            samples: 3000,
-            ..InPlaceConfig::default()
-        },
+        &flip_budget(),
     );
-    assert!(
-        motion.is_none(),
-        "{} configurations",
-        motion.map_or(0, |m| m.len())
-    );
+    assert_none(motion);
 }
 
 #[test]
