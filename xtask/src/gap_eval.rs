@@ -368,11 +368,11 @@ fn markdown(record: &Record) -> String {
          configurations that hold the TCP anywhere on the line up to where the motion back \
          starts, going back and forth as it needs) tries to join the plan's configurations to \
          the motion back's.\n\n\
-         Of {} motions planned back: {} pass `p0` (read forwards, a motion from `p0` longer \
-         than the plan: the search missed it), {} pass the plan's end and are joined to it in \
-         place, {} pass it and are not, {} pass it where a configuration could not be \
-         compared, {} stop before the plan's end, {} have no start. The longest motion from \
-         `p0` shown on these lines (the plan or a motion back past `p0`) sums to {:.2} m of \
+         From {} points beyond the plans' ends, the motions planned back: {} pass `p0` (read \
+         forwards, a motion from `p0` longer than the plan: the search missed it), {} pass the \
+         plan's end and are joined to it in place, {} pass it and are not, {} pass it where a \
+         configuration could not be compared, {} stop before the plan's end, and from {} no \
+         motion starts. The longest motion from `p0` shown on these lines (the plan or a motion back past `p0`) sums to {:.2} m of \
          their {:.2} m bound, {:.2} m with one stop to reconfigure in place (the plan to where \
          a motion back is joined to it, then that motion), {:.2} m going back and forth along \
          the line ({} of the {} motions back that do not pass `p0` are joined to the plan along \

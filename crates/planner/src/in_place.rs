@@ -17,6 +17,8 @@
 
 use emg_control::{ConstraintConfig, OutOfRange, Task, first_violation};
 use emg_kinematics::{JointVector, POINT_TOLERANCE_M, Robot, Vec3, project_to_point};
+use kdtree::KdTree;
+use kdtree::distance::squared_euclidean;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -164,7 +166,8 @@ fn connect(
             }
         }
     }
-    let mut trees = [Tree::rooted(from), Tree::rooted(to)];
+    let dof = manifold.robot.dof();
+    let mut trees = [Tree::rooted(from, dof), Tree::rooted(to, dof)];
     let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     let robot = manifold.robot;
     let limits = robot.limits();
@@ -259,9 +262,12 @@ impl Manifold<'_> {
     }
 }
 
-/// A tree of configurations on the manifold, each node knowing its parent (roots none).
+/// A tree of configurations on the manifold, each node knowing its parent (roots none), with
+/// a k-d tree of their joints to find the node nearest a configuration.
 struct Tree {
     nodes: Vec<Node>,
+    index: KdTree<f64, usize, Vec<f64>>,
+    dof: usize,
 }
 
 struct Node {
@@ -270,11 +276,27 @@ struct Node {
 }
 
 impl Tree {
-    /// A tree of the configurations `roots`, each a root.
-    fn rooted(roots: &[JointVector]) -> Self {
-        Self {
-            nodes: roots.iter().map(|&q| Node { q, parent: None }).collect(),
+    /// A tree of the configurations `roots` of an arm of `dof` joints, each a root.
+    fn rooted(roots: &[JointVector], dof: usize) -> Self {
+        let mut tree = Self {
+            nodes: Vec::new(),
+            index: KdTree::new(dof),
+            dof,
+        };
+        for &q in roots {
+            tree.add(Node { q, parent: None });
         }
+        tree
+    }
+
+    /// Adds `node`; its index.
+    fn add(&mut self, node: Node) -> usize {
+        let at = self.nodes.len();
+        self.index
+            .add(node.q.as_slice()[..self.dof].to_vec(), at)
+            .expect("configurations on the manifold are finite");
+        self.nodes.push(node);
+        at
     }
 
     /// Grows from the node nearest `target` toward it for at most `steps` steps; the last node
@@ -295,24 +317,22 @@ impl Tree {
             let Some(next) = manifold.step(&current, target) else {
                 break;
             };
-            self.nodes.push(Node {
+            at = self.add(Node {
                 q: next,
                 parent: Some(at),
             });
-            at = self.nodes.len() - 1;
             added = Some(at);
         }
         added
     }
 
+    /// The node nearest `target` (Euclidean over the joints).
     fn nearest(&self, target: &JointVector) -> usize {
-        (0..self.nodes.len())
-            .min_by(|&a, &b| {
-                (self.nodes[a].q - target)
-                    .norm_squared()
-                    .total_cmp(&(self.nodes[b].q - target).norm_squared())
-            })
-            .expect("a tree has its root")
+        let nearest = self
+            .index
+            .nearest(&target.as_slice()[..self.dof], 1, &squared_euclidean)
+            .expect("a finite configuration of the arm's joints");
+        *nearest.first().expect("a tree has its root").1
     }
 
     /// The configurations from node `index` back to the root.
