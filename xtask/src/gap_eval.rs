@@ -263,27 +263,18 @@ struct Summary {
 impl Summary {
     fn of(record: &Record) -> Self {
         let loose = &record.loose;
-        let outcomes: Vec<&GapProbeOutcome> = loose
-            .iter()
-            .flat_map(|line| line.probes.iter().map(|probe| &probe.outcome))
-            .collect();
-        let count = |wanted: &dyn Fn(&GapProbeOutcome) -> bool| {
-            outcomes.iter().filter(|outcome| wanted(outcome)).count()
+        let probes: Vec<&GapProbe> = loose.iter().flat_map(|line| &line.probes).collect();
+        let count = |wanted: &dyn Fn(&GapProbe) -> bool| {
+            probes.iter().filter(|probe| wanted(probe)).count()
         };
+        let outcome_is = |wanted: GapProbeOutcome| move |probe: &GapProbe| probe.outcome == wanted;
         let joined = |wanted: Option<bool>| {
-            move |outcome: &GapProbeOutcome| match outcome {
+            move |probe: &GapProbe| match probe.outcome {
                 GapProbeOutcome::Overlaps {
                     joined_in_place, ..
-                } => *joined_in_place == wanted,
+                } => joined_in_place == wanted,
                 _ => false,
             }
-        };
-        let along_line = |wanted: fn(Option<bool>) -> bool| {
-            loose
-                .iter()
-                .flat_map(|line| &line.probes)
-                .filter(|probe| wanted(probe.joined_along_line))
-                .count()
         };
         // Sums from +0, not the empty sum's −0, which prints as "-0.00" when no line is loose.
         let total = |of: fn(&LooseLine) -> f64| loose.iter().map(of).fold(0.0, |a, b| a + b);
@@ -295,15 +286,15 @@ impl Summary {
             shown_m: total(LooseLine::longest_shown_m),
             shown_with_stop_m: total(LooseLine::longest_with_one_stop_m),
             shown_back_and_forth_m: total(LooseLine::longest_back_and_forth_m),
-            probes: outcomes.len(),
-            passes_p0: count(&|o| *o == GapProbeOutcome::PassesP0),
+            probes: probes.len(),
+            passes_p0: count(&outcome_is(GapProbeOutcome::PassesP0)),
             joined: count(&joined(Some(true))),
             not_joined: count(&joined(Some(false))),
             not_compared: count(&joined(None)),
-            stops_short: count(&|o| *o == GapProbeOutcome::StopsShort),
-            no_start: count(&|o| *o == GapProbeOutcome::NoStart),
-            asked_along_line: along_line(|joined| joined.is_some()),
-            joined_along_line: along_line(|joined| joined == Some(true)),
+            stops_short: count(&outcome_is(GapProbeOutcome::StopsShort)),
+            no_start: count(&outcome_is(GapProbeOutcome::NoStart)),
+            asked_along_line: count(&|probe| probe.joined_along_line.is_some()),
+            joined_along_line: count(&|probe| probe.joined_along_line == Some(true)),
             share: record.planned_m / record.bound_m,
             share_of_others: (record.planned_m - loose_planned_m)
                 / (record.bound_m - loose_bound_m),

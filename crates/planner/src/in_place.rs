@@ -166,10 +166,12 @@ fn connect(
             }
         }
     }
-    let dof = manifold.robot.dof();
-    let mut trees = [Tree::rooted(from, dof), Tree::rooted(to, dof)];
-    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     let robot = manifold.robot;
+    let mut trees = [
+        Tree::rooted(from, robot.dof()),
+        Tree::rooted(to, robot.dof()),
+    ];
+    let mut rng = ChaCha8Rng::seed_from_u64(config.seed);
     let limits = robot.limits();
     for draw in 0..config.samples {
         let guess = robot.configuration_from_fn(|i| {
