@@ -16,6 +16,9 @@
 //! * [`export`]: a joint trajectory for a robot's own stack: a ROS 2 `JointTrajectory` in an
 //!   MCAP file (its points thinned, [`ThinningReport`]) or a URScript program
 //!   (`docs/robot-export.md`).
+//! * [`RobotRef`]: how every written file names its robot (a shipped robot by name, any other
+//!   robot file by its path as given, each with the digest of its file), resolved again where
+//!   the file is read.
 //! * [`write_atomically`]: every file of the workspace is written through a uniquely named `.partial`
 //!   sibling renamed into place; [`open_journal`]: a resumable job's journal directory, claimed
 //!   for one job's identity.
@@ -73,6 +76,7 @@ mod mesh;
 mod path_file;
 mod paths;
 mod robot_import;
+mod robot_ref;
 mod rollout_file;
 mod scene_file;
 mod svg;
@@ -99,6 +103,7 @@ pub use robot_import::{
     PEN_PROTRUSION_M, PEN_REACH_TOLERANCE_M, PackagePath, Pen, REP_199_TOOL_LINKS, ToolLinkChoice,
     ToolReach, import_robot,
 };
+pub use robot_ref::{RobotRef, RobotRefError, file_sha256};
 pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};
 pub use svg::{
