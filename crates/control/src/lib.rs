@@ -45,8 +45,8 @@ pub use config::{
 pub use constraints::{Violation, WORK_SURFACE, first_contact, first_violation, tool_angle_deg};
 pub use controller::{ActingController, NullSpaceController};
 pub use path::{
-    CORNER_RAD, Located, MIN_SEGMENT_M, PATH_FORMAT_VERSION, PLANE_TOLERANCE_M, Path, PathError,
-    PathExtent, PathSpec, Piece, SegmentSpec,
+    CORNER_RAD, Located, MIN_SEGMENT_M, PATH_FORMAT_VERSION, PLANE_TOLERANCE_M,
+    PROGRESS_CONTINUITY, Path, PathError, PathExtent, PathSpec, Piece, SegmentSpec,
 };
 pub use path_population::{PathShape, path_tasks, population_path};
 pub use rollout::{

@@ -285,6 +285,13 @@ impl Piece {
     }
 }
 
+/// What a metre of arc length between a candidate point and the last known progress adds to
+/// the candidate's distance from the TCP when [`Path::locate`] picks the nearest path point (m
+/// per m). Of points equally near the TCP (the start and the end of a closed stroke, where the
+/// tool stands before it moves) the one the TCP came along wins; points whose distances differ
+/// by more than a hundredth of their arc-length gap rank as by distance alone.
+pub const PROGRESS_CONTINUITY: f64 = 1e-2;
+
 /// Where a point lies relative to a path: the nearest path point in the window searched.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Located {
@@ -599,11 +606,32 @@ impl Path {
     }
 
     /// The point of the path nearest `p` among those within `window_m` of arc length of
-    /// `s_hint`: the path's progress is followed locally, so that a path passing near itself
-    /// (a full circle at its start) is never taken for its other part.
+    /// `s_hint`, each metre of arc length away from `s_hint` counting as
+    /// [`PROGRESS_CONTINUITY`] m of distance: the path's progress is followed locally and
+    /// continuously, so that a path passing near itself (a full circle at its start, the two
+    /// ends of a closed stroke) is never taken for its other part.
     pub fn locate(&self, p: &Vec3, s_hint: f64, window_m: f64) -> Located {
         let low = (s_hint - window_m).max(0.0);
         let high = (s_hint + window_m).min(self.length_m);
+        self.nearest_between(p, low, high, |s| PROGRESS_CONTINUITY * (s - s_hint).abs())
+            .unwrap_or_else(|| self.located(s_hint.clamp(0.0, self.length_m)))
+    }
+
+    /// The point of the whole path nearest `p` (the first of equally near ones).
+    pub fn nearest_point(&self, p: &Vec3) -> Located {
+        self.nearest_between(p, 0.0, self.length_m, |_| 0.0)
+            .expect("a path has a piece")
+    }
+
+    /// The point at arc length within `[low, high]` whose distance from `p` plus `extra_cost`
+    /// of its arc length is least; `None` where no piece reaches into the range.
+    fn nearest_between(
+        &self,
+        p: &Vec3,
+        low: f64,
+        high: f64,
+        extra_cost: impl Fn(f64) -> f64,
+    ) -> Option<Located> {
         let mut best: Option<(f64, f64)> = None;
         for piece in &self.pieces {
             if piece.start_s > high || piece.start_s + piece.length_m < low {
@@ -621,13 +649,17 @@ impl Path {
                     continue;
                 }
                 let s = (piece.start_s + sigma).clamp(low, high);
-                let distance = (self.point_at(s) - p).norm();
-                if best.is_none_or(|(_, d)| distance < d) {
-                    best = Some((s, distance));
+                let cost = (self.point_at(s) - p).norm() + extra_cost(s);
+                if best.is_none_or(|(_, c)| cost < c) {
+                    best = Some((s, cost));
                 }
             }
         }
-        let s = best.map_or(s_hint.clamp(0.0, self.length_m), |(s, _)| s);
+        best.map(|(s, _)| self.located(s))
+    }
+
+    /// The path point at arc length `s` with its tangent.
+    fn located(&self, s: f64) -> Located {
         Located {
             s,
             point: self.point_at(s),

@@ -316,7 +316,7 @@ impl Task {
     pub fn offset(&self, p: &Vec3) -> Vec3 {
         match &self.path {
             None => self.lateral_error(p),
-            Some(path) => path.locate(p, 0.0, path.length_m()).point - p,
+            Some(path) => path.nearest_point(p).point - p,
         }
     }
 

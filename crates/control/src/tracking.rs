@@ -55,9 +55,10 @@ pub fn onto_task(robot: &Robot, task: &Task, q: &JointVector, tolerance_m: f64) 
     let target_m = CORRECTION_TRIGGER * tolerance_m;
     let mut kinematics = robot.forward(q);
     // A line needs no hint; on a path, the nearest point of the whole path.
-    let s_hint = task.path.as_ref().map_or(0.0, |path| {
-        path.locate(&kinematics.tcp(), 0.0, path.length_m()).s
-    });
+    let s_hint = task
+        .path
+        .as_ref()
+        .map_or(0.0, |path| path.nearest_point(&kinematics.tcp()).s);
     if task.along(&kinematics.tcp(), s_hint).lateral.norm() <= target_m {
         return *q;
     }

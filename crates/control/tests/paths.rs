@@ -682,3 +682,47 @@ fn assert_tangent_continuous(path: &Path, what: &str) {
         );
     }
 }
+
+/// The start and the end of a closed stroke shorter than the tracking window are the same
+/// point: a TCP standing there (to rounding, or a little off the path) is located near the start
+/// before it moves and near the end once it has come round, never the other way.
+#[test]
+fn the_ends_of_a_short_closed_stroke_are_told_apart_by_where_the_tcp_came_from() {
+    let (p, n) = (Vec3::new(0.45, 0.25, 0.25), -Vec3::z());
+    let radius = 0.0075;
+    let circle = spec(
+        p,
+        n,
+        0.0,
+        vec![arc(Some(p + Vec3::x() * radius), None, None, Some(360.0))],
+    );
+    let square = rectangle(p, Vec3::y(), n, 0.012, 0.01, 0.0);
+    for spec in [circle, square] {
+        let forward = Path::new(spec).unwrap();
+        for path in [forward.reversed().unwrap(), forward] {
+            let length = path.length_m();
+            assert!(length < emg_control::TRACKING_WINDOW_M, "{length}");
+            let start = path.point_at(0.0);
+            let normal = path.normal();
+            let across = normal.cross(&path.tangent_at(0.0));
+            for offset in [
+                Vec3::zeros(),
+                Vec3::new(1e-13, -1e-13, 1e-13),
+                Vec3::new(-1e-12, 1e-12, 0.0),
+                across * 3e-4,
+                -across * 3e-4,
+                normal * 2e-4,
+            ] {
+                let tcp = start + offset;
+                let at_start = path.locate(&tcp, 0.0, emg_control::TRACKING_WINDOW_M);
+                assert!(at_start.s < 1e-3, "{offset:?}: {} of {length}", at_start.s);
+                let came_round = path.locate(&tcp, length - 0.002, emg_control::TRACKING_WINDOW_M);
+                assert!(
+                    came_round.s > length - 1e-3,
+                    "{offset:?}: {} of {length}",
+                    came_round.s
+                );
+            }
+        }
+    }
+}

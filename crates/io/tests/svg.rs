@@ -141,7 +141,7 @@ fn path_points(path: &Path, step: f64) -> Vec<Vec3> {
 fn deviations(path: &Path, original: &[Vec3]) -> (f64, f64) {
     let there = original
         .iter()
-        .map(|p| (path.locate(p, 0.0, path.length_m()).point - p).norm())
+        .map(|p| (path.nearest_point(p).point - p).norm())
         .fold(0.0, f64::max);
     let back = path_points(path, 5e-5)
         .iter()

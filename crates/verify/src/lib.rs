@@ -41,8 +41,8 @@ pub use dynamics::{
 };
 pub use model::{ModelError, ReferenceModel};
 pub use record::{
-    Blame, Bounds, Ending, Joints, Line, MAX_JOINTS, MIN_JOINTS, Obstacle, PATH_WINDOW_M,
-    PathPiece, RecordedStep, Recording, Solid, Surface,
+    Blame, Bounds, Ending, Joints, Line, MAX_JOINTS, MIN_JOINTS, Obstacle, PATH_CONTINUITY,
+    PATH_WINDOW_M, PathPiece, RecordedStep, Recording, Solid, Surface,
 };
 pub use replay::{
     DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,

@@ -134,6 +134,12 @@ impl PathPiece {
 /// recorded TCP's nearest path point.
 pub const PATH_WINDOW_M: f64 = 0.05;
 
+/// What each metre of arc length between a candidate path point and a recorded TCP's last known
+/// place adds to the candidate's distance when the checker follows the TCP along a path (m per
+/// m): the progress is followed continuously, so that where the path comes back to a point it
+/// passed (the start and the end of a closed stroke) the TCP is placed where it came from.
+pub const PATH_CONTINUITY: f64 = 0.01;
+
 impl Line {
     /// A straight-line task.
     pub fn straight(p0: Vector3<f64>, d: Vector3<f64>, n: Vector3<f64>) -> Self {
@@ -161,7 +167,7 @@ impl Line {
         if self.path.is_empty() {
             return self.lateral_distance(point);
         }
-        let (s, _) = self.nearest_on_path(point, 0.0, f64::INFINITY);
+        let (s, _) = self.nearest_on_path(point, 0.0, f64::INFINITY, 0.0);
         (self.point_on_path(s) - point).norm()
     }
 
@@ -172,25 +178,48 @@ impl Line {
 
     /// How far `points` (a motion's TCPs in order) get: on a line the last one's progress, on
     /// a path the arc length of its nearest point, followed from the start within
-    /// [`PATH_WINDOW_M`] per point.
+    /// [`PATH_WINDOW_M`] per point (and [`PATH_CONTINUITY`]).
     pub fn reached(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> f64 {
-        let mut s = 0.0;
-        let mut last = None;
-        for point in points {
-            if !self.path.is_empty() {
-                s = self.nearest_on_path(&point, s, PATH_WINDOW_M).0;
-            }
-            last = Some(point);
-        }
-        match last {
-            Some(point) if self.path.is_empty() => self.progress(&point),
-            _ => s,
-        }
+        self.progresses(points).last().copied().unwrap_or(0.0)
     }
 
-    /// The arc length within `window` of `hint` whose path point lies nearest `point`, and its
-    /// distance.
-    fn nearest_on_path(&self, point: &Vector3<f64>, hint: f64, window: f64) -> (f64, f64) {
+    /// The stretch `points` (a motion's TCPs in order) cover: the least and the greatest of
+    /// their progresses as [`Line::reached`] follows them (m); `None` without points.
+    pub fn covered(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> Option<(f64, f64)> {
+        self.progresses(points).into_iter().fold(None, |span, s| {
+            Some(span.map_or((s, s), |(low, high): (f64, f64)| (low.min(s), high.max(s))))
+        })
+    }
+
+    /// Each point's progress: on a line `(p − p0)·d`, on a path the arc length of its nearest
+    /// point, followed from the start.
+    fn progresses(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> Vec<f64> {
+        let mut s = 0.0;
+        points
+            .into_iter()
+            .map(|point| {
+                if self.path.is_empty() {
+                    self.progress(&point)
+                } else {
+                    s = self
+                        .nearest_on_path(&point, s, PATH_WINDOW_M, PATH_CONTINUITY)
+                        .0;
+                    s
+                }
+            })
+            .collect()
+    }
+
+    /// The arc length within `window` of `hint` whose path point lies nearest `point`, each
+    /// metre of arc length from `hint` adding `continuity` m to its distance, and that
+    /// distance (with what was added).
+    fn nearest_on_path(
+        &self,
+        point: &Vector3<f64>,
+        hint: f64,
+        window: f64,
+        continuity: f64,
+    ) -> (f64, f64) {
         let mut best = (hint, f64::INFINITY);
         let mut start = 0.0;
         for piece in &self.path {
@@ -199,9 +228,10 @@ impl Line {
             let high = (hint + window - start).min(length);
             if low <= high {
                 for along in piece.nearest(point, low, high) {
-                    let distance = (piece.point(along) - point).norm();
-                    if distance < best.1 {
-                        best = (start + along, distance);
+                    let cost = (piece.point(along) - point).norm()
+                        + continuity * (start + along - hint).abs();
+                    if cost < best.1 {
+                        best = (start + along, cost);
                     }
                 }
             }
