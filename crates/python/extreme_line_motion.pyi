@@ -262,8 +262,20 @@ class CheckReport:
 def load_tasks(path: PathLike, robot: PathLike = "fr3") -> list[Task]:
     """The tasks of a task file (JSON or EMGTASKS), validated for ``robot``."""
 
-def check(path: PathLike, robot: Optional[PathLike] = None) -> CheckReport:
-    """Verifies a trajectory file with the independent checker; raises CheckFailed."""
+class JobCheckReport:
+    """What the independent checker verified on a job's program (emg-job/1) that holds up."""
+
+    layout: str
+    robot: Path
+    stroke_parts: int
+    moves: int
+    points: int
+
+def check(
+    path: PathLike, robot: Optional[PathLike] = None
+) -> Union[CheckReport, JobCheckReport]:
+    """Verifies a trajectory file or a job's program with the independent checker, as
+    ``emg check`` does; raises CheckFailed."""
 
 class ExportReport:
     """What an export wrote (``export``)."""

@@ -205,7 +205,8 @@ pub struct PlanArgs {
     pub config: Option<PathBuf>,
     /// Output path stem: writes STEM.json and STEM.csv (the planned path) and
     /// STEM.joint_trajectory.json (the motion timed rest to rest within the joint limits)
-    /// (STEM-00000.json, ... for a task file holding several tasks).
+    /// (STEM-00000.json, ... for a task file holding several tasks); missing parent directories
+    /// are created.
     #[arg(long, value_name = "STEM", default_value = "trajectory")]
     pub out: PathBuf,
     /// Also write a self-contained HTML page that animates the planned motion in 3D (for a
@@ -240,11 +241,11 @@ pub struct PlanArgs {
     /// the bound, of the timed motion and of the checker. Default: the --config file's
     /// `rollout.constraints.line_tolerance_m`, else 20 mm (the paper's benchmark; a pen or a
     /// bead wants 0.5 mm or less).
-    #[arg(long, value_name = "MM", value_parser = positive)]
+    #[arg(long, value_name = "MM", value_parser = tolerance_mm, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// Half-angle of the cone around the surface normal the tool axis stays in (degrees).
     /// Default: the --config file's `rollout.constraints.theta_max_deg`, else 30°.
-    #[arg(long, value_name = "DEG", value_parser = positive)]
+    #[arg(long, value_name = "DEG", value_parser = cone_deg, allow_hyphen_values = true)]
     pub cone: Option<f64>,
     /// Scene file (JSON) of obstacles the whole arm, pen included, keeps clear of: half-spaces,
     /// boxes, spheres and capsules in the base frame, each with its clearance (see
@@ -303,11 +304,33 @@ impl PlanArgs {
     }
 }
 
-/// Parses a positive finite number.
-fn positive(s: &str) -> Result<f64, String> {
+/// Parses `--tolerance`: the line tolerance in millimetres, a number > 0 (a negative one is read
+/// as a value, not as a flag, and refused in the flag's unit).
+pub fn tolerance_mm(s: &str) -> Result<f64, String> {
+    bounded(s, "> 0 mm", |mm| mm > 0.0)
+}
+
+/// Parses `--cone`: the tool cone's half-angle in degrees, in (0, 90).
+pub fn cone_deg(s: &str) -> Result<f64, String> {
+    bounded(s, "in (0, 90)°", |deg| deg > 0.0 && deg < 90.0)
+}
+
+/// Parses `--scale`: metres per unit of an SVG drawing, a number > 0, or `physical` for its own
+/// physical size ([`emg_io::SVG_PX_M`] per CSS pixel).
+pub fn parse_scale(s: &str) -> Result<f64, String> {
+    match s.trim() {
+        "physical" => Ok(emg_io::SVG_PX_M),
+        _ => bounded(s, "> 0 m per unit, or 'physical'", |scale| scale > 0.0),
+    }
+}
+
+/// A finite number for which `holds` is true; else an error saying what it must be
+/// (`wanted`) and what it is.
+fn bounded(s: &str, wanted: &str, holds: impl Fn(f64) -> bool) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
-        Ok(value) if value.is_finite() && value > 0.0 => Ok(value),
-        _ => Err(format!("'{s}' is not a positive number")),
+        Ok(value) if value.is_finite() && holds(value) => Ok(value),
+        Ok(_) => Err(format!("must be {wanted}, got {s}")),
+        Err(_) => Err(format!("must be a number {wanted}, got '{s}'")),
     }
 }
 

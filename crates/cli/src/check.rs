@@ -5,7 +5,7 @@
 //! the task and the constraints, and runs [`emg_verify::check_replay`]. The layouts and what is
 //! verified are documented in `docs/joint-trajectory-format.md`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use emg_control::{ConstraintConfig, Task};
@@ -14,6 +14,7 @@ use emg_kinematics::{Robot, Vec3};
 use emg_verify::{JointDynamics, ReferenceModel, ReplayReport};
 
 use crate::args::CheckArgs;
+use crate::output::count;
 use emg_planner::MotionTiming;
 
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
@@ -35,8 +36,8 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
 
     let robot_path = match (&args.robot, &task_from, &carried) {
         (Some(path), _, _) => path.clone(),
-        (None, _, Some(c)) => named_robot(&c.robot, file)?,
-        (None, Some((path, c)), None) => named_robot(&c.robot, path)?,
+        (None, _, Some(c)) => crate::robot::resolve(&c.robot, file)?,
+        (None, Some((path, c)), None) => crate::robot::resolve(&c.robot, path)?,
         (None, None, None) => crate::robot::default_robot(),
     };
     let (robot, model) = robot_and_checker(args, &robot_path)?;
@@ -157,8 +158,6 @@ fn read_task_from(path: &Path) -> Result<Carried> {
         .with_context(|| format!("--task-from {}: carries no task", path.display()))
 }
 
-/// The robot file a trajectory file names; it must exist (paths are as given to `emg plan`,
-/// relative to the working directory).
 /// The job program in `file`, when it is an `emg-job/1` file.
 pub(crate) fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
     let text =
@@ -179,7 +178,7 @@ pub(crate) fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
 fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()> {
     let robot_path = match &args.robot {
         Some(path) => path.clone(),
-        None => named_robot(&job.robot, file)?,
+        None => crate::robot::resolve(&job.robot, file)?,
     };
     let (robot, model) = robot_and_checker(args, &robot_path)?;
     let check = emg_job::verify_job(job, &model, robot.joint_names())
@@ -191,12 +190,12 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
         robot_path.display()
     );
     println!(
-        "  {} stroke parts on their paths ({}), {} moves clear of the arm, the plates and the \
-         scene; {} points from rest to rest within the file's joint limits",
-        check.stroke_parts,
+        "  {} on their paths ({}), {} clear of the arm, the plates and the scene; {} from rest \
+         to rest within the file's joint limits",
+        count(check.stroke_parts, "stroke part"),
         describe(&job.constraints),
-        check.moves,
-        check.points
+        count(check.moves, "move"),
+        count(check.points, "point")
     );
     println!("OK");
     Ok(())
@@ -212,16 +211,6 @@ fn robot_and_checker(args: &CheckArgs, robot_path: &Path) -> Result<(Robot, Refe
     )?;
     let model = crate::robot::load_checker(robot_path, &robot)?;
     Ok((robot, model))
-}
-
-fn named_robot(robot: &str, file: &Path) -> Result<PathBuf> {
-    let path = PathBuf::from(robot);
-    anyhow::ensure!(
-        path.is_file(),
-        "field 'robot' of {} names {robot}, which is not a file here; give --robot <URDF>",
-        file.display()
-    );
-    Ok(path)
 }
 
 /// `task` validated again for `robot` (a validated task comes back bit for bit).
@@ -244,8 +233,10 @@ fn describe(constraints: &ConstraintConfig) -> String {
 
 fn print_report(report: &ReplayReport, limits_origin: Option<&str>) {
     println!(
-        "  {} points, {:.3} s, path length {:.4} m",
-        report.points, report.duration_s, report.path_length_m
+        "  {}, {:.3} s, path length {:.4} m",
+        count(report.points, "point"),
+        report.duration_s,
+        report.path_length_m
     );
     let fractions = |values: &[f64]| -> String {
         let text: Vec<String> = values.iter().map(|f| format!("{f:.3}")).collect();

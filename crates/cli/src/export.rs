@@ -23,7 +23,8 @@ pub struct ExportArgs {
     #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
     pub format: ExportFormat,
     /// The file to write (a URScript motion too long for one program is split where the arm
-    /// rests: OUT with -part1, -part2, ... before its extension).
+    /// rests: OUT with -part1, -part2, ... before its extension; missing parent directories
+    /// are created).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
     /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) or a robot file (URDF). Default:
@@ -66,16 +67,7 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
     };
     let robot_file = match &args.robot {
         Some(path) => path.clone(),
-        None => {
-            let named = PathBuf::from(robot_field);
-            anyhow::ensure!(
-                named.is_file(),
-                "field 'robot' of {} names {}, which is not a file here; give --robot NAME|URDF",
-                args.file.display(),
-                robot_field
-            );
-            named
-        }
+        None => crate::robot::resolve(robot_field, &args.file)?,
     };
     let robot = crate::robot::load_robot(&robot_file, None, None)?;
     let options = ExportOptions {
@@ -107,8 +99,10 @@ pub fn export_to(
     input: &Path,
 ) -> Result<String> {
     let file = robot_file.display().to_string();
+    let reference = crate::robot::reference(robot_file)?.to_string();
     let target = ExportRobot {
         file: &file,
+        reference: &reference,
         shipped: shipped_profile(robot_file),
         kinematics: Some(robot),
     };
@@ -124,6 +118,43 @@ pub fn export_to(
         export.summary,
         written.join(", ")
     ))
+}
+
+/// The file `--export FORMAT` of `emg job` and `emg place` writes beside the program `out`:
+/// its extension `.mcap` or `.script`.
+pub fn beside_program(out: &Path, format: ExportFormat) -> PathBuf {
+    out.with_extension(format.extension())
+}
+
+/// Refuses, before anything is planned, `--export FORMAT` of a program for a robot it cannot run
+/// on (URScript for an arm that is not a Universal Robots arm).
+pub fn refuse_program_export(format: Option<ExportFormat>, robot_file: &Path) -> Result<()> {
+    let Some(format) = format else {
+        return Ok(());
+    };
+    let robot = crate::robot::load_robot(robot_file, None, None)?;
+    refuse_format(format, robot_file, &robot)
+        .context("--export urscript: nothing was planned or written")
+}
+
+/// Exports a job's program `file`, written to `out`, as `format` beside it
+/// ([`beside_program`]); returns what to print.
+pub fn export_program(
+    file: &emg_job::JobFile,
+    format: ExportFormat,
+    out: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    export_to(
+        file.timed_points(),
+        format,
+        &beside_program(out, format),
+        robot_file,
+        robot,
+        &ExportOptions::default(),
+        out,
+    )
 }
 
 /// The file `emg plan --export` writes beside a task's files: `STEM.mcap` or `STEM.script`.

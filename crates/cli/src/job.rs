@@ -9,7 +9,7 @@ use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, Order, plan_job};
 use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
 
-use crate::output::{progress_bar, write_text};
+use crate::output::{count, progress_bar, write_text};
 use crate::robot;
 
 /// What a job is and how it is planned: the options `emg job` and `emg place` share.
@@ -22,10 +22,12 @@ pub struct JobInput {
     #[arg(long, value_parser = robot::parse_robot, default_value_os_t = robot::default_robot())]
     pub robot: PathBuf,
     /// The strokes' line tolerance (mm).
-    #[arg(long, value_name = "MM", default_value_t = emg_job::JOB_TOLERANCE_M * 1e3)]
+    #[arg(long, value_name = "MM", default_value_t = emg_job::JOB_TOLERANCE_M * 1e3,
+          value_parser = crate::args::tolerance_mm, allow_hyphen_values = true)]
     pub tolerance: f64,
     /// The tool cone's half-angle around the surface normal (degrees).
-    #[arg(long, value_name = "DEG", default_value_t = 30.0)]
+    #[arg(long, value_name = "DEG", default_value_t = 30.0, value_parser = crate::args::cone_deg,
+          allow_hyphen_values = true)]
     pub cone: f64,
     /// The drawing order: `shortest` (default: order and directions that cut the pen-up travel)
     /// or `given`; overrides the job file's.
@@ -40,9 +42,14 @@ pub struct JobInput {
     /// SVG only: the drawing's x axis on the surface.
     #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
     pub x_axis: Option<[f64; 3]>,
-    /// SVG only: the drawing's width (m).
+    /// SVG only: the drawing's width (m). Default: 0.2 m, unless --scale sets the size.
     #[arg(long, value_name = "M")]
     pub width: Option<f64>,
+    /// SVG only, instead of --width: metres per unit of the drawing (its CSS pixels), or
+    /// `physical` for the drawing at its own physical size (`width="200mm"` draws 0.2 m wide).
+    #[arg(long, value_name = "M_PER_UNIT|physical", value_parser = crate::args::parse_scale,
+          conflicts_with = "width")]
+    pub scale: Option<f64>,
     /// The cell's obstacles (a scene file, docs/scene.md), which the arm keeps clear of while
     /// drawing and between strokes.
     #[arg(long, value_name = "FILE")]
@@ -55,7 +62,7 @@ pub struct JobArgs {
     /// The job and how it is planned.
     #[command(flatten)]
     pub input: JobInput,
-    /// The program to write (an emg-job/1 file).
+    /// The program to write (an emg-job/1 file; missing parent directories are created).
     #[arg(long, value_name = "FILE", default_value = "job.json")]
     pub out: PathBuf,
     /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
@@ -134,16 +141,12 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
     let input = &args.input;
     let exported = args
         .export
-        .map(|format| args.out.with_extension(format.extension()));
+        .map(|format| crate::export::beside_program(&args.out, format));
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    if let Some(format) = args.export {
-        let robot = robot::load_robot(&input.robot, None, None)?;
-        crate::export::refuse_format(format, &input.robot, &robot)
-            .context("--export urscript: nothing was planned or written")?;
-    }
+    crate::export::refuse_program_export(args.export, &input.robot)?;
     let Ready {
         job,
         planner,
@@ -157,23 +160,16 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         &request,
         &job,
         &timing,
-        &input.robot.display().to_string(),
+        &robot::reference(&input.robot)?.to_string(),
         &|done, _| bar.set_position(done as u64),
     )?;
     bar.finish_and_clear();
     print_summary(&file);
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());
-    if let (Some(format), Some(path)) = (args.export, &exported) {
-        let text = crate::export::export_to(
-            file.timed_points(),
-            format,
-            path,
-            &input.robot,
-            planner.robot(),
-            &emg_io::ExportOptions::default(),
-            &args.out,
-        )?;
+    if let Some(format) = args.export {
+        let text =
+            crate::export::export_program(&file, format, &args.out, &input.robot, planner.robot())?;
         println!("{text}");
     }
     if let Some(path) = &args.html {
@@ -199,8 +195,8 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
 pub fn print_summary(file: &emg_job::JobFile) {
     let s = &file.summary;
     println!(
-        "{} strokes: {} complete, {} resumed after a reconfiguration, {} short",
-        file.strokes.len(),
+        "{}: {} complete, {} resumed after a reconfiguration, {} short",
+        count(file.strokes.len(), "stroke"),
         s.complete,
         s.resumed,
         s.short
@@ -214,15 +210,15 @@ pub fn print_summary(file: &emg_job::JobFile) {
         s.travel_given_m
     );
     println!(
-        "program {:.2} s ({:.2} s pen down, {:.2} s pen up; {} straight moves, {} found by the \
-         sampling planner); planned in {:.2} s ({} searches)",
+        "program {:.2} s ({:.2} s pen down, {:.2} s pen up; {}, {} found by the sampling \
+         planner); planned in {:.2} s ({})",
         s.duration_s,
         s.pen_down_s,
         s.pen_up_s,
-        s.straight_moves,
+        count(s.straight_moves, "straight move"),
         s.sampled_moves,
         s.planning_s,
-        s.searches
+        count(s.searches, "search")
     );
     for stroke in file.strokes.iter().filter(|r| !r.unreached.is_empty()) {
         for (stretch, at) in stroke.unreached.iter().zip(&stroke.unreached_at) {
@@ -260,9 +256,9 @@ fn read_job(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Job> {
         let drawing = read_svg_file(&args.file, &placement, &SvgOptions::default())?;
         if drawing.dropped_tiny > 0 {
             println!(
-                "{}: {} strokes shorter than {} mm dropped",
+                "{}: {} shorter than {} mm dropped",
                 args.file.display(),
-                drawing.dropped_tiny,
+                count(drawing.dropped_tiny, "stroke"),
                 SvgOptions::default().min_stroke_m * 1e3
             );
         }
@@ -272,10 +268,11 @@ fn read_job(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Job> {
             .iter()
             .any(|o| o.is_some())
             || args.width.is_some()
+            || args.scale.is_some()
         {
             anyhow::bail!(
-                "--origin, --normal, --x-axis and --width place an SVG drawing; {} is a job file, \
-                 whose strokes are already placed",
+                "--origin, --normal, --x-axis, --width and --scale place an SVG drawing; {} is a \
+                 job file, whose strokes are already placed",
                 args.file.display()
             );
         }
@@ -304,6 +301,10 @@ fn placement(args: &JobInput) -> Result<Placement> {
     if let Some(width) = args.width {
         placement.width_m = Some(width);
         placement.scale_m_per_unit = None;
+    }
+    if let Some(scale) = args.scale {
+        placement.width_m = None;
+        placement.scale_m_per_unit = Some(scale);
     }
     Ok(placement)
 }

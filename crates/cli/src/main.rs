@@ -62,6 +62,19 @@
 //! The file layouts are documented in `docs/trajectory-format.md` and
 //! `docs/joint-trajectory-format.md`. Errors go to stderr with a
 //! nonzero exit status; with several tasks a failing task is reported and the rest still run.
+//! Output to a closed pipe (`emg place … | head`) is dropped: every file is still written.
+
+/// `println!` for every module of the binary: prints through [`output::print_line`], which drops
+/// what a closed standard output (a pipe whose reader has gone) cannot take instead of
+/// panicking, so that a command still writes its files.
+macro_rules! println {
+    () => {
+        $crate::output::print_line(format_args!(""))
+    };
+    ($($arg:tt)*) => {
+        $crate::output::print_line(format_args!($($arg)*))
+    };
+}
 
 mod args;
 mod check;
@@ -183,9 +196,9 @@ fn run_plan(args: &PlanArgs) -> Result<()> {
         if let Some(stop) = interrupt.received() {
             let written = index - failures.len() - refused.len();
             return Err(anyhow::Error::new(stop).context(format!(
-                "{written} of {} tasks planned and written whole, {} refused, {} failed; the \
-                 rest were not started",
-                tasks.len(),
+                "{written} of {} planned and written whole, {} refused, {} failed; the rest \
+                 were not started",
+                output::count(tasks.len(), "task"),
                 refused.len(),
                 failures.len()
             )));
@@ -452,7 +465,7 @@ fn write_plan(
     let trajectory = &plan.trajectory;
     let bound = (args.reach == OnOff::On).then(|| planner.bound_note(task, plan));
     let paths = PlanPaths::new(&args.out, index);
-    let robot = args.robot.display().to_string();
+    let robot = robot::reference(&args.robot)?.to_string();
     let files = PlanFiles::new(
         planner,
         task,
@@ -514,19 +527,23 @@ fn write_plan(
         None => (String::new(), String::new()),
     };
     Ok(format!(
-        "path length {:.4} m{reachable}, {steps} steps, {duration:.2} s; ended: {}{short}\n  \
+        "path length {:.4} m{reachable}, {}, {duration:.2} s; ended: {}{short}\n  \
          seed: {} ({}){projected}\n  \
          timed rest to rest: {:.3} s ({:.3} s time-optimal without jerk limits), tool at the \
-         requested speed {:.0} % of the time, {} points at {} Hz{rests}{cut}{unreached}\n  \
+         requested speed {:.0} % of the time, {} at {} Hz{rests}{cut}{unreached}\n  \
          wrote {}, {} and {}{viewer}{exported}",
         trajectory.path_length_m,
+        output::count(steps, "step"),
         trajectory.termination,
         plan.seed.source,
         emg_planner::seed_source_meaning(plan.seed.source),
         timed.duration_s,
         timed.time_optimal_s,
         timed.tool_speed_share * 100.0,
-        (timed.duration_s * timed.rate_hz).round() as usize + 1,
+        output::count(
+            (timed.duration_s * timed.rate_hz).round() as usize + 1,
+            "point"
+        ),
         timed.rate_hz,
         paths.json.display(),
         paths.csv.display(),

@@ -1,6 +1,6 @@
 //! `emg place`: where to put a job's part so the arm draws the most of it (`emg_job::place_job`):
 //! progress bars per stage, the certified places as a table, the program at the chosen place,
-//! the heat map and the chosen place as a job file's transform.
+//! the heat map, the chosen place as a job file's transform and the program's export.
 
 use std::path::PathBuf;
 
@@ -50,7 +50,8 @@ pub struct PlaceArgs {
     /// in the cone, each on its own, as reachability studies score).
     #[arg(long, value_parser = parse_score, default_value = "bound")]
     pub score: Score,
-    /// The program planned at the chosen place (an emg-job/1 file).
+    /// The program planned at the chosen place (an emg-job/1 file; missing parent directories
+    /// are created, as for every file written).
     #[arg(long, value_name = "FILE", default_value = "placed.json")]
     pub out: PathBuf,
     /// Also write the heat map (SVG): each position's best score over the turns, the certified
@@ -60,7 +61,12 @@ pub struct PlaceArgs {
     /// Also write the job at the chosen place: a job file (docs/jobs.md) with the strokes as
     /// read and the place as its `transform`, for `emg job`.
     #[arg(long, value_name = "FILE")]
-    pub export: Option<PathBuf>,
+    pub job_out: Option<PathBuf>,
+    /// Also export the program for a robot's own stack, as `emg job --export` does:
+    /// `ros2-mcap` or `urscript`, written beside `--out` (its extension `.mcap` or `.script`;
+    /// see docs/robot-export.md).
+    #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
+    pub export: Option<emg_io::ExportFormat>,
 }
 
 fn parse_range(value: &str) -> Result<[f64; 2], String> {
@@ -94,10 +100,15 @@ fn parse_score(value: &str) -> Result<Score, String> {
 /// Searches the region, prints the certified places and writes the outputs.
 pub fn run_place(args: &PlaceArgs) -> Result<()> {
     let input = &args.input;
+    let exported = args
+        .export
+        .map(|format| crate::export::beside_program(&args.out, format));
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(args.map.as_deref().map(|path| ("--map", path)));
-    outputs.extend(args.export.as_deref().map(|path| ("--export", path)));
+    outputs.extend(args.job_out.as_deref().map(|path| ("--job-out", path)));
+    outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
+    crate::export::refuse_program_export(args.export, &input.robot)?;
     let region = Region {
         moving: args.moving,
         x_m: args.x,
@@ -124,7 +135,7 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
         &request,
         &job,
         &timing,
-        &input.robot.display().to_string(),
+        &crate::robot::reference(&input.robot)?.to_string(),
         &region,
         &settings,
         args.score,
@@ -144,11 +155,21 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
     print_summary(program);
     write_text(&args.out, &(serde_json::to_string(program)? + "\n"))?;
     println!("wrote {}", args.out.display());
+    if let Some(format) = args.export {
+        let text = crate::export::export_program(
+            program,
+            format,
+            &args.out,
+            &input.robot,
+            planner.robot(),
+        )?;
+        println!("{text}");
+    }
     if let Some(path) = &args.map {
         write_text(path, &placement_map(&placement, args.score))?;
         println!("wrote {}", path.display());
     }
-    if let Some(path) = &args.export {
+    if let Some(path) = &args.job_out {
         let spec = JobSpec {
             version: JOB_FORMAT_VERSION,
             strokes: job.strokes.iter().map(|s| s.spec().clone()).collect(),
@@ -194,13 +215,15 @@ fn print_places(placement: &Placement) {
         Moving::Part => "the part",
         Moving::Base => "the base",
     };
+    // In full (the shortest text that reads back to the same number): the place is reproduced
+    // from what is printed.
     println!(
-        "chosen: {what} shifted ({:.3}, {:.3}) m, turned {:.1}°",
+        "chosen: {what} shifted ({}, {}) m, turned {}°",
         place.x_m, place.y_m, place.rotation_deg
     );
     let written = |t: &emg_job::Transform| {
         format!(
-            "translation_m [{:.4}, {:.4}, {:.4}], rpy [{:.4}, {:.4}, {:.4}]",
+            "translation_m [{}, {}, {}], rpy [{}, {}, {}]",
             t.translation_m[0],
             t.translation_m[1],
             t.translation_m[2],

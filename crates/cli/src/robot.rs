@@ -4,8 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+use emg_io::RobotRef;
 use emg_kinematics::{Robot, RobotError};
-use emg_planner::{DataDir, SHIPPED_ROBOTS};
+use emg_planner::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 use emg_verify::ReferenceModel;
 
 /// The shipped data: `$EMG_DATA` when set, else the `data/` directory of the workspace this
@@ -85,6 +86,27 @@ pub fn is_shipped(robot: &Path) -> bool {
     SHIPPED_ROBOTS
         .iter()
         .any(|shipped| shipped.path(&data) == robot)
+}
+
+/// How the files written for the robot file `robot` (as given to `--robot`) name it: a shipped
+/// robot by name, any other by its path as given, each with its file's digest.
+pub fn reference(robot: &Path) -> Result<RobotRef> {
+    let reference = match ShippedRobot::by_path(robot, &data_dir()) {
+        Some(shipped) => RobotRef::shipped(shipped.name, robot),
+        None => RobotRef::file(robot),
+    };
+    Ok(reference?)
+}
+
+/// The robot file that the `robot` field of `file` names: a shipped robot's in the shipped data,
+/// another's at its path as given (from the working directory, else from `file`'s directory);
+/// refused when that file is not the robot the motion was planned for.
+pub fn resolve(field: &str, file: &Path) -> Result<PathBuf> {
+    let reference =
+        RobotRef::parse(field).with_context(|| format!("cannot read {}", file.display()))?;
+    let data = data_dir();
+    let shipped = |name: &str| ShippedRobot::by_name(name).map(|robot| robot.path(&data));
+    Ok(reference.resolve(shipped, file)?)
 }
 
 /// Model file `name` (e.g. `ppo-v1.weights`) shipped for the robot file `robot`, when that file

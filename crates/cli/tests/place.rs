@@ -64,7 +64,7 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
         &placed,
         "--map",
         &map,
-        "--export",
+        "--job-out",
         &export,
     ]);
     let output = emg(&place);
@@ -117,7 +117,7 @@ fn the_base_is_moved_in_its_cell_to_where_the_icon_is_drawn_whole() {
         "2",
         "--out",
         &placed,
-        "--export",
+        "--job-out",
         &export,
     ]);
     let output = emg(&place);

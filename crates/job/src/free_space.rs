@@ -35,11 +35,40 @@ pub fn job_part(robot: &Robot, job: &crate::Job) -> Vec<Task> {
 /// Orientations of a plane's rectangle tried (a half turn, in 1° steps).
 pub const RECTANGLE_ANGLES: usize = 180;
 
+/// How far a path's point may lie outside the polygon of the points [`outline_points`] samples
+/// on it (m): the largest sagitta of their chords across an arc.
+const OUTLINE_SAGITTA_M: f64 = 1e-5;
+
+/// The margin the part's rectangle adds round its strokes (m): every stroke point lies at least
+/// this far inside it.
+const PART_ROUND_M: f64 = 1e-3;
+
+/// Points of `path` whose polygon holds the path to within [`OUTLINE_SAGITTA_M`]: the ends of
+/// every piece, and along an arc points close enough that no chord's sagitta exceeds it (the
+/// extreme points of a tight arc lie between points a centimetre apart, by up to 2 mm on an arc
+/// of 6 mm radius).
+fn outline_points(path: &Path) -> impl Iterator<Item = Vec3> + '_ {
+    path.pieces().iter().flat_map(move |piece| {
+        let (start, end, arc) = piece.outline();
+        let count = match arc {
+            None => 1,
+            Some((centre, _)) => {
+                // A chord `c` across radius `r` has sagitta `c² / 8r`.
+                let chord = (8.0 * (start - centre).norm() * OUTLINE_SAGITTA_M).sqrt();
+                (piece.length_m / chord).ceil().max(1.0) as usize
+            }
+        };
+        (0..count)
+            .map(move |k| path.point_at(piece.start_s + piece.length_m * k as f64 / count as f64))
+            .chain(std::iter::once(end))
+    })
+}
+
 /// One task per plane of `tasks` whose work plate is the part those strokes lie on: its path
 /// runs along the middle of the smallest rectangle (of [`RECTANGLE_ANGLES`] orientations)
-/// holding all the tasks' path points on the plane (sampled every centimetre, 1 mm added round)
-/// and zigzags to its edges, so the plate covers the rectangle with the plate's margins and no
-/// more. A plane whose rectangle makes no task keeps its strokes' own tasks.
+/// holding all the tasks' path points on the plane ([`PART_ROUND_M`] added round) and zigzags
+/// to its edges, so the plate covers the rectangle with the plate's margins and no more. A
+/// plane whose rectangle makes no task keeps its strokes' own tasks.
 pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
     let mut planes: Vec<(Vec3, Vec3, Vec<&Task>)> = Vec::new();
     for task in tasks {
@@ -57,11 +86,7 @@ pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
         let points: Vec<Vec3> = members
             .iter()
             .filter_map(|task| task.path.as_ref())
-            .flat_map(|path| {
-                let samples = (path.length_m() / 0.01).ceil() as usize;
-                (0..=samples)
-                    .map(move |k| path.point_at(path.length_m() * k as f64 / samples as f64))
-            })
+            .flat_map(outline_points)
             .collect();
         match rectangle_path(point, normal, members[0].d, &points)
             .and_then(|path| Task::on_path(robot, path, None).ok())
@@ -74,7 +99,8 @@ pub fn part_surfaces(robot: &Robot, tasks: &[Task]) -> Vec<Task> {
 }
 
 /// The path along the middle of the smallest rectangle on the plane through `point` with
-/// normal `normal` holding `points` (1 mm added round), its sides turned from `u0` by one of
+/// normal `normal` holding `points` ([`PART_ROUND_M`] added round, and the sagitta
+/// [`outline_points`] may leave out), its sides turned from `u0` by one of
 /// [`RECTANGLE_ANGLES`] angles: from the middle of one end to the other's, then round the
 /// rectangle's corners, so its extent across its start direction is half the rectangle's width
 /// to each side.
@@ -83,14 +109,15 @@ fn rectangle_path(point: Vec3, normal: Vec3, u0: Vec3, points: &[Vec3]) -> Optio
         return None;
     }
     let w0 = normal.cross(&u0);
+    let round = PART_ROUND_M + OUTLINE_SAGITTA_M;
     let bounds = |u: &Vec3, w: &Vec3| {
         let mut low = [f64::INFINITY; 2];
         let mut high = [f64::NEG_INFINITY; 2];
         for p in points {
             let offset = p - point;
             for (axis, value) in [offset.dot(u), offset.dot(w)].into_iter().enumerate() {
-                low[axis] = low[axis].min(value - 1e-3);
-                high[axis] = high[axis].max(value + 1e-3);
+                low[axis] = low[axis].min(value - round);
+                high[axis] = high[axis].max(value + round);
             }
         }
         (low, high)
@@ -390,5 +417,79 @@ impl<'a> FreeSpace<'a> {
             }
         }
         path
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The smallest distance (m) from any point of `strokes` (every 0.05 mm along them) to the
+    /// edges of the rectangle of `surface` (negative outside it).
+    fn least_inset(surface: &Task, strokes: &[Path]) -> f64 {
+        let corner = |index: usize| match surface.path.as_ref().unwrap().spec().segments[index] {
+            SegmentSpec::Line { to } => Vec3::from(to),
+            _ => panic!("the rectangle's sides are lines"),
+        };
+        // Segments 2, 3 and 4 end at the corners (low, high), (low, low) and (high, low).
+        let (origin, along_u, along_w) = (corner(3), corner(4) - corner(3), corner(2) - corner(3));
+        let (u, w) = (along_u.normalize(), along_w.normalize());
+        let mut least = f64::INFINITY;
+        for stroke in strokes {
+            let samples = (stroke.length_m() / 5e-5).ceil() as usize;
+            for k in 0..=samples {
+                let offset =
+                    stroke.point_at(stroke.length_m() * k as f64 / samples as f64) - origin;
+                let (a, b) = (offset.dot(&u), offset.dot(&w));
+                least = least
+                    .min(a)
+                    .min(along_u.norm() - a)
+                    .min(b)
+                    .min(along_w.norm() - b);
+            }
+        }
+        least
+    }
+
+    #[test]
+    fn every_stroke_point_lies_at_least_the_round_inside_the_part() {
+        let workspace = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let robot = Robot::from_chain_file(workspace.join("data/robots/fr3_pen.urdf")).unwrap();
+        let drawing = std::fs::read_to_string(workspace.join("examples/drawing.svg")).unwrap();
+        // A polyline and a circle 15 mm across, drawn at 1 mm per unit: the circle's extreme
+        // points lie between points a centimetre apart.
+        let small_circle = r#"<svg xmlns="http://www.w3.org/2000/svg" width="60" height="30">
+            <polyline points="5,5 25,25 40,5" fill="none" stroke="black"/>
+            <circle cx="50" cy="15" r="7.5" fill="none" stroke="black"/></svg>"#;
+        let at_1mm = emg_io::Placement {
+            width_m: None,
+            scale_m_per_unit: Some(1e-3),
+            ..emg_io::Placement::default()
+        };
+        for (svg, placement) in [
+            (drawing.as_str(), emg_io::Placement::default()),
+            (small_circle, at_1mm),
+        ] {
+            let strokes: Vec<Path> =
+                emg_io::read_svg(svg, &placement, &emg_io::SvgOptions::default())
+                    .unwrap()
+                    .strokes
+                    .into_iter()
+                    .map(|spec| Path::new(spec).unwrap())
+                    .collect();
+            let tasks: Vec<Task> = strokes
+                .iter()
+                .map(|stroke| Task::on_path(&robot, stroke.clone(), None).unwrap())
+                .collect();
+            let surfaces = part_surfaces(&robot, &tasks);
+            assert_eq!(surfaces.len(), 1, "one plane, one part");
+            let inset = least_inset(&surfaces[0], &strokes);
+            assert!(
+                inset >= PART_ROUND_M - 1e-9,
+                "a stroke point lies {:.4} mm inside the part's edge, less than {} mm",
+                inset * 1e3,
+                PART_ROUND_M * 1e3
+            );
+        }
     }
 }

@@ -1,5 +1,5 @@
-//! The read stage: a job file (`emg-job` input, version 1) or a drawing's strokes, validated
-//! into a [`Job`].
+//! The read stage: a job file (`emg-job` input, version 1), a path file (a job of one stroke) or
+//! a drawing's strokes, validated into a [`Job`].
 
 use emg_control::{Path, PathError, PathSpec};
 pub use emg_kinematics::Transform;
@@ -244,14 +244,33 @@ impl Job {
         })
     }
 
-    /// Reads a job file's text; `origin` names it in errors.
+    /// Reads a job file's text, or a path file's (docs/paths.md: a job of one stroke, with the
+    /// default settings); `origin` names it in errors.
     pub fn from_json(origin: &str, text: &str, robot: &Robot) -> Result<Self, JobError> {
-        let spec: JobSpec = serde_json::from_str(text).map_err(|e| JobError::Parse {
+        let parse_error = |what: &str, e: serde_json::Error| JobError::Parse {
             origin: origin.to_string(),
-            message: e.to_string(),
-        })?;
+            message: format!("{what}{e}"),
+        };
+        if is_path_file(text) {
+            let stroke: PathSpec = serde_json::from_str(text)
+                .map_err(|e| parse_error("read as a path file (docs/paths.md): ", e))?;
+            return Self::from_strokes(vec![stroke], robot);
+        }
+        let spec: JobSpec = serde_json::from_str(text).map_err(|e| parse_error("", e))?;
         Self::from_spec(spec, robot)
     }
+}
+
+/// Whether `text` is a path file: a JSON object with `segments` and no `strokes`.
+fn is_path_file(text: &str) -> bool {
+    /// The members that tell a path file from a job file.
+    #[derive(Deserialize)]
+    struct Members {
+        strokes: Option<serde::de::IgnoredAny>,
+        segments: Option<serde::de::IgnoredAny>,
+    }
+    serde_json::from_str::<Members>(text)
+        .is_ok_and(|members| members.segments.is_some() && members.strokes.is_none())
 }
 
 /// The home configuration of `values`: one finite value per joint, within the limits.
@@ -276,4 +295,39 @@ fn home(robot: &Robot, values: &[f64]) -> Result<JointVector, JobError> {
         )));
     }
     Ok(q)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fr3() -> Robot {
+        let file =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/fr3_pen.urdf");
+        Robot::from_chain_file(&file).unwrap()
+    }
+
+    #[test]
+    fn a_path_file_is_a_job_of_one_stroke() {
+        let examples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+        let text = std::fs::read_to_string(examples.join("slot.json")).unwrap();
+        let job = Job::from_json("slot.json", &text, &fr3()).unwrap();
+        let spec: PathSpec = serde_json::from_str(&text).unwrap();
+        assert_eq!(job.strokes.len(), 1);
+        assert_eq!(job.strokes[0].spec(), &spec);
+        assert_eq!(job.settings, JobSettings::default());
+        // A path file's own errors name it as such.
+        let broken = text.replacen("\"segments\"", "\"segments\": 3, \"x\"", 1);
+        let error = Job::from_json("slot.json", &broken, &fr3()).unwrap_err();
+        assert!(error.to_string().contains("path file"), "{error}");
+        // A job file is still read as one.
+        let seams = std::fs::read_to_string(examples.join("seams.json")).unwrap();
+        assert!(
+            Job::from_json("seams.json", &seams, &fr3())
+                .unwrap()
+                .strokes
+                .len()
+                > 1
+        );
+    }
 }

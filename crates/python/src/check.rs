@@ -1,4 +1,4 @@
-//! `check`: a trajectory file verified by the independent checker.
+//! `check`: a trajectory file or a job's program verified by the independent checker.
 
 use std::path::{Path, PathBuf};
 
@@ -55,14 +55,83 @@ impl CheckReport {
     }
 }
 
-/// Verifies a trajectory file written by `Plan.save` or `emg plan` (either JSON layout, or the
-/// CSV with the JSON of the same stem beside it) with the independent checker, against the
-/// task, constraints and robot it carries (`robot` overrides the robot: a shipped robot's name
-/// or a robot file). Returns the report; raises `CheckFailed` naming the first failing point
-/// and constraint.
+/// What the independent checker verified on a job's program (`emg-job/1`) that holds up, as
+/// `emg check` reports it.
+#[pyclass(frozen, get_all, module = "extreme_line_motion")]
+pub struct JobCheckReport {
+    /// Always `emg-job/1`.
+    layout: &'static str,
+    /// The robot file it was checked with.
+    robot: PathBuf,
+    /// Stroke parts verified on their paths.
+    stroke_parts: usize,
+    /// Moves between strokes verified clear of the arm, the plates and the scene.
+    moves: usize,
+    /// Samples verified from rest to rest within the file's joint limits.
+    points: usize,
+}
+
+#[pymethods]
+impl JobCheckReport {
+    fn __repr__(&self) -> String {
+        format!(
+            "JobCheckReport(stroke_parts={}, moves={}, points={})",
+            self.stroke_parts, self.moves, self.points
+        )
+    }
+}
+
+/// Verifies a file written by `Plan.save`, `JobPlan.write`, `emg plan` or `emg job` with the
+/// independent checker, as `emg check` does: a trajectory file (either JSON layout, or the CSV
+/// with the JSON of the same stem beside it) against the task, constraints and robot it
+/// carries, returning a `CheckReport`; or a job's program (`emg-job/1`) segment by segment,
+/// returning a `JobCheckReport`. `robot` overrides the robot the file names (a shipped robot's
+/// name or a robot file). Raises `CheckFailed` naming the first failing point or segment and
+/// the constraint.
 #[pyfunction]
 #[pyo3(signature = (path, robot = None))]
-pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
+pub fn check(py: Python<'_>, path: PathBuf, robot: Option<PathBuf>) -> PyResult<Py<PyAny>> {
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
+    if emg_job::JobFile::is_job(&text) {
+        let report = check_job(&path, &text, robot.as_deref())?;
+        return Ok(Py::new(py, report)?.into_any());
+    }
+    Ok(Py::new(py, check_trajectory(path, robot)?)?.into_any())
+}
+
+/// [`check`] of a job's program, `text` read from `path`.
+fn check_job(path: &Path, text: &str, robot: Option<&Path>) -> PyResult<JobCheckReport> {
+    let job: emg_job::JobFile = serde_json::from_str(text).map_err(|e| {
+        InputError::new_err(format!(
+            "{} is not a valid {} file: {e}",
+            path.display(),
+            emg_job::JOB_FILE_FORMAT
+        ))
+    })?;
+    let robot = Robot::named(&job.robot, path, robot)?;
+    let model = checker(&robot)?;
+    let check =
+        emg_job::verify_job(&job, &model, robot.inner.joint_names()).map_err(|failure| {
+            CheckFailed::new_err(format!("{} does not hold up: {failure}", path.display()))
+        })?;
+    Ok(JobCheckReport {
+        layout: emg_job::JOB_FILE_FORMAT,
+        robot: robot.file,
+        stroke_parts: check.stroke_parts,
+        moves: check.moves,
+        points: check.points,
+    })
+}
+
+/// The independent checker's model of `robot`, read again from its file.
+fn checker(robot: &Robot) -> PyResult<ReferenceModel> {
+    ReferenceModel::from_urdf_file(&robot.file, robot.inner.base_link(), robot.inner.tip_link())
+        .map_err(|e| input_error(format!("the checker's robot {}", robot.file.display()), &e))
+}
+
+/// [`check`] of a trajectory file.
+fn check_trajectory(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
     let read = |path: &Path| {
         TrajectoryContents::read(path).map_err(|e| match &e {
             ReadError::Io { .. } => PyOSError::new_err(message(&e)),
@@ -89,13 +158,13 @@ pub fn check(path: PathBuf, robot: Option<PathBuf>) -> PyResult<CheckReport> {
                 path.display()
             ))
         })?;
-    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(&carried.robot)))?;
-    let model = ReferenceModel::from_urdf_file(
-        &robot.file,
-        robot.inner.base_link(),
-        robot.inner.tip_link(),
-    )
-    .map_err(|e| input_error(format!("the checker's robot {}", robot.file.display()), &e))?;
+    let named_by = if own_task {
+        path.clone()
+    } else {
+        task_file_beside(&path).unwrap_or_else(|| path.clone())
+    };
+    let robot = Robot::named(&carried.robot, &named_by, robot.as_deref())?;
+    let model = checker(&robot)?;
     let task = &carried.task;
     let task = task
         .revalidated(&robot.inner)

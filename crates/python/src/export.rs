@@ -72,11 +72,11 @@ pub fn export(
         None => Some(emg_io::read_joint_trajectory(&path).map_err(fail)?),
     };
     let (points, robot_field) = match (&job, &trajectory) {
-        (Some(job), _) => (job.timed_points(), job.robot.clone()),
-        (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.clone()),
+        (Some(job), _) => (job.timed_points(), job.robot.as_str()),
+        (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
         (None, None) => unreachable!("a file is read as one or the other"),
     };
-    let robot = Robot::load(&robot.unwrap_or_else(|| PathBuf::from(robot_field)))?;
+    let robot = Robot::named(robot_field, &path, robot.as_deref())?;
     let shipped = ShippedRobot::by_path(&robot.file, &data_dir()?)
         .and_then(|s| DriverProfile::for_shipped(s.name));
     let file = robot.file.display().to_string();
@@ -87,6 +87,7 @@ pub fn export(
     };
     let target = ExportRobot {
         file: &file,
+        reference: &robot.reference,
         shipped,
         kinematics: Some(&robot.inner),
     };

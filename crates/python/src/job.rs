@@ -119,11 +119,11 @@ fn placement_of(text: &str) -> PyResult<emg_io::Placement> {
 pub(crate) fn plan(
     py: Python<'_>,
     planner: &emg_planner::Planner,
-    robot_file: &std::path::Path,
+    robot: &crate::robot::Robot,
     job: &Job,
     tolerance_mm: f64,
 ) -> PyResult<JobPlan> {
-    let (planner, timing, request) = job_planner(planner, robot_file, tolerance_mm)?;
+    let (planner, timing, request) = job_planner(planner, &robot.file, tolerance_mm)?;
     let file = py
         .detach(|| {
             emg_job::plan_job(
@@ -131,7 +131,7 @@ pub(crate) fn plan(
                 &request,
                 job,
                 &timing,
-                &robot_file.display().to_string(),
+                &robot.reference,
                 &|_, _| {},
             )
         })
@@ -292,7 +292,7 @@ fn read_region(py: Python<'_>, region: &Bound<'_, PyDict>) -> PyResult<emg_job::
 pub(crate) fn place(
     py: Python<'_>,
     planner: &emg_planner::Planner,
-    robot_file: &std::path::Path,
+    robot: &crate::robot::Robot,
     job: &Job,
     region: &Bound<'_, PyDict>,
     tolerance_mm: f64,
@@ -318,7 +318,7 @@ pub(crate) fn place(
     settings
         .validate()
         .map_err(|e| InputError::new_err(message(&e)))?;
-    let (planner, timing, request) = job_planner(planner, robot_file, tolerance_mm)?;
+    let (planner, timing, request) = job_planner(planner, &robot.file, tolerance_mm)?;
     let placement = py
         .detach(|| {
             emg_job::place_job(
@@ -326,7 +326,7 @@ pub(crate) fn place(
                 &request,
                 job,
                 &timing,
-                &robot_file.display().to_string(),
+                &robot.reference,
                 &region,
                 &settings,
                 score,

@@ -7,7 +7,8 @@
 //!   rest ([`timing::Motion`]), `save(stem, …)` writing the files `emg plan` writes, byte for
 //!   byte;
 //! * [`robot::Robot`]: forward kinematics and the position Jacobian;
-//! * [`check::check`]: a trajectory file verified by the independent checker, as a report;
+//! * [`check::check`]: a trajectory file or a job's program verified by the independent
+//!   checker, as a report;
 //! * [`planner::load_tasks`]: a task file (JSON or `EMGTASKS`);
 //! * [`export::export`]: a joint trajectory exported for a robot's own stack (ROS 2 MCAP,
 //!   URScript).
@@ -114,6 +115,7 @@ fn extreme_line_motion(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<timing::Motion>()?;
     module.add_class::<robot::Robot>()?;
     module.add_class::<check::CheckReport>()?;
+    module.add_class::<check::JobCheckReport>()?;
     module.add_function(wrap_pyfunction!(planner::load_tasks, module)?)?;
     module.add_function(wrap_pyfunction!(check::check, module)?)?;
     module.add_class::<export::ExportReport>()?;

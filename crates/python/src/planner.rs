@@ -54,7 +54,10 @@ pub struct Task {
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct Plan {
     planner: Arc<emg_planner::Planner>,
+    /// The robot file (its limits file lies beside it).
     robot: String,
+    /// How the saved files name the robot.
+    reference: String,
     request: PlanRequest,
     task: emg_control::Task,
     plan: emg_planner::Plan,
@@ -160,6 +163,7 @@ impl Planner {
         Plan {
             planner: Arc::clone(&self.inner),
             robot: self.robot.get().file.display().to_string(),
+            reference: self.robot.get().reference.clone(),
             request: request.request.clone(),
             task,
             plan,
@@ -247,7 +251,8 @@ pub(crate) fn array1<'py>(
 #[pymethods]
 impl Planner {
     #[new]
-    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None, surface = None, tolerance_mm = None, cone_deg = None))]
+    #[pyo3(signature = (robot = PathBuf::from("fr3"), models = None, config = None, surface = None, tolerance_mm = None, cone_deg = None),
+           text_signature = "(robot='fr3', models=None, config=None, surface=None, tolerance_mm=None, cone_deg=None)")]
     fn new(
         py: Python<'_>,
         robot: PathBuf,
@@ -376,7 +381,8 @@ impl Planner {
     /// cannot finish it, the strokes joined by checked free moves; the GIL is released while
     /// planning. A malformed job raises `InputError` naming the field; one of which no stroke
     /// can be drawn raises `PlanningError`.
-    #[pyo3(signature = (job, placement = None, tolerance_mm = emg_job::JOB_TOLERANCE_M * 1e3))]
+    // Literal defaults, which `help()` shows (an expression shows as `...`): `emg job`'s.
+    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5))]
     fn plan_job(
         &self,
         py: Python<'_>,
@@ -386,7 +392,7 @@ impl Planner {
     ) -> PyResult<crate::job::JobPlan> {
         let robot = self.robot.get();
         let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
-        crate::job::plan(py, &self.inner, &robot.file, &job, tolerance_mm)
+        crate::job::plan(py, &self.inner, robot, &job, tolerance_mm)
     }
 
     /// Finds where to put a job's part (docs/placement.md): `job` and `placement` as for
@@ -397,7 +403,7 @@ impl Planner {
     /// the share of stroke points with an IK solution), the best `certify` planned as full jobs.
     /// Returns a `JobPlacement`; a bad region or setting raises `InputError` naming it, a
     /// region the arm cannot reach `PlanningError`.
-    #[pyo3(signature = (job, region, placement = None, tolerance_mm = emg_job::JOB_TOLERANCE_M * 1e3, positions = 10, rotations = 5, certify = 5, score = "bound"))]
+    #[pyo3(signature = (job, region, placement = None, tolerance_mm = 0.5, positions = 10, rotations = 5, certify = 5, score = "bound"))]
     #[allow(clippy::too_many_arguments)]
     fn place_job(
         &self,
@@ -416,7 +422,7 @@ impl Planner {
         crate::job::place(
             py,
             &self.inner,
-            &robot.file,
+            robot,
             &job,
             region,
             tolerance_mm,
@@ -595,7 +601,7 @@ impl Plan {
     /// The motion timed rest to rest: `limits` a MoveIt joint_limits.yaml (default: the one
     /// beside the robot file), `velocity_scaling` and `acceleration_scaling` in (0, 1],
     /// `tool_speed` (m/s; default: the rollout's line speed), `rate_hz` samples per second.
-    #[pyo3(signature = (limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = emg_planner::DEFAULT_RATE_HZ))]
+    #[pyo3(signature = (limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = 1000.0))]
     fn timed(
         &self,
         py: Python<'_>,
@@ -633,7 +639,7 @@ impl Plan {
     /// with the same keyword arguments as `emg plan`'s options); returns their paths. A plan
     /// refused at its start (`termination` `"invalid_start"`) has nothing to save and raises
     /// `PlanningError`, as `emg plan` writes nothing for it.
-    #[pyo3(signature = (stem, limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = emg_planner::DEFAULT_RATE_HZ))]
+    #[pyo3(signature = (stem, limits = None, velocity_scaling = 1.0, acceleration_scaling = 1.0, tool_speed = None, rate_hz = 1000.0))]
     fn save(
         &self,
         stem: PathBuf,
@@ -661,7 +667,7 @@ impl Plan {
             rate_hz,
         )?;
         let record = PlanRecord {
-            robot: &self.robot,
+            robot: &self.reference,
             request: &self.request,
             bound: self.bound.as_ref(),
             timing: &timing,
@@ -733,7 +739,7 @@ impl Task {
 /// The tasks of a task file (JSON or the binary `EMGTASKS` set, told apart by the content),
 /// each validated for `robot` (a shipped robot's name or a robot file).
 #[pyfunction]
-#[pyo3(signature = (path, robot = PathBuf::from("fr3")))]
+#[pyo3(signature = (path, robot = PathBuf::from("fr3")), text_signature = "(path, robot='fr3')")]
 pub fn load_tasks(path: PathBuf, robot: PathBuf) -> PyResult<Vec<Task>> {
     let robot = Robot::load(&robot)?;
     let tasks = emg_io::read_tasks(&path, &robot.inner)

@@ -8,7 +8,10 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
-use crate::{input_error, robot_file};
+use emg_io::RobotRef;
+use emg_planner::ShippedRobot;
+
+use crate::{InputError, data_dir, input_error, message, robot_file};
 
 /// A serial arm of six or seven revolute joints from a robot file: `Robot("fr3")`,
 /// `Robot("iiwa14")`, `Robot("ur5e")` or `Robot(path)` (the chain from the file's root link to
@@ -17,6 +20,8 @@ use crate::{input_error, robot_file};
 pub struct Robot {
     pub(crate) inner: Arc<emg_kinematics::Robot>,
     pub(crate) file: PathBuf,
+    /// How written files name it ([`RobotRef`]'s text).
+    pub(crate) reference: String,
 }
 
 impl Robot {
@@ -25,10 +30,31 @@ impl Robot {
         let file = robot_file(robot)?;
         let inner = emg_kinematics::Robot::from_chain_file(&file)
             .map_err(|e| input_error(format!("robot {}", file.display()), &e))?;
+        let reference = match ShippedRobot::by_path(&file, &data_dir()?) {
+            Some(shipped) => RobotRef::shipped(shipped.name, &file),
+            None => RobotRef::file(&file),
+        }
+        .map_err(|e| input_error(format!("robot {}", file.display()), &e))?;
         Ok(Self {
             inner: Arc::new(inner),
             file,
+            reference: reference.to_string(),
         })
+    }
+
+    /// Loads the robot that the `robot` field of `file` names (see [`RobotRef::resolve`]), or
+    /// `given` (a shipped robot's name or a robot file) when there is one.
+    pub(crate) fn named(field: &str, file: &Path, given: Option<&Path>) -> PyResult<Self> {
+        if let Some(given) = given {
+            return Self::load(given);
+        }
+        let reference = RobotRef::parse(field).map_err(|e| input_error(file.display(), &e))?;
+        let data = data_dir()?;
+        let shipped = |name: &str| ShippedRobot::by_name(name).map(|robot| robot.path(&data));
+        let path = reference
+            .resolve(shipped, file)
+            .map_err(|e| InputError::new_err(message(&e)))?;
+        Self::load(&path)
     }
 }
 
@@ -81,7 +107,7 @@ fn vector<'py>(
 #[pymethods]
 impl Robot {
     #[new]
-    #[pyo3(signature = (robot = PathBuf::from("fr3")))]
+    #[pyo3(signature = (robot = PathBuf::from("fr3")), text_signature = "(robot='fr3')")]
     fn new(robot: PathBuf) -> PyResult<Self> {
         Self::load(&robot)
     }

@@ -59,12 +59,66 @@ def test_the_program_is_the_clis_and_passes_the_checker(tmp_path, job_plan):
     run_cli("job", SEAMS, "--out", tmp_path / "cli.job.json")
     python_file = json.loads(ours.read_text())
     cli_file = json.loads((tmp_path / "cli.job.json").read_text())
-    # The same program; only the planning time and the robot file's spelling differ.
+    # The same program, the robot named alike (by name and digest); only the planning time
+    # differs.
+    assert python_file["robot"].startswith("shipped:fr3@sha256:")
     for file in (python_file, cli_file):
         del file["summary"]["planning_s"]
-        del file["robot"]
     assert python_file == cli_file
-    assert "OK" in run_cli("check", ours, "--robot", "fr3").stdout
+    assert "OK" in run_cli("check", ours).stdout
+
+
+def test_check_reads_a_program_as_the_cli_does_from_any_directory(tmp_path, job_plan, monkeypatch):
+    program = tmp_path / "copied" / "seams.job.json"
+    program.parent.mkdir()
+    job_plan.write(program)
+    monkeypatch.chdir(tmp_path)
+    report = elm.check(program)
+    assert isinstance(report, elm.JobCheckReport)
+    assert report.layout == "emg-job/1"
+    assert report.stroke_parts >= 3 and report.moves >= 2 and report.points > 100
+    assert "OK" in run_cli("check", program).stdout
+    # A program one of whose stroke samples is moved off its path is refused, as by the CLI.
+    file = json.loads(program.read_text())
+    stroke = next(s for s in file["segments"] if s["kind"] == "stroke")
+    middle = (stroke["start_s"] + stroke["end_s"]) / 2
+    point = next(p for p in file["points"] if p["time_from_start"]["sec"] + p["time_from_start"]["nanosec"] * 1e-9 >= middle)
+    point["positions"][0] += 0.05
+    tampered = tmp_path / "tampered.job.json"
+    tampered.write_text(json.dumps(file))
+    with pytest.raises(elm.CheckFailed, match="tampered.job.json does not hold up"):
+        elm.check(tampered)
+
+
+def test_a_program_whose_robot_changed_is_refused_naming_both_digests(tmp_path, job_plan):
+    program = tmp_path / "seams.job.json"
+    job_plan.write(program)
+    file = json.loads(program.read_text())
+    recorded = file["robot"].rsplit("@sha256:", 1)[1]
+    other = "0" * 64
+    file["robot"] = f"shipped:fr3@sha256:{other}"
+    program.write_text(json.dumps(file))
+    with pytest.raises(elm.InputError, match=f"field 'robot'.*{other}.*{recorded}"):
+        elm.check(program)
+    # The robot given overrides the file's.
+    assert elm.check(program, robot="fr3").stroke_parts >= 3
+
+
+def test_every_default_shows_its_value_in_help():
+    import inspect
+
+    callables = [elm.Planner, elm.Robot, elm.load_tasks, elm.check, elm.export]
+    callables += [getattr(elm.Planner, name) for name in ("plan", "plan_path", "plan_job", "place_job", "plan_many")]
+    callables += [getattr(elm.Plan, name) for name in ("timed", "save")]
+    for function in callables:
+        signature = inspect.signature(function)
+        for parameter in signature.parameters.values():
+            assert parameter.default is not Ellipsis, f"{function.__qualname__}: {parameter.name}"
+    assert inspect.signature(elm.Planner.plan_job).parameters["tolerance_mm"].default == 0.5
+    assert inspect.signature(elm.Planner).parameters["robot"].default == "fr3"
+    assert inspect.signature(elm.Plan.save).parameters["rate_hz"].default == 1000.0
+    # The job default is `emg job`'s.
+    assert "[default: 0.5]" in run_cli("job", "--help").stdout
 
 
 def test_a_malformed_job_is_refused_naming_the_field():

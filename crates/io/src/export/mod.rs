@@ -174,8 +174,11 @@ pub enum ExportError {
 /// The robot a joint trajectory is exported for.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ExportRobot<'a> {
-    /// The robot file's path, as the export names it.
+    /// The robot file's path, as the export's messages name it.
     pub file: &'a str,
+    /// The robot as the exported files record it (their metadata and header comments): a
+    /// [`crate::RobotRef`]'s text, which names no directory of this machine for a shipped robot.
+    pub reference: &'a str,
     /// The shipped robot's driver profile, when it is a shipped robot (its driver's joint names
     /// and frames); `None` for any other robot, whose file's joint names are kept.
     pub shipped: Option<&'static DriverProfile>,
@@ -349,8 +352,8 @@ fn ros2(
         .map_or("not measured (no robot kinematics)".to_string(), |m| {
             format!("{m:.2e} m")
         });
-    let notes = BTreeMap::from([
-        ("source_robot".to_string(), robot.file.to_string()),
+    let mut notes = BTreeMap::from([
+        ("source_robot".to_string(), robot.reference.to_string()),
         ("driver".to_string(), driver.to_string()),
         (
             "file_joint_names".to_string(),
@@ -370,8 +373,11 @@ fn ros2(
             "max_joint_deviation_rad".to_string(),
             format!("{:e}", report.max_joint_deviation_rad),
         ),
-        ("max_tool_deviation_m".to_string(), tool.clone()),
     ]);
+    // A number, like every other value; absent when not measured.
+    if let Some(m) = report.max_tool_deviation_m {
+        notes.insert("max_tool_deviation_m".to_string(), format!("{m:e}"));
+    }
     let message = ros2_mcap::Ros2Message {
         joint_names: &joint_names,
         frame_id,
@@ -439,19 +445,20 @@ fn ur_script(
         None => "the robot file's base frame as it is",
     };
     let count = parts.len();
-    let files =
-        parts
-            .iter()
-            .enumerate()
-            .map(|(i, &range)| {
-                let path = if count == 1 {
-                    out.to_path_buf()
-                } else {
-                    part_path(out, i + 1)
-                };
-                let header =
-                    vec![
-                format!("written by emg export from a joint trajectory of robot {}", robot.file),
+    let files = parts
+        .iter()
+        .enumerate()
+        .map(|(i, &range)| {
+            let path = if count == 1 {
+                out.to_path_buf()
+            } else {
+                part_path(out, i + 1)
+            };
+            let header = vec![
+                format!(
+                    "written by emg export from a joint trajectory of robot {}",
+                    robot.reference
+                ),
                 "for a Universal Robots e-Series controller (servo period 2 ms); joint values \
                  in the pendant's order and zero"
                     .to_string(),
@@ -471,10 +478,10 @@ fn ur_script(
                      {MOVEJ_SPEED_RAD_S} rad/s) from wherever the arm stands: clear that way"
                 ),
             ];
-                let text = urscript::program(&targets, range, "emg_motion", &header);
-                (path, text.into_bytes())
-            })
-            .collect();
+            let text = urscript::program(&targets, range, "emg_motion", &header);
+            (path, text.into_bytes())
+        })
+        .collect();
     let lines = targets.len() - 1;
     let summary = format!(
         "URScript for a Universal Robots e-Series controller: movej to the start, then {lines} \
