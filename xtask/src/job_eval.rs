@@ -381,7 +381,7 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
     let mut motions = Vec::new();
     for oriented in &ordering.sequence {
         let path = oriented.path(&job.strokes);
-        let plan = plan_stroke(planner, &request, &path, &settings);
+        let plan = plan_stroke(planner, &request, &path, 0.0, &settings);
         motions.extend(
             plan.parts
                 .into_iter()

@@ -15,6 +15,7 @@
 //!
 //! [`plan_job`] runs them in order; [`place_job`] runs it at the best places for the part.
 
+pub mod claims;
 pub mod free_space;
 pub mod order;
 pub mod page;
@@ -24,6 +25,7 @@ pub mod spec;
 pub mod stroke;
 pub mod verify;
 
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use emg_kinematics::JointVector;
@@ -33,6 +35,7 @@ use emg_planner::{
 use emg_timing::time_blended_move;
 use rayon::prelude::*;
 
+pub use claims::{COVERAGE_SLACK_M, Coverage, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use order::{Ordering, Oriented, order_strokes};
 pub use page::{placement_map, viewer_page};
@@ -44,7 +47,7 @@ pub use program::{
     JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
-pub use stroke::{StrokePart, StrokePlan, Unreached, plan_stroke};
+pub use stroke::{StrokePart, StrokePlan, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 
 /// Pen-down lengths closer than this (m) count as the same: of two starts of a stroke that draw
@@ -131,7 +134,7 @@ pub fn plan_job(
         .par_iter()
         .map(|oriented| {
             let path = oriented.path(&job.strokes);
-            let plan = plan_stroke(&on_part, request, &path, settings);
+            let plan = plan_stroke(&on_part, request, &path, 0.0, settings);
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(finished, ordering.sequence.len());
             plan
@@ -147,10 +150,17 @@ pub fn plan_job(
     let (mut straight_moves, mut sampled_moves) = (0, 0);
     // The last part's lift, joined to the move after it.
     let mut retreat: Option<[JointVector; 2]> = None;
+    let mut searches: usize = plans.iter().map(|plan| plan.searches).sum();
     for (oriented, plan) in ordering.sequence.iter().zip(&plans) {
         let mut parts_left_out = Vec::new();
-        let mut drawn_parts = Vec::new();
-        for (index, planned) in plan.parts.iter().enumerate() {
+        // The stretches of the stroke the placed parts' samples cover.
+        let mut covered = Vec::new();
+        let mut queue: VecDeque<StrokePart> = plan.parts.iter().cloned().collect();
+        let mut rest_plans = 0;
+        let mut next_index = 0;
+        while let Some(planned) = queue.pop_front() {
+            let index = next_index;
+            next_index += 1;
             let from = retreat
                 .map(|[_, above]| above)
                 .or(program.last())
@@ -159,20 +169,20 @@ pub fn plan_job(
             // The part planned again from the configuration the arm is in, moved above the
             // part's start and set down there: taken first where it draws as far from a start
             // nearer the arm, and where the searched start cannot be reached.
-            let nearby =
-                from.and_then(|from| connector.replanned_nearby(&on_part, request, planned, &from));
+            let nearby = from
+                .and_then(|from| connector.replanned_nearby(&on_part, request, &planned, &from));
             let as_far =
                 |part: &StrokePart| part.reached_s() >= planned.reached_s() - SAME_LENGTH_M;
             let nearer = |part: &StrokePart| {
                 from.is_some_and(|from| {
                     let start = |p: &StrokePart| p.trajectory.steps[0].q;
-                    (start(part) - from).norm() < (start(planned) - from).norm()
+                    (start(part) - from).norm() < (start(&planned) - from).norm()
                 })
             };
             let (first, fallback) = match &nearby {
-                Some(again) if as_far(again) && nearer(again) => (again, Some(planned)),
-                Some(again) => (planned, Some(again)),
-                None => (planned, None),
+                Some(again) if as_far(again) && nearer(again) => (again, Some(&planned)),
+                Some(again) => (&planned, Some(again)),
+                None => (&planned, None),
             };
             let placed = connector.place(first, from, seed).or_else(|why| {
                 fallback
@@ -186,6 +196,17 @@ pub fn plan_job(
                     continue;
                 }
             };
+            // A stand-in that draws less than the planned part leaves the rest of the stroke
+            // to be planned again from where it ends.
+            if part.reached_s() < planned.reached_s() - SAME_LENGTH_M
+                && rest_plans < settings.max_parts
+            {
+                rest_plans += 1;
+                let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
+                let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings);
+                searches += rest.searches;
+                queue = rest.parts.into();
+            }
             let Placed {
                 timed,
                 above_start,
@@ -210,31 +231,36 @@ pub fn plan_job(
                 SegmentKind::Stroke {
                     stroke: oriented.stroke,
                     part: index,
+                    from_s: part.from_s,
                 },
                 &timed.samples,
                 &[],
                 Some(&part.task),
                 dof,
             );
+            covered.push(part_coverage(
+                robot,
+                &part.task,
+                part.from_s,
+                timed.samples.iter().map(|sample| &sample.q),
+            ));
             retreat = Some([end, above_end]);
-            drawn_parts.push(part);
         }
-        let drawn = StrokePlan {
-            parts: drawn_parts,
-            ..plan.clone()
-        };
+        let length_m = plan.path.length_m();
+        let coverage = Coverage::of(length_m, &covered);
         reports.push(StrokeReport {
             stroke: oriented.stroke,
             reversed: oriented.reversed,
-            length_m: plan.path.length_m(),
-            drawn_m: drawn.drawn_m(),
-            parts: drawn.parts.len(),
-            unreached_at: plan
-                .unreached
+            path: plan.path.spec().clone(),
+            length_m,
+            drawn_m: coverage.drawn_m,
+            parts: covered.len(),
+            unreached_at: coverage
+                .undrawn
                 .iter()
                 .map(|u| plan.path.point_at(u.from_s).into())
                 .collect(),
-            unreached: plan.unreached.clone(),
+            unreached: coverage.undrawn,
             parts_left_out,
         });
     }
@@ -269,7 +295,7 @@ pub fn plan_job(
         &program,
         &ordering,
         (straight_moves, sampled_moves),
-        &plans,
+        searches,
         started,
     );
     summary.ends_at_home = ends_at_home;
@@ -457,11 +483,10 @@ fn summarise(
     program: &Program,
     ordering: &Ordering,
     (straight_moves, sampled_moves): (usize, usize),
-    plans: &[StrokePlan],
+    searches: usize,
     started: Instant,
 ) -> JobSummary {
-    let whole =
-        |r: &&StrokeReport| r.unreached.is_empty() && r.parts_left_out.is_empty() && r.parts > 0;
+    let whole = |r: &&StrokeReport| r.unreached.is_empty() && r.parts > 0;
     let pen_down_s = program
         .segments()
         .iter()
@@ -486,7 +511,7 @@ fn summarise(
         pen_up_s: duration_s - pen_down_s,
         straight_moves,
         sampled_moves,
-        searches: plans.iter().map(|p| p.searches).sum(),
+        searches,
         planning_s: started.elapsed().as_secs_f64(),
         ends_at_home: true,
     }

@@ -23,7 +23,7 @@ pub fn viewer_page(file: &JobFile, job: &Job, robot: &Robot, name: &str) -> Stri
         .iter()
         .map(|segment| emg_viewer::JobSegment {
             kind: match segment.kind {
-                SegmentKind::Stroke { stroke, part } => {
+                SegmentKind::Stroke { stroke, part, .. } => {
                     emg_viewer::JobSegmentKind::Stroke { stroke, part }
                 }
                 SegmentKind::Retreat => emg_viewer::JobSegmentKind::Retreat,

@@ -2,30 +2,33 @@
 //! −n, a free joint-space move, approach along n) into one timed joint trajectory, every segment
 //! listed with its time span, written as an `emg-job/1` file.
 
-use emg_control::{ConstraintConfig, Task};
+use emg_control::{ConstraintConfig, PathSpec, Task};
 use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
 use emg_kinematics::JointVector;
 use emg_planner::MotionTiming;
 use emg_timing::{TimedSample, time_free_move};
 use serde::{Deserialize, Serialize};
 
+use crate::claims::Stretch;
 use crate::order::Ordering;
 use crate::spec::JobSettings;
-use crate::stroke::Unreached;
 
 /// The format tag of a job file.
-pub const JOB_FILE_FORMAT: &str = "emg-job/1";
+pub const JOB_FILE_FORMAT: &str = "emg-job/2";
 
 /// What a segment of the program does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SegmentKind {
-    /// Pen down along part `part` of stroke `stroke` (the job's index).
+    /// Pen down along part `part` of stroke `stroke` (the job's index), whose task is the
+    /// stroke's stretch from `from_s` on.
     Stroke {
         /// The stroke's index in the job.
         stroke: usize,
         /// The part (0 unless the stroke was resumed).
         part: usize,
+        /// Arc length along the stroke as drawn where the part's task starts (m).
+        from_s: f64,
     },
     /// The tool lifted off the surface along −n.
     Retreat,
@@ -61,15 +64,17 @@ pub struct StrokeReport {
     pub stroke: usize,
     /// Whether it was drawn from its end.
     pub reversed: bool,
+    /// The stroke as drawn (reversed where `reversed`).
+    pub path: PathSpec,
     /// Its length (m).
     pub length_m: f64,
-    /// The arc length drawn (m).
+    /// The arc length its stroke parts' samples cover (m; [`crate::claims`]).
     pub drawn_m: f64,
     /// The parts it was drawn in.
     pub parts: usize,
-    /// Stretches no motion reached (arc length along the stroke as drawn), and where each
-    /// starts (base frame, m).
-    pub unreached: Vec<Unreached>,
+    /// Stretches the stroke parts' samples do not cover (arc length along the stroke as
+    /// drawn), and where each starts (base frame, m).
+    pub unreached: Vec<Stretch>,
     /// See `unreached`.
     pub unreached_at: Vec<[f64; 3]>,
     /// Parts planned but left out, each with why: no safe move reached them or they could not

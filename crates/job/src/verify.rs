@@ -3,13 +3,22 @@
 //! from rest to rest within the joint velocity, acceleration and jerk limits; a stroke part's
 //! samples on its stretch of the stroke within the tolerance and the cone, clear of the arm's
 //! own links, its work plate, the part the file's `surfaces` make and the scene; a move's
-//! samples clear of the arm's own links, the part and the scene.
+//! samples clear of the arm's own links, the part and the scene. Then the program's claims
+//! against what its samples draw, measured with the checker's kinematics ([`crate::claims`]):
+//! each stroke part's task is its stroke's stretch, no stroke claims more length drawn than its
+//! samples cover, every stretch they leave undrawn is listed, and the summary's totals and
+//! counts are the strokes'.
 
-use emg_control::{ConstraintConfig, task_bounds};
-use emg_verify::{JointSamples, Joints, ReferenceModel, ReplayError, check_replay};
+use emg_control::{ConstraintConfig, MIN_SEGMENT_M, Path, Task, task_bounds};
+use emg_verify::{JointSamples, Joints, Line, ReferenceModel, ReplayError, check_replay};
 
+use crate::claims::{COVERAGE_SLACK_M, Coverage, Stretch};
 use crate::free_space::with_part;
-use crate::program::{JobFile, SegmentKind};
+use crate::program::{JobFile, SegmentKind, StrokeReport};
+
+/// How much (m) a length a program claims may differ from what the checker measures of its
+/// samples: the rounding between the planners' kinematics and the checker's.
+pub const CLAIM_TOLERANCE_M: f64 = 1e-6;
 
 /// What the check verified.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,6 +29,14 @@ pub struct JobCheck {
     pub moves: usize,
     /// Samples verified.
     pub points: usize,
+    /// Strokes, and those whose samples cover them whole.
+    pub strokes: usize,
+    /// See `strokes`.
+    pub whole_strokes: usize,
+    /// Pen-down length the samples cover, and the strokes' total (m).
+    pub drawn_m: f64,
+    /// See `drawn_m`.
+    pub total_m: f64,
 }
 
 /// Where a job's program fails the check.
@@ -36,6 +53,17 @@ pub enum JobCheckError {
     /// A stroke segment carries no task.
     #[error("segment {0} is a stroke without its task")]
     NoTask(usize),
+    /// A stroke's claims are not what its samples draw.
+    #[error("stroke {stroke}: {problem}")]
+    Claim {
+        /// The stroke's index in the job.
+        stroke: usize,
+        /// What the claim says and what the samples draw.
+        problem: String,
+    },
+    /// The summary's totals or counts are not the strokes'.
+    #[error("summary: {0}")]
+    Summary(String),
     /// A segment breaks a constraint.
     #[error("segment {segment} ({kind}, {start_s:.3} s to {end_s:.3} s): {error}")]
     Segment {
@@ -82,7 +110,13 @@ pub fn verify_job(
         stroke_parts: 0,
         moves: 0,
         points: file.points.len(),
+        strokes: file.strokes.len(),
+        whole_strokes: 0,
+        drawn_m: 0.0,
+        total_m: 0.0,
     };
+    // The stretch each stroke's parts' samples cover, by the stroke's place in `strokes`.
+    let mut covered: Vec<Vec<Stretch>> = vec![Vec::new(); file.strokes.len()];
     for (index, segment) in file.segments.iter().enumerate() {
         let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
         let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
@@ -96,7 +130,7 @@ pub fn verify_job(
         let fail = |error| JobCheckError::Segment {
             segment: index,
             kind: match segment.kind {
-                SegmentKind::Stroke { stroke, part } => format!("stroke {stroke} part {part}"),
+                SegmentKind::Stroke { stroke, part, .. } => format!("stroke {stroke} part {part}"),
                 SegmentKind::Retreat => "retreat".to_string(),
                 SegmentKind::Travel => "travel".to_string(),
                 SegmentKind::Approach => "approach".to_string(),
@@ -106,17 +140,33 @@ pub fn verify_job(
             error,
         };
         match segment.kind {
-            SegmentKind::Stroke { .. } => {
+            SegmentKind::Stroke { stroke, from_s, .. } => {
                 let task = segment.task.as_ref().ok_or(JobCheckError::NoTask(index))?;
+                let line: Line = task.into();
                 check_replay(
                     model,
-                    &task.into(),
+                    &line,
                     &task_bounds(task, &on_part),
                     &samples,
                     None,
                     Some(&dynamics),
                 )
                 .map_err(fail)?;
+                let place = file
+                    .strokes
+                    .iter()
+                    .position(|report| report.stroke == stroke)
+                    .ok_or_else(|| JobCheckError::Claim {
+                        stroke,
+                        problem: format!("segment {index} draws it, but no stroke report has it"),
+                    })?;
+                on_its_stroke(&file.strokes[place], task, from_s, index)?;
+                let tcps = samples.q.iter().map(|q| model.tcp_pose(q).0);
+                let (least, greatest) = line.covered(tcps).expect("a replayed segment has points");
+                covered[place].push(Stretch {
+                    from_s: from_s + least,
+                    to_s: from_s + greatest,
+                });
                 check.stroke_parts += 1;
             }
             _ => {
@@ -136,7 +186,126 @@ pub fn verify_job(
             }
         }
     }
+    for (report, covered) in file.strokes.iter().zip(&covered) {
+        let coverage = verify_claims(report, covered)?;
+        check.whole_strokes += usize::from(coverage.whole());
+        check.drawn_m += coverage.drawn_m;
+        check.total_m += report.length_m;
+    }
+    verify_summary(file)?;
     Ok(check)
+}
+
+/// Checks that `task`, the task of stroke part segment `segment`, is its stroke's stretch from
+/// `from_s`: their points agree along the whole task (to the pieces shorter than
+/// [`MIN_SEGMENT_M`] that a stretch leaves out).
+fn on_its_stroke(
+    report: &StrokeReport,
+    task: &Task,
+    from_s: f64,
+    segment: usize,
+) -> Result<(), JobCheckError> {
+    let claim = |problem: String| JobCheckError::Claim {
+        stroke: report.stroke,
+        problem,
+    };
+    let path = Path::new(report.path.clone())
+        .map_err(|e| claim(format!("its path is not a valid path: {e}")))?;
+    let length = task.length_m().unwrap_or(0.0);
+    const CHECKS: usize = 64;
+    for k in 0..=CHECKS {
+        let s = length * k as f64 / CHECKS as f64;
+        let off = (task.point_at(s) - path.point_at(from_s + s)).norm();
+        if off > 2.0 * MIN_SEGMENT_M {
+            return Err(claim(format!(
+                "segment {segment}'s task is not the stroke's stretch from {from_s:.4} m: {s:.4} m                  along it lies {off:.3e} m off the stroke"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Checks a stroke's claims against the stretches its parts' samples cover (`covered`, as the
+/// checker measures them); returns the coverage measured.
+fn verify_claims(report: &StrokeReport, covered: &[Stretch]) -> Result<Coverage, JobCheckError> {
+    let claim = |problem: String| JobCheckError::Claim {
+        stroke: report.stroke,
+        problem,
+    };
+    let length = Path::new(report.path.clone())
+        .map_err(|e| claim(format!("its path is not a valid path: {e}")))?
+        .length_m();
+    if (length - report.length_m).abs() > CLAIM_TOLERANCE_M {
+        return Err(claim(format!(
+            "claims a length of {} m; its path is {length} m long",
+            report.length_m
+        )));
+    }
+    if report.parts != covered.len() {
+        return Err(claim(format!(
+            "claims {} parts; the program draws {}",
+            report.parts,
+            covered.len()
+        )));
+    }
+    let measured = Coverage::of(length, covered);
+    if report.drawn_m > measured.drawn_m + CLAIM_TOLERANCE_M {
+        return Err(claim(format!(
+            "claims {:.6} m drawn; its samples draw {:.6} m of its {length:.6} m",
+            report.drawn_m, measured.drawn_m
+        )));
+    }
+    for gap in &measured.undrawn {
+        let listed: f64 = report
+            .unreached
+            .iter()
+            .map(|u| (u.to_s.min(gap.to_s) - u.from_s.max(gap.from_s)).max(0.0))
+            .sum();
+        if listed < gap.length_m() - COVERAGE_SLACK_M {
+            return Err(claim(format!(
+                "{:.4} m to {:.4} m along it is not drawn, and not listed as unreached",
+                gap.from_s, gap.to_s
+            )));
+        }
+    }
+    if report.unreached_at.len() != report.unreached.len() {
+        return Err(claim(format!(
+            "lists {} unreached stretches but {} places where they start",
+            report.unreached.len(),
+            report.unreached_at.len()
+        )));
+    }
+    Ok(measured)
+}
+
+/// Checks that the summary's totals and counts are the strokes' claims.
+fn verify_summary(file: &JobFile) -> Result<(), JobCheckError> {
+    let summary = &file.summary;
+    let drawn: f64 = file.strokes.iter().map(|r| r.drawn_m).sum();
+    let total: f64 = file.strokes.iter().map(|r| r.length_m).sum();
+    let whole = |parts: fn(usize) -> bool| {
+        file.strokes
+            .iter()
+            .filter(|r| r.unreached.is_empty() && r.parts > 0 && parts(r.parts))
+            .count()
+    };
+    let complete = whole(|parts| parts == 1);
+    let resumed = whole(|parts| parts > 1);
+    let short = file.strokes.len() - complete - resumed;
+    let tolerance = CLAIM_TOLERANCE_M * (1 + file.strokes.len()) as f64;
+    if (summary.drawn_m - drawn).abs() > tolerance || (summary.total_m - total).abs() > tolerance {
+        return Err(JobCheckError::Summary(format!(
+            "pen down {} m of {} m; the strokes claim {drawn} m of {total} m",
+            summary.drawn_m, summary.total_m
+        )));
+    }
+    if (summary.complete, summary.resumed, summary.short) != (complete, resumed, short) {
+        return Err(JobCheckError::Summary(format!(
+            "{} complete, {} resumed, {} short; the strokes are {complete} complete, {resumed}              resumed, {short} short",
+            summary.complete, summary.resumed, summary.short
+        )));
+    }
+    Ok(())
 }
 
 /// A checker's joint vector from a file's values.

@@ -1,0 +1,211 @@
+//! A program's claims are what its samples draw: the drawings of `../shared/cases/` that once
+//! drew less than they claimed, planned and measured again by the independent checker, and
+//! programs edited to claim more refused naming the stroke.
+
+use std::path::PathBuf;
+
+use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_job::{Job, JobCheckError, JobFile, SegmentKind, plan_job, verify_job};
+use emg_kinematics::Robot;
+use emg_planner::{DataDir, Models, MotionTiming, PlanRequest, Planner, ShippedRobot};
+use emg_verify::ReferenceModel;
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A drawing of `../shared/cases/`.
+fn case(name: &str) -> PathBuf {
+    workspace().join("../shared/cases").join(name)
+}
+
+/// A shipped arm's planner as `emg job` builds it, its timing and its checker.
+fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
+    let data = DataDir::new(workspace().join("data"));
+    let shipped = ShippedRobot::by_name(name).expect("a shipped robot");
+    let file = shipped.path(&data);
+    let robot = Robot::from_chain_file(&file).expect("robot loads");
+    let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
+        .expect("checker loads");
+    let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
+    let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
+    let timing = emg_job::job_timing(&robot, &file, &config).expect("timing");
+    let planner = Planner::new(robot, models, config).expect("planner");
+    (planner, timing, checker, file)
+}
+
+/// `drawing` placed as `placement` says, planned on `robot` as `emg job` plans it.
+fn planned(
+    robot: &str,
+    drawing: &str,
+    placement: &Placement,
+) -> (JobFile, Planner, ReferenceModel) {
+    let (planner, timing, checker, file) = setup(robot);
+    let strokes = read_svg_file(&case(drawing), placement, &SvgOptions::default())
+        .expect("the drawing")
+        .strokes;
+    let job = Job::from_strokes(strokes, planner.robot()).expect("a valid job");
+    let program = plan_job(
+        &planner,
+        &PlanRequest::default(),
+        &job,
+        &timing,
+        &file.display().to_string(),
+        &|_, _| {},
+    )
+    .expect("the job plans");
+    (program, planner, checker)
+}
+
+/// The program's claims equal what the checker measures of its samples.
+fn claims_are_measured(program: &JobFile, planner: &Planner, checker: &ReferenceModel) {
+    let check = verify_job(program, checker, planner.robot().joint_names())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let summary = &program.summary;
+    assert!(
+        (check.drawn_m - summary.drawn_m).abs() < 1e-6,
+        "the samples draw {} m, the program claims {} m",
+        check.drawn_m,
+        summary.drawn_m
+    );
+    assert_eq!(check.whole_strokes, summary.complete + summary.resumed);
+    for stroke in &program.strokes {
+        // Gaps shorter than the slack are neither drawn nor listed: one at each end of a part.
+        let undrawn: f64 = stroke.unreached.iter().map(|u| u.to_s - u.from_s).sum();
+        let slack = emg_job::COVERAGE_SLACK_M * (2 * stroke.parts) as f64 + 1e-6;
+        assert!(
+            (stroke.drawn_m + undrawn - stroke.length_m).abs() < slack,
+            "stroke {}: {} m drawn and {undrawn} m unreached of {} m",
+            stroke.stroke,
+            stroke.drawn_m,
+            stroke.length_m
+        );
+    }
+}
+
+#[test]
+fn a_small_closed_circle_is_drawn_round_not_claimed_at_a_standstill() {
+    let placement = Placement {
+        origin_m: [0.45, 0.25, 0.25],
+        ..Placement::default()
+    };
+    let (program, planner, checker) = planned("fr3", "small-circle.svg", &placement);
+    claims_are_measured(&program, &planner, &checker);
+    let speed = planner.config().rollout.speed_m_per_s;
+    for report in &program.strokes {
+        // Each stroke is drawn at no more than the tool's speed: its segments last at least its
+        // length drawn over that speed.
+        let pen_down_s: f64 = program
+            .segments
+            .iter()
+            .filter(
+                |s| matches!(s.kind, SegmentKind::Stroke { stroke, .. } if stroke == report.stroke),
+            )
+            .map(|s| s.end_s - s.start_s)
+            .sum();
+        assert!(
+            pen_down_s >= report.drawn_m / speed,
+            "stroke {}: {} m drawn in {pen_down_s} s",
+            report.stroke,
+            report.drawn_m
+        );
+    }
+    // The circle (the shorter stroke, 47 mm round) is drawn whole.
+    let circle = program
+        .strokes
+        .iter()
+        .min_by(|a, b| a.length_m.total_cmp(&b.length_m))
+        .expect("two strokes");
+    assert!(
+        (circle.length_m - 0.0471).abs() < 1e-3,
+        "{}",
+        circle.length_m
+    );
+    assert!(circle.unreached.is_empty() && circle.drawn_m > circle.length_m - 1e-3);
+}
+
+#[test]
+fn the_ur5e_house_is_drawn_whole_as_it_claims() {
+    let (program, planner, checker) = planned("ur5e", "house.svg", &Placement::default());
+    claims_are_measured(&program, &planner, &checker);
+    // The walls (the longest stroke) were once claimed whole with a sixth of them drawn.
+    let walls = program
+        .strokes
+        .iter()
+        .max_by(|a, b| a.length_m.total_cmp(&b.length_m))
+        .expect("strokes");
+    assert!(
+        walls.unreached.is_empty() && walls.drawn_m > walls.length_m - 1e-3,
+        "{walls:?}"
+    );
+}
+
+#[test]
+fn a_job_left_short_lists_what_it_misses_and_inflated_claims_are_refused() {
+    // The house twice its size, far out on the UR5e's right: a stroke out of reach.
+    let placement = Placement {
+        origin_m: [0.8, 0.2, 0.2],
+        width_m: Some(0.4),
+        ..Placement::default()
+    };
+    let (program, planner, checker) = planned("ur5e", "house.svg", &placement);
+    claims_are_measured(&program, &planner, &checker);
+    let short = program
+        .strokes
+        .iter()
+        .position(|s| !s.unreached.is_empty())
+        .expect("a stroke left short");
+    assert!(program.summary.short >= 1);
+    let joints = planner.robot().joint_names();
+    let refused = |edited: &JobFile| verify_job(edited, &checker, joints).unwrap_err();
+
+    // A stroke claiming a millimetre more than its samples draw.
+    let mut inflated = program.clone();
+    inflated.strokes[short].drawn_m += 1e-3;
+    let error = refused(&inflated);
+    assert!(
+        matches!(&error, JobCheckError::Claim { stroke, .. } if *stroke == program.strokes[short].stroke),
+        "{error}"
+    );
+    assert!(
+        error.to_string().contains("m drawn; its samples draw"),
+        "{error}"
+    );
+    // A stroke whose undrawn stretch is not listed.
+    let mut hidden = program.clone();
+    hidden.strokes[short].unreached.clear();
+    hidden.strokes[short].unreached_at.clear();
+    let error = refused(&hidden);
+    assert!(
+        error.to_string().contains("not listed as unreached"),
+        "{error}"
+    );
+    // A summary counting one more stroke whole, or claiming more length.
+    let mut counted = program.clone();
+    counted.summary.complete += 1;
+    counted.summary.short -= 1;
+    assert!(matches!(refused(&counted), JobCheckError::Summary(_)));
+    let mut longer = program.clone();
+    longer.summary.drawn_m += 0.01;
+    assert!(matches!(refused(&longer), JobCheckError::Summary(_)));
+    // A stroke claiming a longer path than the one it carries.
+    let mut stretched = program.clone();
+    stretched.strokes[1].length_m += 0.01;
+    assert!(refused(&stretched).to_string().contains("claims a length"));
+    // A stroke part said to start elsewhere along its stroke.
+    let mut shifted = program.clone();
+    let part = shifted
+        .segments
+        .iter_mut()
+        .find_map(|s| match &mut s.kind {
+            SegmentKind::Stroke { from_s, .. } => Some(from_s),
+            _ => None,
+        })
+        .expect("a stroke part");
+    *part += 0.005;
+    let error = refused(&shifted);
+    assert!(
+        error.to_string().contains("is not the stroke's stretch"),
+        "{error}"
+    );
+}
