@@ -91,3 +91,79 @@ fn wrong_jobs_are_refused_and_nothing_is_written() {
         "place an SVG drawing",
     );
 }
+
+#[test]
+fn tolerance_and_cone_take_negative_values_and_refuse_them_in_their_unit() {
+    let seams = examples().join("seams.json");
+    let seams = seams.to_str().unwrap();
+    for command in [&["plan"][..], &["job", seams], &["place", seams]] {
+        for (option, expected) in [
+            (&["--tolerance", "-1"][..], "must be > 0 mm, got -1"),
+            (&["--tolerance=-0.5"][..], "must be > 0 mm, got -0.5"),
+            (&["--cone", "95"][..], "must be in (0, 90)°, got 95"),
+        ] {
+            let output = emg(&[command, option].concat());
+            let stderr = text(&output.stderr);
+            assert!(
+                !output.status.success()
+                    && stderr.contains(&format!("'{}", option[0].split('=').next().unwrap()))
+                    && stderr.contains(expected),
+                "{command:?} {option:?}: {stderr}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_path_file_is_a_job_of_one_stroke_and_an_svg_keeps_its_physical_size() {
+    let dir = temp_dir("job-path-file");
+    // Missing parent directories of --out are created.
+    let out = dir.path().join("new/sub/slot.job.json");
+    let slot = examples().join("slot.json");
+    let output = emg(&[
+        "job",
+        slot.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    assert!(stdout.starts_with("1 stroke: "), "{stdout}");
+    assert_eq!(read_json(&out)["strokes"].as_array().unwrap().len(), 1);
+
+    // 100 mm wide, a line of 80 of its 100 units.
+    let svg = dir.path().join("ruler.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="50mm" viewBox="0 0 100 50">
+           <path d="M 10 25 L 90 25" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let total = |extra: &[&str]| {
+        let out = dir.path().join("ruler.job.json");
+        let mut args = vec!["job", svg.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let output = emg(&args);
+        assert!(output.status.success(), "{}", text(&output.stderr));
+        read_json(&out)["summary"]["total_m"].as_f64().unwrap()
+    };
+    // usvg reads the drawing in single precision: within a micrometre.
+    assert!((total(&["--scale", "physical"]) - 0.08).abs() < 1e-6);
+    // A scale is metres per CSS pixel (96 to the inch) of the drawing's own size.
+    let pixels = 0.08 / (0.0254 / 96.0);
+    assert!((total(&["--scale", "5e-4"]) - pixels * 5e-4).abs() < 1e-6);
+    assert!((total(&[]) - 0.2).abs() < 1e-6, "the default width");
+    let both = emg(&[
+        "job",
+        svg.to_str().unwrap(),
+        "--scale",
+        "physical",
+        "--width",
+        "0.1",
+    ]);
+    assert!(
+        text(&both.stderr).contains("--width"),
+        "{}",
+        text(&both.stderr)
+    );
+}

@@ -27,6 +27,64 @@ fn drawn(program: &serde_json::Value) -> (f64, f64) {
     )
 }
 
+/// The six numbers of the `translation_m [...], rpy [...]` line `emg place` prints for the
+/// job's transform.
+fn printed_transform(stdout: &str) -> Vec<f64> {
+    let line = stdout
+        .lines()
+        .find(|line| line.contains("the job's transform"))
+        .unwrap_or_else(|| panic!("no transform printed:\n{stdout}"));
+    line.split(['[', ']'])
+        .skip(1)
+        .step_by(2)
+        .flat_map(|list| list.split(", ").map(|x| x.parse::<f64>().unwrap()))
+        .collect()
+}
+
+#[test]
+fn a_closed_standard_output_stops_no_file_being_written() {
+    let dir = temp_dir("place-pipe");
+    let file = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let seams = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/seams.json");
+    let (placed, job_out) = (file("placed.json"), file("placed-job.json"));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args([
+            "place",
+            seams.to_str().unwrap(),
+            "--x=-0.02,0.02",
+            "--y=-0.02,0.02",
+            "--rotation=-5,5",
+            "--positions",
+            "2",
+            "--rotations",
+            "2",
+            "--certify",
+            "1",
+            "--out",
+            &placed,
+            "--job-out",
+            &job_out,
+            "--export",
+            "ros2-mcap",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The reader goes before anything is printed, as `| head` does after its lines.
+    drop(child.stdout.take());
+    let output = child.wait_with_output().unwrap();
+    let stderr = text(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for path in [&placed, &job_out, &file("placed.mcap")] {
+        assert!(
+            Path::new(path).is_file(),
+            "{path} was not written: {stderr}"
+        );
+    }
+}
+
 #[test]
 fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let dir = temp_dir("place");
@@ -71,6 +129,15 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     assert!(output.status.success(), "{}", text(&output.stderr));
     let stdout = text(&output.stdout);
     assert!(stdout.contains("screened 18 places"), "{stdout}");
+    // The transform printed is the one written, to the last bit.
+    let printed = printed_transform(&stdout);
+    let transform = &read_json(Path::new(&export))["transform"];
+    let written: Vec<f64> = ["translation_m", "rpy"]
+        .iter()
+        .flat_map(|key| transform[key].as_array().unwrap().clone())
+        .map(|value| value.as_f64().unwrap())
+        .collect();
+    assert_eq!(printed, written, "{stdout}");
     let (placed_drawn, placed_total) = drawn(&read_json(Path::new(&placed)));
     assert!((placed_total - total).abs() < 1e-9);
     assert!(

@@ -10,7 +10,7 @@ use emg_kinematics::{JointVector, Robot};
 use emg_verify::ReferenceModel;
 use serde_json::Value;
 
-use common::{NO_WEIGHTS, emg, read, read_json, task_json, temp_dir, text};
+use common::{NO_WEIGHTS, data_dir, emg, read, read_json, task_json, temp_dir, text};
 
 fn stderr(output: &Output) -> String {
     text(&output.stderr)
@@ -68,7 +68,12 @@ fn demo_task_writes_documented_json_and_csv() {
         "the default controller is the hybrid"
     );
     assert_eq!(doc["joint_names"].as_array().unwrap().len(), 7);
-    assert!(doc["robot"].as_str().unwrap().ends_with("fr3_pen.urdf"));
+    assert!(
+        doc["robot"]
+            .as_str()
+            .unwrap()
+            .starts_with("shipped:fr3@sha256:")
+    );
     for field in ["p0", "d", "n", "q0_seed"] {
         assert!(doc["task"][field].is_array(), "task.{field}");
     }
@@ -447,8 +452,12 @@ fn robot_by_name_and_by_file() {
         stem.to_str().unwrap(),
     ]);
     let doc = read_json(&dir.join("iiwa.json"));
-    let robot_path = PathBuf::from(doc["robot"].as_str().unwrap());
-    assert!(robot_path.ends_with("iiwa14_pen.urdf"), "{robot_path:?}");
+    let reference = doc["robot"].as_str().unwrap();
+    assert!(
+        reference.starts_with("shipped:iiwa14@sha256:"),
+        "{reference}"
+    );
+    let robot_path = data_dir().join("robots/iiwa14_pen.urdf");
     assert_eq!(doc["joint_names"][6], "iiwa_joint_7");
     assert!(doc["path_length_m"].as_f64().unwrap() > 0.1, "{doc}");
     let robot = Robot::from_chain_file(&robot_path).unwrap();
@@ -847,7 +856,7 @@ fn tolerance_and_cone_are_options_every_file_records() {
     let error = stderr(&refused);
     assert_eq!(refused.status.code(), Some(2), "a usage error: {error}");
     assert!(
-        error.contains("--tolerance") && error.contains("positive"),
+        error.contains("--tolerance") && error.contains("must be > 0 mm, got 0"),
         "{error}"
     );
 }
