@@ -54,6 +54,16 @@ pub struct JobInput {
     /// drawing and between strokes.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
+    /// The arm's home (rad, one value per joint, comma-separated): the program starts and ends
+    /// there, through checked free moves. Default: the job file's `home`, else the shipped
+    /// arm's (docs/jobs.md#home); a robot file with neither starts above its first stroke.
+    #[arg(
+        long,
+        value_name = "Q,Q,…",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub home: Option<Vec<f64>>,
 }
 
 /// Options of `emg job`.
@@ -103,7 +113,18 @@ impl JobInput {
     /// The job read and its planner set up.
     pub fn ready(&self) -> Result<Ready> {
         let robot = robot::load_robot(&self.robot, None, None)?;
-        let job = read_job(self, &robot)?;
+        let mut job = read_job(self, &robot)?;
+        let shipped_home = robot::shipped(&self.robot).map(|shipped| shipped.home);
+        match (&self.home, shipped_home) {
+            (Some(values), _) => {
+                job = job.with_home(values, &robot).map_err(|e| match e {
+                    emg_job::JobError::Home(problem) => anyhow::anyhow!("--home {problem}"),
+                    other => other.into(),
+                })?;
+            }
+            (None, Some(values)) if job.home.is_none() => job = job.with_home(values, &robot)?,
+            _ => {}
+        }
         let mut config = emg_job::job_config(self.tolerance * 1e-3);
         config.rollout.constraints.theta_max_deg = self.cone;
         if let Some(path) = &self.scene {
@@ -233,7 +254,12 @@ pub fn print_summary(file: &emg_job::JobFile) {
             );
         }
     }
-    if !s.ends_at_home {
+    if file.home.is_none() {
+        println!(
+            "  the robot has no home: the program starts above its first stroke and ends above \
+             its last (give --home)"
+        );
+    } else if !s.ends_at_home {
         println!(
             "  no free move back to the job's home was found: the program ends above its last stroke"
         );

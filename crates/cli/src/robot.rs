@@ -80,6 +80,11 @@ pub fn load_checker(path: &Path, robot: &Robot) -> Result<ReferenceModel> {
         .with_context(|| format!("the checker cannot load robot {}", path.display()))
 }
 
+/// The shipped robot whose file `robot` is, if it is one.
+pub fn shipped(robot: &Path) -> Option<emg_planner::ShippedRobot> {
+    emg_planner::ShippedRobot::by_path(robot, &data_dir())
+}
+
 /// Whether `robot` is one of the shipped robots' files.
 pub fn is_shipped(robot: &Path) -> bool {
     let data = data_dir();

@@ -165,6 +165,8 @@ pub fn plan_job(
                 .map(|[_, above]| above)
                 .or(program.last())
                 .or(job.home);
+            // Each joint among its whole turns nearest the home (else where the arm is).
+            let planned = turned_toward(planned, job.home.or(from).as_ref(), robot);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
             // The part planned again from the configuration the arm is in, moved above the
             // part's start and set down there: taken first where it draws as far from a start
@@ -273,7 +275,7 @@ pub fn plan_job(
             settings.rrt_max_samples,
         )
     });
-    let ends_at_home = job.home.is_none() || home_travel.is_some();
+    let ends_at_home = home_travel.is_some();
     connector.join(
         &mut program,
         retreat.take(),
@@ -306,6 +308,7 @@ pub fn plan_job(
         constraints: constraints.clone(),
         limits: timing.record(),
         settings: settings.clone(),
+        home: job.home.map(|home| home.as_slice()[..dof].to_vec()),
         ordering,
         strokes: reports,
         summary,
@@ -313,6 +316,25 @@ pub fn plan_job(
         segments: program.segments().to_vec(),
         points: program.points(dof).ok_or(JobPlanError::TooLong)?,
     })
+}
+
+/// `part` with each joint of its motion turned by whole turns toward `reference`
+/// ([`emg_kinematics::JointLimits::turns_toward`]): the same motion of the arm, its joint values
+/// nearest the reference within the limits.
+fn turned_toward(
+    mut part: StrokePart,
+    reference: Option<&JointVector>,
+    robot: &emg_kinematics::Robot,
+) -> StrokePart {
+    let Some(reference) = reference else {
+        return part;
+    };
+    let motion: Vec<JointVector> = part.trajectory.steps.iter().map(|step| step.q).collect();
+    let turns = robot.limits().turns_toward(&motion, reference);
+    for step in &mut part.trajectory.steps {
+        step.q += turns;
+    }
+    part
 }
 
 /// How far before a pen-up move's corner its rounding starts: this share of the shorter of the

@@ -113,8 +113,8 @@ pub struct JobSummary {
     pub searches: usize,
     /// See `searches`.
     pub planning_s: f64,
-    /// Whether the program ends at the job's home (always, without one); false where no free
-    /// move back to it was found.
+    /// Whether the program ends at the job's home: false where the job has none, or where no
+    /// free move back to it was found.
     pub ends_at_home: bool,
 }
 
@@ -133,6 +133,10 @@ pub struct JobFile {
     pub limits: TimingLimits,
     /// The job's settings.
     pub settings: JobSettings,
+    /// The home configuration the program starts at and, where `summary.ends_at_home`, ends at
+    /// (rad, one value per joint); none where the job has no home, and the program starts above
+    /// its first stroke.
+    pub home: Option<Vec<f64>>,
     /// The drawing order.
     pub ordering: Ordering,
     /// Every stroke's outcome, in drawing order.

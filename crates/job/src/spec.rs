@@ -227,6 +227,14 @@ impl Job {
         )
     }
 
+    /// The job with its home at `values` (rad, one per joint, within the limits).
+    pub fn with_home(self, values: &[f64], robot: &Robot) -> Result<Self, JobError> {
+        Ok(Self {
+            home: Some(home(robot, values)?),
+            ..self
+        })
+    }
+
     /// The job with every stroke moved rigidly by `motion`.
     pub fn moved(&self, motion: &Isometry3<f64>) -> Result<Self, JobError> {
         let strokes = self

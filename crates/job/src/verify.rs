@@ -193,6 +193,7 @@ pub fn verify_job(
         check.total_m += report.length_m;
     }
     verify_summary(file)?;
+    verify_home(file)?;
     Ok(check)
 }
 
@@ -276,6 +277,31 @@ fn verify_claims(report: &StrokeReport, covered: &[Stretch]) -> Result<Coverage,
         )));
     }
     Ok(measured)
+}
+
+/// Checks that the program starts at its home, and ends there where it says it does.
+fn verify_home(file: &JobFile) -> Result<(), JobCheckError> {
+    let at = |point: Option<&emg_io::JointTrajectoryPoint>, home: &[f64]| {
+        point.is_some_and(|p| {
+            p.positions.len() == home.len()
+                && p.positions
+                    .iter()
+                    .zip(home)
+                    .all(|(q, h)| (q - h).abs() <= 1e-9)
+        })
+    };
+    match &file.home {
+        Some(home) if !at(file.points.first(), home) => Err(JobCheckError::Summary(format!(
+            "the program does not start at its home {home:?}"
+        ))),
+        Some(home) if file.summary.ends_at_home && !at(file.points.last(), home) => Err(
+            JobCheckError::Summary(format!("the program does not end at its home {home:?}")),
+        ),
+        None if file.summary.ends_at_home => Err(JobCheckError::Summary(
+            "says the program ends at its home, but it has none".to_string(),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// Checks that the summary's totals and counts are the strokes' claims.

@@ -184,6 +184,34 @@ impl JointLimits {
     pub fn clamp(&self, q: &JointVector) -> JointVector {
         q.zip_zip_map(&self.lower, &self.upper, |v, lo, hi| v.clamp(lo, hi))
     }
+
+    /// The whole turns (multiples of 2π, per joint) that bring `motion`'s first configuration
+    /// nearest `reference` while every configuration of `motion`, each turned alike, stays within
+    /// the limits. A revolute joint turned by 2π stands where it stood, so the turned motion
+    /// moves the arm exactly as `motion` does; each joint ends within ±π of `reference` where its
+    /// limits allow. Zero for joints whose range leaves no other choice, and for an empty motion.
+    pub fn turns_toward(&self, motion: &[JointVector], reference: &JointVector) -> JointVector {
+        let Some(first) = motion.first() else {
+            return JointVector::zeros();
+        };
+        let turn = std::f64::consts::TAU;
+        JointVector::from_fn(|i, _| {
+            let (least, greatest) = motion
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                    (lo.min(q[i]), hi.max(q[i]))
+                });
+            // Turns that keep the whole motion within the limits, the nearest to the reference.
+            let fewest = ((self.lower[i] - least) / turn).ceil();
+            let most = ((self.upper[i] - greatest) / turn).floor();
+            let wanted = ((reference[i] - first[i]) / turn).round();
+            if fewest > most {
+                0.0
+            } else {
+                wanted.clamp(fewest, most) * turn
+            }
+        })
+    }
 }
 
 /// Fixed transform of one revolute joint, expressed so that the joint turns about its local +z.

@@ -4,6 +4,7 @@
 //! `data/` next to its workspace, or the `EMG_DATA` directory when that variable is set) and
 //! hands it over as a [`DataDir`].
 
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4};
 use std::path::{Path, PathBuf};
 
 /// The directory of the shipped data: `robots/`, and per robot its `tasks/`, `labels/` and
@@ -40,12 +41,15 @@ impl DataDir {
 
 /// A robot file shipped in `robots/` of the data directory, with the sub-directory that holds
 /// its task sets, labels and models.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShippedRobot {
     /// Selection name (`--robot fr3`).
     pub name: &'static str,
     file: &'static str,
     data_subdir: &'static str,
+    /// The vendor's home or ready pose (rad, one value per joint, base to tip): where a job's
+    /// program starts and ends unless it is given another home.
+    pub home: &'static [f64],
 }
 
 /// The shipped robots: the paper's Franka FR3 (whose data keep the top level of the data
@@ -56,16 +60,33 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
         name: "fr3",
         file: "fr3_pen.urdf",
         data_subdir: "",
+        // Franka's "ready" pose: (0, −π/4, 0, −3π/4, 0, π/2, π/4), the start of franka_ros's
+        // and franka_ros2's controllers and the `ready` state of the Franka MoveIt configuration.
+        home: &[
+            0.0,
+            -FRAC_PI_4,
+            0.0,
+            -3.0 * FRAC_PI_4,
+            0.0,
+            FRAC_PI_2,
+            FRAC_PI_4,
+        ],
     },
     ShippedRobot {
         name: "iiwa14",
         file: "iiwa14_pen.urdf",
         data_subdir: "iiwa14",
+        // KUKA's home position of the LBR iiwa: every axis at zero, the arm upright (the
+        // "candle" pose Sunrise's HOME frame holds by default).
+        home: &[0.0; 7],
     },
     ShippedRobot {
         name: "ur5e",
         file: "ur5e_pen.urdf",
         data_subdir: "ur5e",
+        // Universal Robots' default Home position in PolyScope: the arm upright, shoulder lift
+        // and wrist 1 at −π/2, every other joint at zero.
+        home: &[0.0, -FRAC_PI_2, 0.0, -FRAC_PI_2, 0.0, 0.0],
     },
 ];
 
