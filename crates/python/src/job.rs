@@ -174,7 +174,7 @@ impl JobPlan {
             let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
             let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
             match segment.kind {
-                emg_job::SegmentKind::Stroke { stroke, part } => {
+                emg_job::SegmentKind::Stroke { stroke, part, .. } => {
                     dict.set_item("kind", "stroke")?;
                     dict.set_item("stroke", stroke)?;
                     dict.set_item("part", part)?;
