@@ -263,7 +263,7 @@ def load_tasks(path: PathLike, robot: PathLike = "fr3") -> list[Task]:
     """The tasks of a task file (JSON or EMGTASKS), validated for ``robot``."""
 
 class JobCheckReport:
-    """What the independent checker verified on a job's program (emg-job/1) that holds up."""
+    """What the independent checker verified on a job's program that holds up."""
 
     layout: str
     robot: Path

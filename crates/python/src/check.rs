@@ -55,11 +55,11 @@ impl CheckReport {
     }
 }
 
-/// What the independent checker verified on a job's program (`emg-job/1`) that holds up, as
-/// `emg check` reports it.
+/// What the independent checker verified on a job's program that holds up, as `emg check`
+/// reports it.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]
 pub struct JobCheckReport {
-    /// Always `emg-job/1`.
+    /// The program's format (`emg_job::JOB_FILE_FORMAT`).
     layout: &'static str,
     /// The robot file it was checked with.
     robot: PathBuf,
@@ -84,7 +84,7 @@ impl JobCheckReport {
 /// Verifies a file written by `Plan.save`, `JobPlan.write`, `emg plan` or `emg job` with the
 /// independent checker, as `emg check` does: a trajectory file (either JSON layout, or the CSV
 /// with the JSON of the same stem beside it) against the task, constraints and robot it
-/// carries, returning a `CheckReport`; or a job's program (`emg-job/1`) segment by segment,
+/// carries, returning a `CheckReport`; or a job's program segment by segment,
 /// returning a `JobCheckReport`. `robot` overrides the robot the file names (a shipped robot's
 /// name or a robot file). Raises `CheckFailed` naming the first failing point or segment and
 /// the constraint.

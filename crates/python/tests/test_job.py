@@ -75,7 +75,7 @@ def test_check_reads_a_program_as_the_cli_does_from_any_directory(tmp_path, job_
     monkeypatch.chdir(tmp_path)
     report = elm.check(program)
     assert isinstance(report, elm.JobCheckReport)
-    assert report.layout == "emg-job/1"
+    assert report.layout == json.loads(program.read_text())["format"]
     assert report.stroke_parts >= 3 and report.moves >= 2 and report.points > 100
     assert "OK" in run_cli("check", program).stdout
     # A program one of whose stroke samples is moved off its path is refused, as by the CLI.
