@@ -21,6 +21,33 @@ pub fn limits_file_beside(robot: &Path) -> PathBuf {
     robot.with_file_name(format!("{stem}.joint_limits.yaml"))
 }
 
+/// The path of `file` relative to the directory of `anchor` (both after resolving links and
+/// `..` in their directories; `fr3_pen.joint_limits.yaml` for a file beside `anchor`,
+/// `../limits/arm.yaml` for one in a sibling directory); `file` as given where either directory
+/// cannot be resolved or no relative path joins them (another drive).
+fn relative_to_directory_of(file: &Path, anchor: &Path) -> String {
+    let directory = |path: &Path| match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent.canonicalize(),
+        _ => Path::new(".").canonicalize(),
+    };
+    let (Some(name), Ok(from), Ok(to)) = (file.file_name(), directory(anchor), directory(file))
+    else {
+        return file.display().to_string();
+    };
+    let shared = from
+        .components()
+        .zip(to.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    if shared == 0 {
+        return file.display().to_string();
+    }
+    let mut relative: PathBuf = from.components().skip(shared).map(|_| "..").collect();
+    relative.extend(to.components().skip(shared));
+    relative.push(name);
+    relative.display().to_string()
+}
+
 /// Why timing could not be set up: the limits file, or a request value.
 #[derive(Debug, thiserror::Error)]
 pub enum TimingSetupError {
@@ -35,6 +62,7 @@ pub enum TimingSetupError {
 /// Everything a plan's timing needs, resolved once for a robot.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MotionTiming {
+    /// How [`MotionTiming::record`] names the limits' file.
     limits_file: String,
     assumed: bool,
     /// The arm's joints (the entries of the limits a file records).
@@ -51,7 +79,9 @@ impl MotionTiming {
     /// of `limits` (a MoveIt joint_limits.yaml), else of the one beside the robot file
     /// ([`limits_file_beside`]), else assumed ([`DynamicLimits::assumed`]: the robot file's
     /// velocities with conservative acceleration and jerk limits; [`MotionTiming::assumed`]
-    /// says so).
+    /// says so). Its record names the limits file by its path relative to the robot file's
+    /// directory (`fr3_pen.joint_limits.yaml` for the one beside it): the files written name
+    /// no directory of this machine.
     pub fn for_robot_file(
         robot: &Robot,
         robot_file: &Path,
@@ -85,12 +115,16 @@ impl MotionTiming {
             constraints,
         )?;
         timing.assumed = assumed;
+        if !assumed {
+            timing.limits_file = relative_to_directory_of(origin, robot_file);
+        }
         Ok(timing)
     }
 
     /// Timing for `robot` with the limits of `limits_file` scaled by `scaling`, each velocity
     /// limit at most the robot file's times `constraints.velocity_limit_fraction` (the bound
     /// every planned step holds), the tool at most `tool_speed_m_per_s`, sampled at `rate_hz`.
+    /// Its record names the limits file by its path as given.
     pub fn new(
         robot: &Robot,
         limits_file: &Path,
@@ -181,5 +215,89 @@ impl MotionTiming {
             max_acceleration: joints(&limits.acceleration),
             max_jerk: joints(&limits.jerk),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The timing `for_robot_file` sets up for the FR3 read from `robot_file`, with `limits`.
+    fn timing(robot_file: &Path, limits: Option<&Path>) -> MotionTiming {
+        let robot = crate::test_support::fr3();
+        MotionTiming::for_robot_file(
+            &robot,
+            robot_file,
+            limits,
+            Scaling::default(),
+            0.1,
+            DEFAULT_RATE_HZ,
+            &ConstraintConfig::default(),
+        )
+        .expect("the timing")
+    }
+
+    #[test]
+    fn the_record_names_the_limits_file_from_the_robot_files_directory() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data");
+        let shipped = data.join("robots/fr3_pen.urdf");
+        let beside = "fr3_pen.joint_limits.yaml";
+        // The file beside the robot file by its name, however the robot file is given.
+        for robot_file in [
+            shipped.clone(),
+            shipped.canonicalize().unwrap(),
+            PathBuf::from("../../data/robots/fr3_pen.urdf"),
+        ] {
+            let record = timing(&robot_file, None).record();
+            assert_eq!(record.joint_limits_file, beside, "{}", robot_file.display());
+        }
+        // A file given elsewhere by its path from the robot file's directory.
+        let dir = tempfile::tempdir().unwrap();
+        let (robots, limits) = (dir.path().join("robots"), dir.path().join("limits"));
+        std::fs::create_dir_all(&robots).unwrap();
+        std::fs::create_dir_all(&limits).unwrap();
+        let given = limits.join("arm.yaml");
+        std::fs::copy(data.join("robots").join(beside), &given).unwrap();
+        let robot_file = robots.join("arm.urdf");
+        let elsewhere = timing(&robot_file, Some(&given));
+        assert!(!elsewhere.assumed());
+        let recorded = elsewhere.record().joint_limits_file;
+        assert_eq!(
+            recorded,
+            Path::new("..")
+                .join("limits/arm.yaml")
+                .display()
+                .to_string()
+        );
+        assert_eq!(
+            robots.join(&recorded).canonicalize().unwrap(),
+            given.canonicalize().unwrap()
+        );
+        // None found: assumed.
+        let assumed = timing(&robot_file, None);
+        assert!(assumed.assumed());
+        assert_eq!(assumed.record().joint_limits_file, ASSUMED_LIMITS);
+    }
+
+    #[test]
+    fn a_file_beside_its_anchor_is_named_by_its_name_and_a_bare_name_from_here() {
+        assert_eq!(
+            relative_to_directory_of(Path::new("a.yaml"), Path::new("arm.urdf")),
+            "a.yaml"
+        );
+        assert_eq!(
+            relative_to_directory_of(Path::new("src/a.yaml"), Path::new("arm.urdf")),
+            Path::new("src/a.yaml").display().to_string()
+        );
+        assert_eq!(
+            relative_to_directory_of(Path::new("a.yaml"), Path::new("src/arm.urdf")),
+            Path::new("../a.yaml").display().to_string()
+        );
+        // A directory that does not exist cannot be resolved: the path as given.
+        let missing = Path::new("/no/such/directory/a.yaml");
+        assert_eq!(
+            relative_to_directory_of(missing, Path::new("arm.urdf")),
+            missing.display().to_string()
+        );
     }
 }
