@@ -56,6 +56,10 @@ class Robot:
     @property
     def velocity_limits(self) -> FloatArray:
         """Joint velocity limits (rad/s), shape (n,)."""
+    @property
+    def home(self) -> Optional[FloatArray]:
+        """A shipped arm's home (rad), shape (n,), where a job's program starts and ends unless
+        given another; None for another robot file."""
     def fk(self, q: JointAngles) -> FloatArray:
         """The tool-centre-point pose at ``q`` as a 4x4 homogeneous transform (base frame)."""
     def jacobian(self, q: JointAngles) -> FloatArray:
@@ -188,6 +192,56 @@ class Motion:
     def tool_speed(self) -> float:
         """The largest tool speed asked for (m/s)."""
 
+class JobPlan:
+    """A job's program (docs/jobs.md); arrays have one row per sample at 1 kHz."""
+
+    @property
+    def summary(self) -> dict:
+        """The totals ``emg job`` prints (``drawn_m``, ``total_m``, ``duration_s``,
+        ``ends_at_home``, ...)."""
+    @property
+    def strokes(self) -> list[dict]:
+        """Every stroke's outcome in drawing order, as the program file's."""
+    @property
+    def segments(self) -> list[dict]:
+        """The segments in time order: ``kind``, ``stroke`` and ``part`` for a stroke,
+        ``start_s``, ``end_s``, and the samples as arrays ``time_s`` and ``q``."""
+    @property
+    def time_s(self) -> FloatArray:
+        """Time of every sample (s), shape (N,)."""
+    @property
+    def q(self) -> FloatArray:
+        """Joint positions (rad), shape (N, n)."""
+    @property
+    def qd(self) -> FloatArray:
+        """Joint velocities (rad/s), shape (N, n)."""
+    @property
+    def qdd(self) -> FloatArray:
+        """Joint accelerations (rad/s²), shape (N, n)."""
+    def write(self, path: PathLike) -> None:
+        """Writes the program file ``emg check`` verifies."""
+
+class JobPlacement:
+    """Where to put a job's part (docs/placement.md)."""
+
+    @property
+    def certified(self) -> list[dict]:
+        """The places planned as full jobs, best first; the first is the chosen place."""
+    @property
+    def screened(self) -> list[dict]:
+        """Every screened place in grid order."""
+    @property
+    def base_pose(self) -> Optional[dict]:
+        """Moving the base: its new pose (``translation_m``, ``rpy``); else None."""
+    @property
+    def transform(self) -> dict:
+        """The chosen place as a job file's ``transform`` (``translation_m``, ``rpy``)."""
+    @property
+    def program(self) -> JobPlan:
+        """The program planned at the chosen place."""
+    def map_svg(self) -> str:
+        """The heat map as SVG text (what ``emg place --map`` writes)."""
+
 SeedArg = Union[Literal["dp", "generating", "home", "q_mu", "q_jl"], JointAngles, None]
 ControllerArg = Literal["hybrid", "rl", "classical"]
 PlannerArg = Optional[Literal["controller", "search"]]
@@ -240,6 +294,29 @@ class Planner:
         reach: bool = True,
     ) -> list[Plan]:
         """Plans every task in parallel with the GIL released; plans come in task order."""
+    def plan_job(
+        self,
+        job: Union[PathLike, dict],
+        placement: Optional[dict] = None,
+        tolerance_mm: float = 0.5,
+        home: Optional[JointAngles] = None,
+    ) -> JobPlan:
+        """Plans a job (a job file, an SVG drawing placed by ``placement``, or a dict in the job
+        file's layout) as ``emg job`` does; the program starts and ends at ``home``, by default
+        the job's, else the shipped arm's (``Robot.home``)."""
+    def place_job(
+        self,
+        job: Union[PathLike, dict],
+        region: dict,
+        placement: Optional[dict] = None,
+        tolerance_mm: float = 0.5,
+        positions: int = 10,
+        rotations: int = 5,
+        certify: int = 5,
+        score: Literal["bound", "point_ik"] = "bound",
+        home: Optional[JointAngles] = None,
+    ) -> JobPlacement:
+        """Finds where to put a job's part as ``emg place`` does; ``home`` as for ``plan_job``."""
     def reach(self, p0: Vector3, d: Vector3, n: Vector3) -> float:
         """The task's reachability bound (m)."""
 

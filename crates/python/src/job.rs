@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use emg_job::{Job, JobFile};
+use emg_job::{Job, JobError, JobFile};
 use emg_planner::{DEFAULT_RATE_HZ, PlanRequest};
 use emg_timing::Scaling;
 use numpy::ndarray::Array2;
@@ -63,6 +63,35 @@ pub(crate) fn read_job(
     let text = std::fs::read_to_string(&path)
         .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
     Job::from_json(&path.display().to_string(), &text, robot).map_err(|e| invalid(&e))
+}
+
+/// `job` with the home its program starts and ends at, as `emg job --home` sets it: `home`
+/// when given (a sequence of floats, rad, one per joint, within the limits; else `InputError`
+/// naming `home`), else the job's own, else the shipped arm's for a shipped robot; else none.
+pub(crate) fn with_home(
+    job: Job,
+    robot: &crate::robot::Robot,
+    home: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Job> {
+    let given = home
+        .map(|home| {
+            home.extract::<Vec<f64>>().map_err(|_| {
+                InputError::new_err(format!(
+                    "home: give {} joint angles (rad), one per joint of the arm",
+                    robot.inner.dof()
+                ))
+            })
+        })
+        .transpose()?;
+    let values = match (&given, robot.home) {
+        (Some(values), _) => values.as_slice(),
+        (None, Some(values)) if job.home.is_none() => values,
+        _ => return Ok(job),
+    };
+    job.with_home(values, &robot.inner).map_err(|e| match e {
+        JobError::Home(problem) => InputError::new_err(format!("home: {problem}")),
+        other => input_error("home", &other),
+    })
 }
 
 /// What a job plans with at `tolerance_mm`: `planner` at that tolerance, its timing and the

@@ -379,19 +379,24 @@ impl Planner {
     /// dict in the job file's layout; `tolerance_mm` the strokes' line tolerance (default
     /// 0.5 mm, as `emg job`). Every stroke is searched to the limit, resumed where one motion
     /// cannot finish it, the strokes joined by checked free moves; the GIL is released while
-    /// planning. A malformed job raises `InputError` naming the field; one of which no stroke
-    /// can be drawn raises `PlanningError`.
+    /// planning. `home` (rad, one value per joint) is where the program starts and ends, as
+    /// `emg job --home`: by default the job's `home`, else the shipped arm's (`Robot.home`);
+    /// a robot file with neither starts above its first stroke and ends above its last. A
+    /// malformed job or home raises `InputError` naming the field; one of which no stroke can
+    /// be drawn raises `PlanningError`.
     // Literal defaults, which `help()` shows (an expression shows as `...`): `emg job`'s.
-    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5))]
+    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5, home = None))]
     fn plan_job(
         &self,
         py: Python<'_>,
         job: &Bound<'_, PyAny>,
         placement: Option<&Bound<'_, PyDict>>,
         tolerance_mm: f64,
+        home: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<crate::job::JobPlan> {
         let robot = self.robot.get();
         let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        let job = crate::job::with_home(job, robot, home)?;
         crate::job::plan(py, &self.inner, robot, &job, tolerance_mm)
     }
 
@@ -400,10 +405,11 @@ impl Planner {
     /// `rotation_deg` (turns about its normal), each `[low, high]`, and `moving` (`"part"`, the
     /// default, or `"base"`: the robot's base on its mount); `positions² × rotations`
     /// places screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
-    /// the share of stroke points with an IK solution), the best `certify` planned as full jobs.
-    /// Returns a `JobPlacement`; a bad region or setting raises `InputError` naming it, a
-    /// region the arm cannot reach `PlanningError`.
-    #[pyo3(signature = (job, region, placement = None, tolerance_mm = 0.5, positions = 10, rotations = 5, certify = 5, score = "bound"))]
+    /// the share of stroke points with an IK solution), the best `certify` planned as full jobs,
+    /// each starting and ending at `home` as for `plan_job`. Returns a `JobPlacement`; a bad
+    /// region, setting or home raises `InputError` naming it, a region the arm cannot reach
+    /// `PlanningError`.
+    #[pyo3(signature = (job, region, placement = None, tolerance_mm = 0.5, positions = 10, rotations = 5, certify = 5, score = "bound", home = None))]
     #[allow(clippy::too_many_arguments)]
     fn place_job(
         &self,
@@ -416,9 +422,11 @@ impl Planner {
         rotations: usize,
         certify: usize,
         score: &str,
+        home: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<crate::job::JobPlacement> {
         let robot = self.robot.get();
         let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        let job = crate::job::with_home(job, robot, home)?;
         crate::job::place(
             py,
             &self.inner,

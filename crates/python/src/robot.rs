@@ -22,6 +22,9 @@ pub struct Robot {
     pub(crate) file: PathBuf,
     /// How written files name it ([`RobotRef`]'s text).
     pub(crate) reference: String,
+    /// A shipped arm's home (rad, one value per joint, [`ShippedRobot::home`]); `None` for
+    /// another robot file.
+    pub(crate) home: Option<&'static [f64]>,
 }
 
 impl Robot {
@@ -30,7 +33,8 @@ impl Robot {
         let file = robot_file(robot)?;
         let inner = emg_kinematics::Robot::from_chain_file(&file)
             .map_err(|e| input_error(format!("robot {}", file.display()), &e))?;
-        let reference = match ShippedRobot::by_path(&file, &data_dir()?) {
+        let shipped = ShippedRobot::by_path(&file, &data_dir()?);
+        let reference = match shipped {
             Some(shipped) => RobotRef::shipped(shipped.name, &file),
             None => RobotRef::file(&file),
         }
@@ -39,6 +43,7 @@ impl Robot {
             inner: Arc::new(inner),
             file,
             reference: reference.to_string(),
+            home: shipped.map(|shipped| shipped.home),
         })
     }
 
@@ -152,6 +157,14 @@ impl Robot {
     #[getter]
     fn velocity_limits<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         joint_array(py, &self.inner, &self.inner.limits().velocity)
+    }
+
+    /// A shipped arm's home (rad), shape (n,): its vendor's home or ready pose, where a job's
+    /// program starts and ends unless given another (docs/jobs.md#home); `None` for another
+    /// robot file.
+    #[getter]
+    fn home<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        self.home.map(|home| vector(py, home.iter().copied()))
     }
 
     /// The tool-centre-point pose at `q` (n joint angles, rad) as a 4×4 homogeneous transform in

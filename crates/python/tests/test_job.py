@@ -51,6 +51,11 @@ def test_a_job_is_planned_whole_and_its_segments_are_arrays(job_plan):
         last = np.searchsorted(job_plan.time_s, segment["time_s"][-1])
         assert np.all(job_plan.qd[first] == 0.0) and np.all(job_plan.qd[last] == 0.0)
     assert np.all(np.diff(job_plan.time_s) > 0)
+    # By default it starts and ends at the shipped arm's home, as `emg job` plans it.
+    home = elm.Robot("fr3").home
+    np.testing.assert_array_equal(job_plan.q[0], home)
+    np.testing.assert_array_equal(job_plan.q[-1], home)
+    assert summary["ends_at_home"]
 
 
 def test_the_program_is_the_clis_and_passes_the_checker(tmp_path, job_plan):
@@ -66,6 +71,46 @@ def test_the_program_is_the_clis_and_passes_the_checker(tmp_path, job_plan):
         del file["summary"]["planning_s"]
     assert python_file == cli_file
     assert "OK" in run_cli("check", ours).stdout
+
+
+# A home of the FR3 other than its ready pose, within its limits: the arm turned and lowered.
+OTHER_HOME = [0.5, -0.3, 0.2, -2.0, 0.1, 1.9, 0.3]
+
+
+def test_a_job_given_a_home_starts_and_ends_there_and_passes_the_checker(tmp_path):
+    job = elm.Planner("fr3").plan_job(SEAMS, home=OTHER_HOME)
+    assert job.summary["ends_at_home"]
+    np.testing.assert_array_equal(job.q[0], OTHER_HOME)
+    np.testing.assert_array_equal(job.q[-1], OTHER_HOME)
+    assert not np.allclose(job.q[0], elm.Robot("fr3").home)
+    program = tmp_path / "home.job.json"
+    job.write(program)
+    written = json.loads(program.read_text())
+    assert written["home"] == OTHER_HOME
+    assert written["points"][0]["positions"] == OTHER_HOME
+    assert written["points"][-1]["positions"] == OTHER_HOME
+    assert "OK" in run_cli("check", program).stdout
+
+
+def test_a_home_that_does_not_fit_the_arm_is_refused_naming_home():
+    planner = elm.Planner("fr3")
+    with pytest.raises(elm.InputError, match=r"^home: has 6 values; .* has 7 joints"):
+        planner.plan_job(SEAMS, home=OTHER_HOME[:6])
+    with pytest.raises(elm.InputError, match=r"^home: joint 4 \(0.5 rad\) is outside its limits"):
+        planner.plan_job(SEAMS, home=OTHER_HOME[:3] + [0.5] + OTHER_HOME[4:])
+    with pytest.raises(elm.InputError, match=r"^home: .* is not finite"):
+        planner.plan_job(SEAMS, home=[float("nan")] * 7)
+    with pytest.raises(elm.InputError, match=r"^home: give 7 joint angles"):
+        planner.plan_job(SEAMS, home="0,0,0,0,0,0,0")
+    with pytest.raises(elm.InputError, match=r"^home: has 8 values"):
+        planner.place_job(SEAMS, {"x_m": [0, 0], "y_m": [0, 0], "rotation_deg": [0, 0]}, home=[0.0] * 8)
+
+
+def test_only_a_shipped_robot_has_a_home(tmp_path):
+    assert elm.Robot("ur5e").home.tolist() == pytest.approx([0, -np.pi / 2, 0, -np.pi / 2, 0, 0])
+    robot_file = tmp_path / "arm.urdf"
+    robot_file.write_bytes((ROOT / "data" / "robots" / "fr3_pen.urdf").read_bytes())
+    assert elm.Robot(robot_file).home is None
 
 
 def test_check_reads_a_program_as_the_cli_does_from_any_directory(tmp_path, job_plan, monkeypatch):
@@ -115,6 +160,8 @@ def test_every_default_shows_its_value_in_help():
         for parameter in signature.parameters.values():
             assert parameter.default is not Ellipsis, f"{function.__qualname__}: {parameter.name}"
     assert inspect.signature(elm.Planner.plan_job).parameters["tolerance_mm"].default == 0.5
+    for method in (elm.Planner.plan_job, elm.Planner.place_job):
+        assert inspect.signature(method).parameters["home"].default is None
     assert inspect.signature(elm.Planner).parameters["robot"].default == "fr3"
     assert inspect.signature(elm.Plan.save).parameters["rate_hz"].default == 1000.0
     # The job default is `emg job`'s.

@@ -38,13 +38,16 @@ def test_the_pencil_is_moved_where_it_is_drawn_whole_as_emg_place_moves_it(tmp_p
     assert best["drawn_m"] == pytest.approx(best["total_m"], abs=1e-3)
     summary = placement.program.summary
     assert summary["drawn_m"] == best["drawn_m"]
+    # Its program starts and ends at the arm's home, as `emg place` plans it.
+    home = elm.Robot("fr3").home.tolist()
+    assert placement.program.q[0].tolist() == home and placement.program.q[-1].tolist() == home
     assert placement.map_svg().startswith("<svg")
     exported = tmp_path / "cli-job.json"
     run_cli(
         "place", PENCIL, "--origin", "0.78,0,0.25", "--width", "0.3",
         "--x=-0.3,0", "--y=-0.1,0.1", "--rotation=-45,45",
         "--positions", "3", "--rotations", "2", "--certify", "2",
-        "--out", tmp_path / "cli.json", "--export", exported,
+        "--out", tmp_path / "cli.json", "--job-out", exported,
     )
     cli = json.loads(exported.read_text())["transform"]
     for key in ("translation_m", "rpy"):
