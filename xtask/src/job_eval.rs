@@ -1,11 +1,14 @@
 //! `cargo xtask job-eval`: jobs planned as `emg job` plans them, on line-art icons (the
 //! lucide-static 1.62.0 icons vendored with the SVG reader's tests, or any directory of SVGs)
 //! placed in front of the arm at several positions and sizes, and on generated seams on tilted
-//! surfaces; every program re-checked segment by segment by the independent checker; beside the
+//! surfaces, each starting and ending at the arm's home; every program re-checked segment by
+//! segment by the independent checker, its claims among the rest, and measured for how far its
+//! joints stray from the home and how far its moves turn them; beside the
 //! baseline a user scripts today (each stroke planned alone by the search, one motion, the strokes
 //! joined by straight joint moves with no lift and no collision check):
 //! `docs/results/jobs.{json,md}`.
 
+use std::f64::consts::{PI, TAU};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -13,10 +16,11 @@ use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
-    FreeSpace, Job, JobSettings, Order, job_part, order_strokes, plan_job, plan_stroke, verify_job,
+    FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, job_part,
+    order_strokes, part_coverage, plan_job, plan_stroke, verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
-use emg_planner::{MotionTiming, PlanRequest, Planner};
+use emg_planner::{MotionTiming, PlanRequest, Planner, ShippedRobot};
 use emg_timing::time_free_move;
 use serde::{Deserialize, Serialize};
 
@@ -73,6 +77,18 @@ pub struct JobRow {
     pub sampled_moves: usize,
     /// Whether the independent checker refused the program, and why.
     pub checker_failure: Option<String>,
+    /// Whether the checker refused it for claiming more than its samples draw.
+    pub claims_exceed: bool,
+    /// The largest distance of a joint from its home value over the program (rad).
+    pub from_home_rad: f64,
+    /// Moves: every segment but the strokes.
+    pub moves: usize,
+    /// Moves turning a joint more than half a turn, and of
+    /// those the ones where that joint could have reached the same angle turning less, the
+    /// other way round, within its limits.
+    pub moves_over_half_turn: usize,
+    /// See `moves_over_half_turn`.
+    pub moves_the_long_way: usize,
     /// The baseline: pen-down length its one motion per stroke draws (m), its duration (s), its
     /// straight moves and those of them that collide.
     pub baseline_drawn_m: f64,
@@ -158,6 +174,13 @@ pub struct Record {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let (planner, timing, checker) = setup(&args.robot)?;
     let robot_name = args.robot.display().to_string();
+    let home = ShippedRobot::by_path(&args.robot, &workspace::data_dir())
+        .map(|shipped| shipped.home)
+        .context("job-eval plans the shipped arms, whose homes it starts from")?;
+    let with_home = |strokes: Vec<PathSpec>| {
+        Job::from_strokes(strokes, planner.robot())
+            .and_then(|job| job.with_home(home, planner.robot()))
+    };
     let mut jobs: Vec<(String, Job)> = Vec::new();
     let icons = icon_files(&args.icons)?;
     for icon in &icons {
@@ -176,13 +199,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 origin[2],
                 width
             );
-            jobs.push((name, Job::from_strokes(drawing.strokes, planner.robot())?));
+            jobs.push((name, with_home(drawing.strokes)?));
         }
     }
     for tilt_deg in [0.0, 20.0, 40.0] {
         jobs.push((
             format!("5 seams on a surface tilted {tilt_deg}°"),
-            Job::from_strokes(seams(tilt_deg), planner.robot())?,
+            with_home(seams(tilt_deg))?,
         ));
     }
     let hundreds = [
@@ -190,10 +213,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (HATCH, hatch()),
     ];
     for (name, strokes) in &hundreds {
-        jobs.push((
-            name.to_string(),
-            Job::from_strokes(strokes.clone(), planner.robot())?,
-        ));
+        jobs.push((name.to_string(), with_home(strokes.clone())?));
     }
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
@@ -313,6 +333,8 @@ fn evaluate(
     let row = match planned {
         Ok(program) => {
             let s = &program.summary;
+            let checked = verify_job(&program, checker, planner.robot().joint_names());
+            let turns = move_turns(&program, planner.robot().limits());
             JobRow {
                 job: name.to_string(),
                 strokes: job.strokes.len(),
@@ -326,9 +348,15 @@ fn evaluate(
                 planning_s,
                 straight_moves: s.straight_moves,
                 sampled_moves: s.sampled_moves,
-                checker_failure: verify_job(&program, checker, planner.robot().joint_names())
-                    .err()
-                    .map(|e| e.to_string()),
+                checker_failure: checked.as_ref().err().map(|e| e.to_string()),
+                claims_exceed: matches!(
+                    checked,
+                    Err(JobCheckError::Claim { .. } | JobCheckError::Summary(_))
+                ),
+                from_home_rad: from_home_rad(&program),
+                moves: turns.moves,
+                moves_over_half_turn: turns.over_half,
+                moves_the_long_way: turns.long_way,
                 baseline_drawn_m: baseline.drawn_m,
                 baseline_duration_s: baseline.duration_s,
                 baseline_moves: baseline.moves,
@@ -349,6 +377,11 @@ fn evaluate(
             straight_moves: 0,
             sampled_moves: 0,
             checker_failure: None,
+            claims_exceed: false,
+            from_home_rad: 0.0,
+            moves: 0,
+            moves_over_half_turn: 0,
+            moves_the_long_way: 0,
             baseline_drawn_m: baseline.drawn_m,
             baseline_duration_s: baseline.duration_s,
             baseline_moves: baseline.moves,
@@ -356,6 +389,69 @@ fn evaluate(
         },
     };
     Ok(row)
+}
+
+/// The largest distance of a joint from its home value over `program`'s points (rad).
+fn from_home_rad(program: &JobFile) -> f64 {
+    let Some(home) = &program.home else {
+        return 0.0;
+    };
+    program
+        .points
+        .iter()
+        .flat_map(|p| p.positions.iter().zip(home).map(|(q, h)| (q - h).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// How many of a program's moves turn a joint more than half a turn, and the long way round.
+struct MoveTurns {
+    moves: usize,
+    over_half: usize,
+    long_way: usize,
+}
+
+/// The moves of `program` (every segment but its strokes) that turn a joint more than π over
+/// their samples, and those of them where the joint's net turn `Δ` exceeds π and its end less a
+/// whole turn the way it went (`end − sign(Δ)·2π`) lies within `limits`: a shorter turn to the
+/// same angle existed.
+fn move_turns(program: &JobFile, limits: &emg_kinematics::JointLimits) -> MoveTurns {
+    let times: Vec<f64> = program
+        .points
+        .iter()
+        .map(|p| p.time_from_start.seconds())
+        .collect();
+    let mut turns = MoveTurns {
+        moves: 0,
+        over_half: 0,
+        long_way: 0,
+    };
+    for segment in &program.segments {
+        if matches!(segment.kind, SegmentKind::Stroke { .. }) {
+            continue;
+        }
+        let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
+        let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
+        let points = &program.points[first..last];
+        let (Some(start), Some(end)) = (points.first(), points.last()) else {
+            continue;
+        };
+        turns.moves += 1;
+        let joints = start.positions.len();
+        let turned = |i: usize| -> f64 {
+            points
+                .windows(2)
+                .map(|pair| (pair[1].positions[i] - pair[0].positions[i]).abs())
+                .sum()
+        };
+        let over: Vec<usize> = (0..joints).filter(|&i| turned(i) > PI).collect();
+        turns.over_half += usize::from(!over.is_empty());
+        turns.long_way += usize::from(over.iter().any(|&i| {
+            let net = end.positions[i] - start.positions[i];
+            let other_way = end.positions[i] - net.signum() * TAU;
+            net.abs() > PI && other_way >= limits.lower[i] && other_way <= limits.upper[i]
+        }));
+    }
+    turns
 }
 
 /// What the baseline script gets.
@@ -397,7 +493,13 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
         let Ok(timed) = timing.time(planner.robot(), task, constraints, trajectory) else {
             continue;
         };
-        drawn_m += trajectory.path_length_m;
+        drawn_m += part_coverage(
+            planner.robot(),
+            task,
+            0.0,
+            timed.samples.iter().map(|sample| &sample.q),
+        )
+        .length_m();
         duration_s += timed.report.duration_s;
         let start = timed.samples[0].q;
         if let Some(end) = last {
@@ -426,8 +528,10 @@ fn markdown(record: &Record) -> String {
          Written by `{}` on {}. Every SVG of `{}` placed pen down at {} places in front of the \
          arm, five seams on surfaces tilted 0°, 20° and 40°, {GRID} and {HATCH}, planned as `emg job` plans \
          them (the search per stroke, resumed where one motion cannot finish it, safe moves \
-         between strokes, 0.5 mm, 30°); every program re-checked segment by segment by the \
-         independent checker. The baseline is what a user scripts today: each stroke planned \
+         between strokes, from the arm's home and back, 0.5 mm, 30°); every program re-checked \
+         segment by segment by the independent checker, its claims (length drawn, strokes \
+         whole, stretches unreached) measured again from its samples. Lengths drawn are what \
+         the samples cover, the baseline's too. The baseline is what a user scripts today: each stroke planned \
          alone by the search in one motion, the strokes joined by straight joint moves with \
          no lift and no collision check (counted colliding where `emg job`'s free-space test \
          refuses the move).\n\n\
@@ -438,7 +542,10 @@ fn markdown(record: &Record) -> String {
          | program duration, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | {:.1} |\n\
          | pen-up time / pen-down time | {:.2} | — |\n\
          | planning time per stroke, mean (ms, {} threads) | {:.1} | — |\n\
-         | programs the checker refuses | {} of {} | — |\n",
+         | programs the checker refuses | {} of {} | — |\n\
+         | programs claiming more than their samples draw | {} of {} | — |\n\
+         | largest distance of a joint from its home (rad) | {:.3} | — |\n\
+         | moves turning a joint more than π / of them the long way round | {} / {} of {} | — |\n",
         record.robot,
         record.command,
         record.machine,
@@ -464,6 +571,12 @@ fn markdown(record: &Record) -> String {
         1e3 * sum(|r| r.planning_s) / strokes.max(1) as f64,
         rows.iter().filter(|r| r.checker_failure.is_some()).count(),
         rows.len(),
+        rows.iter().filter(|r| r.claims_exceed).count(),
+        rows.len(),
+        rows.iter().map(|r| r.from_home_rad).fold(0.0, f64::max),
+        count(|r| r.moves_over_half_turn),
+        count(|r| r.moves_the_long_way),
+        count(|r| r.moves),
     );
     for (name, one_thread_s) in &record.one_thread_s {
         if let Some(row) = rows.iter().find(|r| &r.job == name) {

@@ -158,20 +158,17 @@ fn read_task_from(path: &Path) -> Result<Carried> {
         .with_context(|| format!("--task-from {}: carries no task", path.display()))
 }
 
-/// The job program in `file`, when it is an `emg-job/1` file.
+/// The job program in `file`, when it is a job's program (refused where it is one of another
+/// version).
 pub(crate) fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
     if !emg_job::JobFile::is_job(&text) {
         return Ok(None);
     }
-    Ok(Some(serde_json::from_str(&text).with_context(|| {
-        format!(
-            "{} is not a valid {} file",
-            file.display(),
-            emg_job::JOB_FILE_FORMAT
-        )
-    })?))
+    let job =
+        emg_job::JobFile::parse(&text).map_err(|e| anyhow::anyhow!("{} {e}", file.display()))?;
+    Ok(Some(job))
 }
 
 /// `emg check` on a job's program: every segment replayed by the independent checker.
@@ -196,6 +193,18 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
         describe(&job.constraints),
         count(check.moves, "move"),
         count(check.points, "point")
+    );
+    println!(
+        "  claims as the samples draw them: pen down {:.4} m of {:.4} m, {} of {} whole{}",
+        check.drawn_m,
+        check.total_m,
+        check.whole_strokes,
+        count(check.strokes, "stroke"),
+        match &job.home {
+            Some(_) if job.summary.ends_at_home => ", from home and back",
+            Some(_) => ", from home",
+            None => "",
+        }
     );
     println!("OK");
     Ok(())

@@ -1,5 +1,5 @@
 //! `emg job`: a job file or an SVG drawing planned as one program (`emg_job::plan_job`), with a
-//! progress bar and a summary; writes the `emg-job/1` file.
+//! progress bar and a summary; writes the `emg-job/2` file.
 
 use std::path::PathBuf;
 
@@ -72,7 +72,7 @@ pub struct JobArgs {
     /// The job and how it is planned.
     #[command(flatten)]
     pub input: JobInput,
-    /// The program to write (an emg-job/1 file; missing parent directories are created).
+    /// The program to write (an emg-job/2 file; missing parent directories are created).
     #[arg(long, value_name = "FILE", default_value = "job.json")]
     pub out: PathBuf,
     /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written

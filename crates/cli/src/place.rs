@@ -50,7 +50,7 @@ pub struct PlaceArgs {
     /// in the cone, each on its own, as reachability studies score).
     #[arg(long, value_parser = parse_score, default_value = "bound")]
     pub score: Score,
-    /// The program planned at the chosen place (an emg-job/1 file; missing parent directories
+    /// The program planned at the chosen place (an emg-job/2 file; missing parent directories
     /// are created, as for every file written).
     #[arg(long, value_name = "FILE", default_value = "placed.json")]
     pub out: PathBuf,

@@ -167,3 +167,83 @@ fn a_path_file_is_a_job_of_one_stroke_and_an_svg_keeps_its_physical_size() {
         text(&both.stderr)
     );
 }
+
+/// A job starts and ends at the shipped arm's home unless `--home` gives another; a home that
+/// does not fit the arm is refused naming `--home`; `emg check` prints the claims it measured,
+/// and refuses a program of the first version, whose claims it cannot check.
+#[test]
+fn a_job_runs_from_home_and_back_and_check_reports_its_claims() {
+    let dir = temp_dir("job-home");
+    let drawing = examples().join("drawing.svg");
+    let plan = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "job",
+            drawing.to_str().unwrap(),
+            "--robot",
+            "ur5e",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        (emg(&args), out)
+    };
+    let home_of = |program: &serde_json::Value| -> Vec<f64> {
+        serde_json::from_value(program["home"].clone()).expect("a home")
+    };
+    let first_and_last = |program: &serde_json::Value| -> (Vec<f64>, Vec<f64>) {
+        let points = program["points"].as_array().unwrap();
+        let positions = |p: &serde_json::Value| serde_json::from_value(p["positions"].clone());
+        (
+            positions(&points[0]).unwrap(),
+            positions(&points[points.len() - 1]).unwrap(),
+        )
+    };
+    let (output, out) = plan("shipped.job.json", &[]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let program = read_json(&out);
+    let ur_home = vec![
+        0.0,
+        -std::f64::consts::FRAC_PI_2,
+        0.0,
+        -std::f64::consts::FRAC_PI_2,
+        0.0,
+        0.0,
+    ];
+    assert_eq!(home_of(&program), ur_home);
+    assert_eq!(first_and_last(&program), (ur_home.clone(), ur_home));
+    let given = [0.2, -1.4, 0.3, -1.7, -0.1, 0.4];
+    let listed = given.map(|v| v.to_string()).join(",");
+    let (output, out) = plan("given.job.json", &["--home", &listed]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let program = read_json(&out);
+    assert_eq!(home_of(&program), given.to_vec());
+    assert_eq!(first_and_last(&program), (given.to_vec(), given.to_vec()));
+    let checked = emg(&["check", out.to_str().unwrap()]);
+    assert!(checked.status.success(), "{}", text(&checked.stderr));
+    let report = text(&checked.stdout);
+    assert!(
+        report.contains("claims as the samples draw them: pen down")
+            && report.contains("from home and back"),
+        "{report}"
+    );
+    let (output, out) = plan("short.job.json", &["--home", "0,-1.5"]);
+    assert!(!output.status.success() && !out.exists());
+    assert!(
+        text(&output.stderr).contains("--home has 2 values; ur5e_pen has 6 joints"),
+        "{}",
+        text(&output.stderr)
+    );
+    // A program of the first version is refused naming its version.
+    let mut old = program.clone();
+    old["format"] = serde_json::Value::from("emg-job/1");
+    let old_file = dir.path().join("old.job.json");
+    std::fs::write(&old_file, old.to_string()).unwrap();
+    let refused = emg(&["check", old_file.to_str().unwrap()]);
+    assert!(!refused.status.success());
+    assert!(
+        text(&refused.stderr).contains("is an emg-job/1 program, which this emg does not read"),
+        "{}",
+        text(&refused.stderr)
+    );
+}

@@ -44,7 +44,8 @@ impl TimeFromStart {
 /// The joint limits a motion was timed for, as its file records them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TimingLimits {
-    /// The MoveIt `joint_limits.yaml` the limits were read from (the path as given).
+    /// The MoveIt `joint_limits.yaml` the limits were read from, relative to the robot file's
+    /// directory.
     pub joint_limits_file: String,
     /// Factor on the file's velocity limits.
     pub velocity_scaling: f64,

@@ -9,6 +9,10 @@ use emg_kinematics::{JointVector, Obstacle, Robot, Vec3, project_to_point};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// How far beyond the range between a free move's ends its sampled joint values reach first
+/// (rad): a quarter turn.
+pub const SAMPLE_MARGIN_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
 /// The farthest any point of the arm moves between two configurations an edge check visits
 /// (m): far less than the radius of any link's capsule.
 pub const MAX_POINT_TRAVEL_M: f64 = 0.005;
@@ -335,9 +339,12 @@ impl<'a> FreeSpace<'a> {
     }
 
     /// A free move from `a` to `b`: the straight edge where it is free, else a path of dual
-    /// RRT-Connect (the `rrt` crate, samples uniform within the joint limits from `seed`,
-    /// at most `max_samples`), every edge checked as [`FreeSpace::edge_free`] checks it, then
-    /// shortened by shortcuts. `None` where no free move was found.
+    /// RRT-Connect (the `rrt` crate, at most `max_samples` samples from `seed`), every edge
+    /// checked as [`FreeSpace::edge_free`] checks it, then shortened by shortcuts. The samples
+    /// are drawn uniform within the joint limits narrowed to [`SAMPLE_MARGIN_RAD`] beyond
+    /// the range between `a` and `b` (so that no joint wanders a turn away, on an arm whose
+    /// joints span ±2π), and within the whole limits where no move is found there. `None`
+    /// where no free move was found.
     pub fn connect(
         &self,
         a: &JointVector,
@@ -348,30 +355,55 @@ impl<'a> FreeSpace<'a> {
         if self.edge_free(a, b) {
             return Some(vec![*a, *b]);
         }
-        let dof = self.robot.dof();
         let limits = self.robot.limits();
-        // The sampler is called as a shared closure: its generator sits in a cell.
-        let rng = std::cell::RefCell::new(ChaCha8Rng::seed_from_u64(seed));
-        let sampled = rrt::dual_rrt_connect(
-            &a.as_slice()[..dof],
-            &b.as_slice()[..dof],
-            |q: &[f64]| self.free(&self.robot.joint_vector(q)),
-            || {
-                let mut rng = rng.borrow_mut();
-                (0..dof)
-                    .map(|i| rng.random_range(limits.lower[i]..=limits.upper[i]))
-                    .collect()
-            },
-            RRT_EXTEND_RAD,
-            max_samples,
-        )
-        .ok()?;
+        let near = (a.inf(b).add_scalar(-SAMPLE_MARGIN_RAD)).sup(&limits.lower);
+        let far = (a.sup(b).add_scalar(SAMPLE_MARGIN_RAD)).inf(&limits.upper);
+        let sampled = self
+            .sampled_move(a, b, (&near, &far), seed, max_samples)
+            .or_else(|| {
+                let whole = (near != limits.lower || far != limits.upper)
+                    .then_some((&limits.lower, &limits.upper))?;
+                self.sampled_move(a, b, whole, seed, max_samples)
+            })?;
         let mut path: Vec<JointVector> =
             sampled.iter().map(|q| self.robot.joint_vector(q)).collect();
         // The trees checked their nodes only: split every edge that is not free at the check's
         // resolution by its midpoint, where that is free, a few times.
         path = self.refine(path)?;
         Some(self.shortcut(path, seed))
+    }
+
+    /// Dual RRT-Connect from `a` to `b`, its samples uniform between `lower` and `upper`.
+    fn sampled_move(
+        &self,
+        a: &JointVector,
+        b: &JointVector,
+        (lower, upper): (&JointVector, &JointVector),
+        seed: u64,
+        max_samples: usize,
+    ) -> Option<Vec<Vec<f64>>> {
+        let dof = self.robot.dof();
+        // The sampler is called as a shared closure: its generator sits in a cell.
+        let rng = std::cell::RefCell::new(ChaCha8Rng::seed_from_u64(seed));
+        rrt::dual_rrt_connect(
+            &a.as_slice()[..dof],
+            &b.as_slice()[..dof],
+            // The trees' nodes keep the clearance an edge's inner configurations keep, so that
+            // the edges between them are free too; the ends are free as they are.
+            |q: &[f64]| {
+                let q = self.robot.joint_vector(q);
+                q == *a || q == *b || self.free_by(&q, MAX_POINT_TRAVEL_M / 2.0)
+            },
+            || {
+                let mut rng = rng.borrow_mut();
+                (0..dof)
+                    .map(|i| rng.random_range(lower[i]..=upper[i]))
+                    .collect()
+            },
+            RRT_EXTEND_RAD,
+            max_samples,
+        )
+        .ok()
     }
 
     /// `path` with every edge free, midpoints inserted where an edge is not (up to 6 halvings);

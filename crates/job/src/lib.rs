@@ -9,7 +9,7 @@
 //!    approach along n;
 //! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
-//!    an `emg-job/1` file;
+//!    an `emg-job/2` file;
 //!
 //! and [`verify_job`] re-checks a written program with the independent checker.
 //!
@@ -44,7 +44,7 @@ pub use place::{
     Score, Scored, place_job, place_score,
 };
 pub use program::{
-    JOB_FILE_FORMAT, JobFile, JobSummary, Program, Segment, SegmentKind, StrokeReport,
+    JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, Program, Segment, SegmentKind, StrokeReport,
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
 pub use stroke::{StrokePart, StrokePlan, plan_stroke};

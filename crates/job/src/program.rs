@@ -1,6 +1,6 @@
 //! The connect, time and write stages: the planned strokes joined by safe moves (retreat along
 //! −n, a free joint-space move, approach along n) into one timed joint trajectory, every segment
-//! listed with its time span, written as an `emg-job/1` file.
+//! listed with its time span, written as an `emg-job/2` file.
 
 use emg_control::{ConstraintConfig, PathSpec, Task};
 use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
@@ -153,17 +153,32 @@ pub struct JobFile {
 }
 
 impl JobFile {
-    /// Whether `text` is a job's program: JSON whose `format` is [`JOB_FILE_FORMAT`].
+    /// Whether `text` is a job's program of any version: JSON whose `format` starts with
+    /// `emg-job/`.
     pub fn is_job(text: &str) -> bool {
+        Self::format_of(text).is_some_and(|format| format.starts_with("emg-job/"))
+    }
+
+    /// `text` read as a job's program: refused where it is a program of another version than
+    /// [`JOB_FILE_FORMAT`] (an `emg-job/2` program's claims cannot be checked) or not a valid
+    /// one.
+    pub fn parse(text: &str) -> Result<Self, JobFileError> {
+        match Self::format_of(text) {
+            Some(format) if format != JOB_FILE_FORMAT => Err(JobFileError::Version(format)),
+            _ => serde_json::from_str(text).map_err(JobFileError::Invalid),
+        }
+    }
+
+    /// The `format` of a JSON text, if it has one.
+    fn format_of(text: &str) -> Option<String> {
         #[derive(Deserialize)]
         struct Format {
             format: Option<String>,
         }
-        text.trim_start().starts_with('{')
-            && serde_json::from_str::<Format>(text)
-                .ok()
-                .and_then(|f| f.format)
-                .is_some_and(|format| format == JOB_FILE_FORMAT)
+        if !text.trim_start().starts_with('{') {
+            return None;
+        }
+        serde_json::from_str::<Format>(text).ok()?.format
     }
 
     /// The samples as an export reads them ([`emg_io::export`]).
@@ -174,6 +189,20 @@ impl JobFile {
             points: &self.points,
         }
     }
+}
+
+/// Why a job's program cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum JobFileError {
+    /// A program of another version.
+    #[error(
+        "is an {0} program, which this emg does not read (its claims cannot be checked): plan \
+         the job again, which writes {JOB_FILE_FORMAT}"
+    )]
+    Version(String),
+    /// Not a valid program.
+    #[error("is not a valid {JOB_FILE_FORMAT} file: {0}")]
+    Invalid(serde_json::Error),
 }
 
 /// The program being assembled: samples on one time line and the segments they make.

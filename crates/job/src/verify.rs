@@ -1,4 +1,4 @@
-//! The independent check of a job's program (`emg check` on an `emg-job/1` file): every segment
+//! The independent check of a job's program (`emg check` on an `emg-job/2` file): every segment
 //! replayed by the checker (`emg_verify`, which shares no kinematics with the planners), each
 //! from rest to rest within the joint velocity, acceleration and jerk limits; a stroke part's
 //! samples on its stretch of the stroke within the tolerance and the cone, clear of the arm's

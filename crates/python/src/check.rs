@@ -102,13 +102,8 @@ pub fn check(py: Python<'_>, path: PathBuf, robot: Option<PathBuf>) -> PyResult<
 
 /// [`check`] of a job's program, `text` read from `path`.
 fn check_job(path: &Path, text: &str, robot: Option<&Path>) -> PyResult<JobCheckReport> {
-    let job: emg_job::JobFile = serde_json::from_str(text).map_err(|e| {
-        InputError::new_err(format!(
-            "{} is not a valid {} file: {e}",
-            path.display(),
-            emg_job::JOB_FILE_FORMAT
-        ))
-    })?;
+    let job = emg_job::JobFile::parse(text)
+        .map_err(|e| InputError::new_err(format!("{} {e}", path.display())))?;
     let robot = Robot::named(&job.robot, path, robot)?;
     let model = checker(&robot)?;
     let check =

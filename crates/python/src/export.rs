@@ -34,7 +34,7 @@ pub struct ExportReport {
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/1` file) as `format`
+/// there (an `emg-job/2` file) as `format`
 /// (`"ros2-mcap"` or `"urscript"`) to `out`, for its own robot or `robot` (a shipped robot's
 /// name or a robot file), as `emg export` does: nothing is written on an error, and `out` never
 /// replaces `path`.
@@ -57,12 +57,8 @@ pub fn export(
         .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
     let job = if emg_job::JobFile::is_job(&text) {
         Some(
-            serde_json::from_str::<emg_job::JobFile>(&text).map_err(|e| {
-                InputError::new_err(format!(
-                    "{} is not a valid job program: {e}",
-                    path.display()
-                ))
-            })?,
+            emg_job::JobFile::parse(&text)
+                .map_err(|e| InputError::new_err(format!("{} {e}", path.display())))?,
         )
     } else {
         None

@@ -245,7 +245,7 @@ impl JobPlan {
         self.rows(py, 0..self.file.points.len(), |p| &p.accelerations)
     }
 
-    /// Writes the program as an `emg-job/1` file (`emg check` verifies it).
+    /// Writes the program as an `emg-job/2` file (`emg check` verifies it).
     fn write(&self, path: PathBuf) -> PyResult<()> {
         let text = serde_json::to_string(&self.file).expect("a job's program serialises") + "\n";
         emg_io::write_atomically(&path, text)
