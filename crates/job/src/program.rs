@@ -187,6 +187,7 @@ impl JobFile {
             joint_names: &self.joint_names,
             limits: &self.limits,
             points: &self.points,
+            home: self.home.as_deref(),
         }
     }
 }

@@ -26,7 +26,7 @@ pub use thinning::ThinningReport;
 use thinning::{DEFAULT_TOLERANCE_RAD, SplineLimits, measure, thin};
 use urscript::{
     DEFAULT_MAX_SERVOJ_LINES, GAIN, LOOKAHEAD_TIME_S, MOVEJ_ACCELERATION_RAD_S2, MOVEJ_SPEED_RAD_S,
-    SERVO_PERIOD_S, resample,
+    SERVO_PERIOD_S, START_TOLERANCE_RAD, resample,
 };
 
 use crate::joint_trajectory::{JointTrajectory, JointTrajectoryPoint, TimingLimits};
@@ -250,6 +250,10 @@ pub struct TimedPoints<'a> {
     pub limits: &'a TimingLimits,
     /// The samples, from rest to rest.
     pub points: &'a [JointTrajectoryPoint],
+    /// The arm's home, where the motion starts (a job's program): an export that starts the
+    /// arm checks that it stands there, rather than moving it to the start from wherever it
+    /// stands.
+    pub home: Option<&'a [f64]>,
 }
 
 impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {
@@ -258,6 +262,7 @@ impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {
             joint_names: &trajectory.joint_names,
             limits: &trajectory.limits,
             points: &trajectory.points,
+            home: None,
         }
     }
 }
@@ -473,12 +478,27 @@ fn ur_script(
                 ),
                 format!(
                     "servoj: t = {SERVO_PERIOD_S} s (one target per controller cycle), \
-                     lookahead_time = {LOOKAHEAD_TIME_S} s, gain = {GAIN}; the first target is \
-                     reached by movej (a = {MOVEJ_ACCELERATION_RAD_S2} rad/s², v = \
-                     {MOVEJ_SPEED_RAD_S} rad/s) from wherever the arm stands: clear that way"
+                     lookahead_time = {LOOKAHEAD_TIME_S} s, gain = {GAIN}"
                 ),
+                match (i, trajectory.home) {
+                    (0, Some(_)) => format!(
+                        "the motion starts at the arm's home, where the arm must stand: the \
+                         program checks that every joint is within {START_TOLERANCE_RAD} rad \
+                         of it and halts otherwise"
+                    ),
+                    _ => format!(
+                        "the first target is reached by movej (a = \
+                         {MOVEJ_ACCELERATION_RAD_S2} rad/s², v = {MOVEJ_SPEED_RAD_S} rad/s) \
+                         from wherever the arm stands: clear that way"
+                    ),
+                },
             ];
-            let text = urscript::program(&targets, range, "emg_motion", &header);
+            let start = if i == 0 && trajectory.home.is_some() {
+                urscript::Start::Check
+            } else {
+                urscript::Start::Move
+            };
+            let text = urscript::program(&targets, range, "emg_motion", &header, start);
             (path, text.into_bytes())
         })
         .collect();

@@ -17,6 +17,9 @@ pub const GAIN: u32 = 300;
 pub const MOVEJ_SPEED_RAD_S: f64 = 1.05;
 /// `movej`'s joint acceleration on the way to the start (rad/s²): URScript's default.
 pub const MOVEJ_ACCELERATION_RAD_S2: f64 = 1.4;
+/// How far (rad) each joint may stand from the start of a motion that starts at the arm's home
+/// when the program begins.
+pub const START_TOLERANCE_RAD: f64 = 0.01;
 /// How long the last target is held after the motion (s): the lookahead's lag settles.
 pub const HOLD_S: f64 = 0.2;
 /// Most `servoj` lines one program holds by default: 2,500 (5 s of motion). Universal Robots
@@ -111,22 +114,61 @@ fn vector(q: &[f64]) -> String {
     format!("[{}]", values.join(", "))
 }
 
-/// The program running `targets[range.0..=range.1]`, with `header` lines as comments.
-pub fn program(targets: &[Target], range: (usize, usize), name: &str, header: &[String]) -> String {
+/// How a program comes to its first target.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Start {
+    /// `movej` there from wherever the arm stands.
+    Move,
+    /// The arm must stand there (the arm's home): every joint within [`START_TOLERANCE_RAD`]
+    /// of it, else a popup and `halt`.
+    Check,
+}
+
+/// The program running `targets[range.0..=range.1]`, with `header` lines as comments, coming
+/// to its first target as `start` says.
+pub fn program(
+    targets: &[Target],
+    range: (usize, usize),
+    name: &str,
+    header: &[String],
+    start: Start,
+) -> String {
     let mut text = String::new();
     for line in header {
         text.push_str(&format!("# {line}\n"));
     }
     let (first, last) = (&targets[range.0], &targets[range.1]);
     text.push_str(&format!("def {name}():\n"));
-    text.push_str(&format!(
-        "  # the way to the start, at rest (t = {:.3} s of the motion)\n",
-        first.time_s
-    ));
-    text.push_str(&format!(
-        "  movej({}, a={MOVEJ_ACCELERATION_RAD_S2}, v={MOVEJ_SPEED_RAD_S})\n",
-        vector(&first.q)
-    ));
+    match start {
+        Start::Move => {
+            text.push_str(&format!(
+                "  # the way to the start, at rest (t = {:.3} s of the motion)\n",
+                first.time_s
+            ));
+            text.push_str(&format!(
+                "  movej({}, a={MOVEJ_ACCELERATION_RAD_S2}, v={MOVEJ_SPEED_RAD_S})\n",
+                vector(&first.q)
+            ));
+        }
+        Start::Check => {
+            text.push_str("  # the arm's home, where the motion starts: the arm must stand there\n");
+            text.push_str(&format!("  home = {}\n", vector(&first.q)));
+            text.push_str("  actual = get_actual_joint_positions()\n");
+            text.push_str("  joint = 0\n");
+            text.push_str(&format!("  while joint < {}:\n", first.q.len()));
+            text.push_str(&format!(
+                "    if norm(actual[joint] - home[joint]) > {START_TOLERANCE_RAD}:\n"
+            ));
+            text.push_str(
+                "      popup(\"The arm is not at the program's home: move it there first.\", \
+                 title=\"emg\", error=True, blocking=True)\n",
+            );
+            text.push_str("      halt\n");
+            text.push_str("    end\n");
+            text.push_str("    joint = joint + 1\n");
+            text.push_str("  end\n");
+        }
+    }
     text.push_str(&format!(
         "  # servoj(q, a, v, t, lookahead_time, gain): one target every {SERVO_PERIOD_S} s\n"
     ));
