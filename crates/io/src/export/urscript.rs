@@ -151,7 +151,9 @@ pub fn program(
             ));
         }
         Start::Check => {
-            text.push_str("  # the arm's home, where the motion starts: the arm must stand there\n");
+            text.push_str(
+                "  # the arm's home, where the motion starts: the arm must stand there\n",
+            );
             text.push_str(&format!("  home = {}\n", vector(&first.q)));
             text.push_str("  actual = get_actual_joint_positions()\n");
             text.push_str("  joint = 0\n");
