@@ -2,59 +2,27 @@
 //! drew less than they claimed, planned and measured again by the independent checker, and
 //! programs edited to claim more refused naming the stroke.
 
-use std::path::PathBuf;
+mod common;
 
-use emg_io::{Placement, SvgOptions, read_svg_file};
-use emg_job::{Job, JobCheckError, JobFile, SegmentKind, plan_job, verify_job};
-use emg_kinematics::Robot;
-use emg_planner::{DataDir, Models, MotionTiming, PlanRequest, Planner, ShippedRobot};
+use emg_io::Placement;
+use emg_job::{JobCheckError, JobFile, SegmentKind, verify_job};
+use emg_planner::Planner;
 use emg_verify::ReferenceModel;
 
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-/// A drawing of `../shared/cases/`.
-fn case(name: &str) -> PathBuf {
-    workspace().join("../shared/cases").join(name)
-}
-
-/// A shipped arm's planner as `emg job` builds it, its timing and its checker.
-fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
-    let data = DataDir::new(workspace().join("data"));
-    let shipped = ShippedRobot::by_name(name).expect("a shipped robot");
-    let file = shipped.path(&data);
-    let robot = Robot::from_chain_file(&file).expect("robot loads");
-    let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
-        .expect("checker loads");
-    let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
-    let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
-    let timing = emg_job::job_timing(&robot, &file, &config).expect("timing");
-    let planner = Planner::new(robot, models, config).expect("planner");
-    (planner, timing, checker, file)
-}
-
-/// `drawing` placed as `placement` says, planned on `robot` as `emg job` plans it.
+/// `drawing` of `../shared/cases/` placed as `placement` says, planned on `robot` as `emg job`
+/// plans it.
 fn planned(
     robot: &str,
     drawing: &str,
     placement: &Placement,
 ) -> (JobFile, Planner, ReferenceModel) {
-    let (planner, timing, checker, file) = setup(robot);
-    let strokes = read_svg_file(&case(drawing), placement, &SvgOptions::default())
-        .expect("the drawing")
-        .strokes;
-    let job = Job::from_strokes(strokes, planner.robot()).expect("a valid job");
-    let program = plan_job(
-        &planner,
-        &PlanRequest::default(),
-        &job,
-        &timing,
-        &file.display().to_string(),
-        &|_, _| {},
+    let (planner, timing, checker, file) = common::setup(robot);
+    let job = common::drawing(planner.robot(), &common::case(drawing), placement);
+    (
+        common::plan(&planner, &timing, &file, &job),
+        planner,
+        checker,
     )
-    .expect("the job plans");
-    (program, planner, checker)
 }
 
 /// The program's claims equal what the checker measures of its samples.

@@ -2,36 +2,17 @@
 //! SVG reader's tests) planned on the FR3 and on the UR5e, its program re-checked segment by
 //! segment by the independent checker; the order stage; wrong jobs refused naming what is wrong.
 
+mod common;
+
 use std::path::PathBuf;
 
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{Job, JobError, SegmentKind, plan_job, verify_job};
 use emg_kinematics::Robot;
-use emg_planner::{DataDir, Models, MotionTiming, PlanRequest, Planner, ShippedRobot};
-use emg_verify::ReferenceModel;
-
-fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use emg_planner::PlanRequest;
 
 fn icon(name: &str) -> PathBuf {
-    workspace().join(format!("crates/io/tests/data/icons/{name}.svg"))
-}
-
-/// A shipped arm's planner as `emg job` builds it (the cell's plate, 0.5 mm), its timing and
-/// its checker.
-fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
-    let data = DataDir::new(workspace().join("data"));
-    let shipped = ShippedRobot::by_name(name).expect("a shipped robot");
-    let file = shipped.path(&data);
-    let robot = Robot::from_chain_file(&file).expect("robot loads");
-    let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
-        .expect("checker loads");
-    let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
-    let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
-    let timing = emg_job::job_timing(&robot, &file, &config).expect("timing");
-    let planner = Planner::new(robot, models, config).expect("planner");
-    (planner, timing, checker, file)
+    common::workspace().join(format!("crates/io/tests/data/icons/{name}.svg"))
 }
 
 fn icon_job(robot: &Robot, name: &str, placement: &Placement) -> Job {
@@ -40,17 +21,9 @@ fn icon_job(robot: &Robot, name: &str, placement: &Placement) -> Job {
 }
 
 fn plans_and_checks_the_pencil_icon(name: &str) {
-    let (planner, timing, checker, file) = setup(name);
+    let (planner, timing, checker, file) = common::setup(name);
     let job = icon_job(planner.robot(), "pencil", &Placement::default());
-    let program = plan_job(
-        &planner,
-        &PlanRequest::default(),
-        &job,
-        &timing,
-        &file.display().to_string(),
-        &|_, _| {},
-    )
-    .expect("the job plans");
+    let program = common::plan(&planner, &timing, &file, &job);
     let summary = &program.summary;
     assert_eq!(program.strokes.len(), job.strokes.len());
     assert!(
@@ -133,7 +106,7 @@ fn an_icon_is_planned_and_checked_on_the_ur5e() {
 
 #[test]
 fn wrong_jobs_are_refused_naming_what_is_wrong() {
-    let (planner, timing, _, file) = setup("fr3");
+    let (planner, timing, _, file) = common::setup("fr3");
     let robot = planner.robot();
     let parse = |text: &str| {
         Job::from_json("job.json", text, robot)
