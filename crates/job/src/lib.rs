@@ -165,8 +165,9 @@ pub fn plan_job(
                 .map(|[_, above]| above)
                 .or(program.last())
                 .or(job.home);
-            // Each joint among its whole turns nearest the home (else where the arm is).
-            let planned = turned_toward(planned, job.home.or(from).as_ref(), robot);
+            // Each joint among its whole turns nearest the home (else where the arm is), the
+            // tool's free roll centred on it.
+            let planned = toward(planned, job.home.or(from).as_ref(), &free);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
             // The part planned again from the configuration the arm is in, moved above the
             // part's start and set down there: taken first where it draws as far from a start
@@ -318,21 +319,40 @@ pub fn plan_job(
     })
 }
 
-/// `part` with each joint of its motion turned by whole turns toward `reference`
-/// ([`emg_kinematics::JointLimits::turns_toward`]): the same motion of the arm, its joint values
-/// nearest the reference within the limits.
-fn turned_toward(
-    mut part: StrokePart,
-    reference: Option<&JointVector>,
-    robot: &emg_kinematics::Robot,
-) -> StrokePart {
+/// `part` moved toward `reference` without changing what it draws: each joint turned by whole
+/// turns ([`emg_kinematics::JointLimits::turns_toward`]), the same motion of the arm with its
+/// joint values nearest the reference within the limits; then the tool's roll joint, where the
+/// arm has one ([`emg_kinematics::Robot::tool_roll_joint`]), turned by the angle that centres
+/// the range it sweeps on the reference's (within the limits): the TCP and the tool axis, all a
+/// stroke constrains, stay where they were, so the part draws exactly as before with the roll
+/// nearest the home. The roll is kept where the turned tool would not be free (`free`'s test
+/// along the motion: the tool's bodies turn with it).
+fn toward(mut part: StrokePart, reference: Option<&JointVector>, free: &FreeSpace) -> StrokePart {
     let Some(reference) = reference else {
         return part;
     };
+    let robot = free.robot();
     let motion: Vec<JointVector> = part.trajectory.steps.iter().map(|step| step.q).collect();
-    let turns = robot.limits().turns_toward(&motion, reference);
+    let mut shift = robot.limits().turns_toward(&motion, reference);
+    if let Some(roll) = robot.tool_roll_joint() {
+        let (least, greatest) = motion
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                (lo.min(q[roll] + shift[roll]), hi.max(q[roll] + shift[roll]))
+            });
+        let limits = robot.limits();
+        let centring = (reference[roll] - (least + greatest) / 2.0)
+            .min(limits.upper[roll] - greatest)
+            .max(limits.lower[roll] - least);
+        let mut rolled = JointVector::zeros();
+        rolled[roll] = centring;
+        let turned: Vec<JointVector> = motion.iter().map(|q| q + shift + rolled).collect();
+        if centring.abs() > 0.0 && free.path_free(&turned) {
+            shift += rolled;
+        }
+    }
     for step in &mut part.trajectory.steps {
-        step.q += turns;
+        step.q += shift;
     }
     part
 }

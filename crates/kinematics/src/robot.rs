@@ -185,15 +185,16 @@ impl JointLimits {
         q.zip_zip_map(&self.lower, &self.upper, |v, lo, hi| v.clamp(lo, hi))
     }
 
-    /// The whole turns (multiples of 2π, per joint) that bring `motion`'s first configuration
-    /// nearest `reference` while every configuration of `motion`, each turned alike, stays within
-    /// the limits. A revolute joint turned by 2π stands where it stood, so the turned motion
-    /// moves the arm exactly as `motion` does; each joint ends within ±π of `reference` where its
-    /// limits allow. Zero for joints whose range leaves no other choice, and for an empty motion.
+    /// The whole turns (multiples of 2π, per joint) that bring the middle of the range each joint
+    /// of `motion` sweeps nearest `reference` while every configuration of `motion`, each turned
+    /// alike, stays within the limits. A revolute joint turned by 2π stands where it stood, so
+    /// the turned motion moves the arm exactly as `motion` does; a joint whose motion sweeps less
+    /// than a turn stays within ±π of `reference` where its limits allow. Zero for joints whose
+    /// range leaves no other choice, and for an empty motion.
     pub fn turns_toward(&self, motion: &[JointVector], reference: &JointVector) -> JointVector {
-        let Some(first) = motion.first() else {
+        if motion.is_empty() {
             return JointVector::zeros();
-        };
+        }
         let turn = std::f64::consts::TAU;
         JointVector::from_fn(|i, _| {
             let (least, greatest) = motion
@@ -204,7 +205,7 @@ impl JointLimits {
             // Turns that keep the whole motion within the limits, the nearest to the reference.
             let fewest = ((self.lower[i] - least) / turn).ceil();
             let most = ((self.upper[i] - greatest) / turn).floor();
-            let wanted = ((reference[i] - first[i]) / turn).round();
+            let wanted = ((reference[i] - (least + greatest) / 2.0) / turn).round();
             if fewest > most {
                 0.0
             } else {
@@ -578,6 +579,22 @@ impl Robot {
             .0
             .is_finite()
             .then(|| (origin + axis * heights.0, origin + axis * heights.1, radius))
+    }
+
+    /// The joint that only spins the tool about its own axis, if the arm has one: its last
+    /// joint, where that joint's axis runs along the tool axis through the TCP (a pen mounted on
+    /// the flange's axis). Turning it moves neither the TCP nor the tool axis, so a task that
+    /// constrains only those (every task here: the position, the tool cone) leaves it free; it
+    /// still turns the tool's and the flange's bodies, which a collision check must see.
+    pub fn tool_roll_joint(&self) -> Option<usize> {
+        /// Distance (m) and sine of the angle below which the axis counts as the tool's.
+        const ON_AXIS: f64 = 1e-9;
+        let last = self.dof.checked_sub(1)?;
+        let kinematics = self.forward(&self.mid_range());
+        let axis = kinematics.joint_axis(last);
+        let off_axis = (kinematics.tcp() - kinematics.joint_origin(last)).cross(&axis);
+        (axis.cross(&kinematics.tool_axis()).norm() < ON_AXIS && off_axis.norm() < ON_AXIS)
+            .then_some(last)
     }
 
     /// A sphere (centre, radius) that contains every TCP position the arm can reach.

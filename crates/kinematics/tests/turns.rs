@@ -3,7 +3,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use emg_kinematics::{JointLimits, JointVector};
+use emg_kinematics::{JointLimits, JointVector, Robot};
 
 /// The UR5e's ranges: ±2π for every joint but the elbow's ±π.
 fn ur5e_limits() -> JointLimits {
@@ -62,4 +62,60 @@ fn a_motion_that_spans_the_range_is_not_turned() {
     // Wrist 3 from 4 to 4.5 rad turns once down, to −2.28.
     assert!((turns[5] + TAU).abs() < 1e-15, "{}", turns[5]);
     assert_eq!(limits.turns_toward(&[], &reference), JointVector::zeros());
+}
+
+/// The shipped arms' files.
+fn shipped(name: &str) -> Robot {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../data/robots")
+        .join(name);
+    Robot::from_file_between(path, None, None).expect("a shipped robot file loads")
+}
+
+#[test]
+fn the_shipped_pens_spin_on_the_last_joint_which_moves_neither_tcp_nor_tool_axis() {
+    for name in ["fr3_pen.urdf", "iiwa14_pen.urdf", "ur5e_pen.urdf"] {
+        let robot = shipped(name);
+        let roll = robot.tool_roll_joint();
+        assert_eq!(roll, Some(robot.dof() - 1), "{name}");
+        let roll = roll.unwrap();
+        let limits = robot.limits();
+        for share in [0.2, 0.5, 0.8] {
+            let q = limits.lower + (limits.upper - limits.lower) * share;
+            let mut turned = q;
+            turned[roll] += 1.3;
+            let (a, b) = (robot.forward(&q), robot.forward(&turned));
+            assert!((a.tcp() - b.tcp()).norm() < 1e-12, "{name}");
+            assert!((a.tool_axis() - b.tool_axis()).norm() < 1e-12, "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_tool_off_the_last_axis_has_no_roll_joint() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots/ur5e_pen.urdf");
+    let text = std::fs::read_to_string(path).expect("the UR5e file reads");
+    // The pen tip 1 cm off the flange axis.
+    let offset = text.replace(
+        "<child link=\"pen_tip\"/>\n    <origin xyz=\"0 0 0.2034\"",
+        "<child link=\"pen_tip\"/>\n    <origin xyz=\"0.01 0 0.2034\"",
+    );
+    assert_ne!(offset, text);
+    let robot = Robot::from_urdf_str(&offset, "base_link", "pen_tip").expect("the file loads");
+    assert_eq!(robot.tool_roll_joint(), None);
+}
+
+#[test]
+fn a_motion_sweeping_past_the_half_turn_is_turned_by_its_middle() {
+    let limits = ur5e_limits();
+    let reference = JointVector::zeros();
+    // Wrist 3 from 2.5 to 3.8 rad: its middle, 3.15, is nearer −3.13 (a turn down), but either
+    // way the motion crosses ±π; from its first value it would stay.
+    let motion = [
+        configuration([0.0, 0.0, 0.0, 0.0, 0.0, 2.5]),
+        configuration([0.0, 0.0, 0.0, 0.0, 0.0, 3.8]),
+    ];
+    let turns = limits.turns_toward(&motion, &reference);
+    assert!((turns[5] + TAU).abs() < 1e-15, "{}", turns[5]);
 }
