@@ -547,6 +547,63 @@ impl Path {
         .ok()
     }
 
+    /// This path, then `next` moved by the gap from its start to this path's end, as one path:
+    /// each piece of both a segment of its own (as [`Path::stretch`] gives them), so every point
+    /// of `next` lies on the joined path moved by that gap and its length is the sum of both.
+    /// `None` where their normals differ or a piece, a short blend, is shorter than a segment
+    /// may be.
+    pub fn joined(&self, next: &Path) -> Option<Self> {
+        if self.normal.dot(&next.normal) < 1.0 - 1e-12 {
+            return None;
+        }
+        let gap = self.point_at(self.length_m) - next.point_at(0.0);
+        let segments = self
+            .pieces
+            .iter()
+            .map(|piece| self.piece_segment(piece, Vec3::zeros()))
+            .chain(
+                next.pieces
+                    .iter()
+                    .map(|piece| next.piece_segment(piece, gap)),
+            )
+            .collect::<Option<Vec<_>>>()?;
+        Self::new(PathSpec {
+            version: PATH_FORMAT_VERSION,
+            start: self.point_at(0.0).into(),
+            normal: self.normal.into(),
+            blend_radius_m: 0.0,
+            segments,
+        })
+        .ok()
+    }
+
+    /// `piece`, one of this path's, as a segment moved by `offset`; `None` where it is shorter
+    /// than [`MIN_SEGMENT_M`].
+    fn piece_segment(&self, piece: &Piece, offset: Vec3) -> Option<SegmentSpec> {
+        if piece.length_m < MIN_SEGMENT_M {
+            return None;
+        }
+        let (from, to, arc) = piece.outline();
+        Some(match arc {
+            None => SegmentSpec::Line {
+                to: (to + offset).into(),
+            },
+            Some((centre, axis)) => {
+                let turn = if axis.dot(&self.normal) >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                arc_of_length(
+                    centre + offset,
+                    turn,
+                    piece.length_m,
+                    (from - centre).norm(),
+                )
+            }
+        })
+    }
+
     /// The spec the path was validated from.
     pub fn spec(&self) -> &PathSpec {
         &self.spec

@@ -305,6 +305,64 @@ fn whole_circles_stretch_reverse_and_move_as_paths() {
     }
 }
 
+/// Two paths joined are one path of both lengths: the first as it was, the second moved by the
+/// gap between them (blends kept as arcs of their own); paths of other normals do not join.
+#[test]
+fn paths_join_end_to_start_moved_by_the_gap_between_them() {
+    let (p, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::z());
+    let first = Path::new(rectangle(p, Vec3::y(), n, 0.02, 0.01, 0.002)).unwrap();
+    let gap = Vec3::new(3e-4, -2e-4, 0.0);
+    let begin = first.point_at(first.length_m()) + gap;
+    let second = Path::new(spec(
+        begin,
+        n,
+        0.0,
+        vec![
+            arc(
+                Some(begin + Vec3::new(0.0, 0.01, 0.0)),
+                None,
+                None,
+                Some(90.0),
+            ),
+            line(begin + Vec3::new(0.03, 0.01, 0.0)),
+        ],
+    ))
+    .unwrap();
+    assert_close(
+        second.point_at(0.0) - first.point_at(first.length_m()),
+        gap,
+        1e-12,
+        "gap",
+    );
+    let joined = first.joined(&second).unwrap();
+    assert_parameterised(&joined);
+    assert!((joined.length_m() - first.length_m() - second.length_m()).abs() < 1e-12);
+    for k in 0..=50 {
+        let s = first.length_m() * k as f64 / 50.0;
+        assert_close(
+            joined.point_at(s),
+            first.point_at(s),
+            1e-12,
+            "the first path",
+        );
+        let t = second.length_m() * k as f64 / 50.0;
+        assert_close(
+            joined.point_at(first.length_m() + t),
+            second.point_at(t) - gap,
+            1e-12,
+            "the second path moved",
+        );
+    }
+    let tilted = Path::straight(
+        second.point_at(0.0),
+        Vec3::x(),
+        Vec3::new(0.0, 0.1, 1.0).normalize(),
+        0.01,
+    )
+    .unwrap();
+    assert!(first.joined(&tilted).is_none(), "another normal");
+}
+
 #[test]
 fn a_tcp_is_located_near_where_it_was_last() {
     let (p, _, circle) = unit_circle();
