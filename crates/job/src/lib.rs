@@ -2,7 +2,8 @@
 //! stages with one job each, above the planner:
 //!
 //! 1. **read** ([`spec`]): a job file or a drawing's strokes, validated into a [`Job`];
-//! 2. **order** ([`order`]): the drawing order and directions that shorten the pen-up travel;
+//! 2. **order** ([`order`]): strokes that meet end to end merged ([`order::merge`]), the
+//!    drawing order and directions that shorten the pen-up travel;
 //! 3. **plan strokes** ([`stroke`]): each stroke to the limit by the search, resumed after a
 //!    reconfiguration where one motion cannot finish it;
 //! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
@@ -37,7 +38,8 @@ use rayon::prelude::*;
 
 pub use claims::{COVERAGE_SLACK_M, Coverage, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
-pub use order::{Ordering, Oriented, order_strokes};
+pub use order::merge::{Chain, merge_strokes};
+pub use order::{Ordering, Oriented, merge_and_order, order_strokes, order_strokes_counted};
 pub use page::{placement_map, viewer_page};
 pub use place::{
     Certified, Moving, Place, PlaceError, PlaceFrame, PlaceSettings, Placement, Region, SAME_SCORE,
@@ -115,7 +117,12 @@ pub fn plan_job(
     let settings = &job.settings;
     let robot = planner.robot();
     let dof = robot.dof();
-    let ordering = order_strokes(&job.strokes, settings.order);
+    let ordering = merge_and_order(
+        &job.strokes,
+        settings.order,
+        planner.config().rollout.constraints.line_tolerance_m,
+    );
+    let drawn = ordering.drawn_paths(&job.strokes);
     // The part under the strokes, which the arm keeps off while drawing as between strokes.
     let free = FreeSpace::new(
         robot,
@@ -133,7 +140,7 @@ pub fn plan_job(
         .sequence
         .par_iter()
         .map(|oriented| {
-            let path = oriented.path(&job.strokes);
+            let path = oriented.path(&drawn);
             let plan = plan_stroke(&on_part, request, &path, 0.0, settings);
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             progress(finished, ordering.sequence.len());

@@ -13,10 +13,12 @@ use crate::spec::Job;
 
 /// The viewer page of `file`, the program of `job` on `robot`, titled after `name`.
 pub fn viewer_page(file: &JobFile, job: &Job, robot: &Robot, name: &str) -> String {
-    // Every stroke as drawn: reversed where the order draws it from its end.
-    let mut strokes: Vec<Path> = job.strokes.clone();
+    // Every stroke as drawn: merged where the order merged it, reversed where it draws it from
+    // its end.
+    let drawn = file.ordering.drawn_paths(&job.strokes);
+    let mut strokes: Vec<Path> = drawn.clone();
     for oriented in &file.ordering.sequence {
-        strokes[oriented.stroke] = oriented.path(&job.strokes);
+        strokes[oriented.stroke] = oriented.path(&drawn);
     }
     let segments: Vec<emg_viewer::JobSegment<'_>> = file
         .segments

@@ -7,9 +7,11 @@
 //!   round, are merged into strokes that draw the same geometry: every point of the job's
 //!   strokes within the tolerance of the stroke drawn, the lengths summed.
 
+mod common;
+
 use emg_control::{PATH_FORMAT_VERSION, Path, PathSpec, SegmentSpec};
 use emg_job::order::{Ordering, merge_and_order, order_strokes_counted};
-use emg_job::{JOB_TOLERANCE_M, Order};
+use emg_job::{JOB_TOLERANCE_M, Job, JobSettings, Order, verify_job};
 use emg_kinematics::Vec3;
 use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
@@ -209,4 +211,38 @@ fn in_the_given_order_a_stroke_merges_only_with_the_one_listed_before_it() {
     }
     assert_eq!(next, strokes.len());
     assert!(ordering.drawn.len() < strokes.len(), "some strokes merged");
+}
+
+#[test]
+fn a_job_of_strokes_that_merge_is_planned_as_the_merged_strokes_and_checks() {
+    let (planner, timing, checker, file) = common::setup("fr3");
+    // A 3 cm square drawn as four strokes, two of them turned round, the last a tenth of the
+    // tolerance short of the first's start; and a stroke apart.
+    let corner = |x: f64, y: f64| Vec3::new(0.45 + x, y, 0.25);
+    let gap = Vec3::new(0.0, 0.1 * JOB_TOLERANCE_M, 0.0);
+    let strokes = vec![
+        line(corner(0.0, 0.0), corner(0.03, 0.0)),
+        line(corner(0.03, 0.03), corner(0.03, 0.0)),
+        line(corner(0.03, 0.03), corner(0.0, 0.03)),
+        line(corner(0.0, 0.0) + gap, corner(0.0, 0.03)),
+        line(corner(0.0, 0.05), corner(0.03, 0.05)),
+    ];
+    let total_m: f64 = strokes.iter().map(Path::length_m).sum();
+    let job = Job {
+        strokes,
+        settings: JobSettings::default(),
+        home: None,
+    };
+    let program = common::plan(&planner, &timing, &file, &job);
+    assert_eq!(program.ordering.merged(), (4, 1));
+    assert_eq!(program.strokes.len(), 2);
+    let check = verify_job(&program, &checker, planner.robot().joint_names())
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!((check.drawn_m - program.summary.drawn_m).abs() < 1e-6);
+    assert!((program.summary.total_m - total_m).abs() < 1e-9);
+    assert!(
+        program.summary.drawn_m > total_m - 1e-3,
+        "{:?}",
+        program.summary
+    );
 }
