@@ -2,6 +2,8 @@
 //! stroke joins a chain of the job's strokes, each one after the last moved onto its end
 //! ([`Path::joined`]) by the gap between them, the gaps of a chain adding up to the job's line
 //! tolerance at most, so every point of the job's strokes lies within it of the stroke drawn.
+//! Strokes join only where the drawn stroke turns by [`MAX_JOIN_TURN_DEG`] at most: one that
+//! doubles back on itself is drawn as two.
 
 use emg_control::Path;
 use serde::{Deserialize, Serialize};
@@ -9,6 +11,9 @@ use serde::{Deserialize, Serialize};
 use super::Oriented;
 use super::near::Grid;
 use crate::spec::Order;
+
+/// The sharpest turn (degrees) where two merged strokes join.
+pub const MAX_JOIN_TURN_DEG: f64 = 90.0;
 
 /// The job's strokes one drawn stroke joins end to end, in order along it, each in its
 /// direction.
@@ -31,7 +36,7 @@ impl Chain {
 /// counted ([`Grid::work`]). Each chain grows from its first stroke (in the job's order) at its
 /// end, then, where every stroke of it may be reversed, at its start: by the nearest free end of
 /// another stroke within the tolerance the chain has left (a start, or an end where that stroke
-/// may be reversed). In the given order ([`Order::Given`]) a stroke joins only the one listed
+/// may be reversed) that turns by [`MAX_JOIN_TURN_DEG`] at most. In the given order ([`Order::Given`]) a stroke joins only the one listed
 /// before it, end to start. A chain whose strokes do not join is cut where they do not.
 pub fn merge_strokes(
     strokes: &[Path],
@@ -63,7 +68,9 @@ fn listed_chains(strokes: &[Path], tolerance_m: f64) -> Vec<Vec<Oriented>> {
             .checked_sub(1)
             .map(|before| (path.point_at(0.0) - end_of(&strokes[before])).norm());
         match (gap, chains.last_mut()) {
-            (Some(gap), Some(chain)) if gap <= left_m => {
+            (Some(gap), Some(chain))
+                if gap <= left_m && turns_gently(strokes, chain[chain.len() - 1], oriented) =>
+            {
                 left_m -= gap;
                 chain.push(oriented);
             }
@@ -114,7 +121,13 @@ fn nearest_chains(
             loop {
                 let last = chain[chain.len() - 1];
                 let at = grid.point(2 * last.stroke + usize::from(!last.reversed));
-                let accept = |point: usize| point.is_multiple_of(2) || reversible[point / 2];
+                let accept = |point: usize| {
+                    let next = Oriented {
+                        stroke: point / 2,
+                        reversed: !point.is_multiple_of(2),
+                    };
+                    (!next.reversed || reversible[next.stroke]) && turns_gently(strokes, last, next)
+                };
                 let Some(&(gap, point)) = grid.nearest(at, 1, left_m, accept).first() else {
                     break;
                 };
@@ -148,6 +161,25 @@ fn joined(chain: Vec<Oriented>, strokes: &[Path]) -> Vec<(Chain, Path)> {
         }
     }
     drawn
+}
+
+/// Whether `next` drawn after `last` (both of `strokes`) turns by [`MAX_JOIN_TURN_DEG`] at
+/// most where they join.
+fn turns_gently(strokes: &[Path], last: Oriented, next: Oriented) -> bool {
+    // The direction the drawn stroke takes at its start (or end).
+    let tangent = |o: Oriented, at_start: bool| {
+        let path = &strokes[o.stroke];
+        let s = if at_start != o.reversed {
+            0.0
+        } else {
+            path.length_m()
+        };
+        let along = path.tangent_at(s);
+        if o.reversed { -along } else { along }
+    };
+    // A turn of the limit to rounding counts as within it.
+    tangent(last, false).dot(&tangent(next, true))
+        >= libm::cos(MAX_JOIN_TURN_DEG.to_radians()) - 1e-12
 }
 
 /// The end point of `path`.
