@@ -222,6 +222,13 @@ pub fn print_summary(file: &emg_job::JobFile) {
         s.resumed,
         s.short
     );
+    let (merged, into) = file.ordering.merged();
+    if merged > 0 {
+        println!(
+            "{} merged into {into}, meeting end to end",
+            count(merged, "stroke")
+        );
+    }
     println!(
         "pen down {:.4} m of {:.4} m ({:.1} %); pen-up travel {:.3} m in the order drawn ({:.3} m as given)",
         s.drawn_m,
