@@ -397,7 +397,7 @@ fn from_home_rad(program: &JobFile) -> f64 {
         return 0.0;
     };
     program
-        .points
+        .points()
         .iter()
         .flat_map(|p| p.positions.iter().zip(home).map(|(q, h)| (q - h).abs()))
         .fold(0.0, f64::max)
@@ -415,11 +415,8 @@ struct MoveTurns {
 /// whole turn the way it went (`end − sign(Δ)·2π`) lies within `limits`: a shorter turn to the
 /// same angle existed.
 fn move_turns(program: &JobFile, limits: &emg_kinematics::JointLimits) -> MoveTurns {
-    let times: Vec<f64> = program
-        .points
-        .iter()
-        .map(|p| p.time_from_start.seconds())
-        .collect();
+    let points = program.points();
+    let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
     let mut turns = MoveTurns {
         moves: 0,
         over_half: 0,
@@ -431,7 +428,7 @@ fn move_turns(program: &JobFile, limits: &emg_kinematics::JointLimits) -> MoveTu
         }
         let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
         let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
-        let points = &program.points[first..last];
+        let points = &points[first..last];
         let (Some(start), Some(end)) = (points.first(), points.last()) else {
             continue;
         };
@@ -505,7 +502,7 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
         if let Some(end) = last {
             moves += 1;
             colliding += usize::from(!free.edge_free(&end, &start));
-            let samples = time_free_move(&[end, start], timing.request());
+            let samples = time_free_move(&[end, start], timing.request()).samples;
             duration_s += samples.last().map_or(0.0, |s| s.time_s());
         }
         last = Some(timed.samples[timed.samples.len() - 1].q);

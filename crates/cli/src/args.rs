@@ -41,7 +41,7 @@ pub enum Command {
     Export(crate::export::ExportArgs),
     /// Plan a job: a job file or an SVG drawing, every stroke to the limit (resumed after a
     /// reconfiguration where one motion cannot finish it), safe moves between strokes, one timed
-    /// program written as an emg-job/2 file (see docs/jobs.md).
+    /// program written as an emg-job/3 file (see docs/jobs.md).
     Job(crate::job::JobArgs),
     /// Find where to put a job's part (shifted on its surface, turned about its normal) so the
     /// arm draws the most of it: places screened by the strokes' reachability bounds, the best

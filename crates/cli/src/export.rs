@@ -60,8 +60,12 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
         Some(_) => None,
         None => Some(emg_io::read_joint_trajectory(&args.file)?),
     };
+    let job_points = job
+        .as_ref()
+        .map(emg_job::JobFile::points)
+        .unwrap_or_default();
     let (points, robot_field) = match (&job, &trajectory) {
-        (Some(job), _) => (job.timed_points(), job.robot.as_str()),
+        (Some(job), _) => (job.timed_points(&job_points), job.robot.as_str()),
         (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
         (None, None) => unreachable!("a file is read as one or the other"),
     };
@@ -147,7 +151,7 @@ pub fn export_program(
     robot: &Robot,
 ) -> Result<String> {
     export_to(
-        file.timed_points(),
+        file.timed_points(&file.points()),
         format,
         &beside_program(out, format),
         robot_file,

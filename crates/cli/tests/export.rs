@@ -313,7 +313,17 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
 /// velocity and acceleration limits, then a hold at its last point and `stopj`.
 fn assert_urscript_follows(motion: &Path, script: &Path) {
     let file = read_json(motion);
-    let points = file["points"].as_array().unwrap();
+    // A job's program holds what defines its motion; its samples are evaluated from it.
+    let samples = match emg_job::JobFile::is_job(&file.to_string()) {
+        true => serde_json::to_value(
+            emg_job::JobFile::parse(&file.to_string())
+                .expect("a job's program")
+                .points(),
+        )
+        .unwrap(),
+        false => file["points"].clone(),
+    };
+    let points = samples.as_array().unwrap();
     let by_time: std::collections::BTreeMap<i64, Vec<f64>> = points
         .iter()
         .map(|p| (nanoseconds(p), numbers(&p["positions"])))
@@ -373,8 +383,12 @@ fn assert_urscript_follows(motion: &Path, script: &Path) {
                 "target {k} joint {j}"
             );
             let last = &previous[previous.len() - 1];
+            // A move at a joint's speed limit differs from it by the rounding of its positions.
             let speed = (value - last[j]).abs() / 0.002;
-            assert!(speed <= velocity[j], "target {k} joint {j}: {speed} rad/s");
+            assert!(
+                speed <= velocity[j] * (1.0 + 1e-9),
+                "target {k} joint {j}: {speed} rad/s"
+            );
             if previous.len() >= 2 {
                 let before = &previous[previous.len() - 2];
                 let accel = (value - 2.0 * last[j] + before[j]).abs() / 4e-6;

@@ -190,7 +190,7 @@ struct SeamsJob {
     stdout: String,
     /// Where it wrote the page.
     page_path: std::path::PathBuf,
-    /// The program (`emg-job/2`).
+    /// The program (`emg-job/3`).
     program: Value,
     /// The page.
     page: String,

@@ -192,11 +192,12 @@ fn a_job_runs_from_home_and_back_and_check_reports_its_claims() {
         serde_json::from_value(program["home"].clone()).expect("a home")
     };
     let first_and_last = |program: &serde_json::Value| -> (Vec<f64>, Vec<f64>) {
-        let points = program["points"].as_array().unwrap();
-        let positions = |p: &serde_json::Value| serde_json::from_value(p["positions"].clone());
+        let points = emg_job::JobFile::parse(&program.to_string())
+            .expect("a program")
+            .points();
         (
-            positions(&points[0]).unwrap(),
-            positions(&points[points.len() - 1]).unwrap(),
+            points[0].positions.clone(),
+            points[points.len() - 1].positions.clone(),
         )
     };
     let (output, out) = plan("shipped.job.json", &[]);

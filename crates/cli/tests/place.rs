@@ -154,8 +154,8 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let output = emg(&["job", &export, "--out", &again]);
     assert!(output.status.success(), "{}", text(&output.stderr));
     assert_eq!(
-        read_json(Path::new(&again))["points"],
-        read_json(Path::new(&placed))["points"]
+        read_json(Path::new(&again))["segments"],
+        read_json(Path::new(&placed))["segments"]
     );
 }
 
@@ -209,7 +209,10 @@ fn the_base_is_moved_in_its_cell_to_where_the_icon_is_drawn_whole() {
     let again = file("again.json");
     let output = emg(&["job", &export, "--scene", &moved_cell, "--out", &again]);
     assert!(output.status.success(), "{}", text(&output.stderr));
-    assert_eq!(read_json(Path::new(&again))["points"], program["points"]);
+    assert_eq!(
+        read_json(Path::new(&again))["segments"],
+        program["segments"]
+    );
 }
 
 #[test]

@@ -10,7 +10,7 @@
 //!    approach along n;
 //! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
-//!    an `emg-job/2` file;
+//!    an `emg-job/3` file;
 //!
 //! and [`verify_job`] re-checks a written program with the independent checker.
 //!
@@ -18,6 +18,7 @@
 
 pub mod claims;
 pub mod free_space;
+pub mod motion;
 pub mod order;
 pub mod page;
 pub mod place;
@@ -38,6 +39,7 @@ use rayon::prelude::*;
 
 pub use claims::{COVERAGE_SLACK_M, Coverage, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
+pub use motion::Motion;
 pub use order::merge::{Chain, merge_strokes};
 pub use order::{Ordering, Oriented, merge_and_order, order_strokes, order_strokes_counted};
 pub use page::{placement_map, viewer_page};
@@ -46,7 +48,8 @@ pub use place::{
     Score, Scored, place_job, place_score,
 };
 pub use program::{
-    JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, Program, Segment, SegmentKind, StrokeReport,
+    JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, MAX_PROGRAM_S, Program, Segment,
+    SegmentKind, StrokeReport,
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
 pub use stroke::{StrokePart, StrokePlan, plan_stroke};
@@ -243,8 +246,8 @@ pub fn plan_job(
                     part: index,
                     from_s: part.from_s,
                 },
+                &timed.definition,
                 &timed.samples,
-                &[],
                 Some(&part.task),
                 dof,
             );
@@ -309,6 +312,9 @@ pub fn plan_job(
         started,
     );
     summary.ends_at_home = ends_at_home;
+    if program.duration_s() > MAX_PROGRAM_S {
+        return Err(JobPlanError::TooLong);
+    }
     Ok(JobFile {
         format: JOB_FILE_FORMAT.to_string(),
         robot: robot_file.to_string(),
@@ -321,8 +327,8 @@ pub fn plan_job(
         strokes: reports,
         summary,
         surfaces: free.surfaces().to_vec(),
+        rate_hz: timing.request().rate_hz,
         segments: program.segments().to_vec(),
-        points: program.points(dof).ok_or(JobPlanError::TooLong)?,
     })
 }
 
@@ -476,12 +482,13 @@ impl Connector<'_> {
         let request = self.timing.request();
         if retreat.is_some()
             && vertices.len() > 2
-            && let Some(samples) = time_blended_move(&vertices, request, BLEND_SHARE)
+            && let Some(timed) = time_blended_move(&vertices, request, BLEND_SHARE)
             && self
                 .free
-                .path_free(&samples.iter().map(|s| s.q).collect::<Vec<_>>())
+                .path_free(&timed.samples.iter().map(|s| s.q).collect::<Vec<_>>())
         {
-            program.append(SegmentKind::Travel, &samples, &vertices, None, dof);
+            let (definition, samples) = (&timed.definition, &timed.samples);
+            program.append(SegmentKind::Travel, definition, samples, None, dof);
             return;
         }
         if let Some(retreat) = retreat {

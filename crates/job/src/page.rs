@@ -38,7 +38,7 @@ pub fn viewer_page(file: &JobFile, job: &Job, robot: &Robot, name: &str) -> Stri
         })
         .collect();
     let samples: Vec<emg_viewer::JobSample> = file
-        .points
+        .points()
         .iter()
         .map(|point| emg_viewer::JobSample {
             time_s: point.time_from_start.seconds(),

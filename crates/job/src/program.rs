@@ -1,20 +1,26 @@
 //! The connect, time and write stages: the planned strokes joined by safe moves (retreat along
 //! −n, a free joint-space move, approach along n) into one timed joint trajectory, every segment
-//! listed with its time span, written as an `emg-job/2` file.
+//! listed with its time span and what its samples are computed from ([`Motion`]), written as an
+//! `emg-job/3` file; the samples evaluated from it ([`JobFile::points`]).
 
 use emg_control::{ConstraintConfig, PathSpec, Task};
 use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
 use emg_kinematics::JointVector;
 use emg_planner::MotionTiming;
-use emg_timing::{TimedSample, time_free_move};
+use emg_timing::{MotionDefinition, TimedSample, time_free_move};
 use serde::{Deserialize, Serialize};
 
 use crate::claims::Stretch;
+use crate::motion::Motion;
 use crate::order::Ordering;
 use crate::spec::JobSettings;
 
 /// The format tag of a job file.
-pub const JOB_FILE_FORMAT: &str = "emg-job/2";
+pub const JOB_FILE_FORMAT: &str = "emg-job/3";
+
+/// The longest program a file may hold (s): its sample times fit a joint trajectory's
+/// `time_from_start` (2³¹ s).
+pub const MAX_PROGRAM_S: f64 = 2e9;
 
 /// What a segment of the program does.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,6 +61,8 @@ pub struct Segment {
     /// A stroke part's task: the stretch of the stroke it follows.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub task: Option<Task>,
+    /// What the segment's samples are computed from.
+    pub motion: Motion,
 }
 
 /// What became of one stroke.
@@ -146,10 +154,10 @@ pub struct JobFile {
     /// The part the arm keeps off while drawing and moving: one task per plane of the strokes,
     /// whose work plate covers them all ([`crate::part_surfaces`]).
     pub surfaces: Vec<Task>,
+    /// The samples per second of the program's motion.
+    pub rate_hz: f64,
     /// The segments in time order.
     pub segments: Vec<Segment>,
-    /// The samples of the whole program, from rest to rest.
-    pub points: Vec<JointTrajectoryPoint>,
 }
 
 impl JobFile {
@@ -160,13 +168,78 @@ impl JobFile {
     }
 
     /// `text` read as a job's program: refused where it is a program of another version than
-    /// [`JOB_FILE_FORMAT`] (an `emg-job/2` program's claims cannot be checked) or not a valid
-    /// one.
+    /// [`JOB_FILE_FORMAT`] or not a valid one, or where a segment's motion cannot be sampled
+    /// ([`Self::check_motion`]).
     pub fn parse(text: &str) -> Result<Self, JobFileError> {
-        match Self::format_of(text) {
+        let file: Self = match Self::format_of(text) {
             Some(format) if format != JOB_FILE_FORMAT => Err(JobFileError::Version(format)),
             _ => serde_json::from_str(text).map_err(JobFileError::Invalid),
+        }?;
+        file.check_motion()?;
+        Ok(file)
+    }
+
+    /// Checks that every segment's motion can be sampled at the file's rate and that the
+    /// program lasts at most [`MAX_PROGRAM_S`]; else says which segment and field cannot.
+    pub fn check_motion(&self) -> Result<(), JobFileError> {
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0) {
+            return Err(JobFileError::Rate(self.rate_hz));
         }
+        let mut duration_s = 0.0;
+        for (index, segment) in self.segments.iter().enumerate() {
+            let definition = self
+                .definition(segment)
+                .map_err(|why| JobFileError::Motion {
+                    segment: index,
+                    why,
+                })?;
+            duration_s += definition.duration_bound_s(self.rate_hz);
+        }
+        if duration_s > MAX_PROGRAM_S {
+            return Err(JobFileError::TooLong(duration_s));
+        }
+        Ok(())
+    }
+
+    /// What `segment`'s samples are computed from, or why they cannot be (naming the field).
+    fn definition(&self, segment: &Segment) -> Result<MotionDefinition, String> {
+        segment
+            .motion
+            .definition(&segment.vertices, self.joint_names.len(), self.rate_hz)
+    }
+
+    /// The samples of the whole program at [`Self::rate_hz`], from rest to rest: each
+    /// segment's motion sampled ([`MotionDefinition::samples`]), every segment after the first
+    /// from its second sample on (its first is where the one before ends) and after the one
+    /// before's last sample in time. A file [`Self::parse`] accepts or [`crate::plan_job`]
+    /// writes gives the samples its motion was timed with.
+    ///
+    /// # Panics
+    ///
+    /// If a segment's motion cannot be sampled or the program lasts longer than
+    /// [`MAX_PROGRAM_S`] ([`Self::check_motion`]).
+    pub fn points(&self) -> Vec<JointTrajectoryPoint> {
+        let dof = self.joint_names.len();
+        let mut points = Vec::new();
+        let mut offset_ns = 0;
+        for segment in &self.segments {
+            let samples = self
+                .definition(segment)
+                .expect("a program's motion is checked when it is read or planned")
+                .samples(self.rate_hz);
+            let skip = usize::from(!points.is_empty());
+            points.extend(samples.iter().skip(skip).map(|sample| {
+                JointTrajectoryPoint {
+                    positions: sample.q.as_slice()[..dof].to_vec(),
+                    velocities: sample.qd.as_slice()[..dof].to_vec(),
+                    accelerations: sample.qdd.as_slice()[..dof].to_vec(),
+                    time_from_start: TimeFromStart::from_nanoseconds(sample.time_ns + offset_ns)
+                        .expect("a program's duration is checked when it is read or planned"),
+                }
+            }));
+            offset_ns += samples.last().map_or(0, |last| last.time_ns);
+        }
+        points
     }
 
     /// The `format` of a JSON text, if it has one.
@@ -181,12 +254,16 @@ impl JobFile {
         serde_json::from_str::<Format>(text).ok()?.format
     }
 
-    /// The samples as an export reads them ([`emg_io::export`]).
-    pub fn timed_points(&self) -> emg_io::TimedPoints<'_> {
+    /// The samples `points` (the program's: [`Self::points`]) as an export reads them
+    /// ([`emg_io::export`]).
+    pub fn timed_points<'a>(
+        &'a self,
+        points: &'a [JointTrajectoryPoint],
+    ) -> emg_io::TimedPoints<'a> {
         emg_io::TimedPoints {
             joint_names: &self.joint_names,
             limits: &self.limits,
-            points: &self.points,
+            points,
             home: self.home.as_deref(),
         }
     }
@@ -197,59 +274,78 @@ impl JobFile {
 pub enum JobFileError {
     /// A program of another version.
     #[error(
-        "is an {0} program, which this emg does not read (its claims cannot be checked): plan \
-         the job again, which writes {JOB_FILE_FORMAT}"
+        "is an {0} program, which this emg does not read: plan the job again, which writes \
+         {JOB_FILE_FORMAT}"
     )]
     Version(String),
     /// Not a valid program.
     #[error("is not a valid {JOB_FILE_FORMAT} file: {0}")]
     Invalid(serde_json::Error),
+    /// A rate that is not a positive number.
+    #[error("is not a valid {JOB_FILE_FORMAT} file: rate_hz must be positive, got {0}")]
+    Rate(f64),
+    /// A segment whose motion cannot be sampled.
+    #[error("is not a valid {JOB_FILE_FORMAT} file: segments[{segment}].{why}")]
+    Motion {
+        /// The segment's index.
+        segment: usize,
+        /// Why, naming the field.
+        why: String,
+    },
+    /// A program too long for a joint trajectory's times.
+    #[error(
+        "is not a valid {JOB_FILE_FORMAT} file: its motion lasts {0:.0} s, more than \
+         {MAX_PROGRAM_S:.0} s"
+    )]
+    TooLong(f64),
 }
 
-/// The program being assembled: samples on one time line and the segments they make.
+/// The program being assembled: its segments on one time line.
 #[derive(Default)]
 pub struct Program {
-    samples: Vec<TimedSample>,
     segments: Vec<Segment>,
+    /// The last sample so far, on the program's time line.
+    last: Option<TimedSample>,
 }
 
 impl Program {
     /// The configuration the program ends at, if it has begun.
     pub fn last(&self) -> Option<JointVector> {
-        self.samples.last().map(|sample| sample.q)
+        self.last.map(|sample| sample.q)
     }
 
-    /// Appends `samples` (a rest-to-rest motion from the program's last configuration, its times
-    /// from 0) as a segment of `kind` (a stroke part with its `task`).
+    /// Appends the rest-to-rest motion `definition` from the program's last configuration (its
+    /// samples `samples`, times from 0) as a segment of `kind` (a stroke part with its `task`);
+    /// a move's vertices are its definition's.
     pub fn append(
         &mut self,
         kind: SegmentKind,
+        definition: &MotionDefinition,
         samples: &[TimedSample],
-        vertices: &[JointVector],
         task: Option<&Task>,
         dof: usize,
     ) {
-        let offset_ns = self.samples.last().map_or(0, |last| last.time_ns);
-        let skip = usize::from(!self.samples.is_empty());
-        let start_s = offset_ns as f64 * 1e-9;
-        self.samples
-            .extend(samples.iter().skip(skip).map(|sample| TimedSample {
-                time_ns: sample.time_ns + offset_ns,
-                ..*sample
-            }));
-        let end_s = self
-            .samples
-            .last()
-            .map_or(0.0, |last| last.time_ns as f64 * 1e-9);
+        let offset_ns = self.last.map_or(0, |last| last.time_ns);
+        let end = samples.last().map(|last| TimedSample {
+            time_ns: last.time_ns + offset_ns,
+            ..*last
+        });
+        self.last = end.or(self.last);
+        let vertices = match definition {
+            MotionDefinition::Splines { .. } => &[][..],
+            MotionDefinition::Polyline { vertices, .. }
+            | MotionDefinition::Blended { vertices, .. } => vertices,
+        };
         self.segments.push(Segment {
             kind,
-            start_s,
-            end_s,
+            start_s: offset_ns as f64 * 1e-9,
+            end_s: self.last.map_or(0.0, |last| last.time_s()),
             vertices: vertices
                 .iter()
                 .map(|q| q.as_slice()[..dof].to_vec())
                 .collect(),
             task: task.cloned(),
+            motion: Motion::of(definition, dof),
         });
     }
 
@@ -261,8 +357,8 @@ impl Program {
         timing: &MotionTiming,
         dof: usize,
     ) {
-        let samples = time_free_move(vertices, timing.request());
-        self.append(kind, &samples, vertices, None, dof);
+        let timed = time_free_move(vertices, timing.request());
+        self.append(kind, &timed.definition, &timed.samples, None, dof);
     }
 
     /// The segments so far.
@@ -270,24 +366,8 @@ impl Program {
         &self.segments
     }
 
-    /// The samples as joint trajectory points (the arm's `dof` joints); `None` where a time is
-    /// past what the format holds.
-    pub fn points(&self, dof: usize) -> Option<Vec<JointTrajectoryPoint>> {
-        self.samples
-            .iter()
-            .map(|sample| {
-                Some(JointTrajectoryPoint {
-                    positions: sample.q.as_slice()[..dof].to_vec(),
-                    velocities: sample.qd.as_slice()[..dof].to_vec(),
-                    accelerations: sample.qdd.as_slice()[..dof].to_vec(),
-                    time_from_start: TimeFromStart::from_nanoseconds(sample.time_ns)?,
-                })
-            })
-            .collect()
-    }
-
-    /// The samples.
-    pub fn samples(&self) -> &[TimedSample] {
-        &self.samples
+    /// The program's end (s).
+    pub fn duration_s(&self) -> f64 {
+        self.last.map_or(0.0, |last| last.time_s())
     }
 }

@@ -1,4 +1,4 @@
-//! The independent check of a job's program (`emg check` on an `emg-job/2` file): every segment
+//! The independent check of a job's program (`emg check` on an `emg-job/3` file): every segment
 //! replayed by the checker (`emg_verify`, which shares no kinematics with the planners), each
 //! from rest to rest within the joint velocity, acceleration and jerk limits; a stroke part's
 //! samples on its stretch of the stroke within the tolerance and the cone, clear of the arm's
@@ -101,15 +101,15 @@ pub fn verify_job(
         theta_max_deg: 180.0,
         ..on_part.clone()
     };
-    let times: Vec<f64> = file
-        .points
+    let all_points = file.points();
+    let times: Vec<f64> = all_points
         .iter()
         .map(|p| p.time_from_start.seconds())
         .collect();
     let mut check = JobCheck {
         stroke_parts: 0,
         moves: 0,
-        points: file.points.len(),
+        points: all_points.len(),
         strokes: file.strokes.len(),
         whole_strokes: 0,
         drawn_m: 0.0,
@@ -120,7 +120,7 @@ pub fn verify_job(
     for (index, segment) in file.segments.iter().enumerate() {
         let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
         let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
-        let points = &file.points[first..last];
+        let points = &all_points[first..last];
         let samples = JointSamples {
             time_s: times[first..last].to_vec(),
             q: points.iter().map(|p| joints(&p.positions)).collect(),
@@ -193,7 +193,7 @@ pub fn verify_job(
         check.total_m += report.length_m;
     }
     verify_summary(file)?;
-    verify_home(file)?;
+    verify_home(file, &all_points)?;
     Ok(check)
 }
 
@@ -279,8 +279,12 @@ fn verify_claims(report: &StrokeReport, covered: &[Stretch]) -> Result<Coverage,
     Ok(measured)
 }
 
-/// Checks that the program starts at its home, and ends there where it says it does.
-fn verify_home(file: &JobFile) -> Result<(), JobCheckError> {
+/// Checks that the program (its samples `points`) starts at its home, and ends there where it
+/// says it does.
+fn verify_home(
+    file: &JobFile,
+    points: &[emg_io::JointTrajectoryPoint],
+) -> Result<(), JobCheckError> {
     let at = |point: Option<&emg_io::JointTrajectoryPoint>, home: &[f64]| {
         point.is_some_and(|p| {
             p.positions.len() == home.len()
@@ -291,10 +295,10 @@ fn verify_home(file: &JobFile) -> Result<(), JobCheckError> {
         })
     };
     match &file.home {
-        Some(home) if !at(file.points.first(), home) => Err(JobCheckError::Summary(format!(
+        Some(home) if !at(points.first(), home) => Err(JobCheckError::Summary(format!(
             "the program does not start at its home {home:?}"
         ))),
-        Some(home) if file.summary.ends_at_home && !at(file.points.last(), home) => Err(
+        Some(home) if file.summary.ends_at_home && !at(points.last(), home) => Err(
             JobCheckError::Summary(format!("the program does not end at its home {home:?}")),
         ),
         None if file.summary.ends_at_home => Err(JobCheckError::Summary(

@@ -24,10 +24,11 @@ fn the_ur5e_house_starts_and_ends_at_home_every_joint_within_half_a_turn_of_it()
     let home = shipped.home;
     assert_eq!(program.home.as_deref(), Some(home));
     assert!(program.summary.ends_at_home);
-    let first = &program.points[0].positions;
-    let last = &program.points[program.points.len() - 1].positions;
+    let points = program.points();
+    let first = &points[0].positions;
+    let last = &points[points.len() - 1].positions;
     assert_eq!((first.as_slice(), last.as_slice()), (home, home));
-    for point in &program.points {
+    for point in &points {
         for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
             assert!(
                 (q - h).abs() <= PI,

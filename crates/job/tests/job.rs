@@ -63,7 +63,7 @@ fn plans_and_checks_the_pencil_icon(name: &str) {
     }
     let check = verify_job(&program, &checker, planner.robot().joint_names())
         .unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(check.points, program.points.len());
+    assert_eq!(check.points, program.points().len());
     assert!(check.moves > check.stroke_parts);
     // A program moved off its stroke is refused.
     let mut moved = program.clone();

@@ -34,7 +34,7 @@ pub struct ExportReport {
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/2` file) as `format`
+/// there (an `emg-job/3` file) as `format`
 /// (`"ros2-mcap"` or `"urscript"`) to `out`, for its own robot or `robot` (a shipped robot's
 /// name or a robot file), as `emg export` does: nothing is written on an error, and `out` never
 /// replaces `path`.
@@ -67,8 +67,12 @@ pub fn export(
         Some(_) => None,
         None => Some(emg_io::read_joint_trajectory(&path).map_err(fail)?),
     };
+    let job_points = job
+        .as_ref()
+        .map(emg_job::JobFile::points)
+        .unwrap_or_default();
     let (points, robot_field) = match (&job, &trajectory) {
-        (Some(job), _) => (job.timed_points(), job.robot.as_str()),
+        (Some(job), _) => (job.timed_points(&job_points), job.robot.as_str()),
         (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
         (None, None) => unreachable!("a file is read as one or the other"),
     };

@@ -19,6 +19,8 @@ use crate::{InputError, PlanningError, input_error, message};
 #[pyclass(frozen, module = "extreme_line_motion")]
 pub struct JobPlan {
     pub(crate) file: JobFile,
+    /// The program's samples ([`JobFile::points`]).
+    points: Vec<emg_io::JointTrajectoryPoint>,
 }
 
 /// The job of `job`: a job file or an SVG drawing (`str` or `os.PathLike`; an SVG is placed by
@@ -165,7 +167,7 @@ pub(crate) fn plan(
             )
         })
         .map_err(|e| PlanningError::new_err(message(&e)))?;
-    Ok(JobPlan { file })
+    Ok(JobPlan::new(file))
 }
 
 /// A JSON value of the program as Python objects.
@@ -230,22 +232,22 @@ impl JobPlan {
     /// Joint positions of every sample (rad), shape (n, joints).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.rows(py, 0..self.file.points.len(), |p| &p.positions)
+        self.rows(py, 0..self.points.len(), |p| &p.positions)
     }
 
     /// Joint velocities of every sample (rad/s), shape (n, joints).
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.rows(py, 0..self.file.points.len(), |p| &p.velocities)
+        self.rows(py, 0..self.points.len(), |p| &p.velocities)
     }
 
     /// Joint accelerations of every sample (rad/s²), shape (n, joints).
     #[getter]
     fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.rows(py, 0..self.file.points.len(), |p| &p.accelerations)
+        self.rows(py, 0..self.points.len(), |p| &p.accelerations)
     }
 
-    /// Writes the program as an `emg-job/2` file (`emg check` verifies it).
+    /// Writes the program as an `emg-job/3` file (`emg check` verifies it).
     fn write(&self, path: PathBuf) -> PyResult<()> {
         let text = serde_json::to_string(&self.file).expect("a job's program serialises") + "\n";
         emg_io::write_atomically(&path, text)
@@ -268,9 +270,14 @@ impl JobPlan {
 }
 
 impl JobPlan {
+    /// The program `file`, its samples evaluated.
+    pub(crate) fn new(file: JobFile) -> Self {
+        let points = file.points();
+        Self { file, points }
+    }
+
     fn times(&self) -> Vec<f64> {
-        self.file
-            .points
+        self.points
             .iter()
             .map(|p| p.time_from_start.seconds())
             .collect()
@@ -283,7 +290,7 @@ impl JobPlan {
         values: impl Fn(&emg_io::JointTrajectoryPoint) -> &Vec<f64>,
     ) -> Bound<'py, PyArray2<f64>> {
         let joints = self.file.joint_names.len();
-        let points = &self.file.points[range];
+        let points = &self.points[range];
         let flat: Vec<f64> = points.iter().flat_map(|p| values(p).clone()).collect();
         Array2::from_shape_vec((points.len(), joints), flat)
             .expect("one value per joint")
@@ -401,15 +408,15 @@ impl JobPlacement {
     /// The program planned at the chosen place.
     #[getter]
     fn program(&self) -> JobPlan {
-        JobPlan {
-            file: (**self
+        JobPlan::new(
+            (**self
                 .placement
                 .best()
                 .program
                 .as_ref()
                 .expect("the chosen place was planned"))
             .clone(),
-        }
+        )
     }
 
     /// The heat map as SVG text (what `emg place --map` writes).

@@ -87,8 +87,8 @@ def test_a_job_given_a_home_starts_and_ends_there_and_passes_the_checker(tmp_pat
     job.write(program)
     written = json.loads(program.read_text())
     assert written["home"] == OTHER_HOME
-    assert written["points"][0]["positions"] == OTHER_HOME
-    assert written["points"][-1]["positions"] == OTHER_HOME
+    assert written["segments"][0]["vertices"][0] == OTHER_HOME
+    assert written["segments"][-1]["vertices"][-1] == OTHER_HOME
     assert "OK" in run_cli("check", program).stdout
 
 
@@ -123,12 +123,11 @@ def test_check_reads_a_program_as_the_cli_does_from_any_directory(tmp_path, job_
     assert report.layout == json.loads(program.read_text())["format"]
     assert report.stroke_parts >= 3 and report.moves >= 2 and report.points > 100
     assert "OK" in run_cli("check", program).stdout
-    # A program one of whose stroke samples is moved off its path is refused, as by the CLI.
+    # A program whose stroke motion is moved off its path is refused, as by the CLI.
     file = json.loads(program.read_text())
     stroke = next(s for s in file["segments"] if s["kind"] == "stroke")
-    middle = (stroke["start_s"] + stroke["end_s"]) / 2
-    point = next(p for p in file["points"] if p["time_from_start"]["sec"] + p["time_from_start"]["nanosec"] * 1e-9 >= middle)
-    point["positions"][0] += 0.05
+    values = stroke["motion"]["stretches"][0]["values"]
+    values[len(values) // 2][0] += 0.05
     tampered = tmp_path / "tampered.job.json"
     tampered.write_text(json.dumps(file))
     with pytest.raises(elm.CheckFailed, match="tampered.job.json does not hold up"):

@@ -8,8 +8,9 @@
 use emg_kinematics::JointVector;
 
 use crate::dynamics::{TimedSample, breaches};
-use crate::free::{FREE_GRID_PER_RAD, push_samples};
-use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::free::{FREE_GRID_PER_RAD, TimedMove, push_samples};
+use crate::motion::{MotionDefinition, ProfileGrid, at_rest};
+use crate::profile::SmoothedProfile;
 use crate::retime::{ACCELERATION_MARGIN, MAX_SLOWDOWNS, TimingRequest, slow_down};
 use crate::topp::{GridPoint, topp_ra};
 
@@ -155,30 +156,70 @@ fn blended_pieces(vertices: &[JointVector], share: f64) -> Option<Vec<Piece>> {
     Some(pieces)
 }
 
-/// Samples at `request.rate_hz` of the rest-to-rest motion along the polyline `vertices` with
-/// every corner rounded (each arc starting `share` ≤ ½ of the shorter of its edges before its
-/// vertex), not stopping at any inner vertex; `None` where a corner turns back (more than
-/// [`MAX_BLEND_TURN_DEG`]) or the samples break a limit after
-/// [`MAX_SLOWDOWNS`] local slow-downs.
-///
-/// # Panics
-///
-/// If `vertices` is empty.
+/// A polyline with its corners rounded, parameterised by its joint-space arc length from 0.
+pub(crate) struct BlendedPath {
+    pieces: Vec<Piece>,
+    /// Where each piece starts.
+    starts: Vec<f64>,
+    /// The polyline's first and last vertex.
+    ends: [JointVector; 2],
+}
+
+impl BlendedPath {
+    /// The polyline `vertices` with its corners rounded, each arc starting `share` (at most ½)
+    /// of the shorter of its two edges before its vertex; `None` where a corner turns by more
+    /// than [`MAX_BLEND_TURN_DEG`] or the polyline has no length.
+    pub(crate) fn new(vertices: &[JointVector], share: f64) -> Option<Self> {
+        let pieces = blended_pieces(vertices, share.clamp(0.0, 0.5))?;
+        let mut at = 0.0;
+        let starts = pieces
+            .iter()
+            .map(|piece| {
+                let start = at;
+                at += piece.length();
+                start
+            })
+            .collect();
+        let ends = [*vertices.first()?, *vertices.last()?];
+        (!pieces.is_empty()).then_some(Self {
+            pieces,
+            starts,
+            ends,
+        })
+    }
+
+    /// The point, its first and its second derivative by arc length at `s`.
+    fn eval(&self, s: f64) -> (JointVector, JointVector, JointVector) {
+        let index = self.starts.partition_point(|start| *start <= s).max(1) - 1;
+        self.pieces[index].eval(s - self.starts[index])
+    }
+
+    /// The samples at `rate_hz` of the motion along the path by `profile`, from rest at the
+    /// first vertex to rest at the last.
+    pub(crate) fn samples(&self, profile: &SmoothedProfile, rate_hz: f64) -> Vec<TimedSample> {
+        let [first, end] = self.ends;
+        let mut samples = vec![at_rest(first)];
+        push_samples(profile, rate_hz, 0, &end, &mut samples, |s| self.eval(s));
+        samples
+    }
+}
+
+/// The rest-to-rest motion at `request.rate_hz` along the polyline `vertices` with every corner
+/// rounded (each arc starting `share` ≤ ½ of the shorter of its edges before its vertex), not
+/// stopping at any inner vertex; `None` where a corner turns back (more than
+/// [`MAX_BLEND_TURN_DEG`]) or the samples break a limit after [`MAX_SLOWDOWNS`] local
+/// slow-downs.
 pub fn time_blended_move(
     vertices: &[JointVector],
     request: &TimingRequest,
     share: f64,
-) -> Option<Vec<TimedSample>> {
-    let first = *vertices.first().expect("a move has a vertex");
-    let end = *vertices.last().expect("a move has a vertex");
-    let pieces = blended_pieces(vertices, share.clamp(0.0, 0.5))?;
-    let mut starts = Vec::with_capacity(pieces.len());
+) -> Option<TimedMove> {
+    let share = share.clamp(0.0, 0.5);
+    let path = BlendedPath::new(vertices, share)?;
     let mut grid = Vec::new();
-    let mut at = 0.0;
     let limits = &request.limits;
     let (velocity, jerk) = (&limits.velocity, &limits.jerk);
-    for piece in &pieces {
-        starts.push(at);
+    for (piece, at) in path.pieces.iter().zip(&path.starts) {
         let length = piece.length();
         let per_m = match piece {
             Piece::Line { .. } => FREE_GRID_PER_RAD,
@@ -210,21 +251,17 @@ pub fn time_blended_move(
                 )
                 .fold(f64::INFINITY, f64::min);
             grid.push(GridPoint {
-                s: at + local,
+                s: *at + local,
                 dq,
                 ddq,
                 x_max: speed_bound * speed_bound,
             });
         }
-        at += length;
     }
     if grid.len() < 2 {
         return None;
     }
-    let path = |s: f64| {
-        let index = starts.partition_point(|start| *start <= s).max(1) - 1;
-        pieces[index].eval(s - starts[index])
-    };
+    let s: Vec<f64> = grid.iter().map(|g: &GridPoint| g.s).collect();
     // As a stroke is timed: averaged over the window the jerk limits need at full acceleration,
     // slowed down locally wherever a sample still breaks a limit.
     let window = 2.0
@@ -238,23 +275,28 @@ pub fn time_blended_move(
     let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
     let mut factor = vec![1.0; grid.len()];
     for _ in 0..=MAX_SLOWDOWNS {
-        let x = topp_ra(&grid, &planned_acceleration, &factor);
-        let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
-        let mut samples = vec![TimedSample {
-            time_ns: 0,
-            q: first,
-            qd: JointVector::zeros(),
-            qdd: JointVector::zeros(),
-        }];
-        push_samples(&profile, request.rate_hz, 0, &end, &mut samples, path);
+        let profile = ProfileGrid {
+            s: s.clone(),
+            x: topp_ra(&grid, &planned_acceleration, &factor),
+            window_s: window,
+        };
+        let smoothed = profile.smoothed();
+        let samples = path.samples(&smoothed, request.rate_hz);
         let found = breaches(&samples, limits);
         if found.is_empty() {
-            return Some(samples);
+            return Some(TimedMove {
+                samples,
+                definition: MotionDefinition::Blended {
+                    vertices: vertices.to_vec(),
+                    share,
+                    profile,
+                },
+            });
         }
         slow_down(
             &mut factor,
             &grid,
-            &profile,
+            &smoothed,
             &samples,
             &found,
             request.rate_hz,
@@ -266,7 +308,7 @@ pub fn time_blended_move(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::free::tests::{assert_velocities_match_positions, request};
+    use crate::free::tests::{assert_samples, assert_velocities_match_positions, request};
     use crate::{first_breach, time_free_move};
 
     /// Distance of `q` from the polyline `vertices`.
@@ -294,7 +336,9 @@ mod tests {
         d[2] = 0.0;
         let vertices = [a, b, c, d];
         let share = 0.5;
-        let samples = time_blended_move(&vertices, &request, share).expect("a blended move");
+        let samples = time_blended_move(&vertices, &request, share)
+            .expect("a blended move")
+            .samples;
         let (first, last) = (samples[0], samples[samples.len() - 1]);
         assert_eq!((first.q, last.q), (a, d));
         assert_eq!(
@@ -309,8 +353,40 @@ mod tests {
             assert!(sample.qd.norm() > 0.0);
         }
         assert_velocities_match_positions(&samples);
+        // The samples the move's timing gave before programs kept its definition instead.
+        assert_samples(
+            &samples,
+            2566,
+            &[
+                (
+                    582,
+                    [
+                        [0.020672178868354416, 0.0, -0.010336089434177208],
+                        [0.21574309536045663, 0.0, -0.10787154768022832],
+                        [0.5979789868631116, 0.0, -0.2989894934315558],
+                    ],
+                ),
+                (
+                    1164,
+                    [
+                        [0.3507111631839721, 0.0, -0.17535558159198605],
+                        [0.8944271909999171, 0.0, -0.44721359549995854],
+                        [0.0, 0.0, 0.0],
+                    ],
+                ),
+                (
+                    1746,
+                    [
+                        [0.8595202555740978, 0.0, -0.4297601277870489],
+                        [0.7012069419113979, 0.0, -0.35060347095569894],
+                        [-2.1201463091756025, 0.0, 1.0600731545878013],
+                    ],
+                ),
+                (2565, [[1.0, 0.0, -0.5], [0.0; 3], [0.0; 3]]),
+            ],
+        );
         // Faster than stopping at every vertex.
-        let stopping = time_free_move(&vertices, &request);
+        let stopping = time_free_move(&vertices, &request).samples;
         assert!(last.time_ns < stopping[stopping.len() - 1].time_ns);
     }
 

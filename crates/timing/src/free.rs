@@ -7,7 +7,8 @@
 use emg_kinematics::JointVector;
 
 use crate::dynamics::TimedSample;
-use crate::profile::{SmoothedProfile, SpeedProfile};
+use crate::motion::{MotionDefinition, ProfileGrid, at_rest, moving_edges};
+use crate::profile::SmoothedProfile;
 use crate::retime::TimingRequest;
 use crate::topp::{GridPoint, topp_ra};
 
@@ -15,39 +16,56 @@ use crate::topp::{GridPoint, topp_ra};
 /// straight edge is exact up to the grid's interpolation of its acceleration bounds.
 pub const FREE_GRID_PER_RAD: f64 = 100.0;
 
-/// Samples at `request.rate_hz` of the rest-to-rest motion along the polyline `vertices`
-/// (from rest at the first to rest at the last, at rest at every inner vertex), every one at a
-/// time `k / rate` from 0. Edges shorter than 1e-9 rad are skipped; a single vertex is one sample at rest.
+/// A timed move through free space: its samples and what they are computed from.
+#[derive(Clone, Debug)]
+pub struct TimedMove {
+    /// Samples at `k / rate` (rounded to whole nanoseconds), from rest to rest.
+    pub samples: Vec<TimedSample>,
+    /// What the samples are computed from ([`MotionDefinition::samples`] gives them again).
+    pub definition: MotionDefinition,
+}
+
+/// The rest-to-rest motion along the polyline `vertices` at `request.rate_hz` (from rest at the
+/// first to rest at the last, at rest at every inner vertex), every sample at a time `k / rate`
+/// from 0. Edges shorter than 1e-9 rad are skipped; a single vertex is one sample at rest.
 ///
 /// # Panics
 ///
 /// If `vertices` is empty.
-pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Vec<TimedSample> {
-    let first = *vertices.first().expect("a move has a vertex");
-    let mut samples = vec![TimedSample {
-        time_ns: 0,
-        q: first,
-        qd: JointVector::zeros(),
-        qdd: JointVector::zeros(),
-    }];
+pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> TimedMove {
+    assert!(!vertices.is_empty(), "a move has a vertex");
+    let edges = moving_edges(vertices)
+        .map(|(_, _, direction, length)| edge_profile(&direction, length, request))
+        .collect();
+    let definition = MotionDefinition::Polyline {
+        vertices: vertices.to_vec(),
+        edges,
+    };
+    TimedMove {
+        samples: definition.samples(request.rate_hz),
+        definition,
+    }
+}
+
+/// The samples of the motion along the polyline `vertices`, along each edge of at least 1e-9
+/// rad by its profile in `edges` ([`MotionDefinition::Polyline`]).
+pub(crate) fn polyline_samples(
+    vertices: &[JointVector],
+    edges: &[ProfileGrid],
+    rate_hz: f64,
+) -> Vec<TimedSample> {
+    let mut samples = vec![at_rest(vertices[0])];
     // Every sample lies on the grid `k / rate`; an edge's last sample, on the first grid time at
     // or after its end, holds its end vertex at rest.
     let mut elapsed = 0u64;
-    for edge in vertices.windows(2) {
-        let chord = edge[1] - edge[0];
-        let length = chord.norm();
-        if length < 1e-9 {
-            continue;
-        }
-        let direction = chord / length;
-        let profile = edge_profile(&direction, length, request);
+    for ((from, to, direction, _), profile) in moving_edges(vertices).zip(edges) {
         elapsed = push_samples(
-            &profile,
-            request.rate_hz,
+            &profile.smoothed(),
+            rate_hz,
             elapsed,
-            &edge[1],
+            &to,
             &mut samples,
-            |s| (edge[0] + direction * s, direction, JointVector::zeros()),
+            |s| (from + direction * s, direction, JointVector::zeros()),
         );
     }
     samples
@@ -93,7 +111,7 @@ pub(crate) fn push_samples(
 
 /// The jerk-limited rest-to-rest profile along a straight edge of `length` rad in the unit
 /// joint direction `direction`.
-fn edge_profile(direction: &JointVector, length: f64, request: &TimingRequest) -> SmoothedProfile {
+fn edge_profile(direction: &JointVector, length: f64, request: &TimingRequest) -> ProfileGrid {
     let limits = &request.limits;
     let speed_bound = (0..direction.len())
         .filter(|&j| direction[j].abs() > 1e-12)
@@ -120,7 +138,11 @@ fn edge_profile(direction: &JointVector, length: f64, request: &TimingRequest) -
         .filter(|&j| direction[j].abs() > 1e-12)
         .map(|j| 2.0 * largest_sdd * direction[j].abs() / limits.jerk[j])
         .fold(1e-6, f64::max);
-    SmoothedProfile::new(SpeedProfile::new(&grid, &x), window)
+    ProfileGrid {
+        s: grid.iter().map(|g| g.s).collect(),
+        x,
+        window_s: window,
+    }
 }
 
 #[cfg(test)]
@@ -158,7 +180,7 @@ pub(crate) mod tests {
         b[3] = -0.5;
         let mut c = b;
         c[1] = 0.4;
-        let samples = time_free_move(&[a, b, c], &request);
+        let samples = time_free_move(&[a, b, c], &request).samples;
         assert_eq!(samples.first().unwrap().q, a);
         assert_eq!(samples.last().unwrap().q, c);
         assert_eq!(samples.last().unwrap().qd, JointVector::zeros());
@@ -181,6 +203,68 @@ pub(crate) mod tests {
             assert!(on_ab || on_bc, "{q:?} off the polyline");
         }
         assert_velocities_match_positions(&samples);
+    }
+
+    /// Asserts that `samples` has `count` samples, 1 ms apart, and that each of `expected`
+    /// (index; joints 1, 2 and 4's position, velocity and acceleration) holds to 1e-9: the
+    /// samples the move's timing gave before programs kept its definition instead.
+    pub(crate) fn assert_samples(
+        samples: &[TimedSample],
+        count: usize,
+        expected: &[(usize, [[f64; 3]; 3])],
+    ) {
+        assert_eq!(samples.len(), count);
+        for (k, values) in expected {
+            let sample = &samples[*k];
+            assert_eq!(sample.time_ns, *k as u64 * 1_000_000);
+            for (vector, values) in [sample.q, sample.qd, sample.qdd].iter().zip(values) {
+                for (j, value) in [0, 1, 3].iter().zip(values) {
+                    assert!((vector[*j] - value).abs() <= 1e-9, "sample {k}: {vector:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_free_move_gives_the_samples_it_always_gave() {
+        let a = JointVector::zeros();
+        let mut b = a;
+        b[0] = 1.0;
+        b[3] = -0.5;
+        let mut c = b;
+        c[1] = 0.4;
+        let timed = time_free_move(&[a, b, c], &request());
+        assert_samples(
+            &timed.samples,
+            2466,
+            &[
+                (
+                    582,
+                    [
+                        [0.31530627481985096, 0.0, -0.15765313740992548],
+                        [0.9999999999999994, 0.0, -0.4999999999999997],
+                        [0.0, 0.0, 0.0],
+                    ],
+                ),
+                (
+                    1164,
+                    [
+                        [0.8862677824843519, 0.0, -0.44313389124217595],
+                        [0.7982778133540263, 0.0, -0.3991389066770131],
+                        [-2.4591882445955604, 0.0, 1.2295941222977802],
+                    ],
+                ),
+                (
+                    1746,
+                    [
+                        [1.0, 0.023815999999999973, -0.5],
+                        [0.0, 0.3359999999999997, 0.0],
+                        [0.0, 3.0, 0.0],
+                    ],
+                ),
+                (2465, [[1.0, 0.4, -0.5], [0.0; 3], [0.0; 3]]),
+            ],
+        );
     }
 
     /// Asserts that every pair of samples' mean velocity is their positions' finite difference.

@@ -17,6 +17,9 @@
 //! its edges, at rest at every vertex; [`time_blended_move`] rounds its corners and passes them
 //! without stopping.
 //!
+//! Every timed motion comes with its [`MotionDefinition`]: its paths and the speed profile
+//! along each, from which [`MotionDefinition::samples`] gives its samples again.
+//!
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
 mod blend;
@@ -24,6 +27,7 @@ mod dynamics;
 mod free;
 mod inset;
 mod limits;
+mod motion;
 mod path;
 mod profile;
 mod retime;
@@ -32,11 +36,12 @@ mod topp;
 
 pub use blend::{MAX_BLEND_TURN_DEG, time_blended_move};
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
-pub use free::{FREE_GRID_PER_RAD, time_free_move};
+pub use free::{FREE_GRID_PER_RAD, TimedMove, time_free_move};
 pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };
+pub use motion::{MotionDefinition, ProfileGrid, SplineStretch};
 pub use path::{
     CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, LINE_CHECK_MARGIN_M, MAX_REFINEMENTS,
     MIN_KNOT_STEP_M, SmoothPath,

@@ -3,8 +3,6 @@
 //! and `s⃛ = (s̈(t) − s̈(t − w)) / w` is bounded), which also starts and ends the motion with
 //! zero path speed and acceleration.
 
-use crate::topp::GridPoint;
-
 /// The path position and its first two time derivatives at one instant.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathState {
@@ -41,30 +39,31 @@ pub struct SpeedProfile {
 }
 
 impl SpeedProfile {
-    /// The profile of path speeds `x_i = ṡ²` at the grid points (`x_0 = x_N = 0`, every other
-    /// `x_i > 0`): piece `i` lasts `2Δ_i / (√x_i + √x_{i+1})` at `s̈ = (x_{i+1} − x_i) / 2Δ_i`.
-    pub fn new(grid: &[GridPoint], x: &[f64]) -> Self {
-        let mut pieces = Vec::with_capacity(grid.len() - 1);
+    /// The profile of path speeds `x_i = ṡ²` at the grid points `s_i` (`x_0 = x_N = 0`, every
+    /// other `x_i > 0`): piece `i` lasts `2Δ_i / (√x_i + √x_{i+1})` at
+    /// `s̈ = (x_{i+1} − x_i) / 2Δ_i`.
+    pub fn new(s: &[f64], x: &[f64]) -> Self {
+        let mut pieces = Vec::with_capacity(s.len() - 1);
         let (mut t, mut integral) = (0.0, 0.0);
-        for (g, x) in grid.windows(2).zip(x.windows(2)) {
-            let delta = g[1].s - g[0].s;
+        for (g, x) in s.windows(2).zip(x.windows(2)) {
+            let delta = g[1] - g[0];
             let (v0, v1) = (x[0].sqrt(), x[1].sqrt());
             let u = (x[1] - x[0]) / (2.0 * delta);
             let tau = 2.0 * delta / (v0 + v1);
             pieces.push(Piece {
                 t0: t,
-                s0: g[0].s,
+                s0: g[0],
                 v0,
                 u,
                 integral0: integral,
             });
-            integral += g[0].s * tau + v0 * tau * tau / 2.0 + u * tau * tau * tau / 6.0;
+            integral += g[0] * tau + v0 * tau * tau / 2.0 + u * tau * tau * tau / 6.0;
             t += tau;
         }
         Self {
             pieces,
             duration: t,
-            end: grid[grid.len() - 1].s,
+            end: s[s.len() - 1],
             integral_end: integral,
         }
     }

@@ -8,8 +8,10 @@ use emg_kinematics::{JointVector, Robot};
 
 use crate::dynamics::{LimitBreach, TimedSample, breaches};
 use crate::limits::DynamicLimits;
+use crate::motion::{MotionDefinition, ProfileGrid, SplineStretch, at_rest};
 use crate::path::SmoothPath;
-use crate::profile::{PathState, SmoothedProfile, SpeedProfile};
+use crate::profile::{PathState, SmoothedProfile};
+use crate::spline::JointSpline;
 use crate::topp::{GridPoint, profile_duration, topp_ra};
 
 /// Longest grid step of TOPP-RA along the path (m of TCP travel).
@@ -96,6 +98,8 @@ pub struct TimedMotion {
     pub grid_s: Vec<f64>,
     /// What the timing did.
     pub report: TimingReport,
+    /// What the samples are computed from ([`MotionDefinition::samples`] gives them again).
+    pub definition: MotionDefinition,
 }
 
 /// Why a motion could not be timed.
@@ -299,6 +303,16 @@ impl TimedMotion {
                 .collect(),
         };
         self.paths.extend(next.paths);
+        if let (
+            MotionDefinition::Splines { stretches, .. },
+            MotionDefinition::Splines {
+                stretches: following,
+                ..
+            },
+        ) = (&mut self.definition, next.definition)
+        {
+            stretches.extend(following);
+        }
         self
     }
 }
@@ -322,12 +336,7 @@ fn time_stretch(
     let Some(spline) = path.spline() else {
         let start = path.start();
         return Ok(TimedMotion {
-            samples: vec![TimedSample {
-                time_ns: 0,
-                q: start,
-                qd: JointVector::zeros(),
-                qdd: JointVector::zeros(),
-            }],
+            samples: vec![at_rest(start)],
             grid_s: Vec::new(),
             report: TimingReport {
                 duration_s: 0.0,
@@ -341,6 +350,10 @@ fn time_stretch(
                 rests_s: Vec::new(),
             },
             paths: vec![path],
+            definition: MotionDefinition::Splines {
+                start,
+                stretches: Vec::new(),
+            },
         });
     };
     let length = spline.end();
@@ -379,9 +392,14 @@ fn time_stretch(
     let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
     let mut factor = vec![1.0; grid.len()];
     let time_optimal_s = profile_duration(&grid, &topp_ra(&grid, &limits.acceleration, &factor));
+    let grid_s: Vec<f64> = grid.iter().map(|g| g.s).collect();
     for slowdowns in 0..=MAX_SLOWDOWNS {
-        let x = topp_ra(&grid, &planned_acceleration, &factor);
-        let profile = SmoothedProfile::new(SpeedProfile::new(&grid, &x), window);
+        let definition = ProfileGrid {
+            s: grid_s.clone(),
+            x: topp_ra(&grid, &planned_acceleration, &factor),
+            window_s: window,
+        };
+        let profile = definition.smoothed();
         let samples = profile.duration() * request.rate_hz;
         if samples > MAX_SAMPLES {
             return Err(TimingError::TooManySamples {
@@ -396,8 +414,15 @@ fn time_stretch(
             let duration_s = samples[samples.len() - 1].time_s();
             let tool_speed_share = tool_speed_share(&states, &grid, &tool_gain, request);
             return Ok(TimedMotion {
+                definition: MotionDefinition::Splines {
+                    start: samples[0].q,
+                    stretches: vec![SplineStretch {
+                        spline: spline.clone(),
+                        profile: definition,
+                    }],
+                },
                 samples,
-                grid_s: grid.iter().map(|g| g.s).collect(),
+                grid_s,
                 report: TimingReport {
                     duration_s,
                     time_optimal_s,
@@ -455,10 +480,35 @@ pub(crate) fn slow_down(
     }
 }
 
+/// The samples of a path task's motion at `rate_hz` ([`MotionDefinition::Splines`]): at rest at
+/// `start`, then each stretch's samples after its first, on one grid of `k / rate_hz` (rounded
+/// to whole nanoseconds), as [`time_motion`] joins its stretches.
+pub(crate) fn spline_samples(
+    start: &JointVector,
+    stretches: &[SplineStretch],
+    rate_hz: f64,
+) -> Vec<TimedSample> {
+    let mut samples = vec![at_rest(*start)];
+    for stretch in stretches {
+        let offset = samples.len() as u64 - 1;
+        let (part, _) = sample(&stretch.spline, &stretch.profile.smoothed(), rate_hz);
+        samples.extend(
+            part.iter()
+                .enumerate()
+                .skip(1)
+                .map(|(k, sample)| TimedSample {
+                    time_ns: ((offset + k as u64) as f64 * 1e9 / rate_hz).round() as u64,
+                    ..*sample
+                }),
+        );
+    }
+    samples
+}
+
 /// The motion sampled at `k / rate_hz` (rounded to whole nanoseconds) for `k = 0, 1, …` up to
 /// the first sample at or after the end, with the path state of each sample.
 fn sample(
-    spline: &crate::spline::JointSpline,
+    spline: &JointSpline,
     profile: &SmoothedProfile,
     rate_hz: f64,
 ) -> (Vec<TimedSample>, Vec<PathState>) {

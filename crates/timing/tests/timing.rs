@@ -315,3 +315,59 @@ fn a_path_motion_comes_to_rest_at_every_unblended_corner_within_every_limit() {
             < 2e-4
     );
 }
+
+/// Asserts that `again` holds the samples of `timed`: the same times, and positions, velocities
+/// and accelerations within 1e-9.
+fn assert_same_samples(again: &[emg_timing::TimedSample], timed: &[emg_timing::TimedSample]) {
+    assert_eq!(again.len(), timed.len());
+    for (a, b) in again.iter().zip(timed) {
+        assert_eq!(a.time_ns, b.time_ns);
+        for (x, y) in [(a.q, b.q), (a.qd, b.qd), (a.qdd, b.qdd)] {
+            assert!(
+                (x - y).amax() <= 1e-9,
+                "at {} ns: {x:?} vs {y:?}",
+                a.time_ns
+            );
+        }
+    }
+}
+
+#[test]
+fn a_motion_definition_gives_its_samples_again() {
+    let (robot, _) = fr3();
+    let (line, waypoints, config) = planned(&robot);
+    let rectangle = rectangle_task(&robot, 0.08, 0.05);
+    let seed = rectangle.q0_seed.unwrap();
+    let around = rollout(
+        &robot,
+        &rectangle,
+        &seed,
+        &mut ClassicalController::default(),
+        &config,
+    );
+    let around: Vec<JointVector> = around.steps.iter().map(|s| s.q).collect();
+    for rate_hz in [1000.0, 333.0] {
+        let request = TimingRequest {
+            limits: shipped_limits(&robot),
+            tool_speed_m_per_s: 0.2,
+            rate_hz,
+        };
+        for (task, waypoints) in [(&line, &waypoints), (&rectangle, &around)] {
+            let motion =
+                time_motion(&robot, task, &config.constraints, waypoints, &request).unwrap();
+            let definition = &motion.definition;
+            assert_eq!(definition.check(rate_hz), Ok(()));
+            assert_same_samples(&definition.samples(rate_hz), &motion.samples);
+        }
+        // Moves through free space, kept to their edges and blended.
+        let vertices = [
+            waypoints[0],
+            around[around.len() / 2],
+            waypoints[waypoints.len() - 1],
+        ];
+        let kept = emg_timing::time_free_move(&vertices, &request);
+        assert_same_samples(&kept.definition.samples(rate_hz), &kept.samples);
+        let blended = emg_timing::time_blended_move(&vertices, &request, 0.5).unwrap();
+        assert_same_samples(&blended.definition.samples(rate_hz), &blended.samples);
+    }
+}
