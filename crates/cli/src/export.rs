@@ -15,7 +15,7 @@ use crate::args::PlanArgs;
 #[derive(Debug, Args)]
 pub struct ExportArgs {
     /// The motion to export: a joint trajectory (`STEM.joint_trajectory.json`,
-    /// emg-joint-trajectory/2) or a job's program (emg-job/2).
+    /// emg-joint-trajectory/2) or a job's program (emg-job/3).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
     /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file) or `urscript` (a

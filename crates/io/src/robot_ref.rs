@@ -1,5 +1,5 @@
 //! How a written file names the robot its motion was planned for: the `robot` field of
-//! `emg-trajectory/1`, `emg-joint-trajectory/2` and `emg-job/2` files, and the robot an export's
+//! `emg-trajectory/1`, `emg-joint-trajectory/2` and `emg-job/3` files, and the robot an export's
 //! metadata and headers name.
 //!
 //! A shipped robot is recorded by its name and the SHA-256 digest of its shipped file
