@@ -16,7 +16,7 @@ use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
-    FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, job_part,
+    FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, Unwatched, job_part,
     order_strokes, part_coverage, plan_job, plan_stroke, verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
@@ -238,7 +238,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     {
         let started = Instant::now();
         one_thread
-            .install(|| plan_job(&planner, &request, job, &timing, &robot_name, &|_, _| {}))?;
+            .install(|| plan_job(&planner, &request, job, &timing, &robot_name, &Unwatched))?;
         one_thread_s.push((name.clone(), started.elapsed().as_secs_f64()));
     }
     let record = Record {
@@ -326,7 +326,7 @@ fn evaluate(
 ) -> anyhow::Result<JobRow> {
     let request = PlanRequest::default();
     let started = Instant::now();
-    let planned = plan_job(planner, &request, job, timing, robot_name, &|_, _| {});
+    let planned = plan_job(planner, &request, job, timing, robot_name, &Unwatched);
     let planning_s = started.elapsed().as_secs_f64();
     let baseline = baseline(planner, timing, job);
     let total_m: f64 = job.strokes.iter().map(|s| s.length_m()).sum();
@@ -474,7 +474,8 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
     let mut motions = Vec::new();
     for oriented in &ordering.sequence {
         let path = oriented.path(&job.strokes);
-        let plan = plan_stroke(planner, &request, &path, 0.0, &settings);
+        let plan = plan_stroke(planner, &request, &path, 0.0, &settings, &Unwatched)
+            .expect("an unwatched stroke is never stopped");
         motions.extend(
             plan.parts
                 .into_iter()

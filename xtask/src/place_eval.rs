@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
 use emg_job::{
     Job, Moving, PlaceFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE, Score,
-    place_job, plan_job, verify_job,
+    Unwatched, place_job, plan_job, verify_job,
 };
 use emg_planner::{MotionTiming, PlanRequest, Planner};
 use serde::{Deserialize, Serialize};
@@ -196,7 +196,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .map(|scored| {
             let moved = twenty.moved(&frame.job_motion(&scored.place))?;
             Ok(
-                plan_job(&planner, &request, &moved, &timing, &robot_name, &|_, _| {})
+                plan_job(&planner, &request, &moved, &timing, &robot_name, &Unwatched)
                     .map_or(0.0, |program| program.summary.drawn_m),
             )
         })
@@ -214,7 +214,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             &REGION,
             &settings,
             Score::Bound,
-            &|_, _, _| {},
+            &Unwatched,
         )
     })?;
     let same_on_one_thread = again.screened == placement.screened
@@ -256,19 +256,11 @@ fn evaluate(
     settings: &PlaceSettings,
 ) -> anyhow::Result<(PlaceRow, Placement)> {
     let request = PlanRequest::default();
-    let plan = |job: &Job| plan_job(planner, &request, job, timing, robot_name, &|_, _| {}).ok();
+    let plan = |job: &Job| plan_job(planner, &request, job, timing, robot_name, &Unwatched).ok();
     let as_given_m = plan(job).map_or(0.0, |program| program.summary.drawn_m);
     let placed = |score| {
         place_job(
-            planner,
-            &request,
-            job,
-            timing,
-            robot_name,
-            &REGION,
-            settings,
-            score,
-            &|_, _, _| {},
+            planner, &request, job, timing, robot_name, &REGION, settings, score, &Unwatched,
         )
     };
     let ours = placed(Score::Bound)?;

@@ -112,7 +112,7 @@ fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
         &job,
         &timing,
         &robot_path.display().to_string(),
-        &|_, _| {},
+        &emg_job::Unwatched,
     )?;
     let name = Path::new(file).file_stem().map_or_else(
         || file.to_string(),

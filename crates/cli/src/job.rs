@@ -1,14 +1,15 @@
 //! `emg job`: a job file or an SVG drawing planned as one program (`emg_job::plan_job`), with a
-//! progress bar and a summary; writes the `emg-job/2` file.
+//! progress bar and a summary; writes the `emg-job/3` file.
 
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
-use emg_job::{Job, Order, plan_job};
+use emg_job::{Job, JobPlanError, Order, plan_job};
 use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
 
+use crate::interrupt::{Interrupt, Watched};
 use crate::output::{count, progress_bar, write_text};
 use crate::robot;
 
@@ -72,7 +73,7 @@ pub struct JobArgs {
     /// The job and how it is planned.
     #[command(flatten)]
     pub input: JobInput,
-    /// The program to write (an emg-job/2 file; missing parent directories are created).
+    /// The program to write (an emg-job/3 file; missing parent directories are created).
     #[arg(long, value_name = "FILE", default_value = "job.json")]
     pub out: PathBuf,
     /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
@@ -157,8 +158,18 @@ fn parse_order(value: &str) -> Result<Order, String> {
     }
 }
 
-/// Reads the job, plans it, prints its summary and writes its program.
-pub fn run_job(args: &JobArgs) -> Result<()> {
+/// Prints a job's size before it is planned: its strokes and their length.
+pub fn print_size(job: &Job) {
+    println!(
+        "{}, {:.3} m to draw",
+        count(job.strokes.len(), "stroke"),
+        job.strokes.iter().map(|s| s.length_m()).sum::<f64>()
+    );
+}
+
+/// Reads the job, plans it, prints its summary and writes its program; `interrupt` stops the
+/// planning, and then nothing is written.
+pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
     let exported = args
         .export
@@ -174,17 +185,20 @@ pub fn run_job(args: &JobArgs) -> Result<()> {
         timing,
         request,
     } = input.ready()?;
-    let bar = progress_bar(job.strokes.len() as u64, "strokes");
-    bar.set_message("planning");
-    let file = plan_job(
+    print_size(&job);
+    let watch = Watched::new(progress_bar(job.strokes.len() as u64, "strokes"), interrupt);
+    let file = match plan_job(
         &planner,
         &request,
         &job,
         &timing,
         &robot::reference(&input.robot)?.to_string(),
-        &|done, _| bar.set_position(done as u64),
-    )?;
-    bar.finish_and_clear();
+        &watch,
+    ) {
+        Err(JobPlanError::Stopped(_)) => return Err(watch.stopped()),
+        planned => planned?,
+    };
+    watch.finish();
     print_summary(&file);
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());

@@ -112,8 +112,10 @@ fn main() -> ExitCode {
         Command::Check(args) => check::run_check(&args),
         Command::ImportRobot(args) => import::run_import(&args),
         Command::Export(args) => export::run_export(&args),
-        Command::Job(args) => job::run_job(&args),
-        Command::Place(args) => place::run_place(&args),
+        Command::Job(args) => Interrupt::install().and_then(|stop| job::run_job(&args, &stop)),
+        Command::Place(args) => {
+            Interrupt::install().and_then(|stop| place::run_place(&args, &stop))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

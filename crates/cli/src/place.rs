@@ -7,10 +7,11 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 use emg_job::{
-    JOB_FORMAT_VERSION, JobSpec, Moving, PlaceSettings, Placement, Region, Score, place_job,
-    placement_map,
+    JOB_FORMAT_VERSION, JobSpec, Moving, PlaceError, PlaceSettings, Placement, Region, Score,
+    place_job, placement_map,
 };
 
+use crate::interrupt::{Interrupt, Watched};
 use crate::job::{JobInput, Ready, print_summary};
 use crate::output::{progress_bar, write_text};
 
@@ -50,7 +51,7 @@ pub struct PlaceArgs {
     /// in the cone, each on its own, as reachability studies score).
     #[arg(long, value_parser = parse_score, default_value = "bound")]
     pub score: Score,
-    /// The program planned at the chosen place (an emg-job/2 file; missing parent directories
+    /// The program planned at the chosen place (an emg-job/3 file; missing parent directories
     /// are created, as for every file written).
     #[arg(long, value_name = "FILE", default_value = "placed.json")]
     pub out: PathBuf,
@@ -97,8 +98,9 @@ fn parse_score(value: &str) -> Result<Score, String> {
     }
 }
 
-/// Searches the region, prints the certified places and writes the outputs.
-pub fn run_place(args: &PlaceArgs) -> Result<()> {
+/// Searches the region, prints the certified places and writes the outputs; `interrupt` stops
+/// the search, and then nothing is written.
+pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
     let exported = args
         .export
@@ -129,8 +131,9 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
         timing,
         request,
     } = input.ready()?;
-    let bar = progress_bar(0, "places");
-    let placement = place_job(
+    crate::job::print_size(&job);
+    let watch = Watched::new(progress_bar(0, "places"), interrupt);
+    let placement = match place_job(
         &planner,
         &request,
         &job,
@@ -139,13 +142,12 @@ pub fn run_place(args: &PlaceArgs) -> Result<()> {
         &region,
         &settings,
         args.score,
-        &|stage, done, of| {
-            bar.set_message(stage.to_string());
-            bar.set_length(of as u64);
-            bar.set_position(done as u64);
-        },
-    )?;
-    bar.finish_and_clear();
+        &watch,
+    ) {
+        Err(PlaceError::Stopped(_)) => return Err(watch.stopped()),
+        placed => placed?,
+    };
+    watch.finish();
     print_places(&placement);
     let best = placement.best();
     let program = best

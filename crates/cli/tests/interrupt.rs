@@ -1,11 +1,13 @@
 //! `emg plan` stopped by SIGINT or SIGTERM in the middle of a task set: it exits with 128 + the
 //! signal's number and says how far it got, every file it leaves is complete, and no `.partial`
-//! file is left behind.
+//! file is left behind. `emg job` and `emg place` stopped while planning: the same exit, and
+//! nothing written.
 
 #![cfg(unix)]
 
 mod common;
 
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -108,4 +110,106 @@ fn sigint_stops_after_the_current_task() {
 #[test]
 fn sigterm_stops_after_the_current_task() {
     interrupt_midway(libc::SIGTERM, "SIGTERM");
+}
+
+/// A drawing of `strokes` short strokes (3 to 12 mm, one `<path>` each) scattered over a 0.2 m
+/// square, deterministic.
+fn scattered_strokes(strokes: usize) -> String {
+    let mut paths = String::new();
+    for k in 0..strokes {
+        // A low-discrepancy scatter: golden-ratio steps in x, a plastic-number step in y.
+        let x = (k as f64 * 0.618_033_988_749_895).fract() * 200.0;
+        let y = (k as f64 * 0.754_877_666_246_693).fract() * 200.0;
+        // A direction from two more low-discrepancy steps, scaled to the stroke's length.
+        let (u, v) = (
+            (k as f64 * 0.381_966).fract() - 0.5,
+            (k as f64 * 0.569_840).fract() - 0.45,
+        );
+        let length = (3.0 + (k % 10) as f64) / (u * u + v * v).sqrt().max(0.05);
+        paths.push_str(&format!(
+            "<path d=\"M{x:.3},{y:.3} L{:.3},{:.3}\"/>",
+            x + length * u,
+            y + length * v
+        ));
+    }
+    format!("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"-12 -12 224 224\">{paths}</svg>")
+}
+
+/// Runs `emg ARGS`, sends SIGINT once it has printed the job's size (its planning under way),
+/// and checks that it stops with 130 and writes nothing into `dir` but `keep`.
+fn stopped_while_planning(args: &[&str], dir: &Path, keep: &[&str]) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_emg"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("emg starts");
+    let stdout = child.stdout.take().expect("stdout is piped");
+    let size = BufReader::new(stdout)
+        .lines()
+        .map(|line| line.expect("stdout reads"))
+        .find(|line| line.contains("m to draw"))
+        .expect("the job's size is printed before it is planned");
+    let pid = i32::try_from(child.id()).expect("pid fits");
+    // SAFETY: `kill` only sends a signal to the child process started above.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGINT) }, 0, "signal sent");
+    let output = child.wait_with_output().expect("emg ends");
+    let stderr = text(&output.stderr);
+    assert_eq!(output.status.code(), Some(130), "{size}\n{stderr}");
+    assert!(stderr.contains("stopped by SIGINT"), "{stderr}");
+    assert!(stderr.contains("nothing was written"), "{stderr}");
+    let mut left: Vec<String> = std::fs::read_dir(dir)
+        .expect("the directory lists")
+        .map(|entry| {
+            entry
+                .expect("entry")
+                .file_name()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .filter(|name| !keep.contains(&name.as_str()))
+        .collect();
+    left.sort();
+    assert!(left.is_empty(), "written although stopped: {left:?}");
+}
+
+#[test]
+fn sigint_stops_a_job_while_planning_and_nothing_is_written() {
+    let tmp = temp_dir("interrupt-job");
+    let dir = tmp.path();
+    let drawing = dir.join("scatter.svg");
+    std::fs::write(&drawing, scattered_strokes(3000)).expect("drawing written");
+    let out = dir.join("scatter.job.json");
+    let html = dir.join("scatter.html");
+    stopped_while_planning(
+        &[
+            "job",
+            drawing.to_str().expect("utf-8 path"),
+            "--out",
+            out.to_str().expect("utf-8 path"),
+            "--html",
+            html.to_str().expect("utf-8 path"),
+        ],
+        dir,
+        &["scatter.svg"],
+    );
+}
+
+#[test]
+fn sigint_stops_a_placement_while_screening_and_nothing_is_written() {
+    let tmp = temp_dir("interrupt-place");
+    let dir = tmp.path();
+    let drawing = dir.join("scatter.svg");
+    std::fs::write(&drawing, scattered_strokes(200)).expect("drawing written");
+    let out = dir.join("scatter.job.json");
+    stopped_while_planning(
+        &[
+            "place",
+            drawing.to_str().expect("utf-8 path"),
+            "--out",
+            out.to_str().expect("utf-8 path"),
+        ],
+        dir,
+        &["scatter.svg"],
+    );
 }

@@ -128,7 +128,7 @@ fn a_path_file_is_a_job_of_one_stroke_and_an_svg_keeps_its_physical_size() {
     ]);
     assert!(output.status.success(), "{}", text(&output.stderr));
     let stdout = text(&output.stdout);
-    assert!(stdout.starts_with("1 stroke: "), "{stdout}");
+    assert!(stdout.contains("\n1 stroke: 1 complete"), "{stdout}");
     assert_eq!(read_json(&out)["strokes"].as_array().unwrap().len(), 1);
 
     // 100 mm wide, a line of 80 of its 100 units.

@@ -26,6 +26,7 @@ pub mod program;
 pub mod spec;
 pub mod stroke;
 pub mod verify;
+pub mod watch;
 
 use std::collections::VecDeque;
 use std::time::Instant;
@@ -54,6 +55,7 @@ pub use program::{
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
 pub use stroke::{StrokePart, StrokePlan, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
+pub use watch::{Stopped, StopsWith, Unwatched, Watch};
 
 /// Pen-down lengths closer than this (m) count as the same: of two starts of a stroke that draw
 /// as far, the nearer one to the arm is taken; places that draw as much rank by duration.
@@ -101,31 +103,38 @@ pub enum JobPlanError {
     /// The program is too long for the trajectory format.
     #[error("the program lasts longer than a joint trajectory file holds")]
     TooLong,
+    /// The watcher asked the job to stop.
+    #[error(transparent)]
+    Stopped(#[from] Stopped),
 }
 
 /// Plans `job` with `planner` as `request` asks (the search; its constraints and scene) and
 /// times it with `timing`;
-/// `robot_file` is recorded in the file; `progress` is told each stroke planned (strokes
-/// planned so far, strokes in all). Strokes are planned in parallel; the result does not depend
-/// on the number of threads.
+/// `robot_file` is recorded in the file; `watch` is told each stage's progress ("ordering",
+/// "planning" and "connecting", in strokes) and asked between strokes whether to stop
+/// ([`JobPlanError::Stopped`]). Strokes are planned in parallel; the result does not depend on
+/// the number of threads.
 pub fn plan_job(
     planner: &Planner,
     request: &PlanRequest,
     job: &Job,
     timing: &MotionTiming,
     robot_file: &str,
-    progress: &(dyn Fn(usize, usize) + Sync),
+    watch: &dyn Watch,
 ) -> Result<JobFile, JobPlanError> {
     let started = Instant::now();
     let settings = &job.settings;
     let robot = planner.robot();
     let dof = robot.dof();
+    let strokes = job.strokes.len();
+    watch.progress("ordering", 0, strokes);
     let ordering = merge_and_order(
         &job.strokes,
         settings.order,
         planner.config().rollout.constraints.line_tolerance_m,
     );
     let drawn = ordering.drawn_paths(&job.strokes);
+    watch.progress("ordering", strokes, strokes);
     // The part under the strokes, which the arm keeps off while drawing as between strokes.
     let free = FreeSpace::new(
         robot,
@@ -144,12 +153,12 @@ pub fn plan_job(
         .par_iter()
         .map(|oriented| {
             let path = oriented.path(&drawn);
-            let plan = plan_stroke(&on_part, request, &path, 0.0, settings);
+            let plan = plan_stroke(&on_part, request, &path, 0.0, settings, watch)?;
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            progress(finished, ordering.sequence.len());
-            plan
+            watch.progress("planning", finished, ordering.sequence.len());
+            Ok(plan)
         })
-        .collect();
+        .collect::<Result<_, Stopped>>()?;
     let connector = Connector {
         free: &free,
         timing,
@@ -161,7 +170,11 @@ pub fn plan_job(
     // The last part's lift, joined to the move after it.
     let mut retreat: Option<[JointVector; 2]> = None;
     let mut searches: usize = plans.iter().map(|plan| plan.searches).sum();
-    for (oriented, plan) in ordering.sequence.iter().zip(&plans) {
+    for (connected, (oriented, plan)) in ordering.sequence.iter().zip(&plans).enumerate() {
+        if watch.stop_requested() {
+            return Err(Stopped.into());
+        }
+        watch.progress("connecting", connected, ordering.sequence.len());
         let mut parts_left_out = Vec::new();
         // The stretches of the stroke the placed parts' samples cover.
         let mut covered = Vec::new();
@@ -179,29 +192,31 @@ pub fn plan_job(
             // tool's free roll centred on it.
             let planned = toward(planned, job.home.or(from).as_ref(), &free);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
-            // The part planned again from the configuration the arm is in, moved above the
-            // part's start and set down there: taken first where it draws as far from a start
-            // nearer the arm, and where the searched start cannot be reached.
-            let nearby = from
-                .and_then(|from| connector.replanned_nearby(&on_part, request, &planned, &from));
-            let as_far =
-                |part: &StrokePart| part.reached_s() >= planned.reached_s() - SAME_LENGTH_M;
-            let nearer = |part: &StrokePart| {
-                from.is_some_and(|from| {
-                    let start = |p: &StrokePart| p.trajectory.steps[0].q;
-                    (start(part) - from).norm() < (start(&planned) - from).norm()
-                })
-            };
-            let (first, fallback) = match &nearby {
-                Some(again) if as_far(again) && nearer(again) => (again, Some(&planned)),
-                Some(again) => (&planned, Some(again)),
-                None => (&planned, None),
-            };
-            let placed = connector.place(first, from, seed).or_else(|why| {
-                fallback
-                    .ok_or(why.clone())
-                    .and_then(|part| connector.place(part, from, seed).map_err(|_| why))
-            });
+            // The part planned again from the configuration the arm is in and from the home,
+            // each moved above the part's start and set down there: tried first where it draws
+            // as far from a start nearer the arm, and where the searched start cannot be reached.
+            let again: Vec<StrokePart> = [from, job.home]
+                .iter()
+                .flatten()
+                .filter_map(|start| connector.replanned_nearby(&on_part, request, &planned, start))
+                .map(|part| toward(part, job.home.or(from).as_ref(), &free))
+                .collect();
+            let candidates = ranked(planned.clone(), again, from.as_ref());
+            // The first candidate placed, else why the first one could not be.
+            let mut placed = None;
+            let mut first_why = None;
+            for part in &candidates {
+                match connector.place(part, from, seed) {
+                    Ok(done) => {
+                        placed = Some(done);
+                        break;
+                    }
+                    Err(why) => {
+                        first_why.get_or_insert(why);
+                    }
+                }
+            }
+            let placed = placed.ok_or_else(|| first_why.expect("the searched part is a candidate"));
             let (part, placed) = match placed {
                 Ok(placed) => placed,
                 Err(why) => {
@@ -216,7 +231,7 @@ pub fn plan_job(
             {
                 rest_plans += 1;
                 let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
-                let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings);
+                let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings, watch)?;
                 searches += rest.searches;
                 queue = rest.parts.into();
             }
@@ -368,6 +383,29 @@ fn toward(mut part: StrokePart, reference: Option<&JointVector>, free: &FreeSpac
         step.q += shift;
     }
     part
+}
+
+/// The parts that may draw a stretch, in the order they are tried: those drawing as far as the
+/// searched part `planned` (to [`SAME_LENGTH_M`]), the one whose start turns no joint as far
+/// from `from` (where the arm is) first; then the others, the furthest-drawing first.
+/// Deterministic: ties keep the order given, `planned` first.
+fn ranked(
+    planned: StrokePart,
+    again: Vec<StrokePart>,
+    from: Option<&JointVector>,
+) -> Vec<StrokePart> {
+    let reach = planned.reached_s();
+    let as_far = |part: &StrokePart| part.reached_s() >= reach - SAME_LENGTH_M;
+    let turn_from =
+        |part: &StrokePart| from.map_or(0.0, |from| (part.trajectory.steps[0].q - from).amax());
+    let mut candidates: Vec<StrokePart> = std::iter::once(planned).chain(again).collect();
+    candidates.sort_by(|a, b| {
+        as_far(b).cmp(&as_far(a)).then_with(|| match as_far(a) {
+            true => turn_from(a).total_cmp(&turn_from(b)),
+            false => b.reached_s().total_cmp(&a.reached_s()),
+        })
+    });
+    candidates
 }
 
 /// How far before a pen-up move's corner its rounding starts: this share of the shorter of the

@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 use crate::free_space::{job_part, with_part};
 use crate::program::JobFile;
 use crate::spec::{Job, JobError, Transform};
+use crate::watch::{Stopped, StopsWith, Watch};
 use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
 
 /// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
@@ -117,6 +118,9 @@ pub enum PlaceError {
     /// A place moves a stroke into an invalid path.
     #[error(transparent)]
     Job(#[from] JobError),
+    /// The watcher asked the placement to stop.
+    #[error(transparent)]
+    Stopped(#[from] Stopped),
     /// No place of the region lets the arm reach any stroke.
     #[error(
         "no place of the region lets the arm reach any of the job's strokes (the best screened \
@@ -425,7 +429,8 @@ pub fn place_score(
 }
 
 /// The places of `region` for `job`, screened, refined and certified as the module says, by
-/// `score`; `progress` is told the stage's name, the places done and the places in it.
+/// `score`; `watch` is told each stage's progress ("screen", "refine" and "certify", in places)
+/// and asked between places whether to stop ([`PlaceError::Stopped`]).
 #[allow(clippy::too_many_arguments)]
 pub fn place_job(
     planner: &Planner,
@@ -436,7 +441,7 @@ pub fn place_job(
     region: &Region,
     settings: &PlaceSettings,
     score: Score,
-    progress: &(dyn Fn(&str, usize, usize) + Sync),
+    watch: &dyn Watch,
 ) -> Result<Placement, PlaceError> {
     region.validate()?;
     settings.validate()?;
@@ -470,12 +475,15 @@ pub fn place_job(
         places
             .par_iter()
             .map(|place| {
+                if watch.stop_requested() {
+                    return Err(PlaceError::Stopped(Stopped));
+                }
                 let scored = place_score(planner, job, &frame, place, config, score)?;
                 let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                progress(stage, finished, places.len());
+                watch.progress(stage, finished, places.len());
                 Ok(scored)
             })
-            .collect::<Result<Vec<Scored>, JobError>>()
+            .collect::<Result<Vec<Scored>, PlaceError>>()
     };
     let started = std::time::Instant::now();
     let screened = scored("screen", &grid, &coarse)?;
@@ -523,8 +531,18 @@ pub fn place_job(
         let at_place = planner
             .with_config(config)
             .expect("the planner's configuration with its cell moved is valid");
-        let planned = plan_job(&at_place, request, &moved, timing, robot_file, &|_, _| {});
-        progress("certify", index + 1, candidates.len());
+        let planned = plan_job(
+            &at_place,
+            request,
+            &moved,
+            timing,
+            robot_file,
+            &StopsWith(watch),
+        );
+        if let Err(JobPlanError::Stopped(stopped)) = planned {
+            return Err(stopped.into());
+        }
+        watch.progress("certify", index + 1, candidates.len());
         certified.push(match planned {
             Ok(program) => Certified {
                 scored: *candidate,

@@ -6,6 +6,7 @@ use emg_control::{ARRIVAL_M, Path, Task, Termination, Trajectory};
 use emg_planner::{PlanRequest, Planner};
 
 use crate::spec::JobSettings;
+use crate::watch::{Stopped, Watch};
 
 /// One motion along a stretch of a stroke.
 #[derive(Clone, Debug)]
@@ -39,14 +40,16 @@ pub struct StrokePlan {
 /// Plans `path` with `planner` as `request` asks (the search): from `start_s` along it, then
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
 /// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by
-/// `settings.min_gain_m`, up to `settings.max_parts` searches.
+/// `settings.min_gain_m`, up to `settings.max_parts` searches; [`Stopped`] where `watch` asks
+/// to stop before a search.
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,
     path: &Path,
     start_s: f64,
     settings: &JobSettings,
-) -> StrokePlan {
+    watch: &dyn Watch,
+) -> Result<StrokePlan, Stopped> {
     let length = path.length_m();
     let mut plan = StrokePlan {
         path: path.clone(),
@@ -56,6 +59,9 @@ pub fn plan_stroke(
     // How far the stroke is drawn or given up.
     let mut done = start_s;
     while done < length - 2.0 * ARRIVAL_M && plan.searches < settings.max_parts {
+        if watch.stop_requested() {
+            return Err(Stopped);
+        }
         plan.searches += 1;
         let from_s = if plan.parts.is_empty() {
             done
@@ -90,7 +96,7 @@ pub fn plan_stroke(
             _ => done = (done + settings.min_gain_m).min(length),
         }
     }
-    plan
+    Ok(plan)
 }
 
 /// Whether a part ends at the stroke's end.

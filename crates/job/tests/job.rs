@@ -153,7 +153,7 @@ fn wrong_jobs_are_refused_naming_what_is_wrong() {
         &job,
         &timing,
         &file.display().to_string(),
-        &|_, _| {},
+        &emg_job::Unwatched,
     )
     .unwrap_err();
     assert!(

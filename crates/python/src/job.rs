@@ -163,7 +163,7 @@ pub(crate) fn plan(
                 job,
                 &timing,
                 &robot.reference,
-                &|_, _| {},
+                &emg_job::Unwatched,
             )
         })
         .map_err(|e| PlanningError::new_err(message(&e)))?;
@@ -366,7 +366,7 @@ pub(crate) fn place(
                 &region,
                 &settings,
                 score,
-                &|_, _, _| {},
+                &emg_job::Unwatched,
             )
         })
         .map_err(|e| PlanningError::new_err(message(&e)))?;

@@ -57,7 +57,7 @@ pub fn plan(
         job,
         timing,
         &file.display().to_string(),
-        &|_, _| {},
+        &emg_job::Unwatched,
     )
     .expect("the job plans")
 }
