@@ -12,8 +12,8 @@ use serde::{Deserialize, Serialize};
 pub struct Profile {
     /// The grid's path parameters, increasing strictly.
     pub s: Vec<f64>,
-    /// The path speed squared `ṡ²` at each grid point: 0 at both ends, positive between; `s̈`
-    /// is constant between grid points.
+    /// The path speed squared `ṡ²` at each grid point: 0 at both ends, not negative between
+    /// and never 0 at two neighbours; `s̈` is constant between grid points.
     pub x: Vec<f64>,
     /// The moving average's window (s) over which the profile's `s(t)` is averaged.
     pub window_s: f64,

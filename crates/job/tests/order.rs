@@ -188,6 +188,39 @@ fn strokes_that_meet_end_to_end_are_merged_into_strokes_that_draw_the_same() {
 }
 
 #[test]
+fn strokes_that_merge_with_none_keep_their_direction() {
+    // A closed square (its end on its start) and a line apart: neither merges, and neither is
+    // turned round (a stroke's direction decides how far the arm draws it).
+    let corner = |x: f64, y: f64| Vec3::new(0.45 + x, y, 0.25);
+    let square = [
+        (0.0, 0.0),
+        (0.03, 0.0),
+        (0.03, 0.03),
+        (0.0, 0.03),
+        (0.0, 0.0),
+    ];
+    let closed = Path::new(PathSpec {
+        version: PATH_FORMAT_VERSION,
+        start: corner(0.0, 0.0).into(),
+        normal: NORMAL,
+        blend_radius_m: 0.0,
+        segments: square[1..]
+            .iter()
+            .map(|&(x, y)| SegmentSpec::Line {
+                to: corner(x, y).into(),
+            })
+            .collect(),
+    })
+    .expect("a valid square");
+    let strokes = vec![closed, line(corner(0.0, 0.1), corner(0.03, 0.1))];
+    let ordering = merge_and_order(&strokes, Order::Shortest, JOB_TOLERANCE_M);
+    assert_eq!(ordering.merged(), (0, 0));
+    for chain in &ordering.drawn {
+        assert!(chain.0.iter().all(|o| !o.reversed), "{:?}", ordering.drawn);
+    }
+}
+
+#[test]
 fn in_the_given_order_a_stroke_merges_only_with_the_one_listed_before_it() {
     let mut rng = ChaCha8Rng::seed_from_u64(2);
     let (strokes, _) = cut_polylines(&mut rng);

@@ -20,7 +20,9 @@ use crate::spline::JointSpline;
 pub struct ProfileGrid {
     /// The grid's path parameters, increasing strictly.
     pub s: Vec<f64>,
-    /// `ṡ²` at each grid point: 0 at both ends, positive between.
+    /// `ṡ²` at each grid point: 0 at both ends, not negative between, and never 0 at two
+    /// neighbouring points (a stroke may touch rest at a grid point, as TOPP-RA's profile does
+    /// where a limit stops it there).
     pub x: Vec<f64>,
     /// The averaging window (s), positive.
     pub window_s: f64,
@@ -34,7 +36,7 @@ impl ProfileGrid {
 
     /// Why this profile cannot be sampled at `rate_hz` (naming the field), if it cannot: fewer
     /// than three grid points, parameters that do not increase strictly, speeds that are not 0 at
-    /// the ends and positive between, a window that is not positive, or more than
+    /// the ends, negative between or 0 at two neighbouring points, a window that is not positive, or more than
     /// [`MAX_SAMPLES`] samples.
     pub fn check(&self, rate_hz: f64) -> Result<(), String> {
         if self.s.len() < 3 || !self.s.iter().all(|s| s.is_finite()) {
@@ -54,8 +56,19 @@ impl ProfileGrid {
         if self.x[0] != 0.0 || self.x[last] != 0.0 {
             return Err("x must be 0 at both ends (rest to rest)".to_string());
         }
-        if !self.x[1..last].iter().all(|x| x.is_finite() && *x > 0.0) {
-            return Err("x must be positive and finite between the ends".to_string());
+        if !self.x[1..last].iter().all(|x| x.is_finite() && *x >= 0.0) {
+            return Err("x must be finite and not negative between the ends".to_string());
+        }
+        if self
+            .x
+            .windows(2)
+            .any(|pair| pair[0] == 0.0 && pair[1] == 0.0)
+        {
+            return Err(
+                "x must not be 0 at two neighbouring grid points (the motion would never pass \
+                 between them)"
+                    .to_string(),
+            );
         }
         if !(self.window_s.is_finite() && self.window_s > 0.0) {
             return Err(format!("window_s must be positive, got {}", self.window_s));

@@ -108,15 +108,15 @@ fn nearest_chains(
             reversed: false,
         }];
         let mut left_m = tolerance_m;
+        // Whether the chain is turned round to grow at its start.
+        let mut turned = false;
         for side in 0..2 {
             if side == 1 {
                 if !chain.iter().all(|o| reversible[o.stroke]) {
                     break;
                 }
-                chain.reverse();
-                for o in &mut chain {
-                    o.reversed = !o.reversed;
-                }
+                turn_round(&mut chain);
+                turned = true;
             }
             loop {
                 let last = chain[chain.len() - 1];
@@ -140,9 +140,22 @@ fn nearest_chains(
                 });
             }
         }
+        // Back the way the first stroke is given: a stroke that merges with none keeps its
+        // direction.
+        if turned {
+            turn_round(&mut chain);
+        }
         chains.push(chain);
     }
     (chains, grid.work())
+}
+
+/// `chain` drawn the other way: its strokes in reverse order, each reversed.
+fn turn_round(chain: &mut [Oriented]) {
+    chain.reverse();
+    for o in chain.iter_mut() {
+        o.reversed = !o.reversed;
+    }
 }
 
 /// `chain`'s drawn strokes: one where its strokes join, else cut where they do not.
