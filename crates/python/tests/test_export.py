@@ -33,10 +33,10 @@ def ur5e_line(tmp_path_factory):
     return directory / "demo.joint_trajectory.json"
 
 
-def assert_mcap_holds_the_points_of(motion, out, report):
-    """The MCAP `out` holds one JointTrajectory message whose points are samples of `motion` (a
-    joint trajectory file or a job's program) at their times, the first and the last kept."""
-    trajectory = json.loads(motion.read_text())
+def assert_mcap_holds_the_points_of(trajectory, out, report):
+    """The MCAP `out` holds one JointTrajectory message whose points are samples of `trajectory`
+    (a joint trajectory file's JSON: `joint_names` and `points`) at their times, the first and the
+    last kept."""
     by_time = {nanoseconds(p["time_from_start"]): p for p in trajectory["points"]}
     with open(out, "rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
@@ -62,31 +62,45 @@ def assert_mcap_holds_the_points_of(motion, out, report):
         assert list(point.effort) == []
 
 
+def samples_of(plan, joint_names):
+    """A job's samples (`JobPlan`) in a joint trajectory file's layout."""
+    def at(seconds):
+        nanoseconds = round(seconds * 1e9)
+        return {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000}
+
+    return {
+        "joint_names": joint_names,
+        "points": [
+            {"positions": list(q), "velocities": list(qd), "accelerations": list(qdd),
+             "time_from_start": at(t)}
+            for t, q, qd, qdd in zip(plan.time_s, plan.q, plan.qd, plan.qdd)
+        ],
+    }
+
+
 def test_ros2_mcap_holds_every_point_of_the_file(ur5e_line, tmp_path):
     out = tmp_path / "demo.mcap"
     report = elm.export(ur5e_line, "ros2-mcap", out)
     assert report.files == [out]
     assert report.max_joint_deviation_rad <= report.tolerance_rad == 1e-5
     assert report.points_after < report.points_before / 10
-    assert_mcap_holds_the_points_of(ur5e_line, out, report)
+    assert_mcap_holds_the_points_of(json.loads(ur5e_line.read_text()), out, report)
 
 
 def test_a_job_of_several_strokes_exports_as_one_trajectory(tmp_path):
-    """A lucide icon planned by `emg job` on the UR5e: its whole program in one message."""
+    """A lucide icon planned as `emg job` plans it on the UR5e: its whole program in one
+    message, every sample the program's."""
     icon = Path(__file__).resolve().parents[2] / "io" / "tests" / "data" / "icons" / "pencil.svg"
-    subprocess.run(
-        [os.environ.get("EMG_CLI", "emg"), "job", icon, "--robot", "ur5e", "--out", "pencil.job.json"],
-        cwd=tmp_path,
-        check=True,
-        capture_output=True,
-    )
+    plan = elm.Planner("ur5e").plan_job(icon)
     job = tmp_path / "pencil.job.json"
-    strokes = [s for s in json.loads(job.read_text())["segments"] if s["kind"] == "stroke"]
+    plan.write(job)
+    program = json.loads(job.read_text())
+    strokes = [s for s in program["segments"] if s["kind"] == "stroke"]
     assert len(strokes) >= 2
     out = tmp_path / "pencil.mcap"
     report = elm.export(job, "ros2-mcap", out)
     assert report.max_joint_deviation_rad <= report.tolerance_rad
-    assert_mcap_holds_the_points_of(job, out, report)
+    assert_mcap_holds_the_points_of(samples_of(plan, program["joint_names"]), out, report)
 
 
 def test_urscript_and_wrong_inputs(ur5e_line, tmp_path):
