@@ -36,8 +36,8 @@ impl ProfileGrid {
 
     /// Why this profile cannot be sampled at `rate_hz` (naming the field), if it cannot: fewer
     /// than three grid points, parameters that do not increase strictly, speeds that are not 0 at
-    /// the ends, negative between or 0 at two neighbouring points, a window that is not positive, or more than
-    /// [`MAX_SAMPLES`] samples.
+    /// the ends, negative between or 0 at two neighbouring points, a window that is not
+    /// positive, or more than [`MAX_SAMPLES`] samples.
     pub fn check(&self, rate_hz: f64) -> Result<(), String> {
         if self.s.len() < 3 || !self.s.iter().all(|s| s.is_finite()) {
             return Err("s must hold at least three finite numbers".to_string());
