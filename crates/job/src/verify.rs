@@ -9,12 +9,19 @@
 //! samples cover, every stretch they leave undrawn is listed, and the summary's totals and
 //! counts are the strokes'.
 
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
+
 use emg_control::{ConstraintConfig, MIN_SEGMENT_M, Path, Task, task_bounds};
-use emg_verify::{JointSamples, Joints, Line, ReferenceModel, ReplayError, check_replay};
+use emg_io::JointTrajectoryPoint;
+use emg_verify::{
+    JointDynamics, JointSamples, Joints, Line, ReferenceModel, ReplayError, check_replay,
+};
+use rayon::prelude::*;
 
 use crate::claims::{COVERAGE_SLACK_M, Coverage, Stretch};
 use crate::free_space::with_part;
-use crate::program::{JobFile, SegmentKind, StrokeReport};
+use crate::program::{JobFile, Segment, SegmentKind, StrokeReport};
 
 /// How much (m) a length a program claims may differ from what the checker measures of its
 /// samples: the rounding between the planners' kinematics and the checker's.
@@ -115,9 +122,86 @@ pub fn verify_job(
         drawn_m: 0.0,
         total_m: 0.0,
     };
+    // Each stroke's place in `strokes` (the first report of it).
+    let mut places = HashMap::with_capacity(file.strokes.len());
+    for (place, report) in file.strokes.iter().enumerate() {
+        places.entry(report.stroke).or_insert(place);
+    }
+    // Segments are checked in parallel, each on its own; the outcome is the first failing
+    // segment's in segment order (every segment before it is checked, whatever the threads),
+    // else every segment's, gathered in segment order: the same on any number of threads.
+    // A segment after one known to fail is not checked, since its outcome cannot matter.
+    let first_failure = AtomicUsize::new(usize::MAX);
+    let outcomes: Vec<Option<Result<Option<(usize, Stretch)>, JobCheckError>>> = file
+        .segments
+        .par_iter()
+        .enumerate()
+        .map(|(index, segment)| {
+            if index > first_failure.load(AtomicOrdering::Relaxed) {
+                return None;
+            }
+            let context = SegmentContext {
+                file,
+                model,
+                dynamics: &dynamics,
+                on_part: &on_part,
+                free: &free,
+                places: &places,
+            };
+            let outcome = context.verify_segment(index, segment, &all_points, &times);
+            if outcome.is_err() {
+                first_failure.fetch_min(index, AtomicOrdering::Relaxed);
+            }
+            Some(outcome)
+        })
+        .collect();
     // The stretch each stroke's parts' samples cover, by the stroke's place in `strokes`.
     let mut covered: Vec<Vec<Stretch>> = vec![Vec::new(); file.strokes.len()];
-    for (index, segment) in file.segments.iter().enumerate() {
+    for outcome in outcomes {
+        // A segment is left unchecked only after a failing one, which returns first.
+        match outcome.expect("every segment before the first failing one is checked")? {
+            Some((place, stretch)) => {
+                covered[place].push(stretch);
+                check.stroke_parts += 1;
+            }
+            None => check.moves += 1,
+        }
+    }
+    for (report, covered) in file.strokes.iter().zip(&covered) {
+        let coverage = verify_claims(report, covered)?;
+        check.whole_strokes += usize::from(coverage.whole());
+        check.drawn_m += coverage.drawn_m;
+        check.total_m += report.length_m;
+    }
+    verify_summary(file)?;
+    verify_home(file, &all_points)?;
+    Ok(check)
+}
+
+/// What every segment's check shares.
+struct SegmentContext<'a> {
+    file: &'a JobFile,
+    model: &'a ReferenceModel,
+    dynamics: &'a JointDynamics,
+    /// The constraints of a stroke part, the part in the scene.
+    on_part: &'a ConstraintConfig,
+    /// The constraints of a move: only the arm's clearances.
+    free: &'a ConstraintConfig,
+    /// Each stroke's place in the file's `strokes`.
+    places: &'a HashMap<usize, usize>,
+}
+
+impl SegmentContext<'_> {
+    /// Checks segment `index` (`segment`) on its samples among `all_points` (their times
+    /// `times`): a stroke part's, then its task against its stroke, giving its stroke's place
+    /// and the stretch its samples cover; a move's, giving `None`.
+    fn verify_segment(
+        &self,
+        index: usize,
+        segment: &Segment,
+        all_points: &[JointTrajectoryPoint],
+        times: &[f64],
+    ) -> Result<Option<(usize, Stretch)>, JobCheckError> {
         let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
         let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
         let points = &all_points[first..last];
@@ -143,58 +227,50 @@ pub fn verify_job(
             SegmentKind::Stroke { stroke, from_s, .. } => {
                 let task = segment.task.as_ref().ok_or(JobCheckError::NoTask(index))?;
                 let line: Line = task.into();
-                check_replay(
-                    model,
+                let report = check_replay(
+                    self.model,
                     &line,
-                    &task_bounds(task, &on_part),
+                    &task_bounds(task, self.on_part),
                     &samples,
                     None,
-                    Some(&dynamics),
+                    Some(self.dynamics),
                 )
                 .map_err(fail)?;
-                let place = file
-                    .strokes
-                    .iter()
-                    .position(|report| report.stroke == stroke)
+                let place = *self
+                    .places
+                    .get(&stroke)
                     .ok_or_else(|| JobCheckError::Claim {
                         stroke,
                         problem: format!("segment {index} draws it, but no stroke report has it"),
                     })?;
-                on_its_stroke(&file.strokes[place], task, from_s, index)?;
-                let tcps = samples.q.iter().map(|q| model.tcp_pose(q).0);
-                let (least, greatest) = line.covered(tcps).expect("a replayed segment has points");
-                covered[place].push(Stretch {
-                    from_s: from_s + least,
-                    to_s: from_s + greatest,
-                });
-                check.stroke_parts += 1;
+                on_its_stroke(&self.file.strokes[place], task, from_s, index)?;
+                // What `Line::covered` gives of the samples' TCPs.
+                let (least, greatest) = report.progress_range_m;
+                Ok(Some((
+                    place,
+                    Stretch {
+                        from_s: from_s + least,
+                        to_s: from_s + greatest,
+                    },
+                )))
             }
             _ => {
                 // The whole part is in `free`'s scene: one surface's task frames the replay.
-                if let Some(task) = file.surfaces.first() {
+                if let Some(task) = self.file.surfaces.first() {
                     check_replay(
-                        model,
+                        self.model,
                         &task.into(),
-                        &task_bounds(task, &free),
+                        &task_bounds(task, self.free),
                         &samples,
                         None,
-                        Some(&dynamics),
+                        Some(self.dynamics),
                     )
                     .map_err(fail)?;
                 }
-                check.moves += 1;
+                Ok(None)
             }
         }
     }
-    for (report, covered) in file.strokes.iter().zip(&covered) {
-        let coverage = verify_claims(report, covered)?;
-        check.whole_strokes += usize::from(coverage.whole());
-        check.drawn_m += coverage.drawn_m;
-        check.total_m += report.length_m;
-    }
-    verify_summary(file)?;
-    verify_home(file, &all_points)?;
-    Ok(check)
 }
 
 /// Checks that `task`, the task of stroke part segment `segment`, is its stroke's stretch from

@@ -1,6 +1,6 @@
 //! The step-by-step re-check of a recorded motion.
 
-use crate::model::{ReferenceModel, angle_deg, within};
+use crate::model::{ReferenceModel, Scene, angle_deg, within};
 use crate::record::{Blame, Bounds, Ending, Joints, Line, Recording};
 
 /// Numerical slack when comparing recomputed values with recorded ones and with bounds.
@@ -61,6 +61,34 @@ pub struct CheckFailure {
     pub problem: String,
 }
 
+/// The points a check goes through: a recorded motion's, or timed samples whose TCP, tool
+/// angle and path length are what the checker's own kinematics give
+/// ([`crate::JointSamples::to_recording`] without building it).
+#[derive(Clone, Copy)]
+pub(crate) enum Points<'a> {
+    /// A recorded motion, its records compared with the checker's.
+    Recorded(&'a Recording),
+    /// Timed joint positions, their motion [`Ending::Stopped`].
+    Samples {
+        /// Times (s).
+        time_s: &'a [f64],
+        /// Joint positions (rad).
+        q: &'a [Joints],
+    },
+}
+
+/// What a check measured at every point with the checker's kinematics, for a report.
+pub(crate) struct Measured {
+    /// Each point's progress along the line or path ([`Line::reached`] follows them).
+    pub progress: Vec<f64>,
+    /// Largest distance of a TCP from the line or path (m).
+    pub max_line_deviation_m: f64,
+    /// Largest angle between the tool axis and `n` (degrees).
+    pub max_tool_angle_deg: f64,
+    /// Smallest clearance between checked capsule pairs (m), with the first pair's links.
+    pub min_clearance: (f64, String, String),
+}
+
 impl ReferenceModel {
     /// Verifies every point of `recording` against `bounds` and its own records: joint limits,
     /// TCP and tool angle as recorded, line tolerance, tool cone, no self-collision, the
@@ -74,6 +102,18 @@ impl ReferenceModel {
         recording: &Recording,
         bounds: &Bounds,
     ) -> Result<(), CheckFailure> {
+        self.check_points(line, Points::Recorded(recording), bounds)
+            .map(|_| ())
+    }
+
+    /// [`Self::check_recording`] of `points`, measuring every point once (one forward
+    /// kinematics pass per point for every check and every measure).
+    pub(crate) fn check_points(
+        &self,
+        line: &Line,
+        points: Points<'_>,
+        bounds: &Bounds,
+    ) -> Result<Measured, CheckFailure> {
         let limits = self.limits();
         let velocity_limits = self.velocity_limits();
         let fail = |step: usize, check: FailedCheck, problem: String| {
@@ -83,48 +123,83 @@ impl ReferenceModel {
                 problem,
             })
         };
-        let steps = &recording.steps;
-        if steps.is_empty() {
+        let (count, ending) = match points {
+            Points::Recorded(recording) => (recording.steps.len(), &recording.ending),
+            Points::Samples { q, .. } => (q.len(), &Ending::Stopped),
+        };
+        let time = |k: usize| match points {
+            Points::Recorded(recording) => recording.steps[k].time_s,
+            Points::Samples { time_s, .. } => time_s[k],
+        };
+        let joints = |k: usize| match points {
+            Points::Recorded(recording) => &recording.steps[k].q,
+            Points::Samples { q, .. } => &q[k],
+        };
+        if count == 0 {
             return fail(
                 0,
                 FailedCheck::Empty,
                 "the trajectory holds no step, not even its seed".into(),
             );
         }
-        let valid_steps = match recording.ending {
-            Ending::InvalidStart { .. } if steps.len() != 1 => {
+        let valid_steps = match ending {
+            Ending::InvalidStart { .. } if count != 1 => {
                 return fail(
                     1,
                     FailedCheck::Ending,
-                    format!(
-                        "an invalid start must hold only the seed, found {} steps",
-                        steps.len()
-                    ),
+                    format!("an invalid start must hold only the seed, found {count} steps"),
                 );
             }
             Ending::InvalidStart { .. } => 0,
-            _ => steps.len(),
+            _ => count,
         };
-        for (k, step) in steps.iter().enumerate().take(valid_steps) {
-            let q = &step.q;
-            for (i, (lo, hi)) in limits.iter().enumerate() {
-                if !(q[i] >= *lo && q[i] <= *hi) {
-                    return fail(
-                        k,
-                        FailedCheck::JointLimit { joint: i + 1 },
-                        format!("joint {} = {} outside [{lo}, {hi}]", i + 1, q[i]),
-                    );
+        let scene = Scene::new(line, bounds);
+        let mut placement = self.placement();
+        let mut tcps = Vec::with_capacity(count);
+        let mut max_line_deviation_m = 0.0_f64;
+        let mut max_tool_angle_deg = 0.0_f64;
+        let mut min_clearance: (f64, Option<usize>) = (f64::INFINITY, None);
+        for k in 0..count {
+            let q = joints(k);
+            let checked = k < valid_steps;
+            if checked {
+                for (i, (lo, hi)) in limits.iter().enumerate() {
+                    if !(q[i] >= *lo && q[i] <= *hi) {
+                        return fail(
+                            k,
+                            FailedCheck::JointLimit { joint: i + 1 },
+                            format!("joint {} = {} outside [{lo}, {hi}]", i + 1, q[i]),
+                        );
+                    }
                 }
             }
-            let (tcp, z) = self.tcp_pose(q);
-            if !within((tcp - step.tcp).norm(), SLACK) {
+            self.place(q, &mut placement);
+            let (tcp, z) = placement.tcp_pose();
+            tcps.push(tcp);
+            let lateral = line.distance(&tcp);
+            let angle = angle_deg(&z, &line.n);
+            let clearance = self.placed_clearance(&placement);
+            max_line_deviation_m = max_line_deviation_m.max(lateral);
+            max_tool_angle_deg = max_tool_angle_deg.max(angle);
+            if clearance.0 < min_clearance.0 {
+                min_clearance = clearance;
+            }
+            if !checked {
+                continue;
+            }
+            let (recorded_tcp, recorded_angle) = match points {
+                Points::Recorded(recording) => {
+                    (recording.steps[k].tcp, recording.steps[k].tool_angle_deg)
+                }
+                Points::Samples { .. } => (tcp, angle),
+            };
+            if !within((tcp - recorded_tcp).norm(), SLACK) {
                 return fail(
                     k,
                     FailedCheck::RecordedTcp,
-                    format!("recorded TCP {:?} but FK gives {:?}", step.tcp, tcp),
+                    format!("recorded TCP {recorded_tcp:?} but FK gives {tcp:?}"),
                 );
             }
-            let lateral = line.distance(&tcp);
             if !within(lateral, bounds.line_tolerance_m + SLACK) {
                 return fail(
                     k,
@@ -132,7 +207,6 @@ impl ReferenceModel {
                     format!("TCP {lateral} m off the line"),
                 );
             }
-            let angle = angle_deg(&z, &line.n);
             if !within(angle, bounds.theta_max_deg + ANGLE_SLACK_DEG) {
                 return fail(
                     k,
@@ -140,25 +214,25 @@ impl ReferenceModel {
                     format!("tool axis {angle}° from n"),
                 );
             }
-            if !within((angle - step.tool_angle_deg).abs(), ANGLE_SLACK_DEG) {
+            if !within((angle - recorded_angle).abs(), ANGLE_SLACK_DEG) {
                 return fail(
                     k,
                     FailedCheck::RecordedToolAngle,
-                    format!(
-                        "recorded tool angle {} but FK gives {angle}",
-                        step.tool_angle_deg
-                    ),
+                    format!("recorded tool angle {recorded_angle} but FK gives {angle}"),
                 );
             }
-            let (gap, a, b) = self.min_clearance(q);
-            if !within(bounds.collision_margin_m - SLACK, gap) {
+            if !within(bounds.collision_margin_m - SLACK, clearance.0) {
+                let (gap, a, b) = self.clearance_names(clearance);
                 return fail(
                     k,
                     FailedCheck::SelfCollision,
                     format!("{a} and {b} collide (clearance {:.2} mm)", gap * 1e3),
                 );
             }
-            if let Some((margin, link, obstacle)) = self.scene_margin(q, line, bounds)
+            // Every margin's lower bound at least zero: no margin is below −SLACK, and the
+            // margins need not be measured.
+            if !self.scene_clear(&placement, &scene)
+                && let Some((margin, link, obstacle)) = self.placed_scene_margin(&placement, &scene)
                 && !within(-SLACK, margin)
             {
                 return fail(
@@ -170,16 +244,18 @@ impl ReferenceModel {
                     ),
                 );
             }
-            if !step.time_s.is_finite() {
+            let time_s = time(k);
+            if !time_s.is_finite() {
                 return fail(
                     k,
                     FailedCheck::Timestamps,
-                    format!("timestamp {} is not finite", step.time_s),
+                    format!("timestamp {time_s} is not finite"),
                 );
             }
             if k > 0 {
-                let previous = &steps[k - 1];
-                if within(step.time_s, previous.time_s) {
+                let previous_time_s = time(k - 1);
+                let previous = joints(k - 1);
+                if within(time_s, previous_time_s) {
                     return fail(
                         k,
                         FailedCheck::Timestamps,
@@ -187,9 +263,9 @@ impl ReferenceModel {
                     );
                 }
                 if let Some(fraction) = bounds.velocity_limit_fraction {
-                    let elapsed = step.time_s - previous.time_s;
+                    let elapsed = time_s - previous_time_s;
                     for (i, limit) in velocity_limits.iter().enumerate() {
-                        let speed = (step.q[i] - previous.q[i]).abs() / elapsed;
+                        let speed = (q[i] - previous[i]).abs() / elapsed;
                         let allowed = fraction * limit;
                         if !within(speed, allowed * (1.0 + SLACK)) {
                             return fail(
@@ -205,41 +281,54 @@ impl ReferenceModel {
                 }
             }
         }
-        let length = line.reached(steps.iter().map(|step| step.tcp));
-        if let (Ending::Completed, Some(path_length)) = (&recording.ending, line.path_length())
+        let progress = line.progresses(tcps.iter().copied());
+        let (length, claimed) = match points {
+            Points::Recorded(recording) => (
+                line.reached(recording.steps.iter().map(|step| step.tcp)),
+                recording.path_length_m,
+            ),
+            // The TCPs are the checker's, and so is the length claimed.
+            Points::Samples { .. } => {
+                let reached = progress.last().copied().unwrap_or(0.0);
+                (reached, reached)
+            }
+        };
+        if let (Ending::Completed, Some(path_length)) = (ending, line.path_length())
             && !within(path_length - PATH_END_SLACK_M, length)
         {
             return fail(
-                steps.len() - 1,
+                count - 1,
                 FailedCheck::Ending,
                 format!("claims the end of the path ({path_length} m) but reaches {length} m"),
             );
         }
-        if !within((length - recording.path_length_m).abs(), SLACK) {
+        if !within((length - claimed).abs(), SLACK) {
             return fail(
-                steps.len() - 1,
+                count - 1,
                 FailedCheck::PathLength,
-                format!(
-                    "reported path length {} but the last step gives {length}",
-                    recording.path_length_m
-                ),
+                format!("reported path length {claimed} but the last step gives {length}"),
             );
         }
-        let blamed = match &recording.ending {
+        let blamed = match ending {
             Ending::Rejected { blame, rejected_q } => Some((blame, *rejected_q)),
-            Ending::InvalidStart { blame } => Some((blame, steps[0].q)),
+            Ending::InvalidStart { blame } => Some((blame, *joints(0))),
             Ending::Stopped | Ending::Completed => None,
         };
         if let Some((blame, q)) = blamed
             && !self.breaks(line, &q, blame, bounds)
         {
             return fail(
-                steps.len(),
+                count,
                 FailedCheck::Ending,
                 format!("the final configuration does not break {blame:?}"),
             );
         }
-        Ok(())
+        Ok(Measured {
+            progress,
+            max_line_deviation_m,
+            max_tool_angle_deg,
+            min_clearance: self.clearance_names(min_clearance),
+        })
     }
 
     /// Whether configuration `q` breaks the constraint named by `blame`.

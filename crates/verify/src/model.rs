@@ -38,6 +38,10 @@ pub struct ReferenceModel {
     /// Link pairs not checked for self-collision, from an SRDF file beside the robot file;
     /// `None`: links at least three apart are checked.
     disabled: Option<Vec<(String, String)>>,
+    /// The checked capsule pairs (indices into `capsules`, the first the lower), in the order
+    /// the nested loop over `capsules` meets them: `checked` applied once, when the model is
+    /// read.
+    pairs: Vec<(usize, usize)>,
 }
 
 /// The name the work surface goes by in failures.
@@ -225,12 +229,15 @@ impl ReferenceModel {
             .map(|c| c.chain_index)
             .max()
             .filter(|&link| link >= last_moving_link);
-        Ok(Self {
+        let mut model = Self {
             joints,
             capsules,
             tool_link,
             disabled: None,
-        })
+            pairs: Vec::new(),
+        };
+        model.pairs = model.checked_pairs();
+        Ok(model)
     }
 
     /// Reads the chain from `base` to `tip` of a URDF file.
@@ -257,6 +264,7 @@ impl ReferenceModel {
                         problem,
                     })?,
                 );
+            model.pairs = model.checked_pairs();
         }
         Ok(model)
     }
@@ -273,9 +281,31 @@ impl ReferenceModel {
         }
     }
 
+    /// The checked capsule pairs, in the order of the nested loop over `capsules`.
+    fn checked_pairs(&self) -> Vec<(usize, usize)> {
+        let mut pairs = Vec::new();
+        for (i, a) in self.capsules.iter().enumerate() {
+            for (j, b) in self.capsules.iter().enumerate().skip(i + 1) {
+                if self.checked(a, b) {
+                    pairs.push((i, j));
+                }
+            }
+        }
+        pairs
+    }
+
     /// Link frames base to tip (one per link of the chain) for configuration `q`.
     fn link_frames(&self, q: &Joints) -> Vec<Matrix4<f64>> {
-        let mut frames = vec![Matrix4::identity()];
+        let mut frames = Vec::with_capacity(self.joints.len() + 1);
+        self.link_frames_into(q, &mut frames);
+        frames
+    }
+
+    /// [`Self::link_frames`] written into `frames` (cleared first), so that a caller placing
+    /// many configurations reuses one buffer.
+    fn link_frames_into(&self, q: &Joints, frames: &mut Vec<Matrix4<f64>>) {
+        frames.clear();
+        frames.push(Matrix4::identity());
         let mut revolute = 0;
         for joint in &self.joints {
             let mut transform = frames.last().expect("base frame") * joint.origin;
@@ -285,7 +315,35 @@ impl ReferenceModel {
             }
             frames.push(transform);
         }
-        frames
+    }
+
+    /// An empty [`Placement`] of this robot, to be filled by [`Self::place`].
+    pub(crate) fn placement(&self) -> Placement {
+        Placement {
+            frames: Vec::with_capacity(self.joints.len() + 1),
+            ends: Vec::with_capacity(self.capsules.len()),
+            spheres: Vec::with_capacity(self.capsules.len()),
+        }
+    }
+
+    /// Places configuration `q` into `placement`: one pass of forward kinematics, every
+    /// capsule's axis ends in the base frame and its bounding sphere. Each value is computed
+    /// by the very operations [`Self::tcp_pose`], [`Self::min_clearance`] and
+    /// [`Self::scene_margin`] use, so the results from a placement are theirs bit for bit.
+    pub(crate) fn place(&self, q: &Joints, placement: &mut Placement) {
+        self.link_frames_into(q, &mut placement.frames);
+        placement.ends.clear();
+        placement.spheres.clear();
+        for capsule in &self.capsules {
+            let frame = &placement.frames[capsule.chain_index];
+            let world = |v: &Vector3<f64>| (frame * Vector4::new(v.x, v.y, v.z, 1.0)).xyz();
+            let (start, end) = (world(&capsule.start), world(&capsule.end));
+            placement.spheres.push((
+                (start + end) * 0.5,
+                (end - start).norm() * 0.5 + capsule.radius,
+            ));
+            placement.ends.push([start, end]);
+        }
     }
 
     /// TCP position and tool axis (z of the tip link) for `q`.
@@ -318,29 +376,150 @@ impl ReferenceModel {
     /// Smallest clearance (m) over the checked capsule pairs (links at least three apart, or
     /// those an SRDF file beside the robot file does not disable), with their links.
     pub fn min_clearance(&self, q: &Joints) -> (f64, String, String) {
-        let frames = self.link_frames(q);
-        let world = |c: &ReferenceCapsule, v: &Vector3<f64>| {
-            (frames[c.chain_index] * Vector4::new(v.x, v.y, v.z, 1.0)).xyz()
+        let mut placement = self.placement();
+        self.place(q, &mut placement);
+        self.clearance_names(self.placed_clearance(&placement))
+    }
+
+    /// The smallest clearance (m) of a placed configuration and the index in `pairs` of its
+    /// pair: the first pair in `pairs` order with the smallest clearance, as the exhaustive
+    /// loop over the pairs finds it (`None`: no pair, or no clearance below infinity).
+    ///
+    /// Pairs are pruned, soundly: the distance between two capsules' axes is at least the
+    /// distance between their bounding spheres' centres less both half axes (every axis point
+    /// lies within its half axis of the centre), so a pair whose sphere bound exceeds the
+    /// smallest clearance found by more than [`PRUNE_SLACK_M`] (far above the rounding of
+    /// either computation, ~1e-15 m at a robot's scale) cannot be the smallest, nor tie with
+    /// it. The pair with the smallest bound is measured first, so that most pairs are pruned;
+    /// ties then go to the earlier pair, as the exhaustive loop's strict `<` does. Without a
+    /// finite bound (a configuration that is not finite) every pair is measured in order.
+    pub(crate) fn placed_clearance(&self, placement: &Placement) -> (f64, Option<usize>) {
+        let gap = |(i, j): (usize, usize)| {
+            let ([a0, a1], [b0, b1]) = (&placement.ends[i], &placement.ends[j]);
+            segments_gap(a0, a1, b0, b1) - self.capsules[i].radius - self.capsules[j].radius
         };
-        let mut best = (f64::INFINITY, String::new(), String::new());
-        for (i, a) in self.capsules.iter().enumerate() {
-            for b in &self.capsules[i + 1..] {
-                if !self.checked(a, b) {
-                    continue;
-                }
-                let gap = segments_gap(
-                    &world(a, &a.start),
-                    &world(a, &a.end),
-                    &world(b, &b.start),
-                    &world(b, &b.end),
-                ) - a.radius
-                    - b.radius;
+        let bound = |(i, j): (usize, usize)| {
+            let ((ca, ra), (cb, rb)) = (&placement.spheres[i], &placement.spheres[j]);
+            (ca - cb).norm() - ra - rb
+        };
+        let mut seed: Option<(f64, usize)> = None;
+        for (index, &pair) in self.pairs.iter().enumerate() {
+            let lower = bound(pair);
+            if !lower.is_finite() {
+                seed = None;
+                break;
+            }
+            if seed.is_none_or(|(least, _)| lower < least) {
+                seed = Some((lower, index));
+            }
+        }
+        let mut best: (f64, Option<usize>) = (f64::INFINITY, None);
+        let Some((_, first)) = seed else {
+            // The exhaustive loop: the first pair with the smallest clearance.
+            for (index, &pair) in self.pairs.iter().enumerate() {
+                let gap = gap(pair);
                 if gap < best.0 {
-                    best = (gap, a.link.clone(), b.link.clone());
+                    best = (gap, Some(index));
                 }
+            }
+            return best;
+        };
+        let measured = gap(self.pairs[first]);
+        if measured < best.0 {
+            best = (measured, Some(first));
+        }
+        for (index, &pair) in self.pairs.iter().enumerate() {
+            if index == first || bound(pair) > best.0 + PRUNE_SLACK_M {
+                continue;
+            }
+            let gap = gap(pair);
+            if gap < best.0 || (gap == best.0 && best.1.is_some_and(|b| index < b)) {
+                best = (gap, Some(index));
             }
         }
         best
+    }
+
+    /// A clearance of [`Self::placed_clearance`] with its pair's links.
+    pub(crate) fn clearance_names(
+        &self,
+        (gap, pair): (f64, Option<usize>),
+    ) -> (f64, String, String) {
+        match pair {
+            Some(index) => {
+                let (i, j) = self.pairs[index];
+                (
+                    gap,
+                    self.capsules[i].link.clone(),
+                    self.capsules[j].link.clone(),
+                )
+            }
+            None => (gap, String::new(), String::new()),
+        }
+    }
+}
+
+/// How much (m) a lower bound of a distance must exceed the value it is compared with before
+/// the checker skips measuring that distance exactly: far above the rounding of the bound and
+/// of the exact measure (~1e-15 m for coordinates of a few metres), far below any clearance or
+/// tolerance the checker reports.
+pub(crate) const PRUNE_SLACK_M: f64 = 1e-9;
+
+/// One configuration as the checker places it ([`ReferenceModel::place`]): its link frames,
+/// every capsule's axis ends in the base frame and every capsule's bounding sphere.
+pub(crate) struct Placement {
+    frames: Vec<Matrix4<f64>>,
+    /// Per capsule, its axis ends in the base frame.
+    ends: Vec<[Vector3<f64>; 2]>,
+    /// Per capsule, the midpoint of its axis and half the axis plus its radius.
+    spheres: Vec<(Vector3<f64>, f64)>,
+}
+
+impl Placement {
+    /// TCP position and tool axis, as [`ReferenceModel::tcp_pose`] gives them.
+    pub(crate) fn tcp_pose(&self) -> (Vector3<f64>, Vector3<f64>) {
+        let tip = self.frames.last().expect("tip frame");
+        (
+            tip.fixed_view::<3, 1>(0, 3).into_owned(),
+            tip.fixed_view::<3, 1>(0, 2).into_owned(),
+        )
+    }
+}
+
+/// The solids a configuration keeps its distance from: the work surface of a line (which the
+/// tool may touch) and the obstacles of the bounds, each with its clearance, its name and
+/// whether the tool's capsules may touch it.
+pub(crate) struct Scene<'a> {
+    solids: Vec<(std::borrow::Cow<'a, Solid>, f64, &'a str, bool)>,
+}
+
+impl<'a> Scene<'a> {
+    /// The work surface of `line` (when `bounds` ask for one) and the obstacles of `bounds`.
+    pub(crate) fn new(line: &Line, bounds: &'a Bounds) -> Self {
+        let surface = bounds.work_surface.map(|surface| {
+            (
+                std::borrow::Cow::Owned(surface.solid(line)),
+                0.0,
+                WORK_SURFACE,
+                true,
+            )
+        });
+        let obstacles = bounds.obstacles.iter().map(|o| {
+            (
+                std::borrow::Cow::Borrowed(&o.solid),
+                o.clearance_m,
+                o.name.as_str(),
+                o.tool_may_touch,
+            )
+        });
+        Self {
+            solids: surface.into_iter().chain(obstacles).collect(),
+        }
+    }
+
+    /// Whether there is nothing to keep away from.
+    pub(crate) fn is_empty(&self) -> bool {
+        self.solids.is_empty()
     }
 }
 
@@ -355,36 +534,169 @@ impl ReferenceModel {
         line: &Line,
         bounds: &Bounds,
     ) -> Option<(f64, String, String)> {
-        let frames = self.link_frames(q);
-        let surface = bounds.work_surface.map(|surface| surface.solid(line));
-        let surface = surface
-            .as_ref()
-            .map(|solid| (solid, 0.0, WORK_SURFACE, true));
-        let obstacles = bounds
-            .obstacles
+        let mut placement = self.placement();
+        self.place(q, &mut placement);
+        self.placed_scene_margin(&placement, &Scene::new(line, bounds))
+    }
+
+    /// The (solid, capsule) pairs of `scene` a placed configuration is measured against, in
+    /// order: every solid with every capsule, but the tool's where the tool may touch it.
+    fn scene_pairs<'s>(
+        &'s self,
+        scene: &'s Scene<'_>,
+    ) -> impl Iterator<Item = (usize, usize)> + 's {
+        scene
+            .solids
             .iter()
-            .map(|o| (&o.solid, o.clearance_m, o.name.as_str(), o.tool_may_touch));
-        let mut worst: Option<(f64, String, String)> = None;
-        for (solid, clearance, name, tool_may_touch) in surface.into_iter().chain(obstacles) {
-            for capsule in &self.capsules {
-                if tool_may_touch && Some(capsule.chain_index) == self.tool_link {
-                    continue;
-                }
-                let frame = &frames[capsule.chain_index];
-                let world = |v: &Vector3<f64>| (frame * Vector4::new(v.x, v.y, v.z, 1.0)).xyz();
-                let margin = axis_depth(solid, &world(&capsule.start), &world(&capsule.end))
-                    - capsule.radius
-                    - clearance;
-                // NaN is the worst margin of all.
-                if worst
-                    .as_ref()
-                    .is_none_or(|w| margin.is_nan() || margin < w.0)
-                {
-                    worst = Some((margin, capsule.link.clone(), name.to_string()));
+            .enumerate()
+            .flat_map(move |(s, (_, _, _, tool_may_touch))| {
+                self.capsules
+                    .iter()
+                    .enumerate()
+                    .filter(move |(_, capsule)| {
+                        !(*tool_may_touch && Some(capsule.chain_index) == self.tool_link)
+                    })
+                    .map(move |(c, _)| (s, c))
+            })
+    }
+
+    /// The margin of capsule `c` from solid `s` of `scene`, measured exactly.
+    fn scene_pair_margin(
+        &self,
+        placement: &Placement,
+        scene: &Scene<'_>,
+        s: usize,
+        c: usize,
+    ) -> f64 {
+        let (solid, clearance, _, _) = &scene.solids[s];
+        let [start, end] = &placement.ends[c];
+        axis_depth(solid, start, end) - self.capsules[c].radius - clearance
+    }
+
+    /// A lower bound of [`Self::scene_pair_margin`] ([`depth_lower_bound`]).
+    fn scene_pair_bound(
+        &self,
+        placement: &Placement,
+        scene: &Scene<'_>,
+        s: usize,
+        c: usize,
+    ) -> f64 {
+        let (solid, clearance, _, _) = &scene.solids[s];
+        let [start, end] = &placement.ends[c];
+        depth_lower_bound(solid, start, end) - self.capsules[c].radius - clearance
+    }
+
+    /// Whether no capsule of a placed configuration can come within its clearance of a solid
+    /// of `scene`: every lower bound of a margin ([`depth_lower_bound`]) is at least zero, so
+    /// every margin [`Self::scene_margin`] measures is at least minus the rounding of the
+    /// bound (far below the checks' slack). False where a bound is below zero or not a
+    /// number; then the margins must be measured.
+    pub(crate) fn scene_clear(&self, placement: &Placement, scene: &Scene<'_>) -> bool {
+        self.scene_pairs(scene)
+            .all(|(s, c)| self.scene_pair_bound(placement, scene, s, c) >= 0.0)
+    }
+
+    /// [`Self::scene_margin`] of a placed configuration: the first (solid, capsule) pair in
+    /// order with the smallest margin, a margin that is not a number being the worst of all
+    /// (the last such pair).
+    ///
+    /// Pairs are pruned, soundly: a pair whose lower bound ([`depth_lower_bound`]) exceeds
+    /// the smallest margin found by more than [`PRUNE_SLACK_M`] cannot be the smallest, nor
+    /// tie with it. The pair with the smallest bound is measured first; ties then go to the
+    /// earlier pair. Where a bound is not finite, every pair is measured in order.
+    pub(crate) fn placed_scene_margin(
+        &self,
+        placement: &Placement,
+        scene: &Scene<'_>,
+    ) -> Option<(f64, String, String)> {
+        if scene.is_empty() {
+            return None;
+        }
+        let named = |(margin, s, c): (f64, usize, usize)| {
+            (
+                margin,
+                self.capsules[c].link.clone(),
+                scene.solids[s].2.to_string(),
+            )
+        };
+        // The exhaustive loop: the first smallest margin, NaN the worst of all (the last).
+        let exhaustive = || {
+            let mut worst: Option<(f64, usize, usize)> = None;
+            for (s, c) in self.scene_pairs(scene) {
+                let margin = self.scene_pair_margin(placement, scene, s, c);
+                if worst.is_none_or(|w| margin.is_nan() || margin < w.0) {
+                    worst = Some((margin, s, c));
                 }
             }
+            worst
+        };
+        let mut seed: Option<(f64, usize, usize)> = None;
+        for (s, c) in self.scene_pairs(scene) {
+            let lower = self.scene_pair_bound(placement, scene, s, c);
+            if !lower.is_finite() {
+                seed = None;
+                break;
+            }
+            if seed.is_none_or(|(least, ..)| lower < least) {
+                seed = Some((lower, s, c));
+            }
         }
-        worst
+        let Some((_, s0, c0)) = seed else {
+            return exhaustive().map(named);
+        };
+        let measured = self.scene_pair_margin(placement, scene, s0, c0);
+        if measured.is_nan() {
+            // Only an exhaustive loop tells which NaN is the last.
+            return exhaustive().map(named);
+        }
+        let mut worst = (measured, s0, c0);
+        for (s, c) in self.scene_pairs(scene) {
+            if (s, c) == (s0, c0)
+                || self.scene_pair_bound(placement, scene, s, c) > worst.0 + PRUNE_SLACK_M
+            {
+                continue;
+            }
+            let margin = self.scene_pair_margin(placement, scene, s, c);
+            if margin.is_nan() {
+                return exhaustive().map(named);
+            }
+            if margin < worst.0 || (margin == worst.0 && (s, c) < (worst.1, worst.2)) {
+                worst = (margin, s, c);
+            }
+        }
+        Some(named(worst))
+    }
+}
+
+/// A lower bound of [`axis_depth`] that costs a few operations: the exact value for a
+/// half-space, a ball and a capsule (their closest points are cheap); for a box, the largest
+/// over its six faces of the smaller signed distance of the segment's two ends from the
+/// face's plane. A box lies inside each face's half-space, so its signed distance is at least
+/// each face's (outside: the box is farther than the half-space containing it; inside: the
+/// depth is the distance to the nearest face plane), and along the segment a plane's signed
+/// distance is affine, smallest at an end.
+fn depth_lower_bound(solid: &Solid, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    match solid {
+        Solid::Box {
+            centre,
+            axes,
+            half_extents,
+        } => {
+            let (la, lb) = (axes.tr_mul(&(a - centre)), axes.tr_mul(&(b - centre)));
+            let mut bound = f64::NEG_INFINITY;
+            for i in 0..3 {
+                let above = la[i].min(lb[i]);
+                let below = (-la[i]).min(-lb[i]);
+                bound = bound.max(above.max(below) - half_extents[i]);
+            }
+            // Not a number where an end is not finite (`max` and `min` pass NaN over).
+            if (la + lb).iter().all(|v| v.is_finite()) {
+                bound
+            } else {
+                f64::NAN
+            }
+        }
+        _ => axis_depth(solid, a, b),
     }
 }
 

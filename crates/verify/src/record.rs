@@ -86,16 +86,20 @@ impl PathPiece {
     }
 
     /// The lengths along the piece, each within `[low, high]`, of its point nearest `point`:
-    /// on a closed circle, also that point one turn on.
-    fn nearest(&self, point: &Vector3<f64>, low: f64, high: f64) -> Vec<f64> {
+    /// on a closed circle, also that point one turn on (the first `count` entries).
+    fn nearest(&self, point: &Vector3<f64>, low: f64, high: f64) -> ([f64; 4], usize) {
         match *self {
-            Self::Straight { start, end } => {
-                vec![
+            Self::Straight { start, end } => (
+                [
                     (point - start)
                         .dot(&(end - start).normalize())
                         .clamp(low, high),
-                ]
-            }
+                    0.0,
+                    0.0,
+                    0.0,
+                ],
+                1,
+            ),
             Self::Arc {
                 centre,
                 start,
@@ -120,11 +124,16 @@ impl PathPiece {
                 };
                 // One turn on lies on a closed circle too, and a point just before the start
                 // is just before the end: the ends are candidates as well.
-                let mut lengths = vec![angle * radius, 0.0, sweep * radius];
+                let mut lengths = [angle * radius, 0.0, sweep * radius, 0.0];
+                let mut count = 3;
                 if angle + full <= sweep {
-                    lengths.push((angle + full) * radius);
+                    lengths[3] = (angle + full) * radius;
+                    count = 4;
                 }
-                lengths.iter().map(|l| l.clamp(low, high)).collect()
+                for length in &mut lengths[..count] {
+                    *length = length.clamp(low, high);
+                }
+                (lengths, count)
             }
         }
     }
@@ -193,7 +202,7 @@ impl Line {
 
     /// Each point's progress: on a line `(p − p0)·d`, on a path the arc length of its nearest
     /// point, followed from the start.
-    fn progresses(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> Vec<f64> {
+    pub(crate) fn progresses(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> Vec<f64> {
         let mut s = 0.0;
         points
             .into_iter()
@@ -227,7 +236,8 @@ impl Line {
             let low = (hint - window - start).max(0.0);
             let high = (hint + window - start).min(length);
             if low <= high {
-                for along in piece.nearest(point, low, high) {
+                let (candidates, count) = piece.nearest(point, low, high);
+                for &along in &candidates[..count] {
                     let cost = (piece.point(along) - point).norm()
                         + continuity * (start + along - hint).abs();
                     if cost < best.1 {

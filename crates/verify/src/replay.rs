@@ -1,7 +1,7 @@
 //! Verifying timed joint positions read from a file: every point against the task and the
 //! bounds, joint speeds from positions and times, and the velocities the file declares.
 
-use crate::check::FailedCheck;
+use crate::check::{FailedCheck, Points};
 use crate::dynamics::{DynamicsCheck, DynamicsReport, JointDynamics, check_dynamics};
 use crate::model::{ReferenceModel, angle_deg, within};
 use crate::record::{Bounds, Ending, Joints, Line, RecordedStep, Recording};
@@ -115,6 +115,9 @@ pub struct ReplayReport {
     /// `(p_last − p0)·d` (m), from the checker's forward kinematics; along a path, the arc
     /// length reached.
     pub path_length_m: f64,
+    /// The least and the greatest progress of the points (m), followed as `path_length_m` is:
+    /// [`Line::covered`] of their TCPs.
+    pub progress_range_m: (f64, f64),
     /// Per joint, the fastest segment speed `|Δq_i| / Δt` as a fraction of the robot file's
     /// velocity limit of that joint (0 for a single point).
     pub peak_speed_fraction: Vec<f64>,
@@ -251,8 +254,7 @@ pub fn check_replay(
             );
         }
     }
-    let rebuilt;
-    let recording = match recorded {
+    let points = match recorded {
         Some(recording) => {
             assert!(
                 recording.steps.len() == samples.len()
@@ -263,15 +265,16 @@ pub fn check_replay(
                         .all(|(step, (t, q))| step.time_s == *t && step.q == *q),
                 "the recording holds the samples' points"
             );
-            recording
+            Points::Recorded(recording)
         }
-        None => {
-            rebuilt = samples.to_recording(model, line);
-            &rebuilt
-        }
+        // The samples as `JointSamples::to_recording` makes them, checked as that recording.
+        None => Points::Samples {
+            time_s: &samples.time_s,
+            q: &samples.q,
+        },
     };
-    model
-        .check_recording(line, recording, bounds)
+    let measured = model
+        .check_points(line, points, bounds)
         .map_err(|failure| ReplayError::Point {
             point: failure.step,
             check: ReplayCheck::Recording(failure.check),
@@ -364,31 +367,23 @@ pub fn check_replay(
         fastest_joint(&velocities[0]),
         fastest_joint(&velocities[velocities.len() - 1]),
     ];
-    let mut max_line_deviation_m = 0.0_f64;
-    let mut max_tool_angle_deg = 0.0_f64;
-    let mut min_clearance = (f64::INFINITY, String::new(), String::new());
-    let mut tcps = Vec::with_capacity(samples.len());
-    for q in &samples.q {
-        let (tcp, axis) = model.tcp_pose(q);
-        tcps.push(tcp);
-        max_line_deviation_m = max_line_deviation_m.max(line.distance(&tcp));
-        max_tool_angle_deg = max_tool_angle_deg.max(angle_deg(&axis, &line.n));
-        let clearance = model.min_clearance(q);
-        if clearance.0 < min_clearance.0 {
-            min_clearance = clearance;
-        }
-    }
     let last = samples.len() - 1;
+    let progress = &measured.progress;
     Ok(ReplayReport {
         points: samples.len(),
         duration_s: samples.time_s[last],
-        path_length_m: line.reached(tcps),
+        path_length_m: progress[last],
+        progress_range_m: progress
+            .iter()
+            .fold((progress[0], progress[0]), |(low, high), s| {
+                (low.min(*s), high.max(*s))
+            }),
         peak_speed_fraction,
         peak_acceleration_rad_s2,
         boundary_speed_fraction,
-        max_line_deviation_m,
-        max_tool_angle_deg,
-        min_clearance,
+        max_line_deviation_m: measured.max_line_deviation_m,
+        max_tool_angle_deg: measured.max_tool_angle_deg,
+        min_clearance: measured.min_clearance,
         max_declared_velocity_error,
         dynamics,
     })
