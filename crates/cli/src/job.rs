@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, SvgOptions, read_svg_file};
-use emg_job::{Job, JobPlanError, Order, plan_job};
+use emg_job::{Job, JobPlanError, Order, Tool, plan_job};
 use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
 
 use crate::interrupt::{Interrupt, Watched};
@@ -34,6 +34,14 @@ pub struct JobInput {
     /// or `given`; overrides the job file's.
     #[arg(long, value_parser = parse_order)]
     pub order: Option<Order>,
+    /// The tool, whose lift between strokes is the default: `pen` (2 mm), `dispenser` (1 cm)
+    /// or `torch` (3 cm); overrides the job file's.
+    #[arg(long, value_parser = parse_tool)]
+    pub tool: Option<Tool>,
+    /// How far the tool lifts off the surface between strokes (mm); overrides the tool's and
+    /// the job file's.
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub lift: Option<f64>,
     /// SVG only: where the drawing's centre goes (m, base frame).
     #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
@@ -150,6 +158,15 @@ impl JobInput {
     }
 }
 
+fn parse_tool(value: &str) -> Result<Tool, String> {
+    match value {
+        "pen" => Ok(Tool::Pen),
+        "dispenser" => Ok(Tool::Dispenser),
+        "torch" => Ok(Tool::Torch),
+        other => Err(format!("'{other}' is not a tool: pen, dispenser or torch")),
+    }
+}
+
 fn parse_order(value: &str) -> Result<Order, String> {
     match value {
         "shortest" => Ok(Order::Shortest),
@@ -262,6 +279,14 @@ pub fn print_summary(file: &emg_job::JobFile) {
         s.planning_s,
         count(s.searches, "search")
     );
+    println!(
+        "at the arm's limits no program drawing these parts lasts less than {:.2} s ({:.2} s pen \
+         down, {:.2} s pen up): this one takes {:.2}×",
+        s.least_pen_down_s + s.least_pen_up_s,
+        s.least_pen_down_s,
+        s.least_pen_up_s,
+        s.duration_s / (s.least_pen_down_s + s.least_pen_up_s).max(f64::MIN_POSITIVE)
+    );
     for stroke in file.strokes.iter().filter(|r| !r.unreached.is_empty()) {
         for (stretch, at) in stroke.unreached.iter().zip(&stroke.unreached_at) {
             println!(
@@ -329,6 +354,17 @@ fn read_job(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Job> {
     };
     if let Some(order) = args.order {
         job.settings.order = order;
+    }
+    if let Some(tool) = args.tool {
+        job.settings.tool = tool;
+        job.settings.lift_m = None;
+    }
+    if let Some(lift_mm) = args.lift {
+        let lift_m = lift_mm * 1e-3;
+        if !(lift_m.is_finite() && lift_m > 0.0 && lift_m <= 0.5) {
+            anyhow::bail!("--lift must be in (0, 500] mm, got {lift_mm}");
+        }
+        job.settings.lift_m = Some(lift_m);
     }
     Ok(job)
 }

@@ -31,11 +31,11 @@ pub mod watch;
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use emg_kinematics::JointVector;
+use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
 };
-use emg_timing::time_blended_move;
+use emg_timing::{DynamicLimits, least_move_s, time_blended_move};
 use rayon::prelude::*;
 
 pub use claims::{COVERAGE_SLACK_M, Coverage, Stretch, part_coverage};
@@ -52,7 +52,7 @@ pub use program::{
     JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, MAX_PROGRAM_S, Program, Segment,
     SegmentKind, StrokeReport,
 };
-pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Transform};
+pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
 pub use stroke::{StrokePart, StrokePlan, plan_stroke};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 pub use watch::{Stopped, StopsWith, Unwatched, Watch};
@@ -142,6 +142,8 @@ pub fn plan_job(
         &planner.config().rollout.constraints,
     );
     let constraints = &planner.config().rollout.constraints;
+    let limits = &timing.request().limits;
+    let mut least = LeastDuration::new(timing.request(), job.home);
     let mut on_part = planner.config().clone();
     on_part.rollout.constraints = free.constraints().clone();
     let on_part = planner
@@ -190,7 +192,7 @@ pub fn plan_job(
                 .or(job.home);
             // Each joint among its whole turns nearest the home (else where the arm is), the
             // tool's free roll centred on it.
-            let planned = toward(planned, job.home.or(from).as_ref(), &free);
+            let planned = toward(planned, job.home.as_ref(), from.as_ref(), &free);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
             // The part planned again from the configuration the arm is in and from the home,
             // each moved above the part's start and set down there: tried first where it draws
@@ -199,9 +201,9 @@ pub fn plan_job(
                 .iter()
                 .flatten()
                 .filter_map(|start| connector.replanned_nearby(&on_part, request, &planned, start))
-                .map(|part| toward(part, job.home.or(from).as_ref(), &free))
+                .map(|part| toward(part, job.home.as_ref(), from.as_ref(), &free))
                 .collect();
-            let candidates = ranked(planned.clone(), again, from.as_ref());
+            let candidates = ranked(planned.clone(), again, from.as_ref(), limits);
             // The first candidate placed, else why the first one could not be.
             let mut placed = None;
             let mut first_why = None;
@@ -266,12 +268,14 @@ pub fn plan_job(
                 Some(&part.task),
                 dof,
             );
-            covered.push(part_coverage(
+            let stretch = part_coverage(
                 robot,
                 &part.task,
                 part.from_s,
                 timed.samples.iter().map(|sample| &sample.q),
-            ));
+            );
+            least.add_stroke(above_start, start, end, stretch.length_m());
+            covered.push(stretch);
             retreat = Some([end, above_end]);
         }
         let length_m = plan.path.length_m();
@@ -318,6 +322,7 @@ pub fn plan_job(
             .unwrap_or_else(|| "no stroke has a reachable start".to_string());
         return Err(JobPlanError::NothingDrawn(why));
     }
+    least.end_at(program.last());
     let mut summary = summarise(
         &reports,
         &program,
@@ -327,6 +332,8 @@ pub fn plan_job(
         started,
     );
     summary.ends_at_home = ends_at_home;
+    summary.least_pen_down_s = least.pen_down_s;
+    summary.least_pen_up_s = least.pen_up_s;
     if program.duration_s() > MAX_PROGRAM_S {
         return Err(JobPlanError::TooLong);
     }
@@ -336,7 +343,7 @@ pub fn plan_job(
         joint_names: robot.joint_names().to_vec(),
         constraints: constraints.clone(),
         limits: timing.record(),
-        settings: settings.clone(),
+        settings: settings.clone().resolved(),
         home: job.home.map(|home| home.as_slice()[..dof].to_vec()),
         ordering,
         strokes: reports,
@@ -347,61 +354,99 @@ pub fn plan_job(
     })
 }
 
-/// `part` moved toward `reference` without changing what it draws: each joint turned by whole
-/// turns ([`emg_kinematics::JointLimits::turns_toward`]), the same motion of the arm with its
-/// joint values nearest the reference within the limits; then the tool's roll joint, where the
-/// arm has one ([`emg_kinematics::Robot::tool_roll_joint`]), turned by the angle that centres
-/// the range it sweeps on the reference's (within the limits): the TCP and the tool axis, all a
-/// stroke constrains, stay where they were, so the part draws exactly as before with the roll
-/// nearest the home. The roll is kept where the turned tool would not be free (`free`'s test
-/// along the motion: the tool's bodies turn with it).
-fn toward(mut part: StrokePart, reference: Option<&JointVector>, free: &FreeSpace) -> StrokePart {
-    let Some(reference) = reference else {
+/// How far (rad) from the home's roll the tool's roll joint is held: a quarter turn.
+pub const ROLL_FROM_HOME_RAD: f64 = std::f64::consts::FRAC_PI_2;
+
+/// `part` moved without changing what it draws, toward `home` (else `from`, where the arm is):
+/// each joint turned by whole turns ([`emg_kinematics::JointLimits::turns_toward`]), the same
+/// motion of the arm with its joint values nearest the reference within the limits; then the
+/// tool's roll joint, where the arm has one ([`emg_kinematics::Robot::tool_roll_joint`]), held
+/// still at the roll the arm is at (`from`'s, else the home's), within
+/// [`ROLL_FROM_HOME_RAD`] of the home's and the limits: no roll to move while drawing or
+/// between strokes. The TCP and the tool axis, all a stroke constrains, do not depend on the
+/// roll, so the part draws exactly as before. Where the held roll is not free (`free`'s test
+/// along the motion: the tool's bodies turn with it), the part's roll is turned as a whole to
+/// start there instead, and where that is not free either, it is kept.
+fn toward(
+    mut part: StrokePart,
+    home: Option<&JointVector>,
+    from: Option<&JointVector>,
+    free: &FreeSpace,
+) -> StrokePart {
+    let Some(reference) = home.or(from) else {
         return part;
     };
     let robot = free.robot();
     let motion: Vec<JointVector> = part.trajectory.steps.iter().map(|step| step.q).collect();
-    let mut shift = robot.limits().turns_toward(&motion, reference);
+    let shift = robot.limits().turns_toward(&motion, reference);
+    let mut turned: Vec<JointVector> = motion.iter().map(|q| q + shift).collect();
     if let Some(roll) = robot.tool_roll_joint() {
-        let (least, greatest) = motion
+        let limits = robot.limits();
+        let (mut lower, mut upper) = (limits.lower[roll], limits.upper[roll]);
+        if let Some(home) = home {
+            lower = lower.max(home[roll] - ROLL_FROM_HOME_RAD);
+            upper = upper.min(home[roll] + ROLL_FROM_HOME_RAD);
+        }
+        let wanted = from.unwrap_or(reference)[roll].clamp(lower, upper);
+        let held: Vec<JointVector> = turned
+            .iter()
+            .map(|q| {
+                let mut q = *q;
+                q[roll] = wanted;
+                q
+            })
+            .collect();
+        let (least, greatest) = turned
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                (lo.min(q[roll] + shift[roll]), hi.max(q[roll] + shift[roll]))
+                (lo.min(q[roll]), hi.max(q[roll]))
             });
-        let limits = robot.limits();
-        let centring = (reference[roll] - (least + greatest) / 2.0)
+        let turn = (wanted - turned[0][roll])
+            .min(upper - greatest)
+            .max(lower - least)
             .min(limits.upper[roll] - greatest)
             .max(limits.lower[roll] - least);
-        let mut rolled = JointVector::zeros();
-        rolled[roll] = centring;
-        let turned: Vec<JointVector> = motion.iter().map(|q| q + shift + rolled).collect();
-        if centring.abs() > 0.0 && free.path_free(&turned) {
-            shift += rolled;
+        let rolled: Vec<JointVector> = turned
+            .iter()
+            .map(|q| {
+                let mut q = *q;
+                q[roll] += turn;
+                q
+            })
+            .collect();
+        if free.path_free(&held) {
+            turned = held;
+        } else if turn.abs() > 0.0 && free.path_free(&rolled) {
+            turned = rolled;
         }
     }
-    for step in &mut part.trajectory.steps {
-        step.q += shift;
+    for (step, q) in part.trajectory.steps.iter_mut().zip(turned) {
+        step.q = q;
     }
     part
 }
 
 /// The parts that may draw a stretch, in the order they are tried: those drawing as far as the
-/// searched part `planned` (to [`SAME_LENGTH_M`]), the one whose start turns no joint as far
-/// from `from` (where the arm is) first; then the others, the furthest-drawing first.
-/// Deterministic: ties keep the order given, `planned` first.
+/// searched part `planned` (to [`SAME_LENGTH_M`]), the one the arm reaches soonest from `from`
+/// (where it is; [`least_move_s`] to the part's start within `limits`) first; then the others,
+/// the furthest-drawing first. Deterministic: ties keep the order given, `planned` first.
 fn ranked(
     planned: StrokePart,
     again: Vec<StrokePart>,
     from: Option<&JointVector>,
+    limits: &DynamicLimits,
 ) -> Vec<StrokePart> {
     let reach = planned.reached_s();
     let as_far = |part: &StrokePart| part.reached_s() >= reach - SAME_LENGTH_M;
-    let turn_from =
-        |part: &StrokePart| from.map_or(0.0, |from| (part.trajectory.steps[0].q - from).amax());
+    let time_from = |part: &StrokePart| {
+        from.map_or(0.0, |from| {
+            least_move_s(from, &part.trajectory.steps[0].q, limits)
+        })
+    };
     let mut candidates: Vec<StrokePart> = std::iter::once(planned).chain(again).collect();
     candidates.sort_by(|a, b| {
         as_far(b).cmp(&as_far(a)).then_with(|| match as_far(a) {
-            true => turn_from(a).total_cmp(&turn_from(b)),
+            true => time_from(a).total_cmp(&time_from(b)),
             false => b.reached_s().total_cmp(&a.reached_s()),
         })
     });
@@ -411,6 +456,14 @@ fn ranked(
 /// How far before a pen-up move's corner its rounding starts: this share of the shorter of the
 /// corner's edges (half: the tool has risen half its lift before it moves aside).
 pub const BLEND_SHARE: f64 = 0.5;
+
+/// How high a pen-up hop between close parts rises for each metre of lateral distance: half,
+/// so that the tool leaves and meets the surface at about 45°.
+pub const HOP_RISE: f64 = 0.5;
+
+/// A hop rises at most this many lifts; parts further apart are joined by the lift, the move
+/// and the set-down.
+pub const MAX_HOP_RISE_LIFTS: f64 = 4.0;
 
 /// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
 /// into free space (near an obstacle, say).
@@ -454,14 +507,14 @@ impl Connector<'_> {
             LIFT_SHARES
                 .iter()
                 .find_map(|share| {
-                    let lift = -part.task.n * (self.settings.lift_m * share);
+                    let lift = -part.task.n * (self.settings.lift() * share);
                     self.free.reach_point(q, &(robot.forward(q).tcp() + lift))
                 })
                 .ok_or_else(|| {
                     format!(
                         "the tool cannot lift {} m (or a quarter of it) off its {what} into free \
                          space",
-                        self.settings.lift_m
+                        self.settings.lift()
                     )
                 })
         };
@@ -518,13 +571,24 @@ impl Connector<'_> {
             }
         }
         let request = self.timing.request();
-        if retreat.is_some()
-            && vertices.len() > 2
-            && let Some(timed) = time_blended_move(&vertices, request, BLEND_SHARE)
-            && self
-                .free
-                .path_free(&timed.samples.iter().map(|s| s.q).collect::<Vec<_>>())
-        {
+        let blended = (retreat.is_some() && vertices.len() > 2)
+            .then(|| time_blended_move(&vertices, request, BLEND_SHARE))
+            .flatten()
+            .filter(|timed| {
+                self.free
+                    .path_free(&timed.samples.iter().map(|s| s.q).collect::<Vec<_>>())
+            });
+        let hop = match (retreat, travel, approach) {
+            (Some(retreat), [_, _], Some(approach)) => self.hop(retreat, approach),
+            _ => None,
+        };
+        let last_time =
+            |timed: &emg_timing::TimedMove| timed.samples[timed.samples.len() - 1].time_ns;
+        let quickest = match (blended, hop) {
+            (Some(blended), Some(hop)) if last_time(&hop) < last_time(&blended) => Some(hop),
+            (blended, hop) => blended.or(hop),
+        };
+        if let Some(timed) = quickest {
             let (definition, samples) = (&timed.definition, &timed.samples);
             program.append(SegmentKind::Travel, definition, samples, None, dof);
             return;
@@ -540,6 +604,60 @@ impl Connector<'_> {
         }
     }
 
+    /// The short pen-up move from the end of one part to the start of the next on the same
+    /// surface as one hop: up and over through the configuration above the middle between
+    /// them and straight down, the corner rounded ([`time_blended_move`]), the tool rising
+    /// [`HOP_RISE`] of the lateral distance (at least the lift `retreat` and `approach` take,
+    /// at most [`MAX_HOP_RISE_LIFTS`] lifts); `None` where the parts lie on different surfaces,
+    /// lie further apart, or the hop is not free ([`FreeSpace::path_free`]) or comes nearer
+    /// the surface (the nearer end's height) than half of its rise or of its lateral distance
+    /// from that end.
+    fn hop(
+        &self,
+        [end, above_end]: [JointVector; 2],
+        [above_start, start]: [JointVector; 2],
+    ) -> Option<emg_timing::TimedMove> {
+        let robot = self.free.robot();
+        let tcp = |q: &JointVector| robot.forward(q).tcp();
+        let (from, to) = (tcp(&end), tcp(&start));
+        let (lift_end, lift_start) = (tcp(&above_end) - from, tcp(&above_start) - to);
+        let up = lift_end.try_normalize(1e-12)?;
+        let across = to - from;
+        let tolerance = self.free.constraints().line_tolerance_m;
+        if (lift_start.try_normalize(1e-12)? - up).norm() > 1e-6
+            || up.dot(&across).abs() > 2.0 * tolerance
+        {
+            return None;
+        }
+        let lift = lift_end.norm().min(lift_start.norm());
+        // The distance from `origin` across the surface.
+        let lateral = |point: &Vec3, origin: &Vec3| {
+            let offset = point - origin;
+            (offset - up * up.dot(&offset)).norm()
+        };
+        let distance = lateral(&to, &from);
+        let rise = (HOP_RISE * distance).max(lift);
+        if rise > MAX_HOP_RISE_LIFTS * lift {
+            return None;
+        }
+        let middle = (above_end + above_start) / 2.0;
+        let top = self
+            .free
+            .reach_point(&middle, &((from + to) / 2.0 + up * rise))?;
+        let timed = time_blended_move(&[end, top, start], self.timing.request(), BLEND_SHARE)?;
+        let path: Vec<JointVector> = timed.samples.iter().map(|s| s.q).collect();
+        let clear = path.iter().all(|q| {
+            let point = tcp(q);
+            let (off_end, off_start) = (lateral(&point, &from), lateral(&point, &to));
+            let (nearer, off) = match off_end <= off_start {
+                true => (from, off_end),
+                false => (to, off_start),
+            };
+            up.dot(&(point - nearer)) >= 0.5 * off.min(rise) - 1e-9
+        });
+        (clear && self.free.path_free(&path)).then_some(timed)
+    }
+
     /// `part`'s stretch planned again by one rollout from the configuration reached from
     /// `from` (lifted, above the part's start) by moving the tool straight above the start and
     /// down onto it, the arm keeping its branch; `None` where that move is not free.
@@ -552,7 +670,7 @@ impl Connector<'_> {
     ) -> Option<StrokePart> {
         let robot = self.free.robot();
         let start_point = part.task.p0;
-        let lift = -part.task.n * self.settings.lift_m;
+        let lift = -part.task.n * self.settings.lift();
         let above = self.free.reach_point(from, &(start_point + lift))?;
         let start = self.free.reach_point(&above, &start_point)?;
         let rollout = PlanRequest {
@@ -568,6 +686,58 @@ impl Connector<'_> {
             task: part.task.clone(),
             trajectory: planned.trajectory,
         })
+    }
+}
+
+/// The least time a program needs at the arm's limits, summed as its parts are placed
+/// (docs/jobs.md, "Cycle time"): each stroke part at least its drawn length at the tool speed,
+/// and at least the least time its joints need from its start to its end ([`least_move_s`]);
+/// each pen-up move at least the least time from the configuration where the last part ended
+/// (or the program starts) to where the next one starts, whatever path it takes. No program
+/// that draws the same parts from the same configurations within the limits is shorter.
+struct LeastDuration<'a> {
+    request: &'a emg_timing::TimingRequest,
+    /// Where the arm is when the next pen-up move starts: the last part's end, or the home
+    /// before the first (none where the program starts above its first stroke).
+    pen_up_from: Option<JointVector>,
+    /// The sum over stroke parts (s).
+    pen_down_s: f64,
+    /// The sum over pen-up moves (s).
+    pen_up_s: f64,
+}
+
+impl<'a> LeastDuration<'a> {
+    fn new(request: &'a emg_timing::TimingRequest, home: Option<JointVector>) -> Self {
+        Self {
+            request,
+            pen_up_from: home,
+            pen_down_s: 0.0,
+            pen_up_s: 0.0,
+        }
+    }
+
+    /// Adds the stroke part from `start` to `end` drawing `drawn_m`, and the move to it (from
+    /// `above_start` where it is the program's first).
+    fn add_stroke(
+        &mut self,
+        above_start: JointVector,
+        start: JointVector,
+        end: JointVector,
+        drawn_m: f64,
+    ) {
+        let limits = &self.request.limits;
+        let from = self.pen_up_from.unwrap_or(above_start);
+        self.pen_up_s += least_move_s(&from, &start, limits);
+        self.pen_down_s +=
+            (drawn_m / self.request.tool_speed_m_per_s).max(least_move_s(&start, &end, limits));
+        self.pen_up_from = Some(end);
+    }
+
+    /// Adds the move from the last part's end to `last`, the program's last configuration.
+    fn end_at(&mut self, last: Option<JointVector>) {
+        if let Some((from, last)) = self.pen_up_from.zip(last) {
+            self.pen_up_s += least_move_s(&from, &last, &self.request.limits);
+        }
     }
 }
 
@@ -608,5 +778,7 @@ fn summarise(
         searches,
         planning_s: started.elapsed().as_secs_f64(),
         ends_at_home: true,
+        least_pen_down_s: 0.0,
+        least_pen_up_s: 0.0,
     }
 }

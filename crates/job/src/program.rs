@@ -124,6 +124,16 @@ pub struct JobSummary {
     /// Whether the program ends at the job's home: false where the job has none, or where no
     /// free move back to it was found.
     pub ends_at_home: bool,
+    /// The least time its stroke parts need at the arm's limits (s): each at least its drawn
+    /// length at the tool speed and the least time its joints need from its start to its end
+    /// (docs/jobs.md, "Cycle time").
+    #[serde(default)]
+    pub least_pen_down_s: f64,
+    /// The least time its pen-up moves need at the arm's limits (s): each at least the least
+    /// time its joints need from the configuration where one part ends to where the next
+    /// starts, whatever the path.
+    #[serde(default)]
+    pub least_pen_up_s: f64,
 }
 
 /// A job's program as its file holds it.

@@ -42,12 +42,46 @@ pub enum Order {
     Shortest,
 }
 
+/// The tool a job draws, seals or welds with: what it needs between strokes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Tool {
+    /// A pen: lifts [`Tool::PEN_LIFT_M`] off the paper between strokes.
+    #[default]
+    Pen,
+    /// A dispensing or sealing nozzle: lifts [`Tool::DISPENSER_LIFT_M`], clear of its bead.
+    Dispenser,
+    /// A welding torch: lifts [`Tool::TORCH_LIFT_M`], clear of the seam's edges and spatter.
+    Torch,
+}
+
+impl Tool {
+    /// A pen's lift between strokes (m): enough that the tip leaves no mark.
+    pub const PEN_LIFT_M: f64 = 0.002;
+    /// A dispenser's lift between strokes (m).
+    pub const DISPENSER_LIFT_M: f64 = 0.01;
+    /// A torch's lift between strokes (m).
+    pub const TORCH_LIFT_M: f64 = 0.03;
+
+    /// How far the tool lifts off the surface between strokes unless the job says (m).
+    pub fn lift_m(self) -> f64 {
+        match self {
+            Self::Pen => Self::PEN_LIFT_M,
+            Self::Dispenser => Self::DISPENSER_LIFT_M,
+            Self::Torch => Self::TORCH_LIFT_M,
+        }
+    }
+}
+
 /// Settings shared by every stroke and move of a job.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct JobSettings {
-    /// How far the tool lifts off the surface (along −n) between strokes (m).
-    pub lift_m: f64,
+    /// The tool, whose lift between strokes is the default of `lift_m`.
+    pub tool: Tool,
+    /// How far the tool lifts off the surface (along −n) between strokes (m); unset, the
+    /// tool's ([`Tool::lift_m`]). A program's settings have it set.
+    pub lift_m: Option<f64>,
     /// The order of the strokes.
     pub order: Order,
     /// Where a stroke is resumed after a reconfiguration, the tool sets down this far back
@@ -67,7 +101,8 @@ pub struct JobSettings {
 impl Default for JobSettings {
     fn default() -> Self {
         Self {
-            lift_m: 0.03,
+            tool: Tool::Pen,
+            lift_m: None,
             order: Order::Shortest,
             overlap_m: 0.002,
             min_gain_m: 0.005,
@@ -133,6 +168,20 @@ pub enum JobError {
 }
 
 impl JobSettings {
+    /// How far the tool lifts off the surface between strokes (m): `lift_m`, else the tool's.
+    pub fn lift(&self) -> f64 {
+        self.lift_m.unwrap_or(self.tool.lift_m())
+    }
+
+    /// The settings with the lift set: the tool's where `lift_m` is unset (as a program
+    /// records them).
+    pub fn resolved(self) -> Self {
+        Self {
+            lift_m: Some(self.lift()),
+            ..self
+        }
+    }
+
     /// Checks every setting.
     pub fn validate(&self) -> Result<(), JobError> {
         let require = |field, value: f64, allowed, ok: bool| {
@@ -146,12 +195,8 @@ impl JobSettings {
                 })
             }
         };
-        require(
-            "lift_m",
-            self.lift_m,
-            "in (0, 0.5] m",
-            self.lift_m > 0.0 && self.lift_m <= 0.5,
-        )?;
+        let lift = self.lift();
+        require("lift_m", lift, "in (0, 0.5] m", lift > 0.0 && lift <= 0.5)?;
         require(
             "overlap_m",
             self.overlap_m,

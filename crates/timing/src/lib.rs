@@ -23,6 +23,7 @@
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
 mod blend;
+mod bound;
 mod dynamics;
 mod free;
 mod inset;
@@ -35,6 +36,7 @@ mod spline;
 mod topp;
 
 pub use blend::{MAX_BLEND_TURN_DEG, time_blended_move};
+pub use bound::{least_move_s, rest_to_rest_s};
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
 pub use free::{FREE_GRID_PER_RAD, TimedMove, time_free_move};
 pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
