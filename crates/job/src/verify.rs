@@ -132,7 +132,7 @@ pub fn verify_job(
     // else every segment's, gathered in segment order: the same on any number of threads.
     // A segment after one known to fail is not checked, since its outcome cannot matter.
     let first_failure = AtomicUsize::new(usize::MAX);
-    let outcomes: Vec<Option<Result<Option<(usize, Stretch)>, JobCheckError>>> = file
+    let outcomes: Vec<Option<SegmentOutcome>> = file
         .segments
         .par_iter()
         .enumerate()
@@ -178,6 +178,10 @@ pub fn verify_job(
     Ok(check)
 }
 
+/// A segment's check: a stroke part's stroke (its place in the file's `strokes`) and the
+/// stretch its samples cover, or `None` for a move.
+type SegmentOutcome = Result<Option<(usize, Stretch)>, JobCheckError>;
+
 /// What every segment's check shares.
 struct SegmentContext<'a> {
     file: &'a JobFile,
@@ -201,7 +205,7 @@ impl SegmentContext<'_> {
         segment: &Segment,
         all_points: &[JointTrajectoryPoint],
         times: &[f64],
-    ) -> Result<Option<(usize, Stretch)>, JobCheckError> {
+    ) -> SegmentOutcome {
         let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
         let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
         let points = &all_points[first..last];
@@ -421,4 +425,93 @@ fn joints(values: &[f64]) -> Joints {
         q[i] = *v;
     }
     q
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+
+    use emg_io::{Placement, SvgOptions, read_svg_file};
+    use emg_kinematics::Robot;
+    use emg_planner::{DataDir, Models, PlanRequest, Planner, ShippedRobot};
+
+    use super::*;
+    use crate::{JOB_TOLERANCE_M, Job, Unwatched, job_config, job_timing, plan_job};
+
+    /// A line-art icon (lucide's `pencil`, vendored with the SVG reader's tests) planned on the
+    /// FR3 as `emg job` plans it, the FR3's checker and joint names.
+    fn pencil_on_the_fr3() -> (JobFile, ReferenceModel, Vec<String>) {
+        let workspace = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let data = DataDir::new(workspace.join("data"));
+        let shipped = ShippedRobot::by_name("fr3").expect("a shipped robot");
+        let file = shipped.path(&data);
+        let robot = Robot::from_chain_file(&file).expect("robot loads");
+        let checker = ReferenceModel::from_urdf_file(&file, robot.base_link(), robot.tip_link())
+            .expect("checker loads");
+        let names = robot.joint_names().to_vec();
+        let models = Models::shipped(&robot, &shipped.data_dir(&data)).expect("shipped models");
+        let config = job_config(JOB_TOLERANCE_M);
+        let timing = job_timing(&robot, &file, &config).expect("timing");
+        let planner = Planner::new(robot, models, config).expect("planner");
+        let icon = workspace.join("crates/io/tests/data/icons/pencil.svg");
+        let strokes = read_svg_file(&icon, &Placement::default(), &SvgOptions::default())
+            .expect("icon")
+            .strokes;
+        let job = Job::from_strokes(strokes, planner.robot()).expect("a valid job");
+        let program = plan_job(
+            &planner,
+            &PlanRequest::default(),
+            &job,
+            &timing,
+            &file.display().to_string(),
+            &Unwatched,
+        )
+        .expect("the job plans");
+        (program, checker, names)
+    }
+
+    /// `verify_job` on a pool of `threads` threads, its error as text.
+    fn on_threads(
+        threads: usize,
+        program: &JobFile,
+        checker: &ReferenceModel,
+        names: &[String],
+    ) -> Result<JobCheck, String> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+            .install(|| verify_job(program, checker, names))
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_program_checks_alike_on_any_number_of_threads() {
+        let (program, checker, names) = pencil_on_the_fr3();
+        let one = on_threads(1, &program, &checker, &names);
+        assert!(one.is_ok(), "{one:?}");
+        for threads in [2, 3, 8] {
+            assert_eq!(on_threads(threads, &program, &checker, &names), one);
+        }
+        // Every stroke part breaks a line tolerance of 1 nm, and so does every segment after
+        // the first: the first stroke part's failure is reported, whatever the threads.
+        let mut tight = program.clone();
+        tight.constraints.line_tolerance_m = 1e-9;
+        let first_part = program
+            .segments
+            .iter()
+            .position(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
+            .expect("a stroke part");
+        let failure = on_threads(1, &tight, &checker, &names).expect_err("too tight");
+        assert!(
+            failure.starts_with(&format!("segment {first_part} (stroke ")),
+            "{failure}"
+        );
+        for threads in [2, 3, 8] {
+            assert_eq!(
+                on_threads(threads, &tight, &checker, &names),
+                Err(failure.clone())
+            );
+        }
+    }
 }

@@ -871,3 +871,308 @@ fn merge_sphere_caps(
         .filter_map(|((element, _), keep)| keep.then_some(element))
         .collect())
 }
+
+#[cfg(test)]
+mod tests {
+    //! The pruned measures against the exhaustive loops they replace, bit for bit, on the
+    //! shipped arms in random configurations among obstacles placed on and around the arm.
+
+    use super::*;
+    use crate::record::{Obstacle, Surface};
+
+    /// The shipped arms' checkers.
+    fn arms() -> Vec<ReferenceModel> {
+        let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../data/robots");
+        [
+            ("fr3_pen.urdf", "link0"),
+            ("iiwa14_pen.urdf", "iiwa_link_0"),
+            ("ur5e_pen.urdf", "base_link"),
+        ]
+        .iter()
+        .map(|(file, base)| {
+            ReferenceModel::from_urdf_file(&data.join(file), base, "pen_tip").expect("arm")
+        })
+        .collect()
+    }
+
+    /// A small deterministic stream of numbers in [0, 1) (xorshift64*).
+    struct Stream(u64);
+
+    impl Stream {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn between(&mut self, low: f64, high: f64) -> f64 {
+            low + (high - low) * self.next()
+        }
+
+        /// A rotation about a random axis by up to half a turn (the checker's own
+        /// construction, on `libm`).
+        fn rotation(&mut self) -> Rotation3<f64> {
+            let axis = Unit::new_normalize(self.vector(1.0));
+            axis_rotation(&axis, self.between(-3.0, 3.0))
+        }
+
+        fn vector(&mut self, half: f64) -> Vector3<f64> {
+            Vector3::new(
+                self.between(-half, half),
+                self.between(-half, half),
+                self.between(-half, half),
+            )
+        }
+    }
+
+    /// A configuration within the limits.
+    fn configuration(model: &ReferenceModel, stream: &mut Stream) -> Joints {
+        let mut q = Joints::zeros();
+        for (i, (lo, hi)) in model.limits().iter().enumerate() {
+            q[i] = stream.between(*lo, *hi);
+        }
+        q
+    }
+
+    /// The exhaustive loop `min_clearance` ran before the pruning.
+    fn exhaustive_clearance(model: &ReferenceModel, q: &Joints) -> (f64, String, String) {
+        let frames = model.link_frames(q);
+        let world = |c: &ReferenceCapsule, v: &Vector3<f64>| {
+            (frames[c.chain_index] * Vector4::new(v.x, v.y, v.z, 1.0)).xyz()
+        };
+        let mut best = (f64::INFINITY, String::new(), String::new());
+        for (i, a) in model.capsules.iter().enumerate() {
+            for b in &model.capsules[i + 1..] {
+                if !model.checked(a, b) {
+                    continue;
+                }
+                let gap = segments_gap(
+                    &world(a, &a.start),
+                    &world(a, &a.end),
+                    &world(b, &b.start),
+                    &world(b, &b.end),
+                ) - a.radius
+                    - b.radius;
+                if gap < best.0 {
+                    best = (gap, a.link.clone(), b.link.clone());
+                }
+            }
+        }
+        best
+    }
+
+    /// The exhaustive loop `scene_margin` ran before the pruning.
+    fn exhaustive_margin(
+        model: &ReferenceModel,
+        q: &Joints,
+        line: &Line,
+        bounds: &Bounds,
+    ) -> Option<(f64, String, String)> {
+        let frames = model.link_frames(q);
+        let surface = bounds.work_surface.map(|surface| surface.solid(line));
+        let surface = surface
+            .as_ref()
+            .map(|solid| (solid, 0.0, WORK_SURFACE, true));
+        let obstacles = bounds
+            .obstacles
+            .iter()
+            .map(|o| (&o.solid, o.clearance_m, o.name.as_str(), o.tool_may_touch));
+        let mut worst: Option<(f64, String, String)> = None;
+        for (solid, clearance, name, tool_may_touch) in surface.into_iter().chain(obstacles) {
+            for capsule in &model.capsules {
+                if tool_may_touch && Some(capsule.chain_index) == model.tool_link {
+                    continue;
+                }
+                let frame = &frames[capsule.chain_index];
+                let world = |v: &Vector3<f64>| (frame * Vector4::new(v.x, v.y, v.z, 1.0)).xyz();
+                let margin = axis_depth(solid, &world(&capsule.start), &world(&capsule.end))
+                    - capsule.radius
+                    - clearance;
+                if worst
+                    .as_ref()
+                    .is_none_or(|w| margin.is_nan() || margin < w.0)
+                {
+                    worst = Some((margin, capsule.link.clone(), name.to_string()));
+                }
+            }
+        }
+        worst
+    }
+
+    /// Obstacles of every kind near the arm in `q`: centred on points of its capsules (so
+    /// that some overlap them) or a little off them.
+    fn obstacles_around(model: &ReferenceModel, q: &Joints, stream: &mut Stream) -> Vec<Obstacle> {
+        let mut placement = model.placement();
+        model.place(q, &mut placement);
+        let mut obstacles = Vec::new();
+        for k in 0..6 {
+            let c = (stream.next() * placement.ends.len() as f64) as usize;
+            let [a, b] = placement.ends[c];
+            let on_arm = a + (b - a) * stream.next() + stream.vector(0.12);
+            let direction = stream.vector(1.0).normalize();
+            let solid = match k % 4 {
+                0 => Solid::Box {
+                    centre: on_arm,
+                    axes: *stream.rotation().matrix(),
+                    half_extents: Vector3::new(
+                        stream.between(0.005, 0.2),
+                        stream.between(0.005, 0.2),
+                        stream.between(0.005, 0.2),
+                    ),
+                },
+                1 => Solid::Ball {
+                    centre: on_arm,
+                    radius: stream.between(0.0, 0.08),
+                },
+                2 => Solid::Capsule {
+                    a: on_arm,
+                    b: on_arm + direction * 0.2,
+                    radius: stream.between(0.0, 0.05),
+                },
+                _ => Solid::HalfSpace {
+                    point: on_arm,
+                    outward: direction,
+                },
+            };
+            obstacles.push(Obstacle {
+                name: format!("obstacle {k}"),
+                solid,
+                clearance_m: stream.between(0.0, 0.02),
+                tool_may_touch: stream.next() < 0.5,
+            });
+        }
+        obstacles
+    }
+
+    #[test]
+    fn pruned_clearances_and_margins_are_the_exhaustive_loops_bit_for_bit() {
+        let mut stream = Stream(0x9E37_79B9_7F4A_7C15);
+        let (mut colliding, mut touching) = (0, 0);
+        for model in arms() {
+            for _ in 0..400 {
+                let q = configuration(&model, &mut stream);
+                let clearance = model.min_clearance(&q);
+                assert_eq!(clearance, exhaustive_clearance(&model, &q), "q = {q}");
+                colliding += usize::from(clearance.0 < 0.0);
+                let (tcp, axis) = model.tcp_pose(&q);
+                let line = Line::straight(tcp, axis.cross(&Vector3::x()).normalize(), axis);
+                let bounds = Bounds {
+                    line_tolerance_m: 1.0,
+                    theta_max_deg: 180.0,
+                    collision_margin_m: 0.0,
+                    velocity_limit_fraction: None,
+                    work_surface: Some(if stream.next() < 0.5 {
+                        Surface::HalfSpace
+                    } else {
+                        Surface::Plate {
+                            half_width_m: 0.1,
+                            behind_m: 0.05,
+                            ahead_m: 0.3,
+                            thickness_m: 0.05,
+                        }
+                    }),
+                    obstacles: obstacles_around(&model, &q, &mut stream),
+                };
+                let margin = model.scene_margin(&q, &line, &bounds);
+                assert_eq!(
+                    margin,
+                    exhaustive_margin(&model, &q, &line, &bounds),
+                    "q = {q}"
+                );
+                let mut placement = model.placement();
+                model.place(&q, &mut placement);
+                let scene = Scene::new(&line, &bounds);
+                let worst = margin.expect("a scene").0;
+                touching += usize::from(worst < 0.0);
+                // Clear by the bounds only where the margins are.
+                if model.scene_clear(&placement, &scene) {
+                    assert!(worst >= -1e-12, "clear by the bounds, yet {worst} m");
+                }
+                // Without obstacles: nothing to keep away from.
+                let empty = Bounds {
+                    work_surface: None,
+                    obstacles: Vec::new(),
+                    ..bounds
+                };
+                assert_eq!(model.scene_margin(&q, &line, &empty), None);
+            }
+        }
+        // The configurations cover both sides of every measure.
+        assert!(colliding > 20 && touching > 200, "{colliding} {touching}");
+    }
+
+    #[test]
+    fn ties_go_to_the_first_pair_and_a_configuration_not_finite_is_measured_in_full() {
+        let model = &arms()[0];
+        // A configuration that is not a number: every measure NaN, as the exhaustive loops
+        // give them (no clearance below infinity; the last NaN margin).
+        let q = Joints::from_element(f64::NAN);
+        assert_eq!(model.min_clearance(&q), exhaustive_clearance(model, &q));
+        let line = Line::straight(Vector3::zeros(), Vector3::x(), Vector3::z());
+        let bounds = Bounds {
+            line_tolerance_m: 1.0,
+            theta_max_deg: 180.0,
+            collision_margin_m: 0.0,
+            velocity_limit_fraction: None,
+            work_surface: Some(Surface::HalfSpace),
+            obstacles: Vec::new(),
+        };
+        let margin = model.scene_margin(&q, &line, &bounds).expect("a surface");
+        let exhaustive = exhaustive_margin(model, &q, &line, &bounds).expect("a surface");
+        assert!(margin.0.is_nan() && exhaustive.0.is_nan());
+        assert_eq!((margin.1, margin.2), (exhaustive.1, exhaustive.2));
+        // Two identical balls: the same smallest margin twice, the first one named.
+        let mut stream = Stream(7);
+        let q = configuration(model, &mut stream);
+        let ball = |name: &str| Obstacle {
+            name: name.to_string(),
+            solid: Solid::Ball {
+                centre: Vector3::new(0.3, 0.1, 0.4),
+                radius: 0.05,
+            },
+            clearance_m: 0.0,
+            tool_may_touch: false,
+        };
+        let bounds = Bounds {
+            work_surface: None,
+            obstacles: vec![ball("first"), ball("second")],
+            ..bounds
+        };
+        let margin = model.scene_margin(&q, &line, &bounds).expect("balls");
+        assert_eq!(margin.2, "first");
+        assert_eq!(Some(margin), exhaustive_margin(model, &q, &line, &bounds));
+    }
+
+    #[test]
+    fn a_box_bound_is_below_the_box_depth_of_every_segment() {
+        let mut stream = Stream(0xDEAD_BEEF);
+        for _ in 0..20_000 {
+            let solid = Solid::Box {
+                centre: stream.vector(0.2),
+                axes: *stream.rotation().matrix(),
+                half_extents: Vector3::new(
+                    stream.between(0.001, 0.3),
+                    stream.between(0.001, 0.3),
+                    stream.between(0.001, 0.3),
+                ),
+            };
+            let a = stream.vector(0.6);
+            let b = if stream.next() < 0.1 {
+                a
+            } else {
+                a + stream.vector(0.4)
+            };
+            let bound = depth_lower_bound(&solid, &a, &b);
+            let depth = axis_depth(&solid, &a, &b);
+            assert!(bound <= depth + 1e-12, "{bound} > {depth}");
+        }
+        let solid = Solid::Box {
+            centre: Vector3::zeros(),
+            axes: Matrix3::identity(),
+            half_extents: Vector3::new(1.0, 1.0, 1.0),
+        };
+        let nan = Vector3::new(f64::NAN, 0.0, 0.0);
+        assert!(depth_lower_bound(&solid, &nan, &Vector3::zeros()).is_nan());
+    }
+}
