@@ -26,6 +26,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
+mod large;
+
 /// Options of `job-eval`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -38,6 +40,10 @@ pub struct Args {
     /// Output directory of jobs.{json,md}.
     #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
+    /// Sizes of the large jobs (strokes of generated drawings, comma-separated), each planned
+    /// on all threads and on one; none with an empty list.
+    #[arg(long, value_delimiter = ',', default_value = "500,2000,10000")]
+    large: Vec<usize>,
 }
 
 /// Where an icon is placed: the centre of its bounding box (m) and its width (m), pen down.
@@ -69,6 +75,13 @@ pub struct JobRow {
     pub pen_down_s: f64,
     /// See `pen_down_s`.
     pub pen_up_s: f64,
+    /// The least duration pen down and pen up the arm's limits allow for the same parts
+    /// (`JobSummary::least_pen_down_s`, `least_pen_up_s`) (s).
+    #[serde(default)]
+    pub least_pen_down_s: f64,
+    /// See `least_pen_down_s`.
+    #[serde(default)]
+    pub least_pen_up_s: f64,
     /// Planning time of the whole job (s) on this machine.
     pub planning_s: f64,
     /// Free moves straight, and found by the sampling planner.
@@ -168,6 +181,9 @@ pub struct Record {
     pub one_thread_s: Vec<(String, f64)>,
     /// Every job.
     pub rows: Vec<JobRow>,
+    /// The large jobs, each on all threads and on one.
+    #[serde(default)]
+    pub large: Vec<large::LargeRow>,
 }
 
 /// Plans, checks and compares every job; writes the record and its table.
@@ -241,6 +257,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .install(|| plan_job(&planner, &request, job, &timing, &robot_name, &Unwatched))?;
         one_thread_s.push((name.clone(), started.elapsed().as_secs_f64()));
     }
+    let mut large_rows = Vec::new();
+    let sizes = progress::bar(2 * args.large.len() as u64, "large jobs");
+    for &strokes in &args.large {
+        for threads in [None, Some(1)] {
+            large_rows.push(large::evaluate(
+                &planner,
+                &timing,
+                &checker,
+                &robot_name,
+                home,
+                strokes,
+                threads,
+            )?);
+            sizes.inc(1);
+        }
+    }
+    sizes.finish();
     let record = Record {
         robot: planner.robot().name().to_string(),
         command: workspace::command_for("job-eval", &args.robot),
@@ -249,6 +282,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         threads: rayon::current_num_threads(),
         one_thread_s,
         rows,
+        large: large_rows,
     };
     workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
     let failures = record
@@ -256,6 +290,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .iter()
         .filter(|r| r.checker_failure.is_some())
         .count();
+    let failures = failures
+        + record
+            .large
+            .iter()
+            .filter(|r| r.checker_failure.is_some())
+            .count();
     anyhow::ensure!(failures == 0, "{failures} programs fail the checker");
     Ok(())
 }
@@ -345,6 +385,8 @@ fn evaluate(
                 total_m,
                 pen_down_s: s.pen_down_s,
                 pen_up_s: s.pen_up_s,
+                least_pen_down_s: s.least_pen_down_s,
+                least_pen_up_s: s.least_pen_up_s,
                 planning_s,
                 straight_moves: s.straight_moves,
                 sampled_moves: s.sampled_moves,
@@ -373,6 +415,8 @@ fn evaluate(
             total_m,
             pen_down_s: 0.0,
             pen_up_s: 0.0,
+            least_pen_down_s: 0.0,
+            least_pen_up_s: 0.0,
             planning_s,
             straight_moves: 0,
             sampled_moves: 0,
@@ -538,6 +582,7 @@ fn markdown(record: &Record) -> String {
          | strokes complete / resumed / short (of {strokes}) | {} / {} / {} | — |\n\
          | moves colliding | 0 of {} (checked) | {} of {} |\n\
          | program duration, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | {:.1} |\n\
+         | least duration at the arm's limits, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | — |\n\
          | pen-up time / pen-down time | {:.2} | — |\n\
          | planning time per stroke, mean (ms, {} threads) | {:.1} | — |\n\
          | programs the checker refuses | {} of {} | — |\n\
@@ -564,6 +609,9 @@ fn markdown(record: &Record) -> String {
         sum(|r| r.pen_up_s),
         sum(|r| r.pen_down_s),
         sum(|r| r.baseline_duration_s),
+        sum(|r| r.least_pen_up_s + r.least_pen_down_s),
+        sum(|r| r.least_pen_up_s),
+        sum(|r| r.least_pen_down_s),
         sum(|r| r.pen_up_s) / sum(|r| r.pen_down_s).max(f64::MIN_POSITIVE),
         record.threads,
         1e3 * sum(|r| r.planning_s) / strokes.max(1) as f64,
@@ -612,6 +660,9 @@ fn markdown(record: &Record) -> String {
             r.baseline_colliding_moves,
             r.baseline_moves
         ));
+    }
+    if !record.large.is_empty() {
+        md.push_str(&large::markdown(&record.large));
     }
     md
 }

@@ -112,29 +112,6 @@ fn sigterm_stops_after_the_current_task() {
     interrupt_midway(libc::SIGTERM, "SIGTERM");
 }
 
-/// A drawing of `strokes` short strokes (3 to 12 mm, one `<path>` each) scattered over a 0.2 m
-/// square, deterministic.
-fn scattered_strokes(strokes: usize) -> String {
-    let mut paths = String::new();
-    for k in 0..strokes {
-        // A low-discrepancy scatter: golden-ratio steps in x, a plastic-number step in y.
-        let x = (k as f64 * 0.618_033_988_749_895).fract() * 200.0;
-        let y = (k as f64 * 0.754_877_666_246_693).fract() * 200.0;
-        // A direction from two more low-discrepancy steps, scaled to the stroke's length.
-        let (u, v) = (
-            (k as f64 * 0.381_966).fract() - 0.5,
-            (k as f64 * 0.569_840).fract() - 0.45,
-        );
-        let length = (3.0 + (k % 10) as f64) / (u * u + v * v).sqrt().max(0.05);
-        paths.push_str(&format!(
-            "<path d=\"M{x:.3},{y:.3} L{:.3},{:.3}\"/>",
-            x + length * u,
-            y + length * v
-        ));
-    }
-    format!("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"-12 -12 224 224\">{paths}</svg>")
-}
-
 /// Runs `emg ARGS`, sends SIGINT once it has printed the job's size (its planning under way),
 /// and checks that it stops with 130 and writes nothing into `dir` but `keep`.
 fn stopped_while_planning(args: &[&str], dir: &Path, keep: &[&str]) {
@@ -178,7 +155,7 @@ fn sigint_stops_a_job_while_planning_and_nothing_is_written() {
     let tmp = temp_dir("interrupt-job");
     let dir = tmp.path();
     let drawing = dir.join("scatter.svg");
-    std::fs::write(&drawing, scattered_strokes(3000)).expect("drawing written");
+    std::fs::write(&drawing, emg_io::scattered_strokes_svg(3000)).expect("drawing written");
     let out = dir.join("scatter.job.json");
     let html = dir.join("scatter.html");
     stopped_while_planning(
@@ -200,7 +177,7 @@ fn sigint_stops_a_placement_while_screening_and_nothing_is_written() {
     let tmp = temp_dir("interrupt-place");
     let dir = tmp.path();
     let drawing = dir.join("scatter.svg");
-    std::fs::write(&drawing, scattered_strokes(200)).expect("drawing written");
+    std::fs::write(&drawing, emg_io::scattered_strokes_svg(200)).expect("drawing written");
     let out = dir.join("scatter.job.json");
     stopped_while_planning(
         &[

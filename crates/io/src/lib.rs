@@ -108,7 +108,7 @@ pub use rollout_file::{RolloutRecord, TRAJECTORY_FORMAT, TrajectoryFile};
 pub use scene_file::{SceneFileError, read_scene};
 pub use svg::{
     Drawing, DrawingBounds, MAX_SMOOTH_JOIN_DEG, MIN_CURVE_TOLERANCE_M, Placement, SVG_PX_M,
-    SvgError, SvgFileError, SvgOptions, read_svg, read_svg_file,
+    SvgError, SvgFileError, SvgOptions, read_svg, read_svg_file, scattered_strokes_svg,
 };
 pub use task_file::{
     TASK_FORMAT_VERSION, TaskFileError, TaskSpec, parse_tasks, read_each_task, read_tasks,

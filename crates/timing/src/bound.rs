@@ -40,7 +40,7 @@ pub fn rest_to_rest_s(distance: f64, velocity: f64, acceleration: f64, jerk: f64
         return speed_up_s + d / v;
     }
     if jerk_bounded {
-        let ramp_s = (d / (2.0 * jerk)).cbrt();
+        let ramp_s = libm::cbrt(d / (2.0 * jerk));
         if jerk * ramp_s <= a {
             return 4.0 * ramp_s;
         }
@@ -103,7 +103,7 @@ mod tests {
             // The profile of that duration: jerk ramps of `tj` (the shortest of the times the
             // acceleration, the speed and the distance allow them), then either no cruise
             // (the acceleration held for what the duration leaves) or the speed held at `v`.
-            let tj = (a / j).min((v / j).sqrt()).min((d / (2.0 * j)).cbrt());
+            let tj = (a / j).min((v / j).sqrt()).min(libm::cbrt(d / (2.0 * j)));
             let top_a = j * tj;
             let no_cruise = total / 2.0;
             let (hold, cruise) = if top_a * (no_cruise - tj) <= v * (1.0 + 1e-9) {
@@ -123,7 +123,7 @@ mod tests {
             assert!(
                 (top_v - v).abs() < 1e-6 * v
                     || (reached_a - a).abs() < 1e-6 * a
-                    || (tj - (d / (2.0 * j)).cbrt()).abs() < 1e-12,
+                    || (tj - libm::cbrt(d / (2.0 * j))).abs() < 1e-12,
                 "{d}: no limit reached"
             );
         }

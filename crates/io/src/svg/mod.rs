@@ -7,6 +7,7 @@ mod error;
 mod outline;
 mod piece;
 mod placement;
+mod scattered;
 mod stroke;
 
 use std::path::Path;
@@ -16,6 +17,7 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{SvgError, SvgFileError};
 pub use placement::{Placement, SVG_PX_M};
+pub use scattered::scattered_strokes_svg;
 
 use bezier::V2;
 use piece::Piece;
