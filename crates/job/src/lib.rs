@@ -190,6 +190,10 @@ pub fn plan_job(
                 .map(|[_, above]| above)
                 .or(program.last())
                 .or(job.home);
+            // The way the tool rose off the last part, which it may rise further along.
+            let risen = retreat.and_then(|[end, above]| {
+                (robot.forward(&above).tcp() - robot.forward(&end).tcp()).try_normalize(1e-12)
+            });
             // Each joint among its whole turns nearest the home (else where the arm is), the
             // tool's free roll centred on it.
             let planned = toward(planned, job.home.as_ref(), from.as_ref(), &free);
@@ -208,7 +212,7 @@ pub fn plan_job(
             let mut placed = None;
             let mut first_why = None;
             for part in &candidates {
-                match connector.place(part, from, seed) {
+                match connector.place(part, from.map(|from| (from, risen)), seed) {
                     Ok(done) => {
                         placed = Some(done);
                         break;
@@ -242,12 +246,13 @@ pub fn plan_job(
                 above_start,
                 above_end,
                 travel,
+                sampled,
             } = placed;
             let (start, end) = (timed.samples[0].q, timed.samples[timed.samples.len() - 1].q);
-            match travel.len() {
-                0 => {}
-                2 => straight_moves += 1,
-                _ => sampled_moves += 1,
+            match (travel.is_empty(), sampled) {
+                (true, _) => {}
+                (false, false) => straight_moves += 1,
+                (false, true) => sampled_moves += 1,
             }
             // Without a home the program begins above the first stroke.
             connector.join(
@@ -465,6 +470,10 @@ pub const HOP_RISE: f64 = 0.5;
 /// and the set-down.
 pub const MAX_HOP_RISE_LIFTS: f64 = 4.0;
 
+/// How much further (m) the tool rises where no straight free move joins two parts at its lift:
+/// a torch's lift, clear of what lies on the part.
+pub const CLEARANCE_LIFT_M: f64 = 0.03;
+
 /// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
 /// into free space (near an obstacle, say).
 const LIFT_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
@@ -477,6 +486,8 @@ struct Placed {
     above_end: JointVector,
     /// Empty when the program begins here.
     travel: Vec<JointVector>,
+    /// Whether the sampling planner found a stretch of `travel` (else its edges are straight).
+    sampled: bool,
 }
 
 /// The connect stage for one part at a time.
@@ -487,12 +498,13 @@ struct Connector<'a> {
 }
 
 impl Connector<'_> {
-    /// `part` timed and joined to the arm's configuration `from` (none at the program's start):
-    /// lifted at both ends, the free move to above its start; or why it cannot be.
+    /// `part` timed and joined to the arm's configuration `from` (none at the program's start;
+    /// with the way the tool rose there off the last part, if it did): lifted at both ends,
+    /// the free move to above its start; or why it cannot be.
     fn place(
         &self,
         part: &StrokePart,
-        from: Option<JointVector>,
+        from: Option<(JointVector, Option<Vec3>)>,
         seed: u64,
     ) -> Result<(StrokePart, Placed), String> {
         let robot = self.free.robot();
@@ -520,11 +532,10 @@ impl Connector<'_> {
         };
         let above_start = above(&start, "start")?;
         let above_end = above(&end, "end")?;
-        let travel = match from {
-            None => Vec::new(),
-            Some(from) => self
-                .free
-                .connect(&from, &above_start, seed, self.settings.rrt_max_samples)
+        let (travel, sampled) = match from {
+            None => (Vec::new(), false),
+            Some((from, risen)) => self
+                .travel(&from, risen, &above_start, &-part.task.n, seed)
                 .ok_or_else(|| {
                     format!(
                         "no free move to its start found in {} samples",
@@ -539,8 +550,50 @@ impl Connector<'_> {
                 above_start,
                 above_end,
                 travel,
+                sampled,
             },
         ))
+    }
+
+    /// The free move from `from` (risen along `risen` off the last part, if it did) to `to`
+    /// (above the next part, which the tool leaves along `up`): the straight joint-space edge
+    /// where it is free; else over both, each risen [`CLEARANCE_LIFT_M`] further where that is
+    /// free, the straight edge between them or a sampled move ([`FreeSpace::connect`]); else a
+    /// sampled move between `from` and `to` themselves. With whether the sampling planner found
+    /// a stretch of it.
+    fn travel(
+        &self,
+        from: &JointVector,
+        risen: Option<Vec3>,
+        to: &JointVector,
+        up: &Vec3,
+        seed: u64,
+    ) -> Option<(Vec<JointVector>, bool)> {
+        if self.free.edge_free(from, to) {
+            return Some((vec![*from, *to], false));
+        }
+        let robot = self.free.robot();
+        let rise = |q: &JointVector, up: &Vec3| {
+            self.free
+                .reach_point(q, &(robot.forward(q).tcp() + up * CLEARANCE_LIFT_M))
+        };
+        let over = || {
+            let (high_from, high_to) = (
+                risen.map_or(Some(*from), |up| rise(from, &up))?,
+                rise(to, up)?,
+            );
+            let between =
+                self.free
+                    .connect(&high_from, &high_to, seed, self.settings.rrt_max_samples)?;
+            let sampled = between.len() > 2;
+            Some(([vec![*from], between, vec![*to]].concat(), sampled))
+        };
+        over().or_else(|| {
+            let path = self
+                .free
+                .connect(from, to, seed, self.settings.rrt_max_samples)?;
+            Some((path, true))
+        })
     }
 
     /// Appends the pen-up move between two parts (or after the last): `retreat` (the lift off
@@ -660,7 +713,9 @@ impl Connector<'_> {
 
     /// `part`'s stretch planned again by one rollout from the configuration reached from
     /// `from` (lifted, above the part's start) by moving the tool straight above the start and
-    /// down onto it, the arm keeping its branch; `None` where that move is not free.
+    /// down onto it, the arm keeping its branch: at the tool's lift, else risen
+    /// [`CLEARANCE_LIFT_M`] higher first (over what a low move would graze); `None` where
+    /// neither move is free.
     fn replanned_nearby(
         &self,
         planner: &Planner,
@@ -670,8 +725,20 @@ impl Connector<'_> {
     ) -> Option<StrokePart> {
         let robot = self.free.robot();
         let start_point = part.task.p0;
-        let lift = -part.task.n * self.settings.lift();
-        let above = self.free.reach_point(from, &(start_point + lift))?;
+        let up = -part.task.n;
+        let above = self
+            .free
+            .reach_point(from, &(start_point + up * self.settings.lift()))
+            .or_else(|| {
+                let high = self
+                    .free
+                    .reach_point(from, &(robot.forward(from).tcp() + up * CLEARANCE_LIFT_M))?;
+                let over = self
+                    .free
+                    .reach_point(&high, &(start_point + up * CLEARANCE_LIFT_M))?;
+                self.free
+                    .reach_point(&over, &(start_point + up * self.settings.lift()))
+            })?;
         let start = self.free.reach_point(&above, &start_point)?;
         let rollout = PlanRequest {
             planner: emg_planner::PlannerKind::Controller,
