@@ -198,7 +198,7 @@ class JobPlan:
     @property
     def summary(self) -> dict:
         """The totals ``emg job`` prints (``drawn_m``, ``total_m``, ``duration_s``,
-        ``ends_at_home``, ...)."""
+        ``ends_at_home``, ``least_pen_down_s``, ``least_pen_up_s``, ...)."""
     @property
     def strokes(self) -> list[dict]:
         """Every stroke's outcome in drawing order, as the program file's."""

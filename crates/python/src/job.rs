@@ -180,7 +180,8 @@ fn python<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound
 impl JobPlan {
     /// The totals `emg job` prints: `complete`, `resumed`, `short`, `drawn_m`, `total_m`,
     /// `travel_given_m`, `travel_m`, `duration_s`, `pen_down_s`, `pen_up_s`, `straight_moves`,
-    /// `sampled_moves`, `searches`, `planning_s`, `ends_at_home`.
+    /// `sampled_moves`, `searches`, `planning_s`, `ends_at_home`, and the least duration the
+    /// arm's limits allow, `least_pen_down_s` and `least_pen_up_s`.
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         python(py, &self.file.summary)
