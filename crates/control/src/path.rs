@@ -7,10 +7,14 @@
 //! straight or circular, may be rounded by a blend arc of the radius the spec gives, tangent to
 //! both. A straight line is the one-segment path.
 
+use std::cell::Cell;
 use std::f64::consts::PI;
 
 use emg_kinematics::Vec3;
 use serde::{Deserialize, Serialize};
+
+mod bounds;
+use bounds::{Ball, PieceTree};
 
 /// The version of the path format this build reads and writes.
 pub const PATH_FORMAT_VERSION: u32 = 1;
@@ -322,6 +326,8 @@ pub struct Path {
     spec: PathSpec,
     normal: Vec3,
     pieces: Vec<Piece>,
+    /// Balls bounding runs of the pieces, for [`Path::nearest_point`].
+    tree: PieceTree,
     length_m: f64,
     extent: PathExtent,
 }
@@ -418,10 +424,15 @@ impl Path {
         }
         let pieces = blended(shapes, normal, blend)?;
         let length_m = pieces.last().map_or(0.0, |p| p.start_s + p.length_m);
+        let balls: Vec<Ball> = pieces
+            .iter()
+            .map(|piece| Ball::of_curve(piece.point(0.5 * piece.length_m), piece.length_m))
+            .collect();
         let mut path = Self {
             spec,
             normal,
             pieces,
+            tree: PieceTree::new(&balls),
             length_m,
             extent: PathExtent {
                 behind_m: 0.0,
@@ -650,14 +661,14 @@ impl Path {
         piece.tangent(sigma)
     }
 
-    /// The piece holding arc length `s` and how far into it `s` lies.
+    /// The piece holding arc length `s` (the last one starting at or before it, by bisection:
+    /// the pieces lie in order along the path) and how far into it `s` lies.
     fn piece_at(&self, s: f64) -> (&Piece, f64) {
         let s = s.clamp(0.0, self.length_m);
         let index = self
             .pieces
-            .iter()
-            .rposition(|piece| piece.start_s <= s)
-            .unwrap_or(0);
+            .partition_point(|piece| piece.start_s <= s)
+            .saturating_sub(1);
         let piece = &self.pieces[index];
         (piece, (s - piece.start_s).min(piece.length_m))
     }
@@ -674,14 +685,27 @@ impl Path {
             .unwrap_or_else(|| self.located(s_hint.clamp(0.0, self.length_m)))
     }
 
-    /// The point of the whole path nearest `p` (the first of equally near ones).
+    /// The point of the whole path nearest `p` (of equally near ones the first along the
+    /// path): the pieces looked at are those whose bounding balls ([`bounds`]) come nearer
+    /// `p` than the nearest point found so far, so a long path costs few.
     pub fn nearest_point(&self, p: &Vec3) -> Located {
-        self.nearest_between(p, 0.0, self.length_m, |_| 0.0)
-            .expect("a path has a piece")
+        let best: Cell<Option<(f64, f64)>> = Cell::new(None);
+        self.tree.visit(
+            p,
+            &|| best.get().map_or(f64::INFINITY, |(_, cost)| cost),
+            &mut |k| {
+                let mut found = best.get();
+                self.consider(&self.pieces[k], p, 0.0, self.length_m, &|_| 0.0, &mut found);
+                best.set(found);
+            },
+        );
+        let (s, _) = best.get().expect("a path has a piece");
+        self.located(s)
     }
 
     /// The point at arc length within `[low, high]` whose distance from `p` plus `extra_cost`
-    /// of its arc length is least; `None` where no piece reaches into the range.
+    /// of its arc length is least (of equal ones the first along the path); `None` where no
+    /// piece reaches into the range.
     fn nearest_between(
         &self,
         p: &Vec3,
@@ -690,29 +714,48 @@ impl Path {
         extra_cost: impl Fn(f64) -> f64,
     ) -> Option<Located> {
         let mut best: Option<(f64, f64)> = None;
-        for piece in &self.pieces {
-            if piece.start_s > high || piece.start_s + piece.length_m < low {
-                continue;
+        // The pieces lie in order along the path: those ending before `low` are skipped by
+        // bisection, and the search ends at the first starting after `high`.
+        let first = self
+            .pieces
+            .partition_point(|piece| piece.start_s + piece.length_m < low);
+        for piece in &self.pieces[first..] {
+            if piece.start_s > high {
+                break;
             }
-            // On a closed circle the nearest angle is also one turn further or back, and a
-            // point just before the start is just before the end: the ends are candidates too.
-            let turn = match piece.shape {
-                Shape::Straight(_) => f64::INFINITY,
-                Shape::Circular(arc) => 2.0 * PI * arc.radius_m,
-            };
-            let sigma = piece.nearest(p);
-            for sigma in [sigma, sigma - turn, sigma + turn, 0.0, piece.length_m] {
-                if !(0.0..=piece.length_m).contains(&sigma) {
-                    continue;
-                }
-                let s = (piece.start_s + sigma).clamp(low, high);
-                let cost = (self.point_at(s) - p).norm() + extra_cost(s);
-                if best.is_none_or(|(_, c)| cost < c) {
-                    best = Some((s, cost));
-                }
-            }
+            self.consider(piece, p, low, high, &extra_cost, &mut best);
         }
         best.map(|(s, _)| self.located(s))
+    }
+
+    /// Lowers `best` (arc length, cost) to `piece`'s point nearest `p` within `[low, high]`
+    /// where its distance plus `extra_cost` is less, or as much at a smaller arc length.
+    fn consider(
+        &self,
+        piece: &Piece,
+        p: &Vec3,
+        low: f64,
+        high: f64,
+        extra_cost: &dyn Fn(f64) -> f64,
+        best: &mut Option<(f64, f64)>,
+    ) {
+        // On a closed circle the nearest angle is also one turn further or back, and a
+        // point just before the start is just before the end: the ends are candidates too.
+        let turn = match piece.shape {
+            Shape::Straight(_) => f64::INFINITY,
+            Shape::Circular(arc) => 2.0 * PI * arc.radius_m,
+        };
+        let sigma = piece.nearest(p);
+        for sigma in [sigma, sigma - turn, sigma + turn, 0.0, piece.length_m] {
+            if !(0.0..=piece.length_m).contains(&sigma) {
+                continue;
+            }
+            let s = (piece.start_s + sigma).clamp(low, high);
+            let cost = (self.point_at(s) - p).norm() + extra_cost(s);
+            if best.is_none_or(|(best_s, c)| cost < c || (cost == c && s < best_s)) {
+                *best = Some((s, cost));
+            }
+        }
     }
 
     /// The path point at arc length `s` with its tangent.

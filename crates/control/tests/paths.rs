@@ -784,3 +784,53 @@ fn the_ends_of_a_short_closed_stroke_are_told_apart_by_where_the_tcp_came_from()
         }
     }
 }
+
+#[test]
+fn the_nearest_point_of_a_long_path_is_the_nearest_of_all_its_points() {
+    // A zigzag of 600 lines with blended corners and arcs, doubling back near itself.
+    let n = Vec3::new(0.0, 0.0, -1.0);
+    let mut segments = Vec::new();
+    for k in 1..=600 {
+        let x = 0.002 * k as f64;
+        let y = if k % 2 == 0 { 0.0 } else { 0.01 };
+        segments.push(if k % 7 == 0 {
+            arc(
+                None,
+                Some(Vec3::new(x - 0.001, y + 0.002, 0.0)),
+                Some(Vec3::new(x, y, 0.0)),
+                None,
+            )
+        } else {
+            line(Vec3::new(x, y, 0.0))
+        });
+    }
+    let path = Path::new(spec(Vec3::zeros(), n, 0.0005, segments)).expect("a zigzag");
+    // Its points every 20 µm of arc length, and its end.
+    let samples: Vec<Vec3> = (0..=(path.length_m() / 2e-5) as usize)
+        .map(|k| path.point_at(k as f64 * 2e-5))
+        .chain([path.point_at(path.length_m())])
+        .collect();
+    for k in 0..300 {
+        let p = Vec3::new(
+            ((k as f64 * 0.618_034).fract() - 0.1) * 1.5,
+            ((k as f64 * 0.754_878).fract() - 0.5) * 0.05,
+            ((k as f64 * 0.569_840).fract() - 0.5) * 0.02,
+        );
+        let nearest = path.nearest_point(&p);
+        let found = (nearest.point - p).norm();
+        let least = samples
+            .iter()
+            .map(|q| (q - p).norm())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            found <= least + 1e-12 && found >= least - 1e-5,
+            "{p:?}: found {found}, the samples come within {least}"
+        );
+        assert_close(
+            nearest.point,
+            path.point_at(nearest.s),
+            1e-12,
+            "the point at its s",
+        );
+    }
+}
