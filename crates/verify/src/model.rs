@@ -560,30 +560,18 @@ impl ReferenceModel {
             })
     }
 
-    /// The margin of capsule `c` from solid `s` of `scene`, measured exactly.
-    fn scene_pair_margin(
+    /// The margin of capsule `c` from solid `s` of `scene` by `depth`: measured exactly
+    /// ([`axis_depth`]) or its lower bound ([`depth_lower_bound`]).
+    fn scene_pair(
         &self,
         placement: &Placement,
         scene: &Scene<'_>,
-        s: usize,
-        c: usize,
+        (s, c): (usize, usize),
+        depth: fn(&Solid, &Vector3<f64>, &Vector3<f64>) -> f64,
     ) -> f64 {
         let (solid, clearance, _, _) = &scene.solids[s];
         let [start, end] = &placement.ends[c];
-        axis_depth(solid, start, end) - self.capsules[c].radius - clearance
-    }
-
-    /// A lower bound of [`Self::scene_pair_margin`] ([`depth_lower_bound`]).
-    fn scene_pair_bound(
-        &self,
-        placement: &Placement,
-        scene: &Scene<'_>,
-        s: usize,
-        c: usize,
-    ) -> f64 {
-        let (solid, clearance, _, _) = &scene.solids[s];
-        let [start, end] = &placement.ends[c];
-        depth_lower_bound(solid, start, end) - self.capsules[c].radius - clearance
+        depth(solid, start, end) - self.capsules[c].radius - clearance
     }
 
     /// Whether no capsule of a placed configuration can come within its clearance of a solid
@@ -593,7 +581,7 @@ impl ReferenceModel {
     /// number; then the margins must be measured.
     pub(crate) fn scene_clear(&self, placement: &Placement, scene: &Scene<'_>) -> bool {
         self.scene_pairs(scene)
-            .all(|(s, c)| self.scene_pair_bound(placement, scene, s, c) >= 0.0)
+            .all(|(s, c)| self.scene_pair(placement, scene, (s, c), depth_lower_bound) >= 0.0)
     }
 
     /// [`Self::scene_margin`] of a placed configuration: the first (solid, capsule) pair in
@@ -623,7 +611,7 @@ impl ReferenceModel {
         let exhaustive = || {
             let mut worst: Option<(f64, usize, usize)> = None;
             for (s, c) in self.scene_pairs(scene) {
-                let margin = self.scene_pair_margin(placement, scene, s, c);
+                let margin = self.scene_pair(placement, scene, (s, c), axis_depth);
                 if worst.is_none_or(|w| margin.is_nan() || margin < w.0) {
                     worst = Some((margin, s, c));
                 }
@@ -632,7 +620,7 @@ impl ReferenceModel {
         };
         let mut seed: Option<(f64, usize, usize)> = None;
         for (s, c) in self.scene_pairs(scene) {
-            let lower = self.scene_pair_bound(placement, scene, s, c);
+            let lower = self.scene_pair(placement, scene, (s, c), depth_lower_bound);
             if !lower.is_finite() {
                 seed = None;
                 break;
@@ -644,7 +632,7 @@ impl ReferenceModel {
         let Some((_, s0, c0)) = seed else {
             return exhaustive().map(named);
         };
-        let measured = self.scene_pair_margin(placement, scene, s0, c0);
+        let measured = self.scene_pair(placement, scene, (s0, c0), axis_depth);
         if measured.is_nan() {
             // Only an exhaustive loop tells which NaN is the last.
             return exhaustive().map(named);
@@ -652,11 +640,12 @@ impl ReferenceModel {
         let mut worst = (measured, s0, c0);
         for (s, c) in self.scene_pairs(scene) {
             if (s, c) == (s0, c0)
-                || self.scene_pair_bound(placement, scene, s, c) > worst.0 + PRUNE_SLACK_M
+                || self.scene_pair(placement, scene, (s, c), depth_lower_bound)
+                    > worst.0 + PRUNE_SLACK_M
             {
                 continue;
             }
-            let margin = self.scene_pair_margin(placement, scene, s, c);
+            let margin = self.scene_pair(placement, scene, (s, c), axis_depth);
             if margin.is_nan() {
                 return exhaustive().map(named);
             }
