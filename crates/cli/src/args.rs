@@ -277,6 +277,9 @@ pub struct PlanArgs {
     /// `ros2-mcap` (STEM.mcap) or `urscript` (STEM.script).
     #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
+    /// urscript: most servoj lines (2 ms each) per program.
+    #[arg(long, value_name = "N", default_value_t = emg_io::ExportOptions::default().max_servoj_lines)]
+    pub max_servoj: usize,
 }
 
 /// A feature switched on or off on the command line.

@@ -23,7 +23,7 @@ pub struct ExportArgs {
     #[arg(long, value_name = "FORMAT", value_parser = parse_format)]
     pub format: ExportFormat,
     /// The file to write (a URScript motion too long for one program is split where the arm
-    /// rests: OUT with -part1, -part2, ... before its extension; missing parent directories
+    /// rests: OUT without its extension, with -part1.script, -part2.script, ...; missing parent directories
     /// are created).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
@@ -35,7 +35,32 @@ pub struct ExportArgs {
     /// the points kept from any sample of the file.
     #[arg(long, value_name = "RAD", default_value_t = ExportOptions::default().tolerance_rad)]
     pub thinning_tolerance: f64,
-    /// urscript: most servoj lines (2 ms each) per program.
+    /// How a URScript export is written.
+    #[command(flatten)]
+    pub urscript: UrScriptArgs,
+}
+
+/// The form of a URScript export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum UrScriptForm {
+    /// One program as UR integrators write it: movej between strokes, movel down and up, each
+    /// stroke a blended movep run through the plan's poses, the tool switched by its output
+    /// (a job's program on the shipped UR5e).
+    Native,
+    /// The plan's joint values streamed by servoj every 2 ms, split where the arm rests.
+    Servoj,
+}
+
+/// How a URScript export is written; every command that exports takes these.
+#[derive(Clone, Copy, Debug, Args)]
+pub struct UrScriptArgs {
+    /// urscript: `native` (one program of movej, movel and blended movep through the plan's
+    /// targets, with the tool's output; a job's program on the shipped ur5e) or `servoj` (the
+    /// joint values every 2 ms). Default: native for a job's program, servoj for a joint
+    /// trajectory.
+    #[arg(long, value_name = "FORM", value_enum)]
+    pub urscript: Option<UrScriptForm>,
+    /// urscript servoj: most servoj lines (2 ms each) per program.
     #[arg(long, value_name = "N", default_value_t = ExportOptions::default().max_servoj_lines)]
     pub max_servoj: usize,
 }
@@ -56,6 +81,32 @@ fn shipped_profile(robot_file: &Path) -> Option<&'static DriverProfile> {
 /// Runs `emg export`: reads the file, resolves its robot, exports, and prints what it wrote.
 pub fn run_export(args: &ExportArgs) -> Result<()> {
     let job = crate::check::read_job_file(&args.file)?;
+    if let Some(job) = &job {
+        let robot_file = match &args.robot {
+            Some(path) => path.clone(),
+            None => crate::robot::resolve(&job.robot, &args.file)?,
+        };
+        let robot = crate::robot::load_robot(&robot_file, None, None)?;
+        let target = ExportTarget {
+            format: args.format,
+            out: &args.out,
+            urscript: &args.urscript,
+            thinning_tolerance: args.thinning_tolerance,
+        };
+        println!(
+            "{}",
+            export_job(job, &target, &args.file, &robot_file, &robot)?
+        );
+        return Ok(());
+    }
+    if args.urscript.urscript == Some(UrScriptForm::Native) && args.format == ExportFormat::UrScript
+    {
+        anyhow::bail!(
+            "--urscript native writes a job's program (emg-job/3, which `emg job` writes); {} is a \
+             joint trajectory: export it with --urscript servoj",
+            args.file.display()
+        );
+    }
     let trajectory = match &job {
         Some(_) => None,
         None => Some(emg_io::read_joint_trajectory(&args.file)?),
@@ -76,7 +127,7 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
     let robot = crate::robot::load_robot(&robot_file, None, None)?;
     let options = ExportOptions {
         tolerance_rad: args.thinning_tolerance,
-        max_servoj_lines: args.max_servoj,
+        max_servoj_lines: args.urscript.max_servoj,
     };
     let text = export_to(
         points,
@@ -132,13 +183,22 @@ pub fn beside_program(out: &Path, format: ExportFormat) -> PathBuf {
 
 /// Refuses, before anything is planned, `--export FORMAT` of a program for a robot it cannot run
 /// on (URScript for an arm that is not a Universal Robots arm).
-pub fn refuse_program_export(format: Option<ExportFormat>, robot_file: &Path) -> Result<()> {
+pub fn refuse_program_export(
+    format: Option<ExportFormat>,
+    urscript: &UrScriptArgs,
+    robot_file: &Path,
+) -> Result<()> {
     let Some(format) = format else {
         return Ok(());
     };
     let robot = crate::robot::load_robot(robot_file, None, None)?;
     refuse_format(format, robot_file, &robot)
-        .context("--export urscript: nothing was planned or written")
+        .context("--export urscript: nothing was planned or written")?;
+    if format == ExportFormat::UrScript {
+        writes_native(urscript, robot_file)
+            .context("--export urscript: nothing was planned or written")?;
+    }
+    Ok(())
 }
 
 /// Exports a job's program `file`, written to `out`, as `format` beside it
@@ -146,19 +206,131 @@ pub fn refuse_program_export(format: Option<ExportFormat>, robot_file: &Path) ->
 pub fn export_program(
     file: &emg_job::JobFile,
     format: ExportFormat,
+    urscript: &UrScriptArgs,
     out: &Path,
     robot_file: &Path,
     robot: &Robot,
 ) -> Result<String> {
+    let target = ExportTarget {
+        format,
+        out: &beside_program(out, format),
+        urscript,
+        thinning_tolerance: ExportOptions::default().tolerance_rad,
+    };
+    export_job(file, &target, out, robot_file, robot)
+}
+
+/// What a job's program is exported as, and where.
+struct ExportTarget<'a> {
+    format: ExportFormat,
+    out: &'a Path,
+    urscript: &'a UrScriptArgs,
+    thinning_tolerance: f64,
+}
+
+/// Exports the job's program `file` (read from `input`) for the robot of `robot_file`: a native
+/// UR program unless `--urscript servoj` asks for the joint stream; returns what to print.
+fn export_job(
+    file: &emg_job::JobFile,
+    target: &ExportTarget<'_>,
+    input: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    if target.format == ExportFormat::UrScript && writes_native(target.urscript, robot_file)? {
+        return native_ur_program(file, target.out, input, robot_file, robot);
+    }
+    let options = ExportOptions {
+        tolerance_rad: target.thinning_tolerance,
+        max_servoj_lines: target.urscript.max_servoj,
+    };
     export_to(
         file.timed_points(&file.points()),
-        format,
-        &beside_program(out, format),
+        target.format,
+        target.out,
         robot_file,
         robot,
-        &ExportOptions::default(),
-        out,
+        &options,
+        input,
     )
+}
+
+/// Whether a URScript export of a job's program is written native: where `--urscript` asks
+/// (refused for a robot other than the shipped UR5e, the one whose base and flange frames are
+/// known to be the controller's Base and tool flange), and by default on the shipped UR5e;
+/// servoj on any other UR arm.
+fn writes_native(urscript: &UrScriptArgs, robot_file: &Path) -> Result<bool> {
+    let known = shipped_profile(robot_file).is_some_and(|profile| profile.robot == "ur5e");
+    match urscript.urscript {
+        Some(UrScriptForm::Servoj) => Ok(false),
+        Some(UrScriptForm::Native) if !known => anyhow::bail!(
+            "--urscript native writes poses in the controller's Base frame with the TCP on the \
+             tool flange, frames known for the shipped ur5e only; robot {} is not it: export \
+             --urscript servoj",
+            robot_file.display()
+        ),
+        Some(UrScriptForm::Native) => Ok(true),
+        None => Ok(known),
+    }
+}
+
+/// Writes the job's program `file` (read from `input`) as one native UR program to `out`;
+/// returns what to print.
+fn native_ur_program(
+    file: &emg_job::JobFile,
+    out: &Path,
+    input: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    let reference = crate::robot::reference(robot_file)?.to_string();
+    let tool = file.settings.tool_output;
+    let header = vec![
+        format!("written by emg export from a job's program for robot {reference}"),
+        "for a Universal Robots e-Series controller (PolyScope 5): run it in a Script node or \
+         send it to port 30002 (docs/robot-export.md)"
+            .to_string(),
+        "poses p[x, y, z, rx, ry, rz] in the controller's Base frame (m, rotation vector); \
+         joints in the pendant's order and zero; the TCP at the pen's tip (set_tcp)"
+            .to_string(),
+        format!(
+            "the tool: {:?} digital output {}, {} switches it on; lead {} s, lag {} s",
+            tool.bank,
+            tool.number,
+            if tool.on_high { "high" } else { "low" },
+            tool.lead_s,
+            tool.lag_s
+        ),
+        match &file.home {
+            Some(_) => "the program starts at the arm's home, where the arm must stand: it halts \
+                        otherwise"
+                .to_string(),
+            None => {
+                "the first movej starts from wherever the arm stands: clear that way".to_string()
+            }
+        },
+    ];
+    let program = emg_job::ur_program::ur_program(file, robot, &header)?;
+    emg_io::refuse_overwriting(
+        &[("job program", input), ("robot", robot_file)],
+        &[("--out", out)],
+    )?;
+    emg_io::write_atomically(out, program.text.as_bytes())
+        .with_context(|| format!("cannot write {}", out.display()))?;
+    Ok(format!(
+        "URScript for a Universal Robots e-Series controller, native: one program of {} moves \
+         ({} movej, {} movel, {} movep) for {} stroke parts, each a blended movep run within \
+         {:.3} mm of its stroke between targets, the tool on {:?} digital output {}\n  wrote {}",
+        program.moves(),
+        program.movej,
+        program.movel,
+        program.movep,
+        program.stroke_parts,
+        program.worst_chord_m * 1e3,
+        tool.bank,
+        tool.number,
+        out.display()
+    ))
 }
 
 /// The file `emg plan --export` writes beside a task's files: `STEM.mcap` or `STEM.script`.
@@ -223,7 +395,10 @@ pub fn after_plan(args: &PlanArgs, robot: &Robot, paths: &PlanPaths) -> Result<S
         &plan_output(paths, format),
         &args.robot,
         robot,
-        &ExportOptions::default(),
+        &ExportOptions {
+            max_servoj_lines: args.max_servoj,
+            ..ExportOptions::default()
+        },
         input,
     )
     .with_context(|| {

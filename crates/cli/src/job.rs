@@ -88,6 +88,9 @@ pub struct JobArgs {
     /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
+    /// How a URScript export is written.
+    #[command(flatten)]
+    pub urscript: crate::export::UrScriptArgs,
     /// Also write the program's viewer page (self-contained HTML): the arm playing the whole
     /// program, every stroke on the part (drawn stretches solid, the rest faint), the pen-up
     /// moves dashed, the segment under way named.
@@ -195,7 +198,7 @@ pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    crate::export::refuse_program_export(args.export, &input.robot)?;
+    crate::export::refuse_program_export(args.export, &args.urscript, &input.robot)?;
     let Ready {
         job,
         planner,
@@ -220,8 +223,14 @@ pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());
     if let Some(format) = args.export {
-        let text =
-            crate::export::export_program(&file, format, &args.out, &input.robot, planner.robot())?;
+        let text = crate::export::export_program(
+            &file,
+            format,
+            &args.urscript,
+            &args.out,
+            &input.robot,
+            planner.robot(),
+        )?;
         println!("{text}");
     }
     if let Some(path) = &args.html {

@@ -68,6 +68,9 @@ pub struct PlaceArgs {
     /// see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
+    /// How a URScript export is written.
+    #[command(flatten)]
+    pub urscript: crate::export::UrScriptArgs,
 }
 
 fn parse_range(value: &str) -> Result<[f64; 2], String> {
@@ -110,7 +113,7 @@ pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     outputs.extend(args.job_out.as_deref().map(|path| ("--job-out", path)));
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    crate::export::refuse_program_export(args.export, &input.robot)?;
+    crate::export::refuse_program_export(args.export, &args.urscript, &input.robot)?;
     let region = Region {
         moving: args.moving,
         x_m: args.x,
@@ -161,6 +164,7 @@ pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
         let text = crate::export::export_program(
             program,
             format,
+            &args.urscript,
             &args.out,
             &input.robot,
             planner.robot(),

@@ -25,6 +25,8 @@ pub mod place;
 pub mod program;
 pub mod spec;
 pub mod stroke;
+pub mod tool_output;
+pub mod ur_program;
 pub mod verify;
 pub mod watch;
 
@@ -54,6 +56,7 @@ pub use program::{
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
 pub use stroke::{StrokePart, StrokePlan, plan_stroke};
+pub use tool_output::{OutputBank, ToolOutput};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 pub use watch::{Stopped, StopsWith, Unwatched, Watch};
 

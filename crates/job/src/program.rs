@@ -233,10 +233,7 @@ impl JobFile {
         let mut points = Vec::new();
         let mut offset_ns = 0;
         for segment in &self.segments {
-            let samples = self
-                .definition(segment)
-                .expect("a program's motion is checked when it is read or planned")
-                .samples(self.rate_hz);
+            let samples = self.segment_samples(segment);
             let skip = usize::from(!points.is_empty());
             points.extend(samples.iter().skip(skip).map(|sample| {
                 JointTrajectoryPoint {
@@ -250,6 +247,18 @@ impl JobFile {
             offset_ns += samples.last().map_or(0, |last| last.time_ns);
         }
         points
+    }
+
+    /// The samples of `segment` (one of [`Self::segments`]) at [`Self::rate_hz`], times from
+    /// the segment's start.
+    ///
+    /// # Panics
+    ///
+    /// If the segment's motion cannot be sampled ([`Self::check_motion`]).
+    pub fn segment_samples(&self, segment: &Segment) -> Vec<TimedSample> {
+        self.definition(segment)
+            .expect("a program's motion is checked when it is read or planned")
+            .samples(self.rate_hz)
     }
 
     /// The `format` of a JSON text, if it has one.

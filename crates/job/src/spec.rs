@@ -1,6 +1,7 @@
 //! The read stage: a job file (`emg-job` input, version 1), a path file (a job of one stroke) or
 //! a drawing's strokes, validated into a [`Job`].
 
+use crate::tool_output::ToolOutput;
 use emg_control::{Path, PathError, PathSpec};
 pub use emg_kinematics::Transform;
 use emg_kinematics::{JointVector, Robot};
@@ -96,6 +97,8 @@ pub struct JobSettings {
     pub seed: u64,
     /// Samples the sampling planner draws at most per move.
     pub rrt_max_samples: usize,
+    /// The output that switches the tool on along each stroke.
+    pub tool_output: ToolOutput,
 }
 
 impl Default for JobSettings {
@@ -109,6 +112,7 @@ impl Default for JobSettings {
             max_parts: 6,
             seed: 20_261_127,
             rrt_max_samples: 4000,
+            tool_output: ToolOutput::default(),
         }
     }
 }
@@ -220,7 +224,8 @@ impl JobSettings {
             self.rrt_max_samples as f64,
             "in [1, 1000000]",
             (1..=1_000_000).contains(&self.rrt_max_samples),
-        )
+        )?;
+        self.tool_output.validate()
     }
 }
 

@@ -494,6 +494,12 @@ impl Robot {
         &self.tip_link
     }
 
+    /// The TCP's frame in the frame of the last joint's segment (where the tool is mounted):
+    /// its position (m) and its rotation (columns are the TCP frame's axes).
+    pub fn tcp_offset(&self) -> (Vec3, Matrix3<f64>) {
+        (self.tcp_offset.translation, self.tcp_offset.rotation)
+    }
+
     /// Number of revolute joints `n` (6 or 7): the leading entries of every [`JointVector`] of
     /// this arm.
     pub fn dof(&self) -> usize {

@@ -22,6 +22,7 @@ use emg_kinematics::Robot;
 pub use drivers::{DRIVER_PROFILES, DriverProfile, UR_JOINT_NAMES, is_universal_robots_arm};
 pub use ros2_mcap::JOINT_TRAJECTORY_TYPE;
 pub use thinning::ThinningReport;
+pub use urscript::{home_check, joint_list};
 
 use thinning::{DEFAULT_TOLERANCE_RAD, SplineLimits, measure, thin};
 use urscript::{
@@ -280,7 +281,8 @@ pub fn read_joint_trajectory(path: &Path) -> Result<JointTrajectory, ExportError
 }
 
 /// Exports the timed motion `trajectory` for `robot` as `format` to `out` (a URScript motion
-/// longer than one program: `out` with `-part1`, `-part2`, ... before its extension), in memory.
+/// longer than one program: `out` without its extension, with `-part1.script`,
+/// `-part2.script`, ...), in memory.
 pub fn export(
     trajectory: TimedPoints<'_>,
     format: ExportFormat,
@@ -523,13 +525,9 @@ fn ur_script(
     })
 }
 
-/// `out` with `-part<n>` before its extension.
+/// `out` without its extension, with `-part<n>.script`: a URScript program's part.
 fn part_path(out: &Path, n: usize) -> PathBuf {
     let mut name = OsString::from(out.with_extension("").as_os_str());
-    name.push(format!("-part{n}"));
-    if let Some(ext) = out.extension() {
-        name.push(".");
-        name.push(ext);
-    }
+    name.push(format!("-part{n}.script"));
     PathBuf::from(name)
 }

@@ -108,10 +108,34 @@ pub fn split(targets: &[Target], max_lines: usize) -> Result<Vec<(usize, usize)>
     Ok(parts)
 }
 
-/// A joint vector as URScript writes it, every number in its shortest round-trip form.
-fn vector(q: &[f64]) -> String {
-    let values: Vec<String> = q.iter().map(|v| format!("{v:?}")).collect();
+/// A joint vector as URScript writes it, every number in its shortest round-trip form and in
+/// plain decimals (never an exponent).
+pub fn joint_list(q: &[f64]) -> String {
+    let values: Vec<String> = q.iter().map(|v| format!("{v}")).collect();
     format!("[{}]", values.join(", "))
+}
+
+/// The lines of a program's body (indented by two spaces) that halt it, with a message on the
+/// pendant, unless the arm stands at `home`: every joint within [`START_TOLERANCE_RAD`] of it.
+pub fn home_check(home: &[f64]) -> String {
+    let mut text = String::new();
+    text.push_str("  # the arm's home, where the motion starts: the arm must stand there\n");
+    text.push_str(&format!("  home = {}\n", joint_list(home)));
+    text.push_str("  actual = get_actual_joint_positions()\n");
+    text.push_str("  joint = 0\n");
+    text.push_str(&format!("  while joint < {}:\n", home.len()));
+    text.push_str(&format!(
+        "    if norm(actual[joint] - home[joint]) > {START_TOLERANCE_RAD}:\n"
+    ));
+    text.push_str(
+        "      popup(\"The arm is not at the program's home: move it there first.\", \
+         title=\"emg\", error=True, blocking=True)\n",
+    );
+    text.push_str("      halt\n");
+    text.push_str("    end\n");
+    text.push_str("    joint = joint + 1\n");
+    text.push_str("  end\n");
+    text
 }
 
 /// How a program comes to its first target.
@@ -147,29 +171,10 @@ pub fn program(
             ));
             text.push_str(&format!(
                 "  movej({}, a={MOVEJ_ACCELERATION_RAD_S2}, v={MOVEJ_SPEED_RAD_S})\n",
-                vector(&first.q)
+                joint_list(&first.q)
             ));
         }
-        Start::Check => {
-            text.push_str(
-                "  # the arm's home, where the motion starts: the arm must stand there\n",
-            );
-            text.push_str(&format!("  home = {}\n", vector(&first.q)));
-            text.push_str("  actual = get_actual_joint_positions()\n");
-            text.push_str("  joint = 0\n");
-            text.push_str(&format!("  while joint < {}:\n", first.q.len()));
-            text.push_str(&format!(
-                "    if norm(actual[joint] - home[joint]) > {START_TOLERANCE_RAD}:\n"
-            ));
-            text.push_str(
-                "      popup(\"The arm is not at the program's home: move it there first.\", \
-                 title=\"emg\", error=True, blocking=True)\n",
-            );
-            text.push_str("      halt\n");
-            text.push_str("    end\n");
-            text.push_str("    joint = joint + 1\n");
-            text.push_str("  end\n");
-        }
+        Start::Check => text.push_str(&home_check(&first.q)),
     }
     text.push_str(&format!(
         "  # servoj(q, a, v, t, lookahead_time, gain): one target every {SERVO_PERIOD_S} s\n"
@@ -177,7 +182,7 @@ pub fn program(
     for target in &targets[range.0 + 1..=range.1] {
         text.push_str(&format!(
             "  servoj({}, 0, 0, {SERVO_PERIOD_S}, {LOOKAHEAD_TIME_S}, {GAIN})\n",
-            vector(&target.q)
+            joint_list(&target.q)
         ));
     }
     text.push_str(&format!(
@@ -186,7 +191,7 @@ pub fn program(
     ));
     text.push_str(&format!(
         "  servoj({}, 0, 0, {HOLD_S}, {LOOKAHEAD_TIME_S}, {GAIN})\n",
-        vector(&last.q)
+        joint_list(&last.q)
     ));
     text.push_str(&format!("  stopj({MOVEJ_ACCELERATION_RAD_S2})\n"));
     text.push_str("end\n");
