@@ -355,6 +355,16 @@ impl ReferenceModel {
         )
     }
 
+    /// TCP position and orientation (the tip link's frame: its rotation's columns are the
+    /// tip's x, y and z axes in the base frame, z the tool axis of [`Self::tcp_pose`]) for `q`.
+    pub fn tcp_frame(&self, q: &Joints) -> (Vector3<f64>, Matrix3<f64>) {
+        let tip = *self.link_frames(q).last().expect("tip frame");
+        (
+            tip.fixed_view::<3, 1>(0, 3).into_owned(),
+            tip.fixed_view::<3, 3>(0, 0).into_owned(),
+        )
+    }
+
     /// Joint limits `(lower, upper)` of the revolute joints in order.
     pub fn limits(&self) -> Vec<(f64, f64)> {
         self.joints
@@ -922,6 +932,22 @@ mod tests {
             q[i] = stream.between(*lo, *hi);
         }
         q
+    }
+
+    #[test]
+    fn the_tcp_frame_holds_the_tcp_pose_and_a_rotation() {
+        let mut stream = Stream(0x5EED_F4A3);
+        for model in arms() {
+            for _ in 0..50 {
+                let q = configuration(&model, &mut stream);
+                let (tcp, axis) = model.tcp_pose(&q);
+                let (position, rotation) = model.tcp_frame(&q);
+                assert_eq!(position, tcp);
+                assert_eq!(rotation.column(2).into_owned(), axis);
+                assert!((rotation.transpose() * rotation - Matrix3::identity()).amax() < 1e-12);
+                assert!((rotation.determinant() - 1.0).abs() < 1e-12);
+            }
+        }
     }
 
     /// The exhaustive loop `min_clearance` ran before the pruning.
