@@ -428,7 +428,6 @@ fn assert_reads_back(report: &ReadReport, plan: &emg_job::JobFile) {
 }
 
 #[test]
-#[ignore = "until the native UR program exporter lands"]
 fn the_ur5e_house_program_reads_back_within_the_tolerance_and_cone() {
     let tmp = temp_dir("ur-house");
     let (script, plan) = exported(&case("house.svg"), tmp.path(), &[]);
@@ -437,7 +436,6 @@ fn the_ur5e_house_program_reads_back_within_the_tolerance_and_cone() {
 }
 
 #[test]
-#[ignore = "until the native UR program exporter lands"]
 fn a_hundred_stroke_ur5e_program_reads_back() {
     let tmp = temp_dir("ur-hundred");
     let drawing = tmp.path().join("scatter.svg");
@@ -450,7 +448,6 @@ fn a_hundred_stroke_ur5e_program_reads_back() {
 }
 
 #[test]
-#[ignore = "until the native UR program exporter lands"]
 fn a_target_moved_by_a_millimetre_fails_the_reader() {
     let tmp = temp_dir("ur-moved");
     let (script, plan) = exported(&case("house.svg"), tmp.path(), &[]);

@@ -1042,8 +1042,8 @@ impl JointIndex {
     }
 }
 
-/// The TCP poses of the plan's configurations (by the checker), sorted by x, for finding a
-/// Cartesian target.
+/// The TCP poses of the plan's configurations and vertices (by the checker), sorted by x, for
+/// finding a Cartesian target.
 struct PoseIndex(Vec<Pose>);
 
 impl PoseIndex {
@@ -1299,7 +1299,9 @@ impl<'a> Reading<'a> {
                 end: tcp(last - 1),
             });
         }
-        let mut joints: Vec<[f64; 6]> = configurations.clone();
+        // The samples, then the vertices of the moves' joint-space polylines (which a blended
+        // move's samples pass by, not through).
+        let mut joints: Vec<[f64; 6]> = configurations;
         for segment in &file.segments {
             for vertex in &segment.vertices {
                 if vertex.len() >= 6 {
@@ -1307,11 +1309,8 @@ impl<'a> Reading<'a> {
                 }
             }
         }
+        let mut poses: Vec<Pose> = joints.iter().map(|q| checker_tcp(model, q)).collect();
         joints.sort_by(|a, b| a[0].total_cmp(&b[0]));
-        let mut poses: Vec<Pose> = configurations
-            .iter()
-            .map(|q| checker_tcp(model, q))
-            .collect();
         poses.sort_by(|a, b| a.position.x.total_cmp(&b.position.x));
         Ok(Self {
             model,
@@ -1421,7 +1420,8 @@ impl<'a> Reading<'a> {
         })
     }
 
-    /// Checks that a Cartesian target is the TCP pose of a configuration of the plan.
+    /// Checks that a Cartesian target is the TCP pose of a configuration (a sample or a move's
+    /// vertex) of the plan.
     fn target(&self, pose: Pose, line: usize) -> Result<(), ReadError> {
         if self.poses_index.holds(&pose) {
             return Ok(());
