@@ -374,9 +374,13 @@ def export(
     robot: Optional[PathLike] = None,
     tolerance_rad: Optional[float] = None,
     max_servoj_lines: Optional[int] = None,
+    urscript: Optional[Literal["native", "servoj"]] = None,
 ) -> ExportReport:
-    """Exports a joint trajectory file as ``emg export`` does: ``"ros2-mcap"`` (a ROS 2
-    trajectory_msgs/msg/JointTrajectory in an MCAP file, its points thinned within
-    ``tolerance_rad``, default 1e-5) or ``"urscript"`` (a program for a six-joint Universal
-    Robots arm, a servoj target every 2 ms, at most ``max_servoj_lines`` per program, default
-    2500). Raises InputError for a wrong input, writing nothing."""
+    """Exports a joint trajectory file or a job's program as ``emg export`` does:
+    ``"ros2-mcap"`` (a ROS 2 trajectory_msgs/msg/JointTrajectory in an MCAP file, its points
+    thinned within ``tolerance_rad``, default 1e-5; a job's tool switching beside it on
+    ``/emg/tool_output``, std_msgs/msg/Bool) or ``"urscript"``: ``urscript="native"`` (one
+    program of movej, movel and blended movep through the plan's poses, the tool switched by its
+    output; a job's program on the shipped UR5e, its default there) or ``"servoj"`` (a servoj
+    target every 2 ms, at most ``max_servoj_lines`` per program, default 2500). Raises InputError
+    for a wrong input, writing nothing."""

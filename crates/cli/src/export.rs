@@ -81,43 +81,13 @@ fn shipped_profile(robot_file: &Path) -> Option<&'static DriverProfile> {
 /// Runs `emg export`: reads the file, resolves its robot, exports, and prints what it wrote.
 pub fn run_export(args: &ExportArgs) -> Result<()> {
     let job = crate::check::read_job_file(&args.file)?;
-    if let Some(job) = &job {
-        let robot_file = match &args.robot {
-            Some(path) => path.clone(),
-            None => crate::robot::resolve(&job.robot, &args.file)?,
-        };
-        let robot = crate::robot::load_robot(&robot_file, None, None)?;
-        let target = ExportTarget {
-            format: args.format,
-            out: &args.out,
-            urscript: &args.urscript,
-            thinning_tolerance: args.thinning_tolerance,
-        };
-        println!(
-            "{}",
-            export_job(job, &target, &args.file, &robot_file, &robot)?
-        );
-        return Ok(());
-    }
-    if args.urscript.urscript == Some(UrScriptForm::Native) && args.format == ExportFormat::UrScript
-    {
-        anyhow::bail!(
-            "--urscript native writes a job's program (emg-job/3, which `emg job` writes); {} is a \
-             joint trajectory: export it with --urscript servoj",
-            args.file.display()
-        );
-    }
     let trajectory = match &job {
         Some(_) => None,
         None => Some(emg_io::read_joint_trajectory(&args.file)?),
     };
-    let job_points = job
-        .as_ref()
-        .map(emg_job::JobFile::points)
-        .unwrap_or_default();
-    let (points, robot_field) = match (&job, &trajectory) {
-        (Some(job), _) => (job.timed_points(&job_points), job.robot.as_str()),
-        (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
+    let robot_field = match (&job, &trajectory) {
+        (Some(job), _) => &job.robot,
+        (None, Some(trajectory)) => &trajectory.robot,
         (None, None) => unreachable!("a file is read as one or the other"),
     };
     let robot_file = match &args.robot {
@@ -125,19 +95,40 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
         None => crate::robot::resolve(robot_field, &args.file)?,
     };
     let robot = crate::robot::load_robot(&robot_file, None, None)?;
-    let options = ExportOptions {
-        tolerance_rad: args.thinning_tolerance,
-        max_servoj_lines: args.urscript.max_servoj,
+    let target = ExportTarget {
+        format: args.format,
+        out: &args.out,
+        urscript: &args.urscript,
+        thinning_tolerance: args.thinning_tolerance,
     };
-    let text = export_to(
-        points,
-        args.format,
-        &args.out,
-        &robot_file,
-        &robot,
-        &options,
-        &args.file,
-    )?;
+    let text = match (&job, &trajectory) {
+        (Some(job), _) => export_job(job, &target, &args.file, &robot_file, &robot)?,
+        (None, Some(trajectory)) => {
+            if args.urscript.urscript == Some(UrScriptForm::Native)
+                && args.format == ExportFormat::UrScript
+            {
+                anyhow::bail!(
+                    "--urscript native writes a job's program (emg-job/3, which `emg job` \
+                     writes); {} is a joint trajectory: export it with --urscript servoj",
+                    args.file.display()
+                );
+            }
+            let options = ExportOptions {
+                tolerance_rad: args.thinning_tolerance,
+                max_servoj_lines: args.urscript.max_servoj,
+            };
+            export_to(
+                trajectory.into(),
+                args.format,
+                &args.out,
+                &robot_file,
+                &robot,
+                &options,
+                &args.file,
+            )?
+        }
+        (None, None) => unreachable!("a file is read as one or the other"),
+    };
     println!("{text}");
     Ok(())
 }
@@ -244,8 +235,14 @@ fn export_job(
         tolerance_rad: target.thinning_tolerance,
         max_servoj_lines: target.urscript.max_servoj,
     };
+    let (points, switches) = (file.points(), file.tool_switches());
+    let output = file.settings.tool_output.to_string();
+    let tool = emg_io::ToolSwitching {
+        switches: &switches,
+        output: &output,
+    };
     export_to(
-        file.timed_points(&file.points()),
+        file.timed_points(&points, tool),
         target.format,
         target.out,
         robot_file,
@@ -260,7 +257,7 @@ fn export_job(
 /// known to be the controller's Base and tool flange), and by default on the shipped UR5e;
 /// servoj on any other UR arm.
 fn writes_native(urscript: &UrScriptArgs, robot_file: &Path) -> Result<bool> {
-    let known = shipped_profile(robot_file).is_some_and(|profile| profile.robot == "ur5e");
+    let known = shipped_profile(robot_file).is_some_and(DriverProfile::has_ur_controller_frames);
     match urscript.urscript {
         Some(UrScriptForm::Servoj) => Ok(false),
         Some(UrScriptForm::Native) if !known => anyhow::bail!(
@@ -284,53 +281,9 @@ fn native_ur_program(
     robot: &Robot,
 ) -> Result<String> {
     let reference = crate::robot::reference(robot_file)?.to_string();
-    let tool = file.settings.tool_output;
-    let header = vec![
-        format!("written by emg export from a job's program for robot {reference}"),
-        "for a Universal Robots e-Series controller (PolyScope 5): run it in a Script node or \
-         send it to port 30002 (docs/robot-export.md)"
-            .to_string(),
-        "poses p[x, y, z, rx, ry, rz] in the controller's Base frame (m, rotation vector); \
-         joints in the pendant's order and zero; the TCP at the pen's tip (set_tcp)"
-            .to_string(),
-        format!(
-            "the tool: {:?} digital output {}, {} switches it on; lead {} s, lag {} s",
-            tool.bank,
-            tool.number,
-            if tool.on_high { "high" } else { "low" },
-            tool.lead_s,
-            tool.lag_s
-        ),
-        match &file.home {
-            Some(_) => "the program starts at the arm's home, where the arm must stand: it halts \
-                        otherwise"
-                .to_string(),
-            None => {
-                "the first movej starts from wherever the arm stands: clear that way".to_string()
-            }
-        },
-    ];
-    let program = emg_job::ur_program::ur_program(file, robot, &header)?;
-    emg_io::refuse_overwriting(
-        &[("job program", input), ("robot", robot_file)],
-        &[("--out", out)],
-    )?;
-    emg_io::write_atomically(out, program.text.as_bytes())
-        .with_context(|| format!("cannot write {}", out.display()))?;
-    Ok(format!(
-        "URScript for a Universal Robots e-Series controller, native: one program of {} moves \
-         ({} movej, {} movel, {} movep) for {} stroke parts, each a blended movep run within \
-         {:.3} mm of its stroke between targets, the tool on {:?} digital output {}\n  wrote {}",
-        program.moves(),
-        program.movej,
-        program.movel,
-        program.movep,
-        program.stroke_parts,
-        program.worst_chord_m * 1e3,
-        tool.bank,
-        tool.number,
-        out.display()
-    ))
+    let export = emg_job::ur_program::ur_program_export(file, robot, &reference, out)?;
+    export.write(&[("job program", input), ("robot", robot_file)])?;
+    Ok(format!("{}\n  wrote {}", export.summary, out.display()))
 }
 
 /// The file `emg plan --export` writes beside a task's files: `STEM.mcap` or `STEM.script`.

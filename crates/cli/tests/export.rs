@@ -250,9 +250,9 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
         ],
     );
     assert_eq!(code, Some(0), "{stderr}");
-    // From home and back the program lasts more than one program's 2,500 targets: split where
-    // the arm rests, the first part starting at home.
-    assert!(stdout.contains("wrote pencil.job"), "{stdout}");
+    // The job's program as one native program beside it.
+    assert!(stdout.contains("native: one program of"), "{stdout}");
+    assert!(stdout.contains("wrote pencil.job.script"), "{stdout}");
     let job = read_json(&dir.path().join("pencil.job.json"));
     let strokes = job["segments"]
         .as_array()
@@ -270,6 +270,8 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
             "urscript",
             "--out",
             "whole.script",
+            "--urscript",
+            "servoj",
             "--max-servoj",
             "100000",
         ],

@@ -88,8 +88,9 @@ pub use csv::{csv_header, read_csv, samples_from_steps, trajectory_csv};
 pub use error::FormatError;
 pub use export::{
     DRIVER_PROFILES, DriverProfile, Export, ExportError, ExportFormat, ExportOptions, ExportRobot,
-    JOINT_TRAJECTORY_TYPE, ThinningReport, TimedPoints, UR_JOINT_NAMES, export, home_check,
-    is_universal_robots_arm, joint_list, read_joint_trajectory,
+    JOINT_TRAJECTORY_TYPE, TOOL_OUTPUT_TOPIC, TOOL_OUTPUT_TYPE, ThinningReport, TimedPoints,
+    ToolSwitch, ToolSwitching, UR_JOINT_NAMES, export, home_check, is_universal_robots_arm,
+    joint_list, read_joint_trajectory,
 };
 pub use joint_trajectory::{
     JOINT_TRAJECTORY_FORMAT, JointTrajectory, JointTrajectoryPoint, TimeFromStart, TimingLimits,

@@ -274,17 +274,41 @@ impl JobFile {
     }
 
     /// The samples `points` (the program's: [`Self::points`]) as an export reads them
-    /// ([`emg_io::export`]).
+    /// ([`emg_io::export`]), with the tool's switching `tool` (its switches:
+    /// [`Self::tool_switches`]).
     pub fn timed_points<'a>(
         &'a self,
         points: &'a [JointTrajectoryPoint],
+        tool: emg_io::ToolSwitching<'a>,
     ) -> emg_io::TimedPoints<'a> {
         emg_io::TimedPoints {
             joint_names: &self.joint_names,
             limits: &self.limits,
             points,
             home: self.home.as_deref(),
+            tool: Some(tool),
         }
+    }
+
+    /// Where the tool is switched on and off: on where each stroke part starts, off where it
+    /// ends (a stroke segment is where the tool is on; `settings.tool_output` names its output).
+    pub fn tool_switches(&self) -> Vec<emg_io::ToolSwitch> {
+        self.segments
+            .iter()
+            .filter(|segment| matches!(segment.kind, SegmentKind::Stroke { .. }))
+            .flat_map(|segment| {
+                [
+                    emg_io::ToolSwitch {
+                        time_s: segment.start_s,
+                        on: true,
+                    },
+                    emg_io::ToolSwitch {
+                        time_s: segment.end_s,
+                        on: false,
+                    },
+                ]
+            })
+            .collect()
     }
 }
 

@@ -17,6 +17,14 @@ pub enum OutputBank {
 }
 
 impl OutputBank {
+    /// The bank's name in a job file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Standard => "standard",
+            Self::Tool => "tool",
+        }
+    }
+
     /// The highest output number of the bank.
     pub fn last_output(self) -> u32 {
         match self {
@@ -92,6 +100,20 @@ impl ToolOutput {
     /// The output's level that switches the tool on (`on`) or off.
     pub fn level(&self, on: bool) -> bool {
         on == self.on_high
+    }
+}
+
+impl std::fmt::Display for ToolOutput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} digital output {}, {} switches it on; lead {} s, lag {} s",
+            self.bank.name(),
+            self.number,
+            if self.on_high { "high" } else { "low" },
+            self.lead_s,
+            self.lag_s
+        )
     }
 }
 

@@ -121,6 +121,57 @@ impl Pose {
     }
 }
 
+/// `file`'s program exported as one native UR program to `out`, in memory
+/// ([`emg_io::Export::write`] writes it): [`ur_program`] for `robot` (the shipped UR5e),
+/// recorded in its header as `reference`.
+pub fn ur_program_export(
+    file: &JobFile,
+    robot: &Robot,
+    reference: &str,
+    out: &std::path::Path,
+) -> Result<emg_io::Export, UrProgramError> {
+    let tool = file.settings.tool_output;
+    let header = vec![
+        format!("written by emg from a job's program for robot {reference}"),
+        "for a Universal Robots e-Series controller (PolyScope 5): run it in a Script node or \
+         send it to port 30002 (docs/robot-export.md)"
+            .to_string(),
+        "poses p[x, y, z, rx, ry, rz] in the controller's Base frame (m, rotation vector); \
+         joints in the pendant's order and zero; the TCP at the tool's tip (set_tcp)"
+            .to_string(),
+        format!("the tool: {tool}"),
+        match &file.home {
+            Some(_) => "the program starts at the arm's home, where the arm must stand: it halts \
+                        otherwise"
+                .to_string(),
+            None => {
+                "the first movej starts from wherever the arm stands: clear that way".to_string()
+            }
+        },
+    ];
+    let program = ur_program(file, robot, &header)?;
+    let summary = format!(
+        "URScript for a Universal Robots e-Series controller, native: one program of {} moves \
+         ({} movej, {} movel, {} movep) for {} stroke parts, each a blended movep run within \
+         {:.3} mm of its stroke between targets, the tool on {} digital output {}",
+        program.moves(),
+        program.movej,
+        program.movel,
+        program.movep,
+        program.stroke_parts,
+        program.worst_chord_m * 1e3,
+        tool.bank.name(),
+        tool.number,
+    );
+    Ok(emg_io::Export {
+        format: emg_io::ExportFormat::UrScript,
+        files: vec![(out.to_path_buf(), program.text.into_bytes())],
+        thinning: None,
+        servoj_targets: 0,
+        summary,
+    })
+}
+
 /// `job`'s program as one native URScript program for `robot` (the shipped UR5e: its base
 /// frame the controller's Base frame, its last joint's segment the tool flange), with `header`
 /// as comment lines.

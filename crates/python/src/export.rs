@@ -29,17 +29,19 @@ pub struct ExportReport {
     max_joint_deviation_rad: Option<f64>,
     /// ros2-mcap: its largest deviation at the tool (m).
     max_tool_deviation_m: Option<f64>,
-    /// urscript: the `servoj` targets, one every 2 ms.
+    /// urscript servoj: the `servoj` targets, one every 2 ms (0 for a native program).
     servoj_targets: usize,
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/3` file) as `format`
-/// (`"ros2-mcap"` or `"urscript"`) to `out`, for its own robot or `robot` (a shipped robot's
-/// name or a robot file), as `emg export` does: nothing is written on an error, and `out` never
-/// replaces `path`.
+/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"` or `"urscript"`) to `out`, for its own
+/// robot or `robot` (a shipped robot's name or a robot file), as `emg export` does: nothing is
+/// written on an error, and `out` never replaces `path`. `urscript` is `"native"` (one program of
+/// movej, movel and blended movep with the tool's output: a job's program on the shipped UR5e,
+/// its default there) or `"servoj"` (the joint values every 2 ms, split where the arm rests
+/// into programs of at most `max_servoj_lines`).
 #[pyfunction]
-#[pyo3(signature = (path, format, out, robot = None, tolerance_rad = None, max_servoj_lines = None))]
+#[pyo3(signature = (path, format, out, robot = None, tolerance_rad = None, max_servoj_lines = None, urscript = None))]
 pub fn export(
     path: PathBuf,
     format: &str,
@@ -47,12 +49,23 @@ pub fn export(
     robot: Option<PathBuf>,
     tolerance_rad: Option<f64>,
     max_servoj_lines: Option<usize>,
+    urscript: Option<&str>,
 ) -> PyResult<ExportReport> {
     let fail = |e: ExportError| match &e {
         ExportError::Read { .. } | ExportError::Write { .. } => PyOSError::new_err(message(&e)),
         _ => InputError::new_err(message(&e)),
     };
     let format: ExportFormat = format.parse().map_err(fail)?;
+    let native = match urscript {
+        None => None,
+        Some("native") => Some(true),
+        Some("servoj") => Some(false),
+        Some(other) => {
+            return Err(InputError::new_err(format!(
+                "urscript is '{other}': give 'native' or 'servoj'"
+            )));
+        }
+    };
     let text = std::fs::read_to_string(&path)
         .map_err(|e| PyOSError::new_err(format!("cannot read {}: {e}", path.display())))?;
     let job = if emg_job::JobFile::is_job(&text) {
@@ -67,12 +80,20 @@ pub fn export(
         Some(_) => None,
         None => Some(emg_io::read_joint_trajectory(&path).map_err(fail)?),
     };
-    let job_points = job
+    let (job_points, switches) = job
         .as_ref()
-        .map(emg_job::JobFile::points)
+        .map(|job| (job.points(), job.tool_switches()))
         .unwrap_or_default();
+    let output = job
+        .as_ref()
+        .map(|job| job.settings.tool_output.to_string())
+        .unwrap_or_default();
+    let tool = emg_io::ToolSwitching {
+        switches: &switches,
+        output: &output,
+    };
     let (points, robot_field) = match (&job, &trajectory) {
-        (Some(job), _) => (job.timed_points(&job_points), job.robot.as_str()),
+        (Some(job), _) => (job.timed_points(&job_points, tool), job.robot.as_str()),
         (None, Some(trajectory)) => (trajectory.into(), trajectory.robot.as_str()),
         (None, None) => unreachable!("a file is read as one or the other"),
     };
@@ -91,7 +112,22 @@ pub fn export(
         shipped,
         kinematics: Some(&robot.inner),
     };
-    let export = emg_io::export(points, format, &out, &target, &options).map_err(fail)?;
+    let frames = shipped.is_some_and(DriverProfile::has_ur_controller_frames);
+    let export = match (&job, format, native) {
+        (Some(job), ExportFormat::UrScript, Some(true) | None) if frames => {
+            emg_job::ur_program::ur_program_export(job, &robot.inner, &robot.reference, &out)
+                .map_err(|e| InputError::new_err(message(&e)))?
+        }
+        (_, ExportFormat::UrScript, Some(true)) => {
+            return Err(InputError::new_err(format!(
+                "urscript='native' writes a job's program (emg-job/3) for the shipped ur5e, \
+                 whose frames are the controller's; {} for robot {file} is not one: give \
+                 urscript='servoj'",
+                path.display()
+            )));
+        }
+        _ => emg_io::export(points, format, &out, &target, &options).map_err(fail)?,
+    };
     export
         .write(&[
             ("joint trajectory", path.as_path()),

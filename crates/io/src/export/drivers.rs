@@ -108,6 +108,13 @@ impl DriverProfile {
     pub fn for_shipped(name: &str) -> Option<&'static Self> {
         DRIVER_PROFILES.iter().find(|p| p.robot == name)
     }
+
+    /// Whether the robot's base frame and its last joint's segment are a Universal Robots
+    /// controller's Base frame and tool flange, so that a native UR program's poses and TCP
+    /// mean on the controller what they mean here: the shipped UR5e's, authored so.
+    pub fn has_ur_controller_frames(&self) -> bool {
+        self.robot == UR5E.robot
+    }
 }
 
 /// Whether `joint_names` are a Universal Robots arm's six.

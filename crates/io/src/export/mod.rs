@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use emg_kinematics::Robot;
 
 pub use drivers::{DRIVER_PROFILES, DriverProfile, UR_JOINT_NAMES, is_universal_robots_arm};
-pub use ros2_mcap::JOINT_TRAJECTORY_TYPE;
+pub use ros2_mcap::{JOINT_TRAJECTORY_TYPE, TOOL_OUTPUT_TOPIC, TOOL_OUTPUT_TYPE};
 pub use thinning::ThinningReport;
 pub use urscript::{home_check, joint_list};
 
@@ -255,6 +255,27 @@ pub struct TimedPoints<'a> {
     /// arm checks that it stands there, rather than moving it to the start from wherever it
     /// stands.
     pub home: Option<&'a [f64]>,
+    /// The tool switched on and off along the motion (a job's program), which a ROS 2 export
+    /// writes beside the trajectory.
+    pub tool: Option<ToolSwitching<'a>>,
+}
+
+/// The tool switched on and off along a motion.
+#[derive(Clone, Copy, Debug)]
+pub struct ToolSwitching<'a> {
+    /// Each switch in time order.
+    pub switches: &'a [ToolSwitch],
+    /// The output that switches the tool, in words.
+    pub output: &'a str,
+}
+
+/// The tool switched on or off at a time of the motion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToolSwitch {
+    /// Time since the motion's start (s).
+    pub time_s: f64,
+    /// Whether the tool is switched on (else off).
+    pub on: bool,
 }
 
 impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {
@@ -264,6 +285,7 @@ impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {
             limits: &trajectory.limits,
             points: &trajectory.points,
             home: None,
+            tool: None,
         }
     }
 }
@@ -385,14 +407,32 @@ fn ros2(
     if let Some(m) = report.max_tool_deviation_m {
         notes.insert("max_tool_deviation_m".to_string(), format!("{m:e}"));
     }
+    if let Some(tool) = &trajectory.tool {
+        notes.insert("tool_output".to_string(), tool.output.to_string());
+        notes.insert(
+            "tool_output_topic".to_string(),
+            format!(
+                "{TOOL_OUTPUT_TOPIC} ({TOOL_OUTPUT_TYPE}: true switches the tool on), each \
+                 message logged at its time from the trajectory's start"
+            ),
+        );
+    }
     let message = ros2_mcap::Ros2Message {
         joint_names: &joint_names,
         frame_id,
         topic,
         notes,
+        tool: trajectory.tool.map(|tool| tool.switches),
     };
     let bytes =
         ros2_mcap::mcap_bytes(trajectory.points, &kept, &message).map_err(ExportError::Encoding)?;
+    let tool_line = trajectory.tool.map_or(String::new(), |tool| {
+        format!(
+            "\n  the tool ({}) switched {} times on {TOOL_OUTPUT_TOPIC} ({TOOL_OUTPUT_TYPE})",
+            tool.output,
+            tool.switches.len()
+        )
+    });
     let summary = format!(
         "{JOINT_TRAJECTORY_TYPE} on {topic} (joint names of {driver}; frame_id {frame_id}: \
          {relation})\n  {} of {} points kept: the quintic spline through them stays within \
@@ -404,7 +444,7 @@ fn ros2(
         report.max_joint_deviation_rad,
         report.max_velocity_deviation_rad_s,
         report.max_acceleration_deviation_rad_s2,
-    );
+    ) + &tool_line;
     Ok(Export {
         format: ExportFormat::Ros2Mcap,
         files: vec![(out.to_path_buf(), bytes)],

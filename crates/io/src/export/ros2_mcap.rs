@@ -43,6 +43,13 @@ int32 sec
 uint32 nanosec
 ";
 
+/// The topic of the tool's switching, beside the trajectory.
+pub const TOOL_OUTPUT_TOPIC: &str = "/emg/tool_output";
+/// The message type of the tool's switching: `data` true switches the tool on.
+pub const TOOL_OUTPUT_TYPE: &str = "std_msgs/msg/Bool";
+/// The `ros2msg` schema of [`TOOL_OUTPUT_TYPE`].
+const TOOL_OUTPUT_SCHEMA: &str = "bool data\n";
+
 /// CDR encapsulation header: CDR, little-endian, no options.
 const CDR_LE_HEADER: [u8; 4] = [0x00, 0x01, 0x00, 0x00];
 
@@ -89,6 +96,8 @@ pub struct Ros2Message<'a> {
     /// Notes written as the file's `emg_export` metadata record (the source, the driver, the
     /// frames, the thinning).
     pub notes: BTreeMap<String, String>,
+    /// The tool's switches, written on [`TOOL_OUTPUT_TOPIC`] at their times.
+    pub tool: Option<&'a [super::ToolSwitch]>,
 }
 
 /// The CDR bytes of the message with `points` (the header's stamp zero: "start now" to
@@ -122,7 +131,7 @@ fn cdr(message: &Ros2Message<'_>, points: &[&JointTrajectoryPoint]) -> Result<Ve
 }
 
 /// The MCAP file holding one message on `message.topic` with the points `kept` of `points`,
-/// logged at time 0.
+/// logged at time 0, and the tool's switches on [`TOOL_OUTPUT_TOPIC`] at their times.
 pub fn mcap_bytes(
     points: &[JointTrajectoryPoint],
     kept: &[usize],
@@ -153,6 +162,31 @@ pub fn mcap_bytes(
             &data,
         )
         .map_err(fail)?;
+    if let Some(switches) = message.tool {
+        let schema = writer
+            .add_schema(TOOL_OUTPUT_TYPE, "ros2msg", TOOL_OUTPUT_SCHEMA.as_bytes())
+            .map_err(fail)?;
+        let channel = writer
+            .add_channel(schema, TOOL_OUTPUT_TOPIC, "cdr", &BTreeMap::new())
+            .map_err(fail)?;
+        for (sequence, switch) in (1..).zip(switches) {
+            // `std_msgs/msg/Bool`: one byte behind the encapsulation header.
+            let mut data = CDR_LE_HEADER.to_vec();
+            data.push(u8::from(switch.on));
+            let time_ns = (switch.time_s * 1e9).round() as u64;
+            writer
+                .write_to_known_channel(
+                    &mcap::records::MessageHeader {
+                        channel_id: channel,
+                        sequence,
+                        log_time: time_ns,
+                        publish_time: time_ns,
+                    },
+                    &data,
+                )
+                .map_err(fail)?;
+        }
+    }
     writer
         .write_metadata(&mcap::records::Metadata {
             name: "emg_export".to_string(),
