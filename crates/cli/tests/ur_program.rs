@@ -502,3 +502,107 @@ fn a_target_moved_by_a_millimetre_fails_the_reader() {
     let error = read_back(&edited, &plan).expect_err("a moved target");
     assert_eq!(error.line, line, "{error}");
 }
+
+/// `script` with line `line` (1-based) replaced by `with`.
+fn with_line(script: &str, line: usize, with: &str) -> String {
+    script
+        .lines()
+        .enumerate()
+        .map(|(i, l)| if i + 1 == line { with } else { l })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn edits_of_the_house_program_are_refused_at_their_line() {
+    let tmp = temp_dir("ur-edits");
+    let (script, plan) = exported(&case("house.svg"), tmp.path(), &[]);
+    let checker = ur5e_checker();
+    let lines: Vec<&str> = script.lines().collect();
+    let find = |from: usize, prefix: &str| {
+        (from..lines.len())
+            .find(|&i| lines[i].trim_start().starts_with(prefix))
+            .map(|i| i + 1)
+            .unwrap_or_else(|| panic!("no '{prefix}' after line {from}"))
+    };
+    let refused_at = |edited: &str, line: usize, on_level: bool, why: &str| {
+        let error = read_program(edited, &plan, &checker, on_level).expect_err("refused");
+        assert_eq!(error.line, line, "{error}");
+        assert!(error.problem.contains(why), "{error}");
+    };
+    // A movej target 1 µrad off the plan.
+    let movej = find(0, "movej(");
+    let bent = lines[movej - 1].replacen("movej([", "movej([0.000001 + ", 1);
+    let program = parse_program(&with_line(&script, movej, &bent));
+    assert!(program.is_err(), "an expression is no number");
+    let ur_reader::Statement::MoveJ { q } = parse_program(&script)
+        .expect("parses")
+        .statements
+        .into_iter()
+        .find(|(line, _)| *line == movej)
+        .expect("the movej")
+        .1
+    else {
+        panic!("line {movej} is a movej");
+    };
+    let off: Vec<String> = q
+        .iter()
+        .enumerate()
+        .map(|(i, v)| format!("{:?}", if i == 0 { v + 1e-6 } else { *v }))
+        .collect();
+    let rest = lines[movej - 1]
+        .split_once("],")
+        .expect("movej([...], a, v)")
+        .1;
+    refused_at(
+        &with_line(
+            &script,
+            movej,
+            &format!("  movej([{}],{rest}", off.join(", ")),
+        ),
+        movej,
+        true,
+        "is no configuration of the plan",
+    );
+    // A blend radius wider than half of a line next to it.
+    let blended = (0..lines.len())
+        .find(|&i| lines[i].contains("movep(") && !lines[i].contains("r=0.000000000"))
+        .map(|i| i + 1)
+        .expect("a blended movep");
+    let (head, _) = lines[blended - 1].rsplit_once("r=").expect("r=");
+    refused_at(
+        &with_line(&script, blended, &format!("{head}r=0.5)")),
+        blended,
+        true,
+        "exceeds half of an adjacent line",
+    );
+    // The tool switched on before the move that sets it down, the lift above its stroke.
+    let on = find(0, "set_standard_digital_out(0, True)");
+    let set_down = (0..on)
+        .rev()
+        .find(|&i| lines[i].trim_start().starts_with("movel("))
+        .expect("the set-down")
+        + 1;
+    let mut moved: Vec<&str> = lines.clone();
+    let switch = moved.remove(on - 1);
+    moved.insert(set_down - 1, switch);
+    refused_at(
+        &moved.join("\n"),
+        set_down,
+        true,
+        "the tool switches on 2.0000 mm from the start of stroke part 0",
+    );
+    // The tool's levels swapped: the program reads back when low switches the tool on, and is
+    // refused at its first write when high does.
+    let swapped = script
+        .replace("(0, True)", "(0, Low)")
+        .replace("(0, False)", "(0, True)")
+        .replace("(0, Low)", "(0, False)");
+    read_program(&swapped, &plan, &checker, false).unwrap_or_else(|e| panic!("{e}"));
+    refused_at(
+        &swapped,
+        find(0, "set_standard_digital_out("),
+        true,
+        "the tool switches on before the first move",
+    );
+}

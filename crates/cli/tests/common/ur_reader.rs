@@ -1652,7 +1652,9 @@ impl<'a> Reading<'a> {
                 ),
             );
         };
-        let pose = self.current_pose(state, line)?;
+        let Some(pose) = state.pose else {
+            return fail(line, "the tool switches on before the first move");
+        };
         let off = (pose.position - part.start).norm();
         if off > part.bounds.line_tolerance_m + SLACK_M {
             return fail(
