@@ -40,7 +40,8 @@ def assert_mcap_holds_the_points_of(trajectory, out, report):
     by_time = {nanoseconds(p["time_from_start"]): p for p in trajectory["points"]}
     with open(out, "rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
-        decoded = list(reader.iter_decoded_messages())
+        decoded = list(reader.iter_decoded_messages(
+            topics=["/scaled_joint_trajectory_controller/joint_trajectory"]))
     assert len(decoded) == 1
     schema, channel, _, message = decoded[0]
     assert schema.name == "trajectory_msgs/msg/JointTrajectory"
@@ -101,6 +102,42 @@ def test_a_job_of_several_strokes_exports_as_one_trajectory(tmp_path):
     report = elm.export(job, "ros2-mcap", out)
     assert report.max_joint_deviation_rad <= report.tolerance_rad
     assert_mcap_holds_the_points_of(samples_of(plan, program["joint_names"]), out, report)
+    # The tool switched on where each stroke part starts and off where it ends, beside the
+    # trajectory, at those times from its start.
+    with open(out, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        switches = [(channel.topic, schema.name, record.log_time, message.data)
+                    for schema, channel, record, message
+                    in reader.iter_decoded_messages(topics=["/emg/tool_output"])]
+        metadata = {m.name: m.metadata for m in reader.iter_metadata()}
+    expected = [(round(s[key] * 1e9), on) for s in strokes
+                for key, on in (("start_s", True), ("end_s", False))]
+    assert [(t, on) for _, _, t, on in switches] == expected
+    assert {(topic, name) for topic, name, _, _ in switches} == {
+        ("/emg/tool_output", "std_msgs/msg/Bool")}
+    assert metadata["emg_export"]["tool_output"].startswith("standard digital output 0")
+
+
+def test_a_job_exports_as_one_native_ur_program(tmp_path):
+    """A job's program on the UR5e as one native program: the tool switched on and off once
+    per stroke part, each stroke a movep run."""
+    icon = Path(__file__).resolve().parents[2] / "io" / "tests" / "data" / "icons" / "pencil.svg"
+    job = tmp_path / "pencil.job.json"
+    elm.Planner("ur5e").plan_job(icon).write(job)
+    parts = sum(1 for s in json.loads(job.read_text())["segments"] if s["kind"] == "stroke")
+    out = tmp_path / "pencil.script"
+    report = elm.export(job, "urscript", out)
+    assert report.files == [out] and report.servoj_targets == 0
+    assert "native: one program" in report.summary
+    lines = [line.strip() for line in out.read_text().splitlines()]
+    assert lines.count("set_standard_digital_out(0, True)") == parts
+    assert sum(line.startswith("movep(") for line in lines) >= parts
+    assert not any(line.startswith("servoj(") for line in lines)
+    servoj = elm.export(job, "urscript", tmp_path / "stream.script", urscript="servoj",
+                        max_servoj_lines=100_000)
+    assert servoj.servoj_targets > 0
+    with pytest.raises(elm.InputError, match="urscript is 'fast'"):
+        elm.export(job, "urscript", tmp_path / "x.script", urscript="fast")
 
 
 def test_urscript_and_wrong_inputs(ur5e_line, tmp_path):
