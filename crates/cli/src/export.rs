@@ -124,7 +124,7 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
                 &robot_file,
                 &robot,
                 &options,
-                &args.file,
+                ("joint trajectory", &args.file),
             )?
         }
         (None, None) => unreachable!("a file is read as one or the other"),
@@ -133,8 +133,8 @@ pub fn run_export(args: &ExportArgs) -> Result<()> {
     Ok(())
 }
 
-/// Exports the timed motion `trajectory` (read from `input`: a joint trajectory or a job's
-/// program) for the robot of `robot_file`; returns what to print.
+/// Exports the timed motion `trajectory` (read from `input`, named by what it is: a joint
+/// trajectory or a job's program) for the robot of `robot_file`; returns what to print.
 pub fn export_to(
     trajectory: emg_io::TimedPoints<'_>,
     format: ExportFormat,
@@ -142,7 +142,7 @@ pub fn export_to(
     robot_file: &Path,
     robot: &Robot,
     options: &ExportOptions,
-    input: &Path,
+    input: (&str, &Path),
 ) -> Result<String> {
     let file = robot_file.display().to_string();
     let reference = crate::robot::reference(robot_file)?.to_string();
@@ -153,7 +153,7 @@ pub fn export_to(
         kinematics: Some(robot),
     };
     let export = emg_io::export(trajectory, format, out, &target, options)?;
-    export.write(&[("joint trajectory", input), ("robot", robot_file)])?;
+    export.write(&[input, ("robot", robot_file)])?;
     let written: Vec<String> = export
         .files
         .iter()
@@ -248,7 +248,7 @@ fn export_job(
         robot_file,
         robot,
         &options,
-        input,
+        ("job program", input),
     )
 }
 
@@ -352,7 +352,7 @@ pub fn after_plan(args: &PlanArgs, robot: &Robot, paths: &PlanPaths) -> Result<S
             max_servoj_lines: args.max_servoj,
             ..ExportOptions::default()
         },
-        input,
+        ("joint trajectory", input),
     )
     .with_context(|| {
         format!(

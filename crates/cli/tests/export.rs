@@ -282,6 +282,46 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
         &dir.path().join("pencil.job.json"),
         &dir.path().join("whole.script"),
     );
+    // The joint stream split where the arm rests, each part a `.script` whatever --out's
+    // extension; an --out replacing the program refused, nothing written.
+    let (code, stdout, stderr) = run(
+        dir.path(),
+        &[
+            "export",
+            "pencil.job.json",
+            "--format",
+            "urscript",
+            "--urscript",
+            "servoj",
+            "--out",
+            "split.json",
+        ],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("split where the arm rests"), "{stdout}");
+    assert!(dir.path().join("split-part1.script").is_file(), "{stdout}");
+    assert!(!dir.path().join("split.json").exists());
+    let before = std::fs::read(dir.path().join("pencil.job.json")).unwrap();
+    for form in ["native", "servoj"] {
+        let (code, _, stderr) = run(
+            dir.path(),
+            &[
+                "export",
+                "pencil.job.json",
+                "--format",
+                "urscript",
+                "--urscript",
+                form,
+                "--max-servoj",
+                "100000",
+                "--out",
+                "pencil.job.json",
+            ],
+        );
+        assert_eq!(code, Some(1), "{form}: {stderr}");
+        assert!(stderr.contains("which is the job program"), "{form}: {stderr}");
+    }
+    assert_eq!(std::fs::read(dir.path().join("pencil.job.json")).unwrap(), before);
     let (code, stdout, stderr) = run(
         dir.path(),
         &[
@@ -416,7 +456,21 @@ fn wrong_inputs_are_refused_and_nothing_is_written() {
     let bad = examples.join("bad.joint_trajectory.json");
     let bad = bad.to_str().unwrap();
     let out = |name: &str| dir.path().join(name);
-    let cases: [(Vec<&str>, &str, i32); 4] = [
+    let cases: [(Vec<&str>, &str, i32); 5] = [
+        (
+            vec![
+                "--format",
+                "urscript",
+                "--urscript",
+                "native",
+                "--out",
+                "n.script",
+                "--robot",
+                "ur5e",
+            ],
+            "--urscript native writes a job's program",
+            1,
+        ),
         (
             vec![
                 "--format", "urscript", "--out", "a.script", "--robot", "fr3",
