@@ -319,9 +319,15 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
             ],
         );
         assert_eq!(code, Some(1), "{form}: {stderr}");
-        assert!(stderr.contains("which is the job program"), "{form}: {stderr}");
+        assert!(
+            stderr.contains("which is the job program"),
+            "{form}: {stderr}"
+        );
     }
-    assert_eq!(std::fs::read(dir.path().join("pencil.job.json")).unwrap(), before);
+    assert_eq!(
+        std::fs::read(dir.path().join("pencil.job.json")).unwrap(),
+        before
+    );
     let (code, stdout, stderr) = run(
         dir.path(),
         &[
