@@ -25,8 +25,9 @@ mod ur5e;
 
 pub use geometry::{Pose, Rotation, angle_deg, wrap};
 pub use native::{
-    COVERAGE_ALLOWANCE_M, JOINT_MATCH_RAD, JOINT_STEP_RAD, MAX_JOINT_JUMP_RAD, NativeReport,
-    PATH_STEP_M, POSE_MATCH, Piece, TURN_STEP_RAD, movep_path, read_native,
+    COVERAGE_ALLOWANCE_M, JOINT_MATCH_RAD, JOINT_STEP_RAD, JointPiece, MAX_JOINT_JUMP_RAD,
+    NativeReport, PATH_STEP_M, POSE_MATCH, Piece, TURN_STEP_RAD, movej_path, movep_path,
+    read_native,
 };
 pub use script::{Form, Output, Program, Statement, parse_program};
 pub use servoj::{

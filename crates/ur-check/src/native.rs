@@ -237,6 +237,184 @@ pub fn movep_path(
     Ok(pieces)
 }
 
+/// One piece of a joint-space path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum JointPiece {
+    /// The stretch from fraction `from` to fraction `to` of the straight joint line from `a`
+    /// to `b`.
+    Line {
+        /// The line's start.
+        a: [f64; 6],
+        /// The line's end.
+        b: [f64; 6],
+        /// Where the stretch starts (fraction of the line).
+        from: f64,
+        /// Where it ends.
+        to: f64,
+    },
+    /// A blend at constant joint acceleration (parabolic in time, a quadratic Bézier curve in
+    /// joint space) from `entry` on the line into the `corner` to `exit` on the line out of it.
+    Blend {
+        /// Where the blend leaves the incoming line.
+        entry: [f64; 6],
+        /// The target blended past.
+        corner: [f64; 6],
+        /// Where the blend joins the outgoing line.
+        exit: [f64; 6],
+    },
+}
+
+impl JointPiece {
+    /// The joints a fraction `f` of the way along the piece.
+    pub fn at(&self, f: f64) -> [f64; 6] {
+        match *self {
+            Self::Line { a, b, from, to } => {
+                let s = from + (to - from) * f;
+                std::array::from_fn(|i| a[i] + (b[i] - a[i]) * s)
+            }
+            Self::Blend {
+                entry,
+                corner,
+                exit,
+            } => std::array::from_fn(|i| {
+                (1.0 - f) * (1.0 - f) * entry[i] + 2.0 * f * (1.0 - f) * corner[i] + f * f * exit[i]
+            }),
+        }
+    }
+
+    /// An upper bound of the largest change of any joint along the piece (rad).
+    pub fn extent(&self) -> f64 {
+        match *self {
+            Self::Line { .. } => largest_change(&self.at(0.0), &self.at(1.0)),
+            Self::Blend {
+                entry,
+                corner,
+                exit,
+            } => largest_change(&entry, &corner) + largest_change(&corner, &exit),
+        }
+    }
+}
+
+/// Where on the joint line from `a` to `b` (fraction from `a`) the TCP (`tcp_of`) first lies
+/// `radius` (m) from its place at the line's end `b` (`corner_at_b`) or start `a`, seen from
+/// that corner: the point a blend of that radius there leaves or joins the line; `None` where
+/// the whole line lies within it.
+fn blend_point(
+    a: &[f64; 6],
+    b: &[f64; 6],
+    corner_at_b: bool,
+    radius: f64,
+    tcp_of: &dyn Fn(&[f64; 6]) -> Vec3,
+) -> Option<f64> {
+    let line = JointPiece::Line {
+        a: *a,
+        b: *b,
+        from: 0.0,
+        to: 1.0,
+    };
+    let corner = tcp_of(if corner_at_b { b } else { a });
+    // The fraction measured from the corner.
+    let from_corner = |u: f64| if corner_at_b { 1.0 - u } else { u };
+    let within = |u: f64| (tcp_of(&line.at(from_corner(u))) - corner).norm() < radius;
+    let steps = (line.extent() / JOINT_STEP_RAD).ceil().max(1.0) as usize;
+    let outside = (1..=steps)
+        .map(|k| k as f64 / steps as f64)
+        .find(|u| !within(*u))?;
+    let (mut inside, mut outside) = (outside - 1.0 / steps as f64, outside);
+    for _ in 0..50 {
+        let middle = 0.5 * (inside + outside);
+        if within(middle) {
+            inside = middle;
+        } else {
+            outside = middle;
+        }
+    }
+    Some(from_corner(outside))
+}
+
+/// The path of a run of `movej` targets (`targets`: each configuration, its blend radius and
+/// its line) from `start`: straight joint lines between the targets, each target with a radius
+/// `r > 0` blended past from where the TCP comes within `r` of its place at the target on the
+/// line in to where it leaves that distance on the line out ([`JointPiece::Blend`]); `tcp_of`
+/// gives the TCP of a configuration. Each piece comes with the line of the target whose line or
+/// blend it belongs to.
+pub fn movej_path(
+    start: &[f64; 6],
+    targets: &[([f64; 6], f64, usize)],
+    tcp_of: &dyn Fn(&[f64; 6]) -> Vec3,
+) -> Result<Vec<(JointPiece, usize)>, ReadError> {
+    let mut pieces = Vec::new();
+    let Some(&(_, last_radius, last_line)) = targets.last() else {
+        return Ok(pieces);
+    };
+    if last_radius > 0.0 {
+        return fail(
+            last_line,
+            format!("a blend radius of {last_radius} m at a run's last target"),
+        );
+    }
+    let corners: Vec<[f64; 6]> = std::iter::once(*start)
+        .chain(targets.iter().map(|t| t.0))
+        .collect();
+    // The fraction of line i (from corner i to corner i + 1) where the path leaves it.
+    let mut from = 0.0;
+    for (i, &(target, radius, line)) in targets.iter().enumerate() {
+        let a = corners[i];
+        let (to, exit) = if radius > 0.0 {
+            let next = corners[i + 2];
+            let too_wide = || ReadError {
+                program: None,
+                line,
+                problem: format!(
+                    "blend radius {radius} m holds a whole joint move next to its target"
+                ),
+            };
+            let to = blend_point(&a, &target, true, radius, tcp_of).ok_or_else(too_wide)?;
+            let exit = blend_point(&target, &next, false, radius, tcp_of).ok_or_else(too_wide)?;
+            (to, Some((next, exit)))
+        } else {
+            (1.0, None)
+        };
+        if to < from {
+            return fail(
+                line,
+                format!("the blend at this target overlaps the one before it (radius {radius} m)"),
+            );
+        }
+        pieces.push((
+            JointPiece::Line {
+                a,
+                b: target,
+                from,
+                to,
+            },
+            line,
+        ));
+        from = 0.0;
+        if let Some((next, leave)) = exit {
+            let point = |a: &[f64; 6], b: &[f64; 6], s: f64| {
+                JointPiece::Line {
+                    a: *a,
+                    b: *b,
+                    from: s,
+                    to: s,
+                }
+                .at(0.0)
+            };
+            pieces.push((
+                JointPiece::Blend {
+                    entry: point(&a, &target, to),
+                    corner: target,
+                    exit: point(&target, &next, leave),
+                },
+                line,
+            ));
+            from = leave;
+        }
+    }
+    Ok(pieces)
+}
+
 /// The plan's configurations, sorted by their first joint, for finding a `movej` target.
 struct JointIndex(Vec<[f64; 6]>);
 
@@ -371,6 +549,8 @@ struct State {
     covered: Vec<Vec<Stretch>>,
     /// The pending `movep` run: each target, its radius and its line.
     run: Vec<(Pose, f64, usize)>,
+    /// The pending run of blended `movej`: each target, its radius and its line.
+    joint_run: Vec<([f64; 6], f64, usize)>,
     report: NativeReport,
 }
 
@@ -395,6 +575,7 @@ pub fn read_native(
         drawn: Vec::new(),
         covered: vec![Vec::new(); file.strokes.len()],
         run: Vec::new(),
+        joint_run: Vec::new(),
         report: NativeReport {
             movej: 0,
             movel: 0,
@@ -419,6 +600,7 @@ pub fn read_native(
         reading.execute(&mut state, *line, statement)?;
     }
     reading.end_run(&mut state)?;
+    reading.end_joint_run(&mut state)?;
     let last_line = text.lines().count();
     if state.tool_on {
         return fail(last_line, "the program ends with the tool on");
@@ -548,6 +730,9 @@ impl<'a> Reading<'a> {
         if !matches!(statement, Statement::MoveP { .. }) {
             self.end_run(state)?;
         }
+        if !matches!(statement, Statement::MoveJ { .. }) {
+            self.end_joint_run(state)?;
+        }
         match *statement {
             Statement::SetTcp(tcp) => {
                 if state.joints.is_some() {
@@ -595,9 +780,21 @@ impl<'a> Reading<'a> {
                 state.report.home_tolerance_rad = Some(tolerance_rad);
                 self.arrive(state, home, line)?;
             }
-            Statement::MoveJ { q } => {
+            Statement::MoveJ { q, radius_m } => {
                 state.report.movej += 1;
-                self.move_joints(state, line, q)?;
+                if state.tool_on {
+                    return fail(line, "movej with the tool on");
+                }
+                if !self.joints_index.holds(&q) {
+                    return fail(
+                        line,
+                        format!("movej target {q:?} is no configuration of the plan"),
+                    );
+                }
+                state.joint_run.push((q, radius_m, line));
+                if radius_m == 0.0 {
+                    self.end_joint_run(state)?;
+                }
             }
             Statement::MoveL { pose } => {
                 state.report.movel += 1;
@@ -685,26 +882,27 @@ impl<'a> Reading<'a> {
         Ok(())
     }
 
-    /// A `movej` of line `line` to `q`.
-    fn move_joints(&self, state: &mut State, line: usize, q: [f64; 6]) -> Result<(), ReadError> {
-        if state.tool_on {
-            return fail(line, "movej with the tool on");
-        }
-        if !self.joints_index.holds(&q) {
-            return fail(
-                line,
-                format!("movej target {q:?} is no configuration of the plan"),
-            );
-        }
+    /// Runs the pending run of `movej`, if any: from the arm's joints along the path of
+    /// [`movej_path`], every configuration checked, to its last target.
+    fn end_joint_run(&self, state: &mut State) -> Result<(), ReadError> {
+        let run = std::mem::take(&mut state.joint_run);
+        let Some(&(end, _, last_line)) = run.last() else {
+            return Ok(());
+        };
         if let Some(from) = state.joints {
-            let steps = (largest_change(&from, &q) / JOINT_STEP_RAD).ceil().max(1.0) as usize;
-            for k in 1..steps {
-                let f = k as f64 / steps as f64;
-                let between: [f64; 6] = std::array::from_fn(|i| from[i] + (q[i] - from[i]) * f);
-                self.check_configuration(state, &between, line)?;
+            let Some(tcp) = state.tcp else {
+                return fail(run[0].2, "a movej before set_tcp");
+            };
+            let tcp_of = |q: &[f64; 6]| ur5e_flange(q).then(&tcp).position;
+            for (piece, line) in movej_path(&from, &run, &tcp_of)? {
+                let count = (piece.extent() / JOINT_STEP_RAD).ceil().max(1.0) as usize;
+                for k in 1..=count {
+                    let q = piece.at(k as f64 / count as f64);
+                    self.check_configuration(state, &q, line)?;
+                }
             }
         }
-        self.arrive(state, q, line)
+        self.arrive(state, end, last_line)
     }
 
     /// Checks a configuration the arm passes: the joint limits and the checker's clearances

@@ -36,10 +36,12 @@ pub enum Statement {
         /// The tolerance (rad).
         tolerance_rad: f64,
     },
-    /// `movej([...], a=, v=)`.
+    /// `movej([...], a=, v=)` or `movej([...], a=, v=, r=)`.
     MoveJ {
         /// The target joints (rad).
         q: [f64; 6],
+        /// The blend radius at the target (m, at the TCP; 0 without `r=`).
+        radius_m: f64,
     },
     /// `movel(p[...], a=, v=)`.
     MoveL {
@@ -304,8 +306,16 @@ fn parse_statement(code: &str, form: Form) -> Result<Statement, String> {
         },
         "movej" => {
             let q = target("joints")?;
-            move_parameters(&args[1..], &["a", "v"])?;
-            Ok(Statement::MoveJ { q })
+            let names: &[&str] = if args.len() == 4 {
+                &["a", "v", "r"]
+            } else {
+                &["a", "v"]
+            };
+            let parameters = move_parameters(&args[1..], names)?;
+            Ok(Statement::MoveJ {
+                q,
+                radius_m: parameters.get(2).copied().unwrap_or(0.0),
+            })
         }
         "movel" => {
             let pose = Pose::from_ur(&target("pose")?);

@@ -324,7 +324,9 @@ impl<'a> Stream<'a> {
                 }
                 state.report.home_checked = true;
             }
-            (Some((line, Statement::MoveJ { q })), _, home) if index > 0 || home.is_none() => {
+            (Some((line, Statement::MoveJ { q, radius_m })), _, home)
+                if *radius_m == 0.0 && (index > 0 || home.is_none()) =>
+            {
                 if *q != resting {
                     return fail(
                         *line,

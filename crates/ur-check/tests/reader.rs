@@ -8,8 +8,8 @@ use std::path::Path;
 use emg_io::{JointTrajectoryPoint, TimeFromStart, TimingLimits};
 use emg_kinematics::Vec3;
 use emg_ur_check::{
-    Form, PATH_STEP_M, Piece, Pose, Rotation, Statement, TimedMotion, checker_tcp, movep_path,
-    parse_program, read_servoj_motion, ur5e_flange, ur5e_inverse, wrap,
+    Form, JointPiece, PATH_STEP_M, Piece, Pose, Rotation, Statement, TimedMotion, checker_tcp,
+    movej_path, movep_path, parse_program, read_servoj_motion, ur5e_flange, ur5e_inverse, wrap,
 };
 use emg_verify::ReferenceModel;
 
@@ -568,4 +568,52 @@ fn each_form_refuses_the_other_forms_calls() {
             .expect_err("out of range");
         assert_eq!(error.line, 4, "{error}");
     }
+}
+
+#[test]
+fn a_blended_movej_run_leaves_and_joins_its_lines_where_the_tcp_is_the_radius_away() {
+    // A TCP that is the first three joints: distances in joint space and at the TCP agree.
+    let tcp_of = |q: &[f64; 6]| Vec3::new(q[0], q[1], q[2]);
+    let at = |x: f64, y: f64| [x, y, 0.0, 0.0, 0.0, 0.0];
+    let start = at(0.0, 0.0);
+    let targets = [(at(0.1, 0.0), 0.02, 7), (at(0.1, 0.1), 0.0, 8)];
+    let pieces = movej_path(&start, &targets, &tcp_of).expect("a valid run");
+    let lines: Vec<usize> = pieces.iter().map(|(_, line)| *line).collect();
+    assert_eq!(lines, [7, 7, 8]);
+    let JointPiece::Blend { entry, exit, .. } = pieces[1].0 else {
+        panic!("{:?} is not a blend", pieces[1].0);
+    };
+    let near = |a: [f64; 6], b: [f64; 6]| a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-9);
+    assert!(near(entry, at(0.08, 0.0)), "{entry:?}");
+    assert!(near(exit, at(0.1, 0.02)), "{exit:?}");
+    // The path is continuous: each piece starts where the one before it ends.
+    let mut previous = start;
+    for (piece, _) in &pieces {
+        assert!(near(piece.at(0.0), previous), "{piece:?}");
+        previous = piece.at(1.0);
+    }
+    assert!(near(previous, at(0.1, 0.1)));
+    // A radius holding a whole move, overlapping blends, and a blend at a run's end are
+    // refused at their lines.
+    let wide = [(at(0.1, 0.0), 0.2, 11), (at(0.1, 0.1), 0.0, 12)];
+    assert_eq!(
+        movej_path(&start, &wide, &tcp_of).expect_err("wide").line,
+        11
+    );
+    let overlapping = [
+        (at(0.1, 0.0), 0.06, 21),
+        (at(0.1, 0.1), 0.06, 22),
+        (at(0.2, 0.1), 0.0, 23),
+    ];
+    assert_eq!(
+        movej_path(&start, &overlapping, &tcp_of)
+            .expect_err("overlapping")
+            .line,
+        22
+    );
+    let open = [(at(0.1, 0.0), 0.01, 31)];
+    assert_eq!(
+        movej_path(&start, &open, &tcp_of).expect_err("open").line,
+        31
+    );
 }
