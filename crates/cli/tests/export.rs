@@ -2,12 +2,13 @@
 //! the MCAP file read back with the `mcap` crate's reader (its CDR message decoded here by hand,
 //! independently of the encoder), every point compared with the joint trajectory and the
 //! controller's quintic spline between the kept points checked against every sample; the
-//! URScript program parsed back, every `servoj` target compared with the trajectory at its time
-//! and checked against the UR5e's limits; wrong inputs refused with nothing written.
+//! URScript programs read back by the independent reader (`emg-ur-check`), every `servoj`
+//! target compared with the trajectory at its time and checked against the UR5e's limits; wrong
+//! inputs refused with nothing written.
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use common::{data_dir, read_json, temp_dir, text};
 use serde_json::Value;
@@ -201,19 +202,6 @@ fn ros2_mcap_holds_every_point_and_the_spline_stays_within_tolerance() {
     assert_eq!(notes.metadata["points_after"], kept.len().to_string());
 }
 
-/// The UR5e's limits file's `max_velocity` and `max_acceleration` of every joint.
-fn ur5e_limits() -> (Vec<f64>, Vec<f64>) {
-    let yaml =
-        std::fs::read_to_string(data_dir().join("robots/ur5e_pen.joint_limits.yaml")).unwrap();
-    let values = |key: &str| -> Vec<f64> {
-        yaml.lines()
-            .filter_map(|line| line.trim().strip_prefix(key))
-            .map(|v| v.trim().parse().unwrap())
-            .collect()
-    };
-    (values("max_velocity:"), values("max_acceleration:"))
-}
-
 #[test]
 fn urscript_targets_are_the_trajectory_every_2_ms_within_the_ur5e_limits() {
     let dir = temp_dir("export-urscript");
@@ -227,7 +215,7 @@ fn urscript_targets_are_the_trajectory_every_2_ms_within_the_ur5e_limits() {
     assert!(stdout.contains("wrote demo.script"), "{stdout}");
     assert_urscript_follows(
         &dir.path().join("demo.joint_trajectory.json"),
-        &dir.path().join("demo.script"),
+        &[dir.path().join("demo.script")],
     );
 }
 
@@ -280,7 +268,7 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
     assert!(stdout.contains("wrote whole.script"), "{stdout}");
     assert_urscript_follows(
         &dir.path().join("pencil.job.json"),
-        &dir.path().join("whole.script"),
+        &[dir.path().join("whole.script")],
     );
     // The joint stream split where the arm rests, each part a `.script` whatever --out's
     // extension; an --out replacing the program refused, nothing written.
@@ -300,6 +288,12 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
     assert_eq!(code, Some(0), "{stderr}");
     assert!(stdout.contains("split where the arm rests"), "{stdout}");
     assert!(dir.path().join("split-part1.script").is_file(), "{stdout}");
+    let parts: Vec<PathBuf> = (1..)
+        .map(|n| dir.path().join(format!("split-part{n}.script")))
+        .take_while(|part| part.is_file())
+        .collect();
+    let split = assert_urscript_follows(&dir.path().join("pencil.job.json"), &parts);
+    assert!(split.programs >= 2 && split.home_checked, "{split:?}");
     assert!(!dir.path().join("split.json").exists());
     let before = std::fs::read(dir.path().join("pencil.job.json")).unwrap();
     for form in ["native", "servoj"] {
@@ -354,105 +348,41 @@ fn a_job_of_several_strokes_exports_to_urscript_and_ros2() {
     assert!(!dir.path().join("fr3.job.json").exists());
 }
 
-/// The URScript program `script` exported from the timed motion in `motion` (a joint
-/// trajectory or a job's program): a `movej` to its first point (a job's program, which starts
-/// at its home, checks that the arm stands there instead and halts where it does not), then one
-/// `servoj` target every 2 ms, each the motion's sample at that time, within the UR5e's joint,
-/// velocity and acceleration limits, then a hold at its last point and `stopj`.
-fn assert_urscript_follows(motion: &Path, script: &Path) {
-    let file = read_json(motion);
-    // A job's program holds what defines its motion; its samples are evaluated from it.
-    let samples = match emg_job::JobFile::is_job(&file.to_string()) {
-        true => serde_json::to_value(
-            emg_job::JobFile::parse(&file.to_string())
-                .expect("a job's program")
-                .points(),
-        )
-        .unwrap(),
-        false => file["points"].clone(),
-    };
-    let points = samples.as_array().unwrap();
-    let by_time: std::collections::BTreeMap<i64, Vec<f64>> = points
+/// The URScript programs `scripts` (in order) exported from the timed motion in `motion` (a
+/// joint trajectory or a job's program), read back by the independent reader
+/// (`emg_ur_check::read_servoj_motion`): a `movej` to its first point (a job's program, which
+/// starts at its home, checks that the arm stands there instead and halts where it does not),
+/// then one `servoj` target every 2 ms, each the motion's sample at that time, within the UR5e's
+/// joint limits and the motion's velocity and acceleration limits, then a hold where the arm
+/// rests and `stopj`; each later program from where the one before it stopped.
+fn assert_urscript_follows(motion: &Path, scripts: &[PathBuf]) -> emg_ur_check::ServojReport {
+    let text = std::fs::read_to_string(motion).unwrap();
+    let programs: Vec<String> = scripts
         .iter()
-        .map(|p| (nanoseconds(p), numbers(&p["positions"])))
+        .map(|path| std::fs::read_to_string(path).unwrap())
         .collect();
-    let script = std::fs::read_to_string(script).unwrap();
-    let vector = |text: &str| -> Vec<f64> {
-        let inner = &text[text.find('[').unwrap() + 1..text.find(']').unwrap()];
-        inner
-            .split(',')
-            .map(|v| v.trim().parse().unwrap())
-            .collect()
-    };
-    let body: Vec<&str> = script
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.starts_with('#') && !l.is_empty())
-        .collect();
-    assert_eq!(body[0], "def emg_motion():");
-    if file["home"].is_array() {
-        assert_eq!(numbers(&file["home"]), numbers(&points[0]["positions"]));
-        assert!(body[1].starts_with("home = ["), "{}", body[1]);
-        assert_eq!(body[2], "actual = get_actual_joint_positions()");
-        assert!(body.contains(&"if norm(actual[joint] - home[joint]) > 0.01:"));
-        assert!(body.contains(&"halt"));
-        assert!(!body.iter().any(|l| l.starts_with("movej(")), "{script}");
+    let programs: Vec<&str> = programs.iter().map(String::as_str).collect();
+    let checker = emg_verify::ReferenceModel::from_urdf_file(
+        &data_dir().join("robots/ur5e_pen.urdf"),
+        "base_link",
+        "pen_tip",
+    )
+    .unwrap();
+    let report = if emg_job::JobFile::is_job(&text) {
+        let plan = emg_job::JobFile::parse(&text).expect("a job's program");
+        emg_ur_check::read_servoj(&programs, &plan, &checker)
     } else {
-        assert!(body[1].starts_with("movej(["), "{}", body[1]);
-    }
-    assert_eq!(vector(body[1]), numbers(&points[0]["positions"]));
-    let servoj: Vec<&str> = body
-        .iter()
-        .copied()
-        .filter(|l| l.starts_with("servoj("))
-        .collect();
-    let stream = &servoj[..servoj.len() - 1];
-    let end_ns = nanoseconds(points.last().unwrap());
-    assert_eq!(stream.len() as i64, (end_ns + 1_999_999) / 2_000_000);
-    let (velocity, acceleration) = ur5e_limits();
-    assert_eq!((velocity.len(), acceleration.len()), (6, 6));
-    let robot = urdf_rs::read_file(data_dir().join("robots/ur5e_pen.urdf")).unwrap();
-    let limits: Vec<(f64, f64)> = emg_io::UR_JOINT_NAMES
-        .iter()
-        .map(|name| {
-            let joint = robot.joints.iter().find(|j| j.name == *name).unwrap();
-            (joint.limit.lower, joint.limit.upper)
-        })
-        .collect();
-    let mut previous: Vec<Vec<f64>> = vec![vector(body[1])];
-    for (k, line) in stream.iter().enumerate() {
-        assert!(line.ends_with(", 0, 0, 0.002, 0.1, 300)"), "{line}");
-        let q = vector(line);
-        let t = ((k as i64 + 1) * 2_000_000).min(end_ns);
-        assert_eq!(&q, &by_time[&t], "servoj target {k} at {t} ns");
-        for (j, value) in q.iter().enumerate() {
-            assert!(
-                limits[j].0 <= *value && *value <= limits[j].1,
-                "target {k} joint {j}"
-            );
-            let last = &previous[previous.len() - 1];
-            // A move at a joint's speed limit differs from it by the rounding of its positions.
-            let speed = (value - last[j]).abs() / 0.002;
-            assert!(
-                speed <= velocity[j] * (1.0 + 1e-9),
-                "target {k} joint {j}: {speed} rad/s"
-            );
-            if previous.len() >= 2 {
-                let before = &previous[previous.len() - 2];
-                let accel = (value - 2.0 * last[j] + before[j]).abs() / 4e-6;
-                assert!(
-                    accel <= acceleration[j] * 1.01,
-                    "target {k} joint {j}: {accel}"
-                );
-            }
-        }
-        previous.push(q);
-    }
-    let hold = servoj.last().unwrap();
-    assert!(hold.ends_with(", 0, 0, 0.2, 0.1, 300)"), "{hold}");
-    assert_eq!(vector(hold), numbers(&points.last().unwrap()["positions"]));
-    assert_eq!(body[body.len() - 2], "stopj(1.4)");
-    assert_eq!(body[body.len() - 1], "end");
+        let trajectory = emg_io::JointTrajectory::from_json(&text).expect("a joint trajectory");
+        let motion = emg_ur_check::TimedMotion {
+            points: &trajectory.points,
+            limits: &trajectory.limits,
+            home: None,
+        };
+        emg_ur_check::read_servoj_motion(&programs, &motion, &checker)
+    };
+    let report = report.unwrap_or_else(|e| panic!("{}: {e}", motion.display()));
+    assert_eq!(report.programs, scripts.len());
+    report
 }
 
 #[test]
