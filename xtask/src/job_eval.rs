@@ -27,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use crate::{progress, workspace};
 
 mod large;
+mod ur_programs;
 
 /// Options of `job-eval`.
 #[derive(clap::Args)]
@@ -184,15 +185,27 @@ pub struct Record {
     /// The large jobs, each on all threads and on one.
     #[serde(default)]
     pub large: Vec<large::LargeRow>,
+    /// On the UR5e, each program of `rows` exported both ways and read back.
+    #[serde(default)]
+    pub ur_programs: Vec<ur_programs::UrRow>,
 }
 
 /// Plans, checks and compares every job; writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let (planner, timing, checker) = setup(&args.robot)?;
     let robot_name = args.robot.display().to_string();
-    let home = ShippedRobot::by_path(&args.robot, &workspace::data_dir())
-        .map(|shipped| shipped.home)
+    let shipped = ShippedRobot::by_path(&args.robot, &workspace::data_dir())
         .context("job-eval plans the shipped arms, whose homes it starts from")?;
+    let home = shipped.home;
+    // The arm whose controller's frames a native UR program is written in: the UR5e.
+    let ur_arm = emg_io::DriverProfile::for_shipped(shipped.name)
+        .filter(|profile| profile.has_ur_controller_frames())
+        .map(|profile| ur_programs::UrArm {
+            robot: planner.robot(),
+            robot_file: &args.robot,
+            profile,
+            checker: &checker,
+        });
     let with_home = |strokes: Vec<PathSpec>| {
         Job::from_strokes(strokes, planner.robot())
             .and_then(|job| job.with_home(home, planner.robot()))
@@ -233,15 +246,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
+    let mut ur_rows = Vec::new();
     for (name, job) in &jobs {
-        rows.push(evaluate(
+        let (row, ur_row) = evaluate(
             &planner,
             &timing,
             &checker,
             &robot_name,
-            name,
-            job,
-        )?);
+            (name, job),
+            ur_arm.as_ref(),
+        )?;
+        rows.push(row);
+        ur_rows.extend(ur_row);
         bar.inc(1);
     }
     bar.finish();
@@ -283,6 +299,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         one_thread_s,
         rows,
         large: large_rows,
+        ur_programs: ur_rows,
     };
     workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
     let failures = record
@@ -297,6 +314,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .filter(|r| r.checker_failure.is_some())
             .count();
     anyhow::ensure!(failures == 0, "{failures} programs fail the checker");
+    let unread: Vec<&str> = record
+        .ur_programs
+        .iter()
+        .filter_map(|r| r.failure.as_deref())
+        .collect();
+    anyhow::ensure!(
+        unread.is_empty(),
+        "{} UR programs do not read back:\n{}",
+        unread.len(),
+        unread.join("\n")
+    );
     Ok(())
 }
 
@@ -355,21 +383,26 @@ fn seams(tilt_deg: f64) -> Vec<PathSpec> {
         .collect()
 }
 
-/// `job` planned, checked and compared with the baseline.
+/// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e (`ur_arm`)
+/// its program exported both ways and read back.
 fn evaluate(
     planner: &Planner,
     timing: &MotionTiming,
     checker: &emg_verify::ReferenceModel,
     robot_name: &str,
-    name: &str,
-    job: &Job,
-) -> anyhow::Result<JobRow> {
+    (name, job): (&str, &Job),
+    ur_arm: Option<&ur_programs::UrArm<'_>>,
+) -> anyhow::Result<(JobRow, Option<ur_programs::UrRow>)> {
     let request = PlanRequest::default();
     let started = Instant::now();
     let planned = plan_job(planner, &request, job, timing, robot_name, &Unwatched);
     let planning_s = started.elapsed().as_secs_f64();
     let baseline = baseline(planner, timing, job);
     let total_m: f64 = job.strokes.iter().map(|s| s.length_m()).sum();
+    let ur_row = match (&planned, ur_arm) {
+        (Ok(program), Some(arm)) => Some(ur_programs::read_back(arm, name, program)),
+        _ => None,
+    };
     let row = match planned {
         Ok(program) => {
             let s = &program.summary;
@@ -432,7 +465,7 @@ fn evaluate(
             baseline_colliding_moves: baseline.colliding,
         },
     };
-    Ok(row)
+    Ok((row, ur_row))
 }
 
 /// The largest distance of a joint from its home value over `program`'s points (rad).
@@ -663,6 +696,9 @@ fn markdown(record: &Record) -> String {
     }
     if !record.large.is_empty() {
         md.push_str(&large::markdown(&record.large));
+    }
+    if !record.ur_programs.is_empty() {
+        md.push_str(&ur_programs::markdown(&record.ur_programs));
     }
     md
 }
