@@ -331,6 +331,27 @@ impl<'a> FreeSpace<'a> {
         true
     }
 
+    /// Whether the joint-space triangle with corners `a`, `w` and `b` is free all over: its
+    /// corners, and a grid over it whose cells are at most half a [`FreeSpace::edge_free`] step
+    /// across along each side (every point within half a step of a grid point, as along a
+    /// checked edge), the grid points with half [`MAX_POINT_TRAVEL_M`] more clearance. Any path
+    /// inside the triangle (a blend rounding the corner `w` between the edges `a`–`w` and
+    /// `w`–`b`, whatever its shape) is then free.
+    pub fn triangle_free(&self, a: &JointVector, w: &JointVector, b: &JointVector) -> bool {
+        let longer = (w - a).abs().sum().max((w - b).abs().sum());
+        let cells = (2.0 * longer / self.step_l1_rad).ceil().max(1.0) as usize;
+        let (towards_a, towards_b) = ((a - w) / cells as f64, (b - w) / cells as f64);
+        self.free(a)
+            && self.free(w)
+            && self.free(b)
+            && (0..=cells).all(|i| {
+                (0..=cells - i).all(|j| {
+                    let q = w + towards_a * i as f64 + towards_b * j as f64;
+                    self.free_by(&q, MAX_POINT_TRAVEL_M / 2.0)
+                })
+            })
+    }
+
     /// The configuration near `q` whose TCP lies at `target` ([`project_to_point`]), if the
     /// Newton steps converge to a free configuration joined to `q` by a free edge.
     pub fn reach_point(&self, q: &JointVector, target: &Vec3) -> Option<JointVector> {

@@ -6,8 +6,9 @@
 //! * The moves between strokes: `movej` through the plan's joint vertices (each edge of the
 //!   joint-space polyline checked free, [`FreeSpace::edge_free`]; where one is not, through the
 //!   plan's own samples thinned to free edges within [`MOVE_DEVIATION_RAD`] of the planned
-//!   path), at rest at each; the lift off a stroke's end and the set-down onto the next start as
-//!   `movel` where the tool keeps its orientation.
+//!   path), each corner blended where the joint-space triangle the blend cuts is free
+//!   ([`FreeSpace::triangle_free`]); the lift off a stroke's end and the set-down onto the next
+//!   start as `movel` where the tool keeps its orientation.
 //! * A stroke part: the tool switched on (its [`ToolOutput`], with its lead), a run of `movep`
 //!   through poses of the plan's configurations (`p[x, y, z, rx, ry, rz]` in the controller's
 //!   Base frame, the rotation vector of the TCP frame), each straight line between two targets
@@ -52,6 +53,17 @@ pub const MOVE_DEVIATION_RAD: f64 = 0.01;
 /// An edge off a stroke's end or onto a stroke's start is a straight `movel` where the tool
 /// turns less than this along it (rad).
 pub const LIFT_TURN_RAD: f64 = 0.01;
+/// A `movej` corner's blend radius (m, the TCP's distance from the corner where the blend
+/// begins and ends) is at most this share of the TCP's straight distance to either
+/// neighbouring vertex.
+pub const JOINT_BLEND_LENGTH_SHARE: f64 = 0.4;
+/// The largest blend radius of a `movej` corner (m).
+pub const MAX_JOINT_BLEND_M: f64 = 0.05;
+/// The smallest blend radius written (m): below it the corner is left unblended.
+pub const MIN_BLEND_M: f64 = 1e-4;
+/// Step (rad, the joint moving most) at which an edge is scanned for where the TCP comes
+/// within a blend radius of its end.
+const SCAN_STEP_RAD: f64 = 0.005;
 
 /// A native UR program and what it holds.
 #[derive(Clone, Debug)]
@@ -239,7 +251,7 @@ pub fn ur_program(
         (Some(home), _) => writer.program.text.push_str(&emg_io::home_check(home)),
         (None, Some(first)) => {
             writer.line("# the program's start, from wherever the arm stands: clear that way");
-            writer.movej(first);
+            writer.movej(first, 0.0);
         }
         (None, None) => {}
     }
@@ -323,10 +335,16 @@ impl Writer<'_> {
         self.line(&format!("{function}({}, {level})", self.tool.number));
     }
 
-    fn movej(&mut self, q: &JointVector) {
+    /// `movej` to `q`, blended at it by `radius` (m) where that is positive.
+    fn movej(&mut self, q: &JointVector, radius: f64) {
         let joints = emg_io::joint_list(self.robot.joints_of(q));
         let (a, v) = (self.joint_acceleration, self.joint_speed);
-        self.line(&format!("movej({joints}, a={a:.6}, v={v:.6})"));
+        let blend = if radius > 0.0 {
+            format!(", r={radius:.6}")
+        } else {
+            String::new()
+        };
+        self.line(&format!("movej({joints}, a={a:.6}, v={v:.6}{blend})"));
         self.program.movej += 1;
     }
 
@@ -359,14 +377,63 @@ impl Writer<'_> {
             thinned_joint_path(self.free, qs)
         };
         let edges = path.len().saturating_sub(1);
-        for (k, edge) in path.windows(2).enumerate() {
-            let at_surface = (off_stroke && k == 0) || (onto_stroke && k + 1 == edges);
-            if at_surface && self.turn(&edge[0], &edge[1]) < LIFT_TURN_RAD {
-                self.movel(&edge[1]);
-            } else {
-                self.movej(&edge[1]);
+        // Whether each edge is a straight lift or set-down (`movel`), else a joint move.
+        let straight: Vec<bool> = path
+            .windows(2)
+            .enumerate()
+            .map(|(k, edge)| {
+                let at_surface = (off_stroke && k == 0) || (onto_stroke && k + 1 == edges);
+                at_surface && self.turn(&edge[0], &edge[1]) < LIFT_TURN_RAD
+            })
+            .collect();
+        for k in 0..edges {
+            let target = &path[k + 1];
+            if straight[k] {
+                self.movel(target);
+                continue;
             }
+            // A corner between two joint moves is blended where the triangle it cuts is free.
+            let radius = match (straight.get(k + 1), path.get(k + 2)) {
+                (Some(false), Some(next)) => self.joint_blend_radius(&path[k], target, next),
+                _ => 0.0,
+            };
+            self.movej(target, radius);
         }
+    }
+
+    /// The blend radius (m) of the `movej` corner `w` between the joint-space edges from `a`
+    /// and to `b`: at most [`JOINT_BLEND_LENGTH_SHARE`] of the TCP's distance from `w` to either
+    /// and [`MAX_JOINT_BLEND_M`], halved until the joint-space triangle between where the TCP
+    /// comes within it of `w` on each edge ([`Writer::entering`]) and `w` is free
+    /// ([`FreeSpace::triangle_free`]): any blend the controller makes there keeps inside that
+    /// triangle. 0 (no blend) where no radius of at least [`MIN_BLEND_M`] is.
+    fn joint_blend_radius(&self, a: &JointVector, w: &JointVector, b: &JointVector) -> f64 {
+        let tcp = |q: &JointVector| self.robot.forward(q).tcp();
+        let corner = tcp(w);
+        let mut radius = (JOINT_BLEND_LENGTH_SHARE
+            * (tcp(a) - corner).norm().min((tcp(b) - corner).norm()))
+        .min(MAX_JOINT_BLEND_M);
+        while radius >= MIN_BLEND_M {
+            let (entry, exit) = (self.entering(a, w, radius), self.entering(b, w, radius));
+            if self.free.triangle_free(&entry, w, &exit) {
+                return radius;
+            }
+            radius /= 2.0;
+        }
+        0.0
+    }
+
+    /// The configuration on the joint-space edge from `from` to `w` one scan step
+    /// ([`SCAN_STEP_RAD`]) before the first one scanned whose TCP lies within `radius` of `w`'s:
+    /// at or before where a blend of that radius at `w` can begin.
+    fn entering(&self, from: &JointVector, w: &JointVector, radius: f64) -> JointVector {
+        let corner = self.robot.forward(w).tcp();
+        let steps = ((w - from).amax() / SCAN_STEP_RAD).ceil().max(1.0) as usize;
+        let at = |k: usize| from + (w - from) * (k as f64 / steps as f64);
+        let first = (0..=steps)
+            .find(|&k| (self.robot.forward(&at(k)).tcp() - corner).norm() <= radius)
+            .unwrap_or(steps);
+        at(first.saturating_sub(1))
     }
 
     /// The angle (rad) the tool turns from `a` to `b`.
