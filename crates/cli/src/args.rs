@@ -92,9 +92,15 @@ pub struct ImportArgs {
 /// Options of `emg check`.
 #[derive(Debug, Args)]
 pub struct CheckArgs {
-    /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json` or `<stem>.csv`.
+    /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json`, `<stem>.csv`, a job's
+    /// program (emg-job/3) or a URScript program exported from one for the UR5e (`.script`).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
+    /// A URScript program's job program (emg-job/3), which it is read back against. Default: the
+    /// `.json` of the script's name (`drawing.job.script` and `drawing.job-part1.script` →
+    /// `drawing.job.json`).
+    #[arg(long, value_name = "JOB")]
+    pub program: Option<PathBuf>,
     /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) or a robot file (URDF). Default: the
     /// file's `robot` field (a JSON file, or the --task-from file for a CSV), else `fr3`.
     #[arg(long, value_name = "NAME|URDF", value_parser = crate::robot::parse_robot)]

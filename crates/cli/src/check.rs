@@ -20,6 +20,9 @@ use emg_planner::MotionTiming;
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
 pub fn run_check(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
+    if file.extension().is_some_and(|e| e == "script") {
+        return crate::check_script::check_script(args, file);
+    }
     if let Some(job) = read_job_file(file)? {
         return check_job(args, file, &job);
     }
@@ -212,7 +215,7 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
 
 /// The robot of `robot_path` (with the chain's ends the options name) and its independent
 /// checker.
-fn robot_and_checker(args: &CheckArgs, robot_path: &Path) -> Result<(Robot, ReferenceModel)> {
+pub fn robot_and_checker(args: &CheckArgs, robot_path: &Path) -> Result<(Robot, ReferenceModel)> {
     let robot = crate::robot::load_robot(
         robot_path,
         args.base_link.as_deref(),

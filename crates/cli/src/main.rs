@@ -78,6 +78,7 @@ macro_rules! println {
 
 mod args;
 mod check;
+mod check_script;
 mod export;
 mod import;
 mod interrupt;

@@ -156,6 +156,28 @@ fn a_target_moved_by_a_millimetre_fails_the_reader() {
     read_back(&script, &plan).unwrap_or_else(|e| panic!("{e}"));
     let error = read_back(&edited, &plan).expect_err("a moved target");
     assert_eq!(error.line, line, "{error}");
+    // `emg check` does the same: the program beside its plan passes, the edited one (its plan
+    // named) is refused naming the line.
+    let written = tmp.path().join("house.script");
+    let passed = emg(&["check", written.to_str().expect("utf-8 path")]);
+    assert!(passed.status.success(), "{}", text(&passed.stderr));
+    assert!(
+        text(&passed.stdout).contains("native:"),
+        "{}",
+        text(&passed.stdout)
+    );
+    let moved_file = tmp.path().join("moved.script");
+    std::fs::write(&moved_file, &edited).expect("edited program written");
+    let plan_file = tmp.path().join("house.json");
+    let refused = emg(&[
+        "check",
+        moved_file.to_str().expect("utf-8 path"),
+        "--program",
+        plan_file.to_str().expect("utf-8 path"),
+    ]);
+    assert_eq!(refused.status.code(), Some(1));
+    let message = text(&refused.stderr);
+    assert!(message.contains(&format!("line {line}:")), "{message}");
 }
 
 /// `script` with line `line` (1-based) replaced by `with`.

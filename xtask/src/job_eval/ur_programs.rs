@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use emg_io::{DriverProfile, ExportFormat, ExportOptions, ExportRobot, ToolSwitching};
+use emg_io::{DriverProfile, ExportError, ExportFormat, ExportOptions, ExportRobot, ToolSwitching};
 use emg_job::JobFile;
 use emg_kinematics::Robot;
 use emg_ur_check::{NativeReport, ServojReport, read_native, read_servoj};
@@ -46,6 +46,10 @@ pub struct UrRow {
     pub servoj_programs: usize,
     /// See `servoj_programs`.
     pub servoj_targets: usize,
+    /// The longest stretch without rest (`servoj` targets) where it is more than one program
+    /// holds by default (2,500): the stream is then written as one program, which the
+    /// controller must run (`--max-servoj`); `None` where the default split fits.
+    pub servoj_over_limit: Option<usize>,
     /// Why a program was not written or not read back, naming it; `None` where both were.
     pub failure: Option<String>,
 }
@@ -79,6 +83,7 @@ pub fn read_back(arm: &UrArm<'_>, name: &str, file: &JobFile) -> UrRow {
         cartesian_moves: 0,
         servoj_programs: 0,
         servoj_targets: 0,
+        servoj_over_limit: None,
         failure: None,
     };
     match native(arm, file) {
@@ -96,9 +101,10 @@ pub fn read_back(arm: &UrArm<'_>, name: &str, file: &JobFile) -> UrRow {
         Err(why) => row.failure = Some(format!("{name}, native program: {why}")),
     }
     match servoj(arm, file) {
-        Ok(report) => {
+        Ok((report, over_limit)) => {
             row.servoj_programs = report.programs;
             row.servoj_targets = report.targets;
+            row.servoj_over_limit = over_limit;
         }
         Err(why) => {
             let why = format!("{name}, servoj programs: {why}");
@@ -124,11 +130,17 @@ fn native(arm: &UrArm<'_>, file: &JobFile) -> anyhow::Result<NativeReport> {
         anyhow::bail!("{} files, not one program", export.files.len());
     };
     let script = std::str::from_utf8(bytes)?;
-    Ok(read_native(script, file, arm.checker, true)?)
+    Ok(read_native(
+        script,
+        file,
+        arm.checker,
+        file.settings.tool_output.on_high,
+    )?)
 }
 
-/// The joint stream written and read back.
-fn servoj(arm: &UrArm<'_>, file: &JobFile) -> anyhow::Result<ServojReport> {
+/// The joint stream written and read back: at the default most `servoj` lines per program,
+/// else, where a stretch without rest is longer, as one program (with that stretch's length).
+fn servoj(arm: &UrArm<'_>, file: &JobFile) -> anyhow::Result<(ServojReport, Option<usize>)> {
     let reference = arm.robot_file.display().to_string();
     let (points, switches) = (file.points(), file.tool_switches());
     let output = file.settings.tool_output.to_string();
@@ -142,19 +154,29 @@ fn servoj(arm: &UrArm<'_>, file: &JobFile) -> anyhow::Result<ServojReport> {
         shipped: Some(arm.profile),
         kinematics: Some(arm.robot),
     };
-    let export = emg_io::export(
-        file.timed_points(&points, tool),
-        ExportFormat::UrScript,
-        Path::new("job.script"),
-        &robot,
-        &ExportOptions::default(),
-    )?;
+    let timed = file.timed_points(&points, tool);
+    let export_with = |max_servoj_lines: usize| {
+        emg_io::export(
+            timed,
+            ExportFormat::UrScript,
+            Path::new("job.script"),
+            &robot,
+            &ExportOptions {
+                max_servoj_lines,
+                ..ExportOptions::default()
+            },
+        )
+    };
+    let (export, over_limit) = match export_with(ExportOptions::default().max_servoj_lines) {
+        Err(ExportError::TooLong { lines, .. }) => (export_with(usize::MAX)?, Some(lines)),
+        written => (written?, None),
+    };
     let scripts = export
         .files
         .iter()
         .map(|(_, bytes)| std::str::from_utf8(bytes))
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(read_servoj(&scripts, file, arm.checker)?)
+    Ok((read_servoj(&scripts, file, arm.checker)?, over_limit))
 }
 
 /// The section of `jobs.md`: per program what was written and how it read back.
@@ -165,7 +187,9 @@ pub fn markdown(rows: &[UrRow]) -> String {
          Each program above exported both ways on the UR5e, in memory: the native program (`emg \
          job --export urscript`: `movej` between strokes, `movel` and blended `movep` along \
          them) and the joint stream (`--urscript servoj`: a target every 2 ms, at most 2,500 per \
-         program), both read back by the independent reader (`emg-ur-check`, which shares no \
+         program, split where the arm rests; where a stretch without rest is longer, one program, \
+         marked with that stretch's targets: a controller must run it with a higher \
+         `--max-servoj`), both read back by the independent reader (`emg-ur-check`, which shares no \
          code with the exporters) against the plan: the native moves interpolated as the \
          URScript manual defines them and followed by the UR5e's closed-form inverse kinematics, \
          every configuration checked by the checker; every `servoj` target the plan's sample at \
@@ -178,7 +202,7 @@ pub fn markdown(rows: &[UrRow]) -> String {
     );
     for r in rows {
         md.push_str(&format!(
-            "| {} | {} / {} / {} | {:.1} | {:.4} / {:.1} | {:.2} / {:.0} | {:.3} / {:.3} | {} | {} / {} | {} |\n",
+            "| {} | {} / {} / {} | {:.1} | {:.4} / {:.1} | {:.2} / {:.0} | {:.3} / {:.3} | {} | {} / {}{} | {} |\n",
             r.job,
             r.movej,
             r.movel,
@@ -193,6 +217,8 @@ pub fn markdown(rows: &[UrRow]) -> String {
             r.cartesian_moves,
             r.servoj_programs,
             r.servoj_targets,
+            r.servoj_over_limit
+                .map_or(String::new(), |lines| format!(" (one program: {lines} without rest)")),
             r.failure.as_deref().map_or("both", |_| "**no**"),
         ));
     }
