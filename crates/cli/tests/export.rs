@@ -103,21 +103,6 @@ fn nanoseconds(point: &Value) -> i64 {
     t["sec"].as_i64().unwrap() * 1_000_000_000 + t["nanosec"].as_i64().unwrap()
 }
 
-/// The quintic through (p, v, a) at both ends of `h` seconds, at `t` (written here from the
-/// boundary conditions, apart from the exporter's).
-fn quintic(start: [f64; 3], end: [f64; 3], h: f64, t: f64) -> f64 {
-    // Solve for c3..c5 from p(h), p'(h), p''(h).
-    let [p0, v0, a0] = start;
-    let [p1, v1, a1] = end;
-    let r0 = p1 - p0 - v0 * h - 0.5 * a0 * h * h;
-    let r1 = v1 - v0 - a0 * h;
-    let r2 = a1 - a0;
-    let c3 = (10.0 * r0 - 4.0 * r1 * h + 0.5 * r2 * h * h) / h.powi(3);
-    let c4 = (-15.0 * r0 + 7.0 * r1 * h - r2 * h * h) / h.powi(4);
-    let c5 = (6.0 * r0 - 3.0 * r1 * h + 0.5 * r2 * h * h) / h.powi(5);
-    p0 + v0 * t + 0.5 * a0 * t * t + c3 * t.powi(3) + c4 * t.powi(4) + c5 * t.powi(5)
-}
-
 #[test]
 fn ros2_mcap_holds_every_point_and_the_spline_stays_within_tolerance() {
     let dir = temp_dir("export-mcap");
@@ -189,7 +174,8 @@ fn ros2_mcap_holds_every_point_and_the_spline_stays_within_tolerance() {
             let q = numbers(&sample["positions"]);
             for (j, q) in q.iter().enumerate() {
                 let end = |k: usize| [kept[k][0][j], kept[k][1][j], kept[k][2][j]];
-                let s = quintic(end(window), end(window + 1), h, (t - t0) as f64 * 1e-9);
+                let s =
+                    emg_ur_check::quintic(end(window), end(window + 1), h, (t - t0) as f64 * 1e-9);
                 worst = worst.max((s - q).abs());
             }
         }

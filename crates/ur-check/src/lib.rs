@@ -31,8 +31,8 @@ pub use native::{
 };
 pub use script::{Form, Output, Program, Statement, parse_program};
 pub use servoj::{
-    ACCELERATION_SLACK, SERVO_PERIOD_S, ServojReport, TARGET_MATCH_RAD, TimedMotion, read_servoj,
-    read_servoj_motion,
+    ACCELERATION_SLACK, SERVO_PERIOD_S, ServojReport, TARGET_MATCH_RAD, TimedMotion, quintic,
+    read_servoj, read_servoj_motion,
 };
 pub use ur5e::{
     Branch, IkSolution, UR5E_A, UR5E_ALPHA, UR5E_D, checker_joints, checker_tcp,

@@ -135,6 +135,18 @@ impl Piece {
     }
 }
 
+/// Refuses a blend radius `radius` at a run's last target (line `line`): the run ends there, at
+/// rest.
+fn unblended_end(radius: f64, line: usize) -> Result<(), ReadError> {
+    if radius > 0.0 {
+        return fail(
+            line,
+            format!("a blend radius of {radius} m at a run's last target"),
+        );
+    }
+    Ok(())
+}
+
 /// The path of a run of `movep` targets (`targets`: each pose, its blend radius and its line)
 /// from `start`: straight lines between the targets, each corner with a radius `r > 0` replaced
 /// by the circular arc tangent to both lines `r` before and after the target. Each piece comes
@@ -147,12 +159,7 @@ pub fn movep_path(
     let Some(&(_, last_radius, last_line)) = targets.last() else {
         return Ok(pieces);
     };
-    if last_radius > 0.0 {
-        return fail(
-            last_line,
-            format!("a blend radius of {last_radius} m at a run's last target"),
-        );
-    }
+    unblended_end(last_radius, last_line)?;
     let corners: Vec<Pose> = std::iter::once(*start)
         .chain(targets.iter().map(|t| t.0))
         .collect();
@@ -347,12 +354,7 @@ pub fn movej_path(
     let Some(&(_, last_radius, last_line)) = targets.last() else {
         return Ok(pieces);
     };
-    if last_radius > 0.0 {
-        return fail(
-            last_line,
-            format!("a blend radius of {last_radius} m at a run's last target"),
-        );
-    }
+    unblended_end(last_radius, last_line)?;
     let corners: Vec<[f64; 6]> = std::iter::once(*start)
         .chain(targets.iter().map(|t| t.0))
         .collect();

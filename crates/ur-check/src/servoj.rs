@@ -150,8 +150,9 @@ fn nanoseconds(point: &JointTrajectoryPoint) -> i64 {
     i64::from(point.time_from_start.sec) * 1_000_000_000 + i64::from(point.time_from_start.nanosec)
 }
 
-/// The value at `t` (s) of the quintic through `(p, v, a)` at both ends of `h` seconds.
-fn quintic(start: [f64; 3], end: [f64; 3], h: f64, t: f64) -> f64 {
+/// The value at `t` (s) of the quintic through `(p, v, a)` at both ends of `h` seconds (what a
+/// controller interpolates between two timed points, ROS 2's trajectory controller too).
+pub fn quintic(start: [f64; 3], end: [f64; 3], h: f64, t: f64) -> f64 {
     let [p0, v0, a0] = start;
     let [p1, v1, a1] = end;
     // What the cubic, quartic and quintic terms must make up at `h`: position, velocity and
