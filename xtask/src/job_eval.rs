@@ -42,8 +42,8 @@ pub struct Args {
     #[arg(long, default_value_os_t = workspace::results_dir())]
     out_dir: PathBuf,
     /// Sizes of the large jobs (strokes of generated drawings, comma-separated), each planned
-    /// on all threads and on one; none with an empty list.
-    #[arg(long, value_delimiter = ',', default_value = "500,2000,10000")]
+    /// on all threads and on one; none with `--large` alone.
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "500,2000,10000")]
     large: Vec<usize>,
 }
 
