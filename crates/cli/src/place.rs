@@ -216,7 +216,24 @@ fn print_places(placement: &Placement) {
             place.duration_s
         );
     }
-    let place = &placement.best().scored.place;
+    let best = placement.best();
+    let place = &best.scored.place;
+    // A place on the region's edge that leaves some of the drawing undrawn may be bettered past
+    // that edge.
+    if best.drawn_m < best.total_m - emg_job::SAME_LENGTH_M {
+        for edge in placement.region.edges_of(place) {
+            println!(
+                "the best place is on the edge of --{} (its {}, {}): a larger range may draw more",
+                edge.range,
+                if edge.at_maximum {
+                    "maximum"
+                } else {
+                    "minimum"
+                },
+                edge.value
+            );
+        }
+    }
     let what = match placement.frame.moving {
         Moving::Part => "the part",
         Moving::Base => "the base",

@@ -149,6 +149,36 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let svg = std::fs::read_to_string(&map).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("planned places ranked"));
 
+    // A region too small to draw it whole: the chosen place lies on the edge of --x, and the
+    // user is told that a larger range may draw more.
+    let mut small = vec!["place", pencil.to_str().unwrap()];
+    small.extend(FAR);
+    let cramped = file("cramped.json");
+    small.extend([
+        "--x=-0.05,0",
+        "--y=0,0",
+        "--rotation=0,0",
+        "--positions",
+        "2",
+        "--rotations",
+        "1",
+        "--certify",
+        "1",
+        "--out",
+        &cramped,
+    ]);
+    let output = emg(&small);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    let (cramped_drawn, _) = drawn(&read_json(Path::new(&cramped)));
+    assert!(cramped_drawn < total - 1e-3, "{stdout}");
+    assert!(
+        stdout.contains("the best place is on the edge of --x (its ")
+            && stdout.contains("a larger range may draw more"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("edge of --y"), "{stdout}");
+
     // The exported job file plans the same program.
     let again = file("again.json");
     let output = emg(&["job", &export, "--out", &again]);

@@ -47,8 +47,8 @@ pub use order::merge::{Chain, merge_strokes};
 pub use order::{Ordering, Oriented, merge_and_order, order_strokes, order_strokes_counted};
 pub use page::{placement_map, viewer_page};
 pub use place::{
-    Certified, Moving, Place, PlaceError, PlaceFrame, PlaceSettings, Placement, Region, SAME_SCORE,
-    Score, Scored, place_job, place_score,
+    Certified, Moving, Place, PlaceError, PlaceFrame, PlaceSettings, Placement, Region, RegionEdge,
+    SAME_SCORE, Score, Scored, place_job, place_score,
 };
 pub use program::{
     JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, MAX_PROGRAM_S, Program, Segment,

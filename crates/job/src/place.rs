@@ -305,7 +305,47 @@ fn spread(range: [f64; 2], count: usize) -> Vec<f64> {
         .collect()
 }
 
+/// An end of one of the region's ranges that a place lies on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegionEdge {
+    /// The range: `x`, `y` or `rotation` (as the options name them).
+    pub range: &'static str,
+    /// Whether the place lies at its maximum (else its minimum).
+    pub at_maximum: bool,
+    /// The end's value (m, or degrees for the turn).
+    pub value: f64,
+}
+
 impl Region {
+    /// The ends of the region's ranges that `place` lies on: of each range wider than a point
+    /// (and, for the turn, narrower than a whole turn, which has no end), its minimum or
+    /// maximum where the place's value is it. A chosen place there may draw more past it.
+    pub fn edges_of(&self, place: &Place) -> Vec<RegionEdge> {
+        [
+            ("x", self.x_m, place.x_m),
+            ("y", self.y_m, place.y_m),
+            ("rotation", self.rotation_deg, place.rotation_deg),
+        ]
+        .into_iter()
+        .filter(|&(range, [low, high], _)| {
+            low < high && (range != "rotation" || high - low < 360.0)
+        })
+        .filter_map(|(range, [low, high], value)| {
+            let at = |end: f64| (value - end).abs() <= 1e-9 * (1.0 + end.abs());
+            let edge = |at_maximum, value| RegionEdge {
+                range,
+                at_maximum,
+                value,
+            };
+            match (at(low), at(high)) {
+                (true, _) => Some(edge(false, low)),
+                (_, true) => Some(edge(true, high)),
+                _ => None,
+            }
+        })
+        .collect()
+    }
+
     /// Checks every range.
     pub fn validate(&self) -> Result<(), PlaceError> {
         for (field, value) in [
@@ -617,4 +657,44 @@ fn best_first(scored: &[Scored]) -> Vec<Scored> {
             .then(b.depth_m.total_cmp(&a.depth_m))
     });
     ranked
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_place_on_a_ranges_end_is_named_with_that_end() {
+        let region = Region {
+            moving: Moving::Part,
+            x_m: [-0.1, 0.1],
+            y_m: [0.0, 0.0],
+            rotation_deg: [-180.0, 180.0],
+        };
+        let place = |x_m, y_m, rotation_deg| Place {
+            x_m,
+            y_m,
+            rotation_deg,
+        };
+        // A point range and a whole turn have no end; the middle of a range is no end.
+        assert!(region.edges_of(&place(0.0, 0.0, 180.0)).is_empty());
+        assert_eq!(
+            region.edges_of(&place(0.1, 0.0, 0.0)),
+            vec![RegionEdge {
+                range: "x",
+                at_maximum: true,
+                value: 0.1
+            }]
+        );
+        let turned = Region {
+            rotation_deg: [-30.0, 30.0],
+            ..region
+        };
+        let edges = turned.edges_of(&place(-0.1, 0.0, -30.0));
+        assert_eq!(edges.len(), 2);
+        assert!(
+            !edges[0].at_maximum && edges[1].range == "rotation",
+            "{edges:?}"
+        );
+    }
 }
