@@ -42,6 +42,7 @@ const REGION: Region = Region {
     moving: Moving::Part,
     x_m: [-0.2, 0.15],
     y_m: [-0.3, 0.3],
+    z_m: [0.0, 0.0],
     rotation_deg: [-90.0, 90.0],
 };
 

@@ -33,6 +33,10 @@ pub struct PlaceArgs {
     /// The shifts searched along y (the part's: normal × x; the base's own): MIN,MAX (m).
     #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.15,0.15")]
     pub y: [f64; 2],
+    /// The shifts searched along the normal (the part's toward the tool's side; the base's z,
+    /// up): MIN,MAX (m).
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-0.03,0.03")]
+    pub z: [f64; 2],
     /// The turns searched (the part's about its surface normal through its centre, the base's
     /// about its z axis): MIN,MAX (degrees).
     #[arg(long, value_name = "MIN,MAX", value_parser = parse_range, allow_hyphen_values = true, default_value = "-90,90")]
@@ -40,6 +44,9 @@ pub struct PlaceArgs {
     /// Grid positions along each of x and y.
     #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().positions)]
     pub positions: usize,
+    /// Grid heights along the normal.
+    #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().heights)]
+    pub heights: usize,
     /// Grid turns.
     #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().rotations)]
     pub rotations: usize,
@@ -118,10 +125,12 @@ pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
         moving: args.moving,
         x_m: args.x,
         y_m: args.y,
+        z_m: args.z,
         rotation_deg: args.rotation,
     };
     let settings = PlaceSettings {
         positions: args.positions,
+        heights: args.heights,
         rotations: args.rotations,
         certify: args.certify,
         ..PlaceSettings::default()
@@ -199,14 +208,17 @@ fn print_places(placement: &Placement) {
         placement.refined.len(),
         placement.certified.len()
     );
-    println!("rank  x (m)   y (m)   turn (°)  score  drawn (m)  of (m)  complete  program (s)");
+    println!(
+        "rank  x (m)   y (m)   z (m)   turn (°)  score  drawn (m)  of (m)  complete  program (s)"
+    );
     for (rank, place) in placement.certified.iter().enumerate() {
         let p = &place.scored.place;
         println!(
-            "{:>4}  {:>6.3}  {:>6.3}  {:>8.1}  {:>5.3}  {:>9.4}  {:>6.4}  {:>4} / {:<3}  {:>10.2}",
+            "{:>4}  {:>6.3}  {:>6.3}  {:>6.3}  {:>8.1}  {:>5.3}  {:>9.4}  {:>6.4}  {:>4} / {:<3}  {:>10.2}",
             rank + 1,
             p.x_m,
             p.y_m,
+            p.z_m,
             p.rotation_deg,
             place.scored.score,
             place.drawn_m,
@@ -241,8 +253,8 @@ fn print_places(placement: &Placement) {
     // In full (the shortest text that reads back to the same number): the place is reproduced
     // from what is printed.
     println!(
-        "chosen: {what} shifted ({}, {}) m, turned {}°",
-        place.x_m, place.y_m, place.rotation_deg
+        "chosen: {what} shifted ({}, {}, {}) m, turned {}°",
+        place.x_m, place.y_m, place.z_m, place.rotation_deg
     );
     let written = |t: &emg_job::Transform| {
         format!(

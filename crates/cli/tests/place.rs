@@ -128,7 +128,8 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     let output = emg(&place);
     assert!(output.status.success(), "{}", text(&output.stderr));
     let stdout = text(&output.stdout);
-    assert!(stdout.contains("screened 18 places"), "{stdout}");
+    // 3 × 3 positions, 3 heights along the normal, 2 turns.
+    assert!(stdout.contains("screened 54 places"), "{stdout}");
     // The transform printed is the one written, to the last bit.
     let printed = printed_transform(&stdout);
     let transform = &read_json(Path::new(&export))["transform"];
@@ -157,6 +158,7 @@ fn an_icon_out_of_reach_is_moved_to_where_it_is_drawn_whole() {
     small.extend([
         "--x=-0.05,0",
         "--y=0,0",
+        "--z=0,0",
         "--rotation=0,0",
         "--positions",
         "2",
@@ -270,7 +272,32 @@ fn wrong_regions_are_refused_and_nothing_is_written() {
     };
     refused(&["--x=0.2,-0.2"], "region field 'x_m'");
     refused(&["--rotation=10,nan"], "region field 'rotation_deg'");
+    refused(&["--z=0.1,-0.1"], "region field 'z_m'");
     refused(&["--y=0.1"], "is not MIN,MAX");
     // Two metres beyond the arm's reach.
     refused(&["--x=2,2.5"], "no place of the region lets the arm reach");
+}
+
+#[test]
+fn the_ur5e_house_is_placed_with_the_default_region_heights_included_and_drawn_whole() {
+    let dir = temp_dir("place-house");
+    let house = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/cases/house.svg");
+    let placed = dir.path().join("placed.json");
+    let output = emg(&[
+        "place",
+        house.to_str().unwrap(),
+        "--robot",
+        "ur5e",
+        "--out",
+        placed.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let stdout = text(&output.stdout);
+    // 10 × 10 positions, 3 heights 3 cm either side of the surface, 5 turns.
+    assert!(stdout.contains("screened 1500 places"), "{stdout}");
+    let (drawn_m, total_m) = drawn(&read_json(&placed));
+    assert!(
+        drawn_m >= 0.99 * total_m,
+        "{drawn_m} of {total_m} m:\n{stdout}"
+    );
 }

@@ -44,8 +44,9 @@ pub enum Moving {
     Base,
 }
 
-/// The places searched: the shift along the [`PlaceFrame`]'s axes (m) and the turn about its
-/// normal (degrees), each a closed range `[low, high]`, of the part or the base.
+/// The places searched: the shift along the [`PlaceFrame`]'s axes (m), its normal included, and
+/// the turn about its normal (degrees), each a closed range `[low, high]`, of the part or the
+/// base.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Region {
@@ -56,6 +57,10 @@ pub struct Region {
     pub x_m: [f64; 2],
     /// Shift along the frame's y axis (m).
     pub y_m: [f64; 2],
+    /// Shift along the frame's normal, toward the tool's side (m); [`Region::DEFAULT_Z_M`] where
+    /// absent.
+    #[serde(default = "Region::default_z_m")]
+    pub z_m: [f64; 2],
     /// Turn about the normal (degrees, counter-clockwise seen from the tool's side).
     pub rotation_deg: [f64; 2],
 }
@@ -65,6 +70,8 @@ pub struct Region {
 pub struct PlaceSettings {
     /// Grid positions along each of x and y.
     pub positions: usize,
+    /// Grid heights along the normal.
+    pub heights: usize,
     /// Grid turns.
     pub rotations: usize,
     /// Best screened places scored again by the full scan.
@@ -78,11 +85,12 @@ pub struct PlaceSettings {
 }
 
 impl Default for PlaceSettings {
-    /// 10 × 10 positions × 5 turns (500 places), the best 20 refined, the best 5 certified; the
-    /// screening scans every 2 cm with 8 restarts.
+    /// 10 × 10 positions × 3 heights × 5 turns (1,500 places), the best 20 refined, the best 5
+    /// certified; the screening scans every 2 cm with 8 restarts.
     fn default() -> Self {
         Self {
             positions: 10,
+            heights: 3,
             rotations: 5,
             refine: 20,
             certify: 5,
@@ -202,14 +210,16 @@ impl PlaceFrame {
     }
 
     /// The rigid motion that puts what moves at `place`: turned about the normal through the
-    /// centre, then shifted along x and y.
+    /// centre, then shifted along x, y and the normal.
     pub fn motion(&self, place: &Place) -> Isometry3<f64> {
         let centre = Vec3::from(self.centre);
         let turn = UnitQuaternion::from_rotation_matrix(&rotation_about(
             &Vec3::from(self.normal),
             place.rotation_deg.to_radians(),
         ));
-        let shift = Vec3::from(self.x) * place.x_m + Vec3::from(self.y) * place.y_m;
+        let shift = Vec3::from(self.x) * place.x_m
+            + Vec3::from(self.y) * place.y_m
+            + Vec3::from(self.normal) * place.z_m;
         Isometry3::from_parts(Translation3::from(centre + shift - turn * centre), turn)
     }
 }
@@ -221,6 +231,9 @@ pub struct Place {
     pub x_m: f64,
     /// Shift along y (m).
     pub y_m: f64,
+    /// Shift along the normal, toward the tool's side (m).
+    #[serde(default)]
+    pub z_m: f64,
     /// Turn about the normal (degrees).
     pub rotation_deg: f64,
 }
@@ -308,7 +321,7 @@ fn spread(range: [f64; 2], count: usize) -> Vec<f64> {
 /// An end of one of the region's ranges that a place lies on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RegionEdge {
-    /// The range: `x`, `y` or `rotation` (as the options name them).
+    /// The range: `x`, `y`, `z` or `rotation` (as the options name them).
     pub range: &'static str,
     /// Whether the place lies at its maximum (else its minimum).
     pub at_maximum: bool,
@@ -317,6 +330,14 @@ pub struct RegionEdge {
 }
 
 impl Region {
+    /// The shifts along the normal searched unless a region says (m): 3 cm either side, where a
+    /// part lowered or raised a little may draw more.
+    pub const DEFAULT_Z_M: [f64; 2] = [-0.03, 0.03];
+
+    fn default_z_m() -> [f64; 2] {
+        Self::DEFAULT_Z_M
+    }
+
     /// The ends of the region's ranges that `place` lies on: of each range wider than a point
     /// (and, for the turn, narrower than a whole turn, which has no end), its minimum or
     /// maximum where the place's value is it. A chosen place there may draw more past it.
@@ -324,6 +345,7 @@ impl Region {
         [
             ("x", self.x_m, place.x_m),
             ("y", self.y_m, place.y_m),
+            ("z", self.z_m, place.z_m),
             ("rotation", self.rotation_deg, place.rotation_deg),
         ]
         .into_iter()
@@ -351,6 +373,7 @@ impl Region {
         for (field, value) in [
             ("x_m", self.x_m),
             ("y_m", self.y_m),
+            ("z_m", self.z_m),
             ("rotation_deg", self.rotation_deg),
         ] {
             if !(value[0].is_finite() && value[1].is_finite() && value[0] <= value[1]) {
@@ -377,6 +400,7 @@ impl PlaceSettings {
         };
         for (field, value) in [
             ("positions", self.positions),
+            ("heights", self.heights),
             ("rotations", self.rotations),
             ("refine", self.refine),
             ("certify", self.certify),
@@ -488,22 +512,23 @@ pub fn place_job(
     let frame = PlaceFrame::of(job, region.moving);
     let xs = spread(region.x_m, settings.positions);
     let ys = spread(region.y_m, settings.positions);
+    let zs = spread(region.z_m, settings.heights);
     let turns = spread(region.rotation_deg, settings.rotations);
-    let grid: Vec<Place> = xs
-        .iter()
-        .flat_map(|&x_m| {
-            ys.iter().flat_map({
-                let turns = &turns;
-                move |&y_m| {
-                    turns.iter().map(move |&rotation_deg| Place {
+    let mut grid: Vec<Place> = Vec::with_capacity(xs.len() * ys.len() * zs.len() * turns.len());
+    for &x_m in &xs {
+        for &y_m in &ys {
+            for &z_m in &zs {
+                for &rotation_deg in &turns {
+                    grid.push(Place {
                         x_m,
                         y_m,
+                        z_m,
                         rotation_deg,
-                    })
+                    });
                 }
-            })
-        })
-        .collect();
+            }
+        }
+    }
     let full = planner.config().reach.clone();
     let coarse = ReachConfig {
         grid_m: settings.coarse_grid_m.max(full.grid_m),
@@ -543,17 +568,22 @@ pub fn place_job(
         .take(settings.refine)
         .map(|s| s.place)
         .collect();
+    let near_top = |delta: f64, values: &[f64], value: f64, range: [f64; 2]| {
+        (value + delta * step(values)).clamp(range[0], range[1])
+    };
     for dx in [-1.0, 0.0, 1.0] {
         for dy in [-1.0, 0.0, 1.0] {
-            for dr in [-1.0, 0.0, 1.0] {
-                let near = Place {
-                    x_m: (top.x_m + dx * step(&xs)).clamp(region.x_m[0], region.x_m[1]),
-                    y_m: (top.y_m + dy * step(&ys)).clamp(region.y_m[0], region.y_m[1]),
-                    rotation_deg: (top.rotation_deg + dr * step(&turns))
-                        .clamp(region.rotation_deg[0], region.rotation_deg[1]),
-                };
-                if !refine.contains(&near) {
-                    refine.push(near);
+            for dz in [-1.0, 0.0, 1.0] {
+                for dr in [-1.0, 0.0, 1.0] {
+                    let near = Place {
+                        x_m: near_top(dx, &xs, top.x_m, region.x_m),
+                        y_m: near_top(dy, &ys, top.y_m, region.y_m),
+                        z_m: near_top(dz, &zs, top.z_m, region.z_m),
+                        rotation_deg: near_top(dr, &turns, top.rotation_deg, region.rotation_deg),
+                    };
+                    if !refine.contains(&near) {
+                        refine.push(near);
+                    }
                 }
             }
         }
@@ -669,11 +699,13 @@ mod tests {
             moving: Moving::Part,
             x_m: [-0.1, 0.1],
             y_m: [0.0, 0.0],
+            z_m: [-0.03, 0.03],
             rotation_deg: [-180.0, 180.0],
         };
         let place = |x_m, y_m, rotation_deg| Place {
             x_m,
             y_m,
+            z_m: 0.0,
             rotation_deg,
         };
         // A point range and a whole turn have no end; the middle of a range is no end.

@@ -307,8 +307,8 @@ pub struct JobPlacement {
     score: emg_job::Score,
 }
 
-/// The region of `region`, a dict of `x_m`, `y_m` (shifts, m) and `rotation_deg` (turns), each
-/// `[low, high]`.
+/// The region of `region`, a dict of `x_m`, `y_m`, `z_m` (shifts, m; `z_m` by default
+/// [`emg_job::Region::DEFAULT_Z_M`]) and `rotation_deg` (turns), each `[low, high]`.
 fn read_region(py: Python<'_>, region: &Bound<'_, PyDict>) -> PyResult<emg_job::Region> {
     let text: String = py
         .import("json")?
@@ -428,10 +428,11 @@ impl JobPlacement {
     fn __repr__(&self) -> String {
         let best = self.placement.best();
         format!(
-            "JobPlacement({} places screened; chosen shift ({:.3}, {:.3}) m, turn {:.1}°: {:.4} m of {:.4} m drawn)",
+            "JobPlacement({} places screened; chosen shift ({:.3}, {:.3}, {:.3}) m, turn {:.1}°: {:.4} m of {:.4} m drawn)",
             self.placement.screened.len(),
             best.scored.place.x_m,
             best.scored.place.y_m,
+            best.scored.place.z_m,
             best.scored.place.rotation_deg,
             best.drawn_m,
             best.total_m

@@ -401,10 +401,11 @@ impl Planner {
     }
 
     /// Finds where to put a job's part (docs/placement.md): `job` and `placement` as for
-    /// `plan_job`; `region` a dict of `x_m`, `y_m` (shifts along the part's axes, m) and
+    /// `plan_job`; `region` a dict of `x_m`, `y_m` (shifts along the part's axes, m),
+    /// `z_m` (shifts along its normal toward the tool, default `[-0.03, 0.03]`, three heights) and
     /// `rotation_deg` (turns about its normal), each `[low, high]`, and `moving` (`"part"`, the
-    /// default, or `"base"`: the robot's base on its mount); `positions² × rotations`
-    /// places screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
+    /// default, or `"base"`: the robot's base on its mount); `positions² × 3 × rotations` places
+    /// screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
     /// the share of stroke points with an IK solution), the best `certify` planned as full jobs,
     /// each starting and ending at `home` as for `plan_job`. Returns a `JobPlacement`; a bad
     /// region, setting or home raises `InputError` naming it, a region the arm cannot reach

@@ -33,7 +33,7 @@ def test_the_pencil_is_moved_where_it_is_drawn_whole_as_emg_place_moves_it(tmp_p
     placement = elm.Planner("fr3").place_job(
         PENCIL, REGION, placement=FAR, positions=3, rotations=2, certify=2
     )
-    assert len(placement.screened) == 18
+    assert len(placement.screened) == 54  # 3 × 3 positions, 3 heights, 2 turns
     best = placement.certified[0]
     assert best["drawn_m"] == pytest.approx(best["total_m"], abs=1e-3)
     summary = placement.program.summary
@@ -76,4 +76,6 @@ def test_a_bad_region_is_refused_naming_the_field():
     with pytest.raises(elm.InputError, match="region field 'y_m'"):
         planner.place_job(PENCIL, {**REGION, "y_m": [0.1, -0.1]}, placement=FAR)
     with pytest.raises(elm.InputError, match="region"):
-        planner.place_job(PENCIL, {**REGION, "z_m": [0, 1]}, placement=FAR)
+        planner.place_job(PENCIL, {**REGION, "w_m": [0, 1]}, placement=FAR)
+    with pytest.raises(elm.InputError, match="region field 'z_m'"):
+        planner.place_job(PENCIL, {**REGION, "z_m": [0.1, -0.1]}, placement=FAR)
