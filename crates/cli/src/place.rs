@@ -62,7 +62,7 @@ pub struct PlaceArgs {
     /// are created, as for every file written).
     #[arg(long, value_name = "FILE", default_value = "placed.json")]
     pub out: PathBuf,
-    /// Also write the heat map (SVG): each position's best score over the turns, the certified
+    /// Also write the heat map (SVG): each position's best score over the heights and turns, the certified
     /// places ranked.
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
