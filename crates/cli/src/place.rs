@@ -62,8 +62,8 @@ pub struct PlaceArgs {
     /// are created, as for every file written).
     #[arg(long, value_name = "FILE", default_value = "placed.json")]
     pub out: PathBuf,
-    /// Also write the heat map (SVG): each position's best score over the heights and turns, the certified
-    /// places ranked.
+    /// Also write the heat map (SVG): each position's best score over the heights and turns,
+    /// the certified places ranked.
     #[arg(long, value_name = "FILE")]
     pub map: Option<PathBuf>,
     /// Also write the job at the chosen place: a job file (docs/jobs.md) with the strokes as

@@ -65,7 +65,8 @@ pub fn viewer_page(file: &JobFile, job: &Job, robot: &Robot, name: &str) -> Stri
 }
 
 /// The heat map of `placement`'s screened places ([`placement_map_svg`]): per position the
-/// best `score` over the heights and turns, the certified places ranked: what `emg place --map` writes.
+/// best `score` over the heights and turns, the certified places ranked: what `emg place
+/// --map` writes.
 pub fn placement_map(placement: &Placement, score: Score) -> String {
     let mut cells: Vec<MapCell> = Vec::new();
     for scored in &placement.screened {
