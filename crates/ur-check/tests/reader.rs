@@ -12,6 +12,8 @@ use emg_ur_check::{
     movej_path, movep_path, parse_program, read_servoj_motion, ur5e_flange, ur5e_inverse, wrap,
 };
 use emg_verify::ReferenceModel;
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// The shipped UR5e's checker, base `base_link`, tip `pen_tip`.
 fn ur5e_checker() -> ReferenceModel {
@@ -28,32 +30,16 @@ fn pen() -> Pose {
     Pose::from_ur(&[0.0, 0.0, 0.2034, 0.0, 0.0, 0.0])
 }
 
-/// A small deterministic stream of numbers in [0, 1) (xorshift64*).
-struct Stream(u64);
-
-impl Stream {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn between(&mut self, low: f64, high: f64) -> f64 {
-        low + (high - low) * self.next()
-    }
-}
-
 #[test]
 fn the_closed_form_inverse_gives_eight_configurations_of_the_checkers_pose() {
     let checker = ur5e_checker();
-    let mut stream = Stream(0x0005_E5EE_D0FA_11CE);
+    let mut stream = ChaCha8Rng::seed_from_u64(0x0005_E5EE_D0FA_11CE);
     let mut eight = 0;
     for _ in 0..200 {
         let q: [f64; 6] = std::array::from_fn(|i| {
             // The elbow within ±π, as its limits; the others over a full turn and more.
             let span = if i == 2 { 3.0 } else { 6.0 };
-            stream.between(-span, span)
+            stream.random_range(-span..span)
         });
         let tcp = checker_tcp(&checker, &q);
         // The DH chain and the pen are the checker's tip.
@@ -88,19 +74,19 @@ fn the_closed_form_inverse_gives_eight_configurations_of_the_checkers_pose() {
 
 #[test]
 fn rotation_vectors_round_trip_and_slerp_turns_evenly() {
-    let mut stream = Stream(0x0000_0A11_CE5E_ED00);
+    let mut stream = ChaCha8Rng::seed_from_u64(0x0000_0A11_CE5E_ED00);
     for k in 0..500 {
         let axis = Vec3::new(
-            stream.between(-1.0, 1.0),
-            stream.between(-1.0, 1.0),
-            stream.between(-1.0, 1.0),
+            stream.random_range(-1.0..1.0),
+            stream.random_range(-1.0..1.0),
+            stream.random_range(-1.0..1.0),
         )
         .normalize();
         // Angles across (0, π), the last ones within 1e-9 of a half turn.
         let angle = if k < 450 {
-            stream.between(1e-6, PI - 1e-3)
+            stream.random_range(1e-6..PI - 1e-3)
         } else {
-            PI - stream.between(0.0, 1e-9)
+            PI - stream.random_range(0.0..1e-9)
         };
         let rotation = Rotation::from_rotation_vector(&(axis * angle));
         let m = rotation.0;
@@ -131,9 +117,9 @@ fn rotation_vectors_round_trip_and_slerp_turns_evenly() {
         assert!(distance == 0.0 && turn < 1e-9);
         // Slerp from a random rotation to this one: the ends, and the turn shared evenly.
         let start = Rotation::from_rotation_vector(&Vec3::new(
-            stream.between(-1.0, 1.0),
-            stream.between(-1.0, 1.0),
-            stream.between(-1.0, 1.0),
+            stream.random_range(-1.0..1.0),
+            stream.random_range(-1.0..1.0),
+            stream.random_range(-1.0..1.0),
         ));
         let whole = start.angle_to(&rotation);
         assert!(start.slerp(&rotation, 0.0).angle_to(&start) < 1e-12);
