@@ -306,8 +306,11 @@ fn smooth_joints_stay_smooth_and_corners_stay_corners() {
         corners(&svg(r#"<circle cx="50" cy="50" r="40"/>"#), 15.0),
         vec![0]
     );
-    // Two lines meeting at 3° keep their corner: only a curve can bend to a common tangent.
+    // Two lines meeting at 3° are joined by an arc; at 20° they keep their corner.
     let text = svg(r#"<path d="M 0 0 L 50 0 L 100 2.6" fill="none" stroke="black"/>"#);
+    assert_eq!(corners(&text, 15.0), vec![0]);
+    assert_eq!(corners(&text, 2.0), vec![1]);
+    let text = svg(r#"<path d="M 0 0 L 50 0 L 100 18.2" fill="none" stroke="black"/>"#);
     assert_eq!(corners(&text, 15.0), vec![1]);
     // Smoothed joints stay within the tolerance (checked both ways).
     let options = SvgOptions {
@@ -317,6 +320,32 @@ fn smooth_joints_stay_smooth_and_corners_stay_corners() {
     for name in ICONS {
         read_and_check(&icon(name), &Placement::default(), &options);
     }
+}
+
+#[test]
+fn a_polyline_flattening_a_spiral_is_drawn_without_a_corner_within_the_tolerance() {
+    // 100 vertices, each turning 7.2°, 1.3 to 2.5 units apart: plotter and font exports are made so.
+    let points: Vec<String> = (0..100)
+        .map(|i| {
+            let (turn, radius) = (
+                f64::from(i) * 0.04 * std::f64::consts::PI,
+                10.0 + 0.1 * f64::from(i),
+            );
+            let (sin, cos) = libm::sincos(turn);
+            format!("{:.4},{:.4}", 50.0 + radius * cos, 50.0 + radius * sin)
+        })
+        .collect();
+    let text = svg(&format!(r#"<polyline points="{}"/>"#, points.join(" ")));
+    let drawing = read_and_check(&text, &Placement::default(), &SvgOptions::default());
+    let path = validated(&drawing.strokes[0]);
+    assert_eq!(path.corners_m().count(), 0);
+    // Below the turn asked for, every vertex stays a corner.
+    let options = SvgOptions {
+        smooth_join_deg: 5.0,
+        ..SvgOptions::default()
+    };
+    let drawing = read_and_check(&text, &Placement::default(), &options);
+    assert_eq!(validated(&drawing.strokes[0]).corners_m().count(), 98);
 }
 
 #[test]

@@ -41,9 +41,10 @@ pub struct SvgOptions {
     pub curve_tolerance_m: f64,
     /// Strokes shorter than this (m) are dropped and counted (default 1e-3: 1 mm).
     pub min_stroke_m: f64,
-    /// A joint where a curve meets a curve or a line turning by less than this (degrees,
-    /// default 15, at most 45) is made smooth: the path passes it without a corner, the curve
-    /// bent to the common tangent within the tolerance. Bending by `φ` takes about
+    /// A joint turning by less than this (degrees, default 15, at most 45) is made smooth: the
+    /// path passes it without a corner, a curve bent to the common tangent within the
+    /// tolerance, two lines joined by an arc tangent to both within the tolerance of their
+    /// corner. Bending by `φ` takes about
     /// `4 curve_tolerance_m / φ` of the curve, so a joint turning more than
     /// `curve_tolerance_m / 0.2 mm` radians stays a corner whatever this says (14° at the
     /// default tolerance, 0.3° at 1 µm). `0` keeps every corner of the drawing.
@@ -168,7 +169,10 @@ impl Drawing {
 ///   [`emg_control::CORNER_RAD`], so the tool passes without stopping. Joints that turn less
 ///   than [`SvgOptions::smooth_join_deg`] count as smooth (drawings round their coordinates:
 ///   icon sets leave joints they mean to be smooth a few degrees off): the curves there are
-///   fitted to one tangent, still within the tolerance; two lines keep their corner. A `Z` adds
+///   fitted to one tangent, still within the tolerance, and two lines are joined by the arc
+///   tangent to both that leaves their corner by at most the tolerance (taking at most half
+///   of each line), so a polyline that flattens a curve is drawn without a stop at every
+///   vertex. A `Z` adds
 ///   the closing line when it is at least the path format's shortest segment
 ///   ([`emg_control::MIN_SEGMENT_M`], 0.1 mm) long, and leaves a shorter gap open. Shorter
 ///   pieces are merged with a neighbour: where a drawing has features that fine (an `h.04`

@@ -5,7 +5,9 @@
 //! * Where two segments meet at a turn below the smooth-join threshold (drawings round their
 //!   coordinates, and leave joints they mean to be smooth a few degrees off), both take one
 //!   tangent (a line's, or their mean) and the curves are fitted to it within the tolerance, so
-//!   the path passes there without a corner. Two lines keep their corner.
+//!   the path passes there without a corner. Where two lines meet so, the corner is rounded by
+//!   the arc tangent to both that leaves it by at most the tolerance, taking at most half of
+//!   each line (a polyline that flattens a curve is drawn without a stop at every vertex).
 //! * A `Z` adds the closing line back to the start when it is at least [`MIN_SEGMENT_M`]
 //!   long; a shorter gap stays open (the stroke ends that close to its start).
 //! * An arc of radius under [`MIN_SEGMENT_M`] (a dot) becomes its chord; a piece shorter than
@@ -88,7 +90,63 @@ pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) ->
         out.push(without_dot(piece));
         settle(&mut out, tolerance);
     }
+    filleted(&out, tolerance, smooth_join_rad)
+}
+
+/// `pieces` with every corner where two lines meet turning by less than `limit` (rad) rounded
+/// by the arc tangent to both lines that leaves the corner by at most `tolerance`; each arc
+/// takes at most half of each line less half the shortest piece, so the lines keep a length.
+/// A corner whose arc would be shorter than the shortest piece keeps its corner.
+fn filleted(pieces: &[Piece], tolerance: f64, limit: f64) -> Vec<Piece> {
+    // How far each corner's arc reaches along its two lines (0 where it keeps its corner).
+    let mut reach = vec![0.0; pieces.len()];
+    for index in 1..pieces.len() {
+        if let (Piece::Line { .. }, Piece::Line { .. }) = (pieces[index - 1], pieces[index]) {
+            reach[index] = fillet_reach(&pieces[index - 1], &pieces[index], tolerance, limit);
+        }
+    }
+    let mut out = Vec::with_capacity(pieces.len());
+    for (index, piece) in pieces.iter().enumerate() {
+        let Piece::Line { from, to } = *piece else {
+            out.push(*piece);
+            continue;
+        };
+        let direction = (to - from).normalize();
+        let (head, tail) = (reach[index], reach.get(index + 1).copied().unwrap_or(0.0));
+        if head > 0.0 {
+            let previous = pieces[index - 1].start_tangent();
+            let start = from - previous * head;
+            out.extend(arc_from(start, previous, from + direction * head));
+        }
+        out.push(Piece::Line {
+            from: from + direction * head,
+            to: to - direction * tail,
+        });
+    }
     out
+}
+
+/// How far from the corner where `before` meets `after` (two lines) their rounding arc starts
+/// and ends along each (see [`filleted`]); 0 when the corner is kept.
+///
+/// An arc of radius `r` tangent to lines turning by `θ` reaches `r tan(θ/2)` along each and
+/// passes `r (1/cos(θ/2) − 1) = r 2 sin²(θ/4) / cos(θ/2)` inside the corner.
+fn fillet_reach(before: &Piece, after: &Piece, tolerance: f64, limit: f64) -> f64 {
+    let (a, b) = (before.end_tangent(), after.start_tangent());
+    let turn = libm::acos(a.dot(&b).clamp(-1.0, 1.0));
+    if turn <= emg_control::CORNER_RAD || turn >= limit {
+        return 0.0;
+    }
+    let half = 0.5 * turn;
+    let quarter_sin = libm::sin(0.5 * half);
+    let within_tolerance = tolerance * libm::cos(half) / (2.0 * quarter_sin * quarter_sin);
+    let room = 0.5 * (before.length().min(after.length()) - SHORTEST);
+    let reach = (within_tolerance * libm::tan(half)).min(room);
+    let radius = reach / libm::tan(half);
+    if radius * turn < SHORTEST {
+        return 0.0;
+    }
+    reach
 }
 
 /// The segments of `subpath` that have a length and a direction, with their own tangents.
