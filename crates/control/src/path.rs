@@ -191,6 +191,11 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// The ball around the piece's middle holding all of it ([`Ball::of_curve`]).
+    fn ball(&self) -> Ball {
+        Ball::of_curve(self.point(0.5 * self.length_m), self.length_m)
+    }
+
     /// The piece's start and end points, and for an arc its centre and the unit axis it turns
     /// about (right hand).
     pub fn outline(&self) -> (Vec3, Vec3, Option<(Vec3, Vec3)>) {
@@ -326,8 +331,12 @@ pub struct Path {
     spec: PathSpec,
     normal: Vec3,
     pieces: Vec<Piece>,
+    /// The ball around each piece ([`Piece::ball`]), for [`Path::locate`].
+    balls: Vec<Ball>,
     /// Balls bounding runs of the pieces, for [`Path::nearest_point`].
     tree: PieceTree,
+    /// Arc lengths of the corners (the starts of pieces with `corner_before`), increasing.
+    corners_m: Vec<f64>,
     length_m: f64,
     extent: PathExtent,
 }
@@ -424,15 +433,19 @@ impl Path {
         }
         let pieces = blended(shapes, normal, blend)?;
         let length_m = pieces.last().map_or(0.0, |p| p.start_s + p.length_m);
-        let balls: Vec<Ball> = pieces
+        let balls: Vec<Ball> = pieces.iter().map(Piece::ball).collect();
+        let corners_m = pieces
             .iter()
-            .map(|piece| Ball::of_curve(piece.point(0.5 * piece.length_m), piece.length_m))
+            .filter(|piece| piece.corner_before)
+            .map(|piece| piece.start_s)
             .collect();
         let mut path = Self {
             spec,
             normal,
             pieces,
             tree: PieceTree::new(&balls),
+            balls,
+            corners_m,
             length_m,
             extent: PathExtent {
                 behind_m: 0.0,
@@ -637,15 +650,13 @@ impl Path {
 
     /// The arc lengths (m) at which the tool must come to rest: the corners left unblended.
     pub fn corners_m(&self) -> impl Iterator<Item = f64> + '_ {
-        self.pieces
-            .iter()
-            .filter(|piece| piece.corner_before)
-            .map(|piece| piece.start_s)
+        self.corners_m.iter().copied()
     }
 
-    /// The first corner (m) after `s`, if any.
+    /// The first corner (m) after `s`, if any (by bisection).
     pub fn next_corner_m(&self, s: f64) -> Option<f64> {
-        self.corners_m().find(|&corner| corner > s)
+        let after = self.corners_m.partition_point(|&corner| corner <= s);
+        self.corners_m.get(after).copied()
     }
 
     /// The point at arc length `s` (clamped to the path).
@@ -681,7 +692,7 @@ impl Path {
     pub fn locate(&self, p: &Vec3, s_hint: f64, window_m: f64) -> Located {
         let low = (s_hint - window_m).max(0.0);
         let high = (s_hint + window_m).min(self.length_m);
-        self.nearest_between(p, low, high, |s| PROGRESS_CONTINUITY * (s - s_hint).abs())
+        self.nearest_between(p, s_hint, low, high)
             .unwrap_or_else(|| self.located(s_hint.clamp(0.0, self.length_m)))
     }
 
@@ -695,7 +706,7 @@ impl Path {
             &|| best.get().map_or(f64::INFINITY, |(_, cost)| cost),
             &mut |k| {
                 let mut found = best.get();
-                self.consider(&self.pieces[k], p, 0.0, self.length_m, &|_| 0.0, &mut found);
+                self.consider(k, p, 0.0, self.length_m, &|_| 0.0, &mut found);
                 best.set(found);
             },
         );
@@ -703,42 +714,68 @@ impl Path {
         self.located(s)
     }
 
-    /// The point at arc length within `[low, high]` whose distance from `p` plus `extra_cost`
-    /// of its arc length is least (of equal ones the first along the path); `None` where no
-    /// piece reaches into the range.
-    fn nearest_between(
-        &self,
-        p: &Vec3,
-        low: f64,
-        high: f64,
-        extra_cost: impl Fn(f64) -> f64,
-    ) -> Option<Located> {
+    /// The point at arc length within `[low, high]` whose distance from `p` plus
+    /// [`PROGRESS_CONTINUITY`] times its arc length's distance from `s_hint` is least (of equal
+    /// ones the first along the path); `None` where no piece reaches into the range.
+    ///
+    /// The pieces are visited outward from the one holding `s_hint`. A side ends where the
+    /// progress cost alone exceeds the least cost found, and a piece is passed over where its
+    /// bounding ball's distance from `p` plus its progress cost does: neither can hold a point
+    /// as cheap, so the result is that of looking at every piece in the range, at the cost of
+    /// the few near `s_hint`.
+    fn nearest_between(&self, p: &Vec3, s_hint: f64, low: f64, high: f64) -> Option<Located> {
+        let progress_cost = |s: f64| PROGRESS_CONTINUITY * (s - s_hint).abs();
         let mut best: Option<(f64, f64)> = None;
-        // The pieces lie in order along the path: those ending before `low` are skipped by
-        // bisection, and the search ends at the first starting after `high`.
-        let first = self
+        // Whether a point costing at least `cost` is dearer than the best (with a margin for
+        // the rounding of the bounds).
+        let dearer = |best: &Option<(f64, f64)>, cost: f64| {
+            best.is_some_and(|(_, least)| cost > least * (1.0 + 1e-9) + 1e-12)
+        };
+        let look = |k: usize, best: &mut Option<(f64, f64)>| {
+            let piece = &self.pieces[k];
+            let (start, end) = (piece.start_s, piece.start_s + piece.length_m);
+            let gap_cost = PROGRESS_CONTINUITY * (start - s_hint).max(s_hint - end).max(0.0);
+            if dearer(best, gap_cost) {
+                return false;
+            }
+            if !dearer(best, self.balls[k].distance_below(p) + gap_cost) {
+                self.consider(k, p, low, high, &progress_cost, best);
+            }
+            true
+        };
+        // The pieces lie in order along the path: the one holding `s_hint` is found by
+        // bisection, those after it go on until one starts after `high`, those before it
+        // until one ends before `low`.
+        let middle = self
             .pieces
-            .partition_point(|piece| piece.start_s + piece.length_m < low);
-        for piece in &self.pieces[first..] {
-            if piece.start_s > high {
+            .partition_point(|piece| piece.start_s <= s_hint.clamp(low, high))
+            .saturating_sub(1);
+        for k in middle..self.pieces.len() {
+            if self.pieces[k].start_s > high || !look(k, &mut best) {
                 break;
             }
-            self.consider(piece, p, low, high, &extra_cost, &mut best);
+        }
+        for k in (0..middle).rev() {
+            let piece = &self.pieces[k];
+            if piece.start_s + piece.length_m < low || !look(k, &mut best) {
+                break;
+            }
         }
         best.map(|(s, _)| self.located(s))
     }
 
-    /// Lowers `best` (arc length, cost) to `piece`'s point nearest `p` within `[low, high]`
+    /// Lowers `best` (arc length, cost) to piece `k`'s point nearest `p` within `[low, high]`
     /// where its distance plus `extra_cost` is less, or as much at a smaller arc length.
     fn consider(
         &self,
-        piece: &Piece,
+        k: usize,
         p: &Vec3,
         low: f64,
         high: f64,
         extra_cost: &dyn Fn(f64) -> f64,
         best: &mut Option<(f64, f64)>,
     ) {
+        let piece = &self.pieces[k];
         // On a closed circle the nearest angle is also one turn further or back, and a
         // point just before the start is just before the end: the ends are candidates too.
         let turn = match piece.shape {
@@ -751,10 +788,29 @@ impl Path {
                 continue;
             }
             let s = (piece.start_s + sigma).clamp(low, high);
-            let cost = (self.point_at(s) - p).norm() + extra_cost(s);
+            let cost = (self.point_near(k, s) - p).norm() + extra_cost(s);
             if best.is_none_or(|(best_s, c)| cost < c || (cost == c && s < best_s)) {
                 *best = Some((s, cost));
             }
+        }
+    }
+
+    /// [`Path::point_at`] of an `s` on the path that is likely held by piece `k` or begins the
+    /// next: taken from the piece [`Path::piece_at`] would find where it is one of those two,
+    /// which saves the bisection.
+    fn point_near(&self, k: usize, s: f64) -> Vec3 {
+        let start_of = |j: usize| {
+            self.pieces
+                .get(j)
+                .map_or(f64::INFINITY, |piece| piece.start_s)
+        };
+        if s <= self.length_m
+            && let Some(j) = (k..k + 2).find(|&j| (start_of(j)..start_of(j + 1)).contains(&s))
+        {
+            let piece = &self.pieces[j];
+            piece.point((s - piece.start_s).min(piece.length_m))
+        } else {
+            self.point_at(s)
         }
     }
 

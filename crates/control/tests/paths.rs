@@ -382,6 +382,53 @@ fn a_tcp_is_located_near_where_it_was_last() {
 }
 
 #[test]
+fn a_tcp_on_a_path_of_many_pieces_is_located_at_the_least_cost_in_the_window() {
+    use rand::{RngExt, SeedableRng};
+    // A spiral of 2,000 short lines, 0.35 mm apart, each joint rounded by a blend arc.
+    let (centre, n) = (Vec3::new(0.45, 0.0, 0.25), Vec3::z());
+    let at = |i: usize| {
+        let (turn, radius) = (i as f64 * 0.02, 0.01 + 1e-5 * i as f64);
+        centre + Vec3::new(radius * libm::cos(turn), radius * libm::sin(turn), 0.0)
+    };
+    let segments = (1..2000).map(|i| line(at(i))).collect();
+    let path = Path::new(spec(at(0), n, 1e-3, segments)).unwrap();
+    let window = emg_control::TRACKING_WINDOW_M;
+    let cost = |p: &Vec3, hint: f64, s: f64| {
+        (path.point_at(s) - p).norm() + emg_control::PROGRESS_CONTINUITY * (s - hint).abs()
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..100 {
+        let hint = rng.random_range(0.0..path.length_m());
+        let near = hint + rng.random_range(-0.02..0.02);
+        let offset = Vec3::new(
+            rng.random_range(-2e-3..2e-3),
+            rng.random_range(-2e-3..2e-3),
+            rng.random_range(-1e-3..1e-3),
+        );
+        let p = path.point_at(near) + offset;
+        let located = path.locate(&p, hint, window);
+        let found = cost(&p, hint, located.s);
+        // No point of the window, sampled every 10 µm, costs less (each piece offers its point
+        // nearest `p` and its ends, which miss the least cost by about PROGRESS_CONTINUITY² / 2
+        // of the distance).
+        let (low, high) = (
+            (hint - window).max(0.0),
+            (hint + window).min(path.length_m()),
+        );
+        let samples = ((high - low) / 1e-5) as usize;
+        for k in 0..=samples {
+            let s = low + (high - low) * k as f64 / samples as f64;
+            assert!(
+                found <= cost(&p, hint, s) + 1e-4 * found + 1e-12,
+                "located {} (cost {found}) but {s} costs {}",
+                located.s,
+                cost(&p, hint, s)
+            );
+        }
+    }
+}
+
+#[test]
 fn a_malformed_path_is_refused_naming_its_field() {
     let (p, n) = (Vec3::new(0.4, 0.0, 0.3), Vec3::z());
     let refused = |spec: PathSpec| match Path::new(spec) {

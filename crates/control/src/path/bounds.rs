@@ -44,7 +44,7 @@ impl Ball {
     }
 
     /// A lower bound on the distance from `p` to every point in the ball.
-    fn distance_below(&self, p: &Vec3) -> f64 {
+    pub(super) fn distance_below(&self, p: &Vec3) -> f64 {
         ((p - self.centre).norm() - self.radius).max(0.0)
     }
 }
