@@ -41,7 +41,7 @@ pub struct StrokePlan {
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
 /// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by
 /// `settings.min_gain_m`, up to `settings.max_parts` searches; [`Stopped`] where `watch` asks
-/// to stop before a search.
+/// to stop (asked before each search and between a search's rollouts).
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,
@@ -72,13 +72,19 @@ pub fn plan_stroke(
             .stretch(from_s, length)
             .and_then(|stretch| Task::on_path(planner.robot(), stretch, None).ok())
             .and_then(|task| {
-                let planned = planner.plan(&task, request).ok()?;
+                let planned = planner
+                    .plan_until(&task, request, &|| watch.stop_requested())
+                    .ok()?;
                 Some(StrokePart {
                     from_s,
                     task,
                     trajectory: planned.trajectory,
                 })
             });
+        // A search ended by the stop request is not the search's plan: nothing of it is kept.
+        if watch.stop_requested() {
+            return Err(Stopped);
+        }
         let gained = part
             .as_ref()
             .filter(|part| {

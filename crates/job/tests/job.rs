@@ -163,3 +163,65 @@ fn wrong_jobs_are_refused_naming_what_is_wrong() {
         "{failure}"
     );
 }
+
+/// A watch that counts how often it is asked to stop and asks to from its `stop_from`-th
+/// question on (never with `usize::MAX`).
+struct Counting {
+    asked: std::sync::atomic::AtomicUsize,
+    stop_from: usize,
+}
+
+impl emg_job::Watch for Counting {
+    fn progress(&self, _stage: &str, _done: usize, _total: usize) {}
+
+    fn stop_requested(&self) -> bool {
+        let asked = self.asked.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1;
+        asked >= self.stop_from
+    }
+}
+
+#[test]
+fn a_stop_is_asked_for_between_a_searchs_rollouts_and_ends_the_job_at_once() {
+    let (planner, timing, _, file) = common::setup("fr3");
+    // A line running out of the arm's reach: its search spends its whole budget.
+    let job = Job::from_json(
+        "job.json",
+        r#"{"version": 1, "strokes": [{"version": 1, "start": [0.45, 0, 0.25], "normal": [0, 0, -1],
+            "segments": [{"line": {"to": [1.2, 0, 0.25]}}]}]}"#,
+        planner.robot(),
+    )
+    .expect("a valid job");
+    let plan = |watch: &Counting| {
+        plan_job(
+            &planner,
+            &PlanRequest::default(),
+            &job,
+            &timing,
+            &file.display().to_string(),
+            watch,
+        )
+    };
+    let never = Counting {
+        asked: 0.into(),
+        stop_from: usize::MAX,
+    };
+    let program = plan(&never).expect("planned");
+    // One stroke: asked before its searches and while connecting only a handful of times;
+    // every further question came from inside a search.
+    let asked = never.asked.into_inner();
+    assert!(
+        asked > 4 * (program.summary.searches + 2),
+        "asked {asked} times in {} searches",
+        program.summary.searches
+    );
+    // Asked to stop in the middle of the first search, the job stops there.
+    let midway = Counting {
+        asked: 0.into(),
+        stop_from: 3,
+    };
+    assert!(matches!(
+        plan(&midway),
+        Err(emg_job::JobPlanError::Stopped(_))
+    ));
+    assert!(midway.asked.into_inner() <= 6);
+}

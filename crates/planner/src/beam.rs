@@ -102,7 +102,8 @@ struct Proposal {
 
 /// Beam search along `task` from every valid configuration of `starts` (module
 /// documentation), `controller` the search's classical controller; returns the longest motion
-/// found (`None` when no start holds every constraint) and the control steps evaluated.
+/// found (`None` when no start holds every constraint) and the control steps evaluated. It
+/// ends early, with what it has, once `stop` (asked every depth) returns true.
 pub(crate) fn beam_search(
     robot: &Robot,
     task: &Task,
@@ -110,6 +111,7 @@ pub(crate) fn beam_search(
     starts: &[JointVector],
     controller: &mut ClassicalController,
     limits: BeamLimits,
+    stop: &dyn Fn() -> bool,
 ) -> (Option<BeamPlan>, u64) {
     let mut beam = Beam {
         spent: 0,
@@ -126,7 +128,11 @@ pub(crate) fn beam_search(
     );
     let actions = null_actions(robot.dof() - 3);
     let mut depth = 0usize;
-    while !members.is_empty() && beam.spent < limits.budget_steps && !beam.arrived(limits) {
+    while !members.is_empty()
+        && beam.spent < limits.budget_steps
+        && !beam.arrived(limits)
+        && !stop()
+    {
         if depth.is_multiple_of(ROLLOUT_EVERY) {
             for member in members.iter().take(ROLLOUTS) {
                 let trajectory = continue_rollout(member.episode.clone(), controller);

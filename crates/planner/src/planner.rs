@@ -164,6 +164,18 @@ impl Planner {
     /// from that seed through the shared rollout loop; for [`PlannerKind::Search`], that
     /// rollout comes first and many other starts are tried within the configured step budget.
     pub fn plan(&self, task: &Task, request: &PlanRequest) -> Result<Plan, PlanError> {
+        self.plan_until(task, request, &|| false)
+    }
+
+    /// [`Planner::plan`], with the search ending early once `stop` returns true (asked between
+    /// its rollouts): what it returns then is the longest rollout found so far, for a caller
+    /// that has stopped wanting the plan to discard.
+    pub fn plan_until(
+        &self,
+        task: &Task,
+        request: &PlanRequest,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Plan, PlanError> {
         let executor = self.config.executor();
         let mut controller =
             Executor::new(request.controller, self.models.policy.as_ref(), &executor)?;
@@ -193,6 +205,7 @@ impl Planner {
                 reach: &self.config.reach,
                 seeder: self.models.seeder.as_ref(),
                 config: &self.config.search,
+                stop,
             };
             let (seed, trajectory) = search(&context, task, seed, controller, &reach);
             reach.witness(&trajectory);

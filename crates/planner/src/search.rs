@@ -341,6 +341,9 @@ pub(crate) struct SearchContext<'a> {
     pub reach: &'a ReachConfig,
     pub seeder: Option<&'a DpSeeder>,
     pub config: &'a SearchConfig,
+    /// Asked between rollouts whether the one who asked for the plan wants it no more: once it
+    /// says so, the search ends with the longest rollout it has.
+    pub stop: &'a (dyn Fn() -> bool + Sync),
 }
 
 /// An action a rollout issued, and who chose it.
@@ -442,9 +445,10 @@ impl<'a> Search<'a> {
 }
 
 impl Search<'_> {
-    /// Whether the search is over: its budget spent, or its longest rollout long enough.
+    /// Whether the search is over: its budget spent, its longest rollout long enough, or its
+    /// plan no longer wanted.
     fn done(&self) -> bool {
-        self.spent >= self.budget || self.arrived()
+        self.spent >= self.budget || self.arrived() || (self.context.stop)()
     }
 
     /// Whether the longest rollout has got far enough that nothing is left to find.
@@ -738,6 +742,7 @@ impl Search<'_> {
             &configurations,
             &mut controller,
             limits,
+            context.stop,
         );
         self.spent += spent;
         if let Some(plan) = plan {
