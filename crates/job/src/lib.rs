@@ -33,6 +33,7 @@ pub mod watch;
 use std::collections::VecDeque;
 use std::time::Instant;
 
+use emg_control::Path;
 use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
@@ -131,7 +132,7 @@ pub fn plan_job(
     let dof = robot.dof();
     let strokes = job.strokes.len();
     watch.progress("ordering", 0, strokes);
-    let ordering = merge_and_order(
+    let mut ordering = merge_and_order(
         &job.strokes,
         settings.order,
         planner.config().rollout.constraints.line_tolerance_m,
@@ -153,17 +154,26 @@ pub fn plan_job(
         .with_config(on_part)
         .expect("the planner's configuration with obstacles added is valid");
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let plans: Vec<StrokePlan> = ordering
+    let planned: Vec<(Oriented, StrokePlan)> = ordering
         .sequence
         .par_iter()
-        .map(|oriented| {
+        .map(|&oriented| {
             let path = oriented.path(&drawn);
             let plan = plan_stroke(&on_part, request, &path, 0.0, settings, watch)?;
+            let planned = match settings.order {
+                Order::Shortest => the_way_drawing_more((oriented, plan), &drawn, |path| {
+                    plan_stroke(&on_part, request, path, 0.0, settings, watch)
+                })?,
+                Order::Given => (oriented, plan),
+            };
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             watch.progress("planning", finished, ordering.sequence.len());
-            Ok(plan)
+            Ok(planned)
         })
         .collect::<Result<_, Stopped>>()?;
+    let (sequence, plans): (Vec<Oriented>, Vec<StrokePlan>) = planned.into_iter().unzip();
+    ordering.sequence = sequence;
+    ordering.travel_m = ordering.travel_between(&drawn);
     let connector = Connector {
         free: &free,
         timing,
@@ -756,6 +766,36 @@ impl Connector<'_> {
             task: part.task.clone(),
             trajectory: planned.trajectory,
         })
+    }
+}
+
+/// The stroke `planned` drawn the way that draws more: where its plan leaves some of it
+/// undrawn and it may be reversed, it is planned the other way too (`plan`), and that way is
+/// taken where it draws more by [`SAME_LENGTH_M`] or more; the searches of both are counted.
+fn the_way_drawing_more(
+    planned: (Oriented, StrokePlan),
+    drawn: &[Path],
+    plan: impl Fn(&Path) -> Result<StrokePlan, Stopped>,
+) -> Result<(Oriented, StrokePlan), Stopped> {
+    let (oriented, mut first) = planned;
+    let whole = first.path.length_m() - SAME_LENGTH_M;
+    let other = Oriented {
+        reversed: !oriented.reversed,
+        ..oriented
+    };
+    let Some(path) = (first.planned_m() < whole)
+        .then(|| drawn[oriented.stroke].reversed().map(|_| other.path(drawn)))
+        .flatten()
+    else {
+        return Ok((oriented, first));
+    };
+    let mut second = plan(&path)?;
+    if second.planned_m() >= first.planned_m() + SAME_LENGTH_M {
+        second.searches += first.searches;
+        Ok((other, second))
+    } else {
+        first.searches += second.searches;
+        Ok((oriented, first))
     }
 }
 

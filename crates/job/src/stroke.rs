@@ -37,6 +37,20 @@ pub struct StrokePlan {
     pub searches: usize,
 }
 
+impl StrokePlan {
+    /// The length of the stroke its parts cover as planned, from where each starts to where it
+    /// reaches, overlaps counted once (m).
+    pub fn planned_m(&self) -> f64 {
+        let mut reached = f64::NEG_INFINITY;
+        let mut covered = 0.0;
+        for part in &self.parts {
+            covered += (part.reached_s() - part.from_s.max(reached)).max(0.0);
+            reached = reached.max(part.reached_s());
+        }
+        covered
+    }
+}
+
 /// Plans `path` with `planner` as `request` asks (the search): from `start_s` along it, then
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
 /// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by

@@ -225,3 +225,61 @@ fn a_stop_is_asked_for_between_a_searchs_rollouts_and_ends_the_job_at_once() {
     ));
     assert!(midway.asked.into_inner() <= 6);
 }
+
+#[test]
+fn each_stroke_is_drawn_the_way_that_draws_more() {
+    // The signature near the edge of the FR3's reach: its long stroke drawn from its end draws
+    // a tenth of what it draws from its start, the way the order stage would draw it for a
+    // shorter travel.
+    let (planner, timing, _, file) = common::setup("fr3");
+    let robot = planner.robot();
+    let placement = Placement {
+        origin_m: [0.6, 0.5, 0.05],
+        width_m: Some(0.4),
+        ..Placement::default()
+    };
+    let job = icon_job(robot, "signature", &placement);
+    let drawn = |job: &Job| -> Vec<f64> {
+        let program = common::plan(&planner, &timing, &file, job);
+        assert!(
+            program
+                .ordering
+                .drawn
+                .iter()
+                .all(|chain| chain.0.len() == 1)
+        );
+        let mut drawn = vec![0.0; job.strokes.len()];
+        for report in &program.strokes {
+            drawn[report.stroke] = report.drawn_m;
+        }
+        drawn
+    };
+    let mut given = job.clone();
+    given.settings.order = emg_job::Order::Given;
+    let mut reversed = given.clone();
+    reversed.strokes = job
+        .strokes
+        .iter()
+        .map(|path| path.reversed().expect("reversible"))
+        .collect();
+    let (chosen, forward, backward) = (drawn(&job), drawn(&given), drawn(&reversed));
+    for k in 0..job.strokes.len() {
+        assert!(
+            chosen[k] >= forward[k].max(backward[k]) - emg_job::SAME_LENGTH_M,
+            "stroke {k}: {} m drawn, {} m forward, {} m backward",
+            chosen[k],
+            forward[k],
+            backward[k]
+        );
+    }
+    let (whole, better) = (
+        job.strokes.iter().map(|p| p.length_m()).sum::<f64>(),
+        (0..job.strokes.len())
+            .map(|k| forward[k].max(backward[k]))
+            .sum::<f64>(),
+    );
+    assert!(
+        backward.iter().sum::<f64>() < 0.5 * better && chosen.iter().sum::<f64>() >= 0.99 * whole,
+        "{forward:?} {backward:?} {chosen:?} of {whole}"
+    );
+}
