@@ -298,15 +298,31 @@ pub fn print_summary(file: &emg_job::JobFile) {
     );
     for stroke in file.strokes.iter().filter(|r| !r.unreached.is_empty()) {
         for (stretch, at) in stroke.unreached.iter().zip(&stroke.unreached_at) {
-            println!(
-                "  stroke {}: {:.4} m out of reach from {:.4} m along it, at ({:.3}, {:.3}, {:.3})",
-                stroke.stroke,
-                stretch.to_s - stretch.from_s,
-                stretch.from_s,
-                at[0],
-                at[1],
-                at[2]
-            );
+            // Past where the searches were spent, the stroke was not searched.
+            let unsearched = stroke
+                .unsearched_from_s
+                .map_or(stretch.to_s, |s| s.clamp(stretch.from_s, stretch.to_s));
+            if unsearched > stretch.from_s {
+                println!(
+                    "  stroke {}: {:.4} m out of reach from {:.4} m along it, at ({:.3}, {:.3}, {:.3})",
+                    stroke.stroke,
+                    unsearched - stretch.from_s,
+                    stretch.from_s,
+                    at[0],
+                    at[1],
+                    at[2]
+                );
+            }
+            if unsearched < stretch.to_s {
+                println!(
+                    "  stroke {}: {:.4} m from {:.4} m along it not searched: its {} searches \
+                     (settings.max_parts) were spent",
+                    stroke.stroke,
+                    stretch.to_s - unsearched,
+                    unsearched,
+                    file.settings.max_parts
+                );
+            }
         }
     }
     if file.home.is_none() {

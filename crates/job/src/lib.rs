@@ -195,6 +195,7 @@ pub fn plan_job(
         let mut covered = Vec::new();
         let mut queue: VecDeque<StrokePart> = plan.parts.iter().cloned().collect();
         let mut rest_plans = 0;
+        let mut unsearched_from_s = plan.unsearched_from_s;
         let mut next_index = 0;
         while let Some(planned) = queue.pop_front() {
             let index = next_index;
@@ -252,6 +253,7 @@ pub fn plan_job(
                 let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
                 let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings, watch)?;
                 searches += rest.searches;
+                unsearched_from_s = rest.unsearched_from_s;
                 queue = rest.parts.into();
             }
             let Placed {
@@ -312,6 +314,7 @@ pub fn plan_job(
                 .collect(),
             unreached: coverage.undrawn,
             parts_left_out,
+            unsearched_from_s,
         });
     }
     let last = retreat.map(|[_, above]| above).or(program.last());

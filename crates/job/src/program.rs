@@ -88,6 +88,11 @@ pub struct StrokeReport {
     /// Parts planned but left out, each with why: no safe move reached them or they could not
     /// be timed.
     pub parts_left_out: Vec<String>,
+    /// Where the stroke's searches (`settings.max_parts`) were spent before its end (arc length
+    /// along the stroke as drawn, m): what is unreached past it was not searched, not found out
+    /// of reach. Absent where the searches reached the end.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unsearched_from_s: Option<f64>,
 }
 
 /// The job's totals.

@@ -91,7 +91,8 @@ pub struct JobSettings {
     /// A stroke is resumed while a part gains at least this much (m); where a part gains
     /// less, the stretch is skipped by this much and reported out of reach.
     pub min_gain_m: f64,
-    /// Parts a stroke is planned in at most (reconfigurations plus one).
+    /// Searches a stroke is planned with at most; a part that stopped only at the rollout's
+    /// step cap (the arm still able to go on) is not counted.
     pub max_parts: usize,
     /// Seed of the sampling planner of the free moves.
     pub seed: u64,

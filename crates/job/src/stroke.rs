@@ -35,6 +35,10 @@ pub struct StrokePlan {
     pub parts: Vec<StrokePart>,
     /// Searches run (parts planned, those that gained nothing included).
     pub searches: usize,
+    /// Where along the stroke the searches stopped because `settings.max_parts` of them were
+    /// spent before its end: past it the stroke was not searched. `None` where they reached
+    /// the end.
+    pub unsearched_from_s: Option<f64>,
 }
 
 impl StrokePlan {
@@ -54,8 +58,9 @@ impl StrokePlan {
 /// Plans `path` with `planner` as `request` asks (the search): from `start_s` along it, then
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
 /// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by
-/// `settings.min_gain_m`, up to `settings.max_parts` searches; [`Stopped`] where `watch` asks
-/// to stop (asked before each search and between a search's rollouts).
+/// `settings.min_gain_m`, up to `settings.max_parts` searches (a part that stopped only at the
+/// rollout's step cap, the arm still able to go on, is not counted); [`Stopped`] where `watch`
+/// asks to stop (asked before each search and between a search's rollouts).
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,
@@ -69,10 +74,22 @@ pub fn plan_stroke(
         path: path.clone(),
         parts: Vec::new(),
         searches: 0,
+        unsearched_from_s: None,
     };
     // How far the stroke is drawn or given up.
     let mut done = start_s;
-    while done < length - 2.0 * ARRIVAL_M && plan.searches < settings.max_parts {
+    // The searches counted against `settings.max_parts`.
+    let mut counted = 0;
+    // How far along the stroke a search looks: twice what one rollout can draw at most (its
+    // step cap at the commanded speed), so a long stroke is not scanned beyond any use.
+    let rollout = &planner.config().rollout;
+    let searched_m = 2.0 * rollout.max_steps as f64 * rollout.dt_s * rollout.speed_m_per_s;
+    let unfinished = |done: f64| done < length - 2.0 * ARRIVAL_M;
+    while unfinished(done) {
+        if counted == settings.max_parts {
+            plan.unsearched_from_s = Some(done);
+            break;
+        }
         if watch.stop_requested() {
             return Err(Stopped);
         }
@@ -83,7 +100,7 @@ pub fn plan_stroke(
             (done - settings.overlap_m).max(0.0)
         };
         let part = path
-            .stretch(from_s, length)
+            .stretch(from_s, length.min(from_s + searched_m))
             .and_then(|stretch| Task::on_path(planner.robot(), stretch, None).ok())
             .and_then(|task| {
                 let planned = planner
@@ -111,9 +128,15 @@ pub fn plan_stroke(
         match part {
             Some(part) if gained >= settings.min_gain_m || completes(&part, length) => {
                 done = part.reached_s();
+                if part.trajectory.termination != Termination::StepCap {
+                    counted += 1;
+                }
                 plan.parts.push(part);
             }
-            _ => done = (done + settings.min_gain_m).min(length),
+            _ => {
+                counted += 1;
+                done = (done + settings.min_gain_m).min(length);
+            }
         }
     }
     Ok(plan)

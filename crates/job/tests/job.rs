@@ -283,3 +283,40 @@ fn each_stroke_is_drawn_the_way_that_draws_more() {
         "{forward:?} {backward:?} {chosen:?} of {whole}"
     );
 }
+
+#[test]
+fn a_stroke_longer_than_one_rollout_is_drawn_whole_and_what_is_not_searched_is_said() {
+    let (planner, timing, _, file) = common::setup("fr3");
+    let robot = planner.robot();
+    // 28 turns round a circle 5 cm across (8.8 m): more than one rollout draws (5 m at its
+    // step cap), with one counted search; parts that stop only at the step cap are not counted.
+    let turn = r#"{"arc": {"centre": [0.45, 0, 0.25], "sweep_deg": 360}}"#;
+    let coil = format!(
+        r#"{{"version": 1, "settings": {{"max_parts": 1}}, "strokes": [{{"version": 1,
+            "start": [0.5, 0, 0.25], "normal": [0, 0, -1], "segments": [{}]}}]}}"#,
+        vec![turn; 28].join(", ")
+    );
+    let job = Job::from_json("coil.json", &coil, robot).expect("a valid job");
+    let program = common::plan(&planner, &timing, &file, &job);
+    let report = &program.strokes[0];
+    assert!(report.parts >= 2, "{} parts", report.parts);
+    assert!(report.drawn_m >= report.length_m - 1e-3, "{report:?}");
+    assert_eq!(report.unsearched_from_s, None);
+    // A line running out of reach, one search: what lies past where it stopped was not
+    // searched, and the program says so.
+    let line = r#"{"version": 1, "settings": {"max_parts": 1}, "strokes": [{"version": 1,
+        "start": [0.45, 0, 0.25], "normal": [0, 0, -1], "segments": [{"line": {"to": [1.2, 0, 0.25]}}]}]}"#;
+    let job = Job::from_json("line.json", line, robot).expect("a valid job");
+    let program = common::plan(&planner, &timing, &file, &job);
+    let report = &program.strokes[0];
+    let unsearched = report.unsearched_from_s.expect("the search was spent");
+    assert!(
+        (unsearched - report.drawn_m).abs() < 0.01,
+        "{unsearched} {}",
+        report.drawn_m
+    );
+    assert_eq!(
+        report.unreached.last().map(|u| u.to_s),
+        Some(report.length_m)
+    );
+}
