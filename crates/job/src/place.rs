@@ -4,8 +4,10 @@
 //! [`PlaceFrame`], [`Moving`]); the places of a [`Region`] are
 //!
 //! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
-//!    (the part under the strokes kept off, as the job plans), Σ min(bound, length) / Σ length,
-//!    from a coarse scan ([`PlaceSettings::coarse_grid_m`], fewer restarts);
+//!    (the part under the strokes kept off, as the job plans; in the shortest order the better
+//!    of its two ways' bounds, as the job draws a short stroke the way that covers more),
+//!    Σ min(bound, length) / Σ length, from a coarse scan ([`PlaceSettings::coarse_grid_m`],
+//!    fewer restarts);
 //! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
 //!    round the best one, scored again by the full scan;
 //! 3. **certified**: the best [`PlaceSettings::certify`] planned as full jobs ([`plan_job`]) and
@@ -23,7 +25,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::free_space::{job_part, with_part};
 use crate::program::JobFile;
-use crate::spec::{Job, JobError, Transform};
+use crate::spec::{Job, JobError, Order, Transform};
 use crate::watch::{Stopped, StopsWith, Watch};
 use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
 
@@ -474,7 +476,19 @@ pub fn place_score(
         };
         match score {
             Score::Bound => {
-                let bound = reach(robot, &task, &constraints, config, &[]).reachable_m;
+                let bound_of =
+                    |task: &Task| reach(robot, task, &constraints, config, &[]).reachable_m;
+                let mut bound = bound_of(&task);
+                // In the shortest order a stroke left short is drawn the way that covers more
+                // (`plan_job`): it scores the better of its two ways' bounds.
+                if bound < stroke.length_m() && moved.settings.order == Order::Shortest {
+                    let reversed = stroke
+                        .reversed()
+                        .and_then(|path| Task::on_path(robot, path, None).ok());
+                    if let Some(task) = reversed {
+                        bound = bound.max(bound_of(&task));
+                    }
+                }
                 reached += bound.min(stroke.length_m());
                 total += stroke.length_m();
             }
