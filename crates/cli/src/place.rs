@@ -50,7 +50,8 @@ pub struct PlaceArgs {
     /// Grid turns.
     #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().rotations)]
     pub rotations: usize,
-    /// Best refined places planned as full jobs.
+    /// Best refined places planned as full jobs at least; the next ones too while one scores
+    /// above the share the best planned place draws.
     #[arg(long, value_name = "N", default_value_t = PlaceSettings::default().certify)]
     pub certify: usize,
     /// What screens a place: `bound` (default: each stroke's reachability bound, how far one

@@ -10,7 +10,9 @@
 //!    fewer restarts);
 //! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
 //!    round the best one, scored again by the full scan;
-//! 3. **certified**: the best [`PlaceSettings::certify`] planned as full jobs ([`plan_job`]) and
+//! 3. **certified**: the best [`PlaceSettings::certify`] planned as full jobs ([`plan_job`]),
+//!    then the next ones while a place's score exceeds the share drawn at the best planned place
+//!    (the score bounds the share drawn: no refined place left unplanned could draw more), and
 //!    ranked by pen-down length drawn, then by the program's duration.
 //!
 //! Every score and plan is deterministic and independent of the number of threads; ties keep
@@ -32,6 +34,10 @@ use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
 /// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
 /// first.
 pub const SAME_SCORE: f64 = 1e-3;
+
+/// How far a refined place's score must exceed the share drawn at the best planned place for
+/// the place to be planned too, past the first [`PlaceSettings::certify`]: one ranking step.
+const SCORE_MARGIN: f64 = SAME_SCORE;
 
 /// What a placement moves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -78,7 +84,10 @@ pub struct PlaceSettings {
     pub rotations: usize,
     /// Best screened places scored again by the full scan.
     pub refine: usize,
-    /// Best refined places planned as full jobs.
+    /// Best refined places planned as full jobs at least; the next ones are planned too while
+    /// a place's score exceeds the share drawn at the best planned so far (by more than
+    /// [`SAME_SCORE`]), so no refined place left unplanned scores above what the chosen one
+    /// draws.
     pub certify: usize,
     /// Grid spacing of the screening's scan along each stroke (m).
     pub coarse_grid_m: f64,
@@ -603,10 +612,18 @@ pub fn place_job(
         }
     }
     let refined = best_first(&scored("refine", &refine, &full)?);
-    let mut certified = Vec::new();
+    let mut certified: Vec<Certified> = Vec::new();
     let mut first_failure = None;
-    let candidates: Vec<Scored> = refined.iter().take(settings.certify).copied().collect();
-    for (index, candidate) in candidates.iter().enumerate() {
+    for (index, candidate) in refined.iter().enumerate() {
+        // Past the first `settings.certify`, a place is planned while its score (at least the
+        // share the job draws there, `crates/job/tests/place.rs`) could beat the most drawn.
+        let most_drawn = certified
+            .iter()
+            .map(|c| c.drawn_m / c.total_m.max(f64::MIN_POSITIVE))
+            .fold(0.0, f64::max);
+        if index >= settings.certify && candidate.score <= most_drawn + SCORE_MARGIN {
+            break;
+        }
         let motion = frame.job_motion(&candidate.place);
         let moved = job.moved(&motion)?;
         let total_m = moved.strokes.iter().map(|s| s.length_m()).sum();
@@ -626,7 +643,7 @@ pub fn place_job(
         if let Err(JobPlanError::Stopped(stopped)) = planned {
             return Err(stopped.into());
         }
-        watch.progress("certify", index + 1, candidates.len());
+        watch.progress("certify", index + 1, settings.certify.max(index + 1));
         certified.push(match planned {
             Ok(program) => Certified {
                 scored: *candidate,

@@ -1,7 +1,8 @@
 //! The placement screen against what the job draws: near the edge of the FR3's reach, where
 //! the signature's long stroke drawn from one end draws a tenth of what it draws from the
 //! other, the screened score of every place of a small grid is at least the share the job
-//! planned there draws.
+//! planned there draws; and places are planned until no refined place left unplanned scores
+//! above what the chosen one draws.
 
 mod common;
 
@@ -9,8 +10,9 @@ use emg_io::Placement as SvgPlacement;
 use emg_job::{Moving, PlaceSettings, Region, Score, Unwatched, place_job};
 use emg_planner::PlanRequest;
 
-#[test]
-fn the_screened_score_bounds_the_share_drawn_at_every_place() {
+/// The signature 0.4 m wide near the edge of the FR3's reach placed over a 3 × 3 grid of shifts
+/// `x_m` along x (and 0 to 0.2 m along y) with `certify` places planned at least.
+fn placed(x_m: [f64; 2], certify: usize) -> (emg_job::Placement, f64) {
     let (planner, timing, _, file) = common::setup("fr3");
     let robot = planner.robot();
     let svg = common::workspace().join("crates/io/tests/data/icons/signature.svg");
@@ -22,18 +24,17 @@ fn the_screened_score_bounds_the_share_drawn_at_every_place() {
     let job = common::drawing(robot, &svg, &placement);
     let region = Region {
         moving: Moving::Part,
-        x_m: [-0.1, 0.2],
+        x_m,
         y_m: [0.0, 0.2],
         z_m: [0.0, 0.0],
         rotation_deg: [0.0, 0.0],
     };
-    // Every screened place refined and certified.
     let settings = PlaceSettings {
         positions: 3,
         heights: 1,
         rotations: 1,
         refine: 9,
-        certify: 9 + 8,
+        certify,
         ..PlaceSettings::default()
     };
     let found = place_job(
@@ -51,6 +52,13 @@ fn the_screened_score_bounds_the_share_drawn_at_every_place() {
     // The bound is found on a scan of grid points: a motion may go on up to one step past the
     // last of them on each stroke.
     let slack = job.strokes.len() as f64 * planner.config().reach.grid_m;
+    (found, slack)
+}
+
+#[test]
+fn the_screened_score_bounds_the_share_drawn_at_every_place() {
+    // Every screened place refined, and every refined place planned.
+    let (found, slack) = placed([-0.1, 0.2], 9 + 8);
     let mut partial = 0;
     for certified in &found.certified {
         let drawn = certified.drawn_m / certified.total_m;
@@ -64,4 +72,29 @@ fn the_screened_score_bounds_the_share_drawn_at_every_place() {
     }
     assert!(found.certified.len() >= 9);
     assert!(partial >= 2, "{partial} places draw part of the job");
+}
+
+#[test]
+fn places_are_planned_until_none_left_scores_above_the_chosen_one() {
+    // Farther out, where the first place planned draws a quarter of the job and others score
+    // more than that.
+    let (found, _) = placed([0.3, 0.45], 1);
+    let chosen = &found.certified[0];
+    let drawn = chosen.drawn_m / chosen.total_m;
+    assert!(
+        found.certified.len() > 1,
+        "only the first place was planned"
+    );
+    for refined in &found.refined {
+        let planned = found
+            .certified
+            .iter()
+            .any(|c| c.scored.place == refined.place);
+        assert!(
+            planned || refined.score <= drawn + emg_job::SAME_SCORE,
+            "{:?} scores {:.3} above the chosen place's {drawn:.3} and was not planned",
+            refined.place,
+            refined.score
+        );
+    }
 }
