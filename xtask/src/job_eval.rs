@@ -571,7 +571,10 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
         drawn_m += part_coverage(
             planner.robot(),
             task,
-            0.0,
+            emg_job::OnStroke {
+                from_s: 0.0,
+                backward: false,
+            },
             timed.samples.iter().map(|sample| &sample.q),
         )
         .length_m();

@@ -78,14 +78,45 @@ impl Coverage {
     }
 }
 
+/// Where a stroke part's task lies on its stroke: it starts `from_s` along the stroke and runs
+/// toward the stroke's end, or back toward its start where `backward` (a part drawn from the
+/// stroke's other end).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OnStroke {
+    /// Arc length along the stroke where the task starts (m).
+    pub from_s: f64,
+    /// Whether the task runs back toward the stroke's start.
+    pub backward: bool,
+}
+
+impl OnStroke {
+    /// The arc length along the stroke of the point `s` along the task (m).
+    pub fn stroke_s(&self, s: f64) -> f64 {
+        if self.backward {
+            self.from_s - s
+        } else {
+            self.from_s + s
+        }
+    }
+
+    /// The stretch of the stroke between the task's progress `least` and `greatest`.
+    pub fn stretch(&self, least: f64, greatest: f64) -> Stretch {
+        let (a, b) = (self.stroke_s(least), self.stroke_s(greatest));
+        Stretch {
+            from_s: a.min(b),
+            to_s: a.max(b),
+        }
+    }
+}
+
 /// The stretch of its stroke that the configurations `samples` of a stroke part cover, the
-/// part's task starting `from_s` along the stroke: the TCP's progress along the task followed
-/// from its start (as the planners follow it, [`Task::along`]), from its least to its greatest,
-/// shifted by `from_s`.
+/// part's task lying `on` the stroke: the TCP's progress along the task followed from its start
+/// (as the planners follow it, [`Task::along`]), from its least to its greatest, mapped onto
+/// the stroke.
 pub fn part_coverage<'a>(
     robot: &Robot,
     task: &Task,
-    from_s: f64,
+    on: OnStroke,
     samples: impl IntoIterator<Item = &'a JointVector>,
 ) -> Stretch {
     let mut s = 0.0_f64;
@@ -95,10 +126,7 @@ pub fn part_coverage<'a>(
         least = least.min(s);
         greatest = greatest.max(s);
     }
-    Stretch {
-        from_s: from_s + least.min(greatest),
-        to_s: from_s + greatest.max(least),
-    }
+    on.stretch(least.min(greatest), greatest.max(least))
 }
 
 #[cfg(test)]

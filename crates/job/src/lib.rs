@@ -41,7 +41,7 @@ use emg_planner::{
 use emg_timing::{DynamicLimits, least_move_s, time_blended_move};
 use rayon::prelude::*;
 
-pub use claims::{COVERAGE_SLACK_M, Coverage, Stretch, part_coverage};
+pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use motion::Motion;
 pub use order::merge::{Chain, merge_strokes};
@@ -56,7 +56,7 @@ pub use program::{
     SegmentKind, StrokeReport,
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
-pub use stroke::{StrokePart, StrokePlan, plan_stroke};
+pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke};
 pub use tool_output::{OutputBank, ToolOutput};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 pub use watch::{Stopped, StopsWith, Unwatched, Watch};
@@ -161,9 +161,14 @@ pub fn plan_job(
             let path = oriented.path(&drawn);
             let plan = plan_stroke(&on_part, request, &path, 0.0, settings, watch)?;
             let planned = match settings.order {
-                Order::Shortest => the_way_drawing_more((oriented, plan), &drawn, |path| {
-                    plan_stroke(&on_part, request, path, 0.0, settings, watch)
-                })?,
+                Order::Shortest => {
+                    let (oriented, plan) =
+                        the_way_drawing_more((oriented, plan), &drawn, |path| {
+                            plan_stroke(&on_part, request, path, 0.0, settings, watch)
+                        })?;
+                    let plan = finish_from_the_end(&on_part, request, plan, settings, watch)?;
+                    (oriented, plan)
+                }
                 Order::Given => (oriented, plan),
             };
             let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -246,7 +251,8 @@ pub fn plan_job(
             };
             // A stand-in that draws less than the planned part leaves the rest of the stroke
             // to be planned again from where it ends.
-            if part.reached_s() < planned.reached_s() - SAME_LENGTH_M
+            if !planned.backward
+                && part.trajectory.path_length_m < planned.trajectory.path_length_m - SAME_LENGTH_M
                 && rest_plans < settings.max_parts
             {
                 rest_plans += 1;
@@ -254,7 +260,9 @@ pub fn plan_job(
                 let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings, watch)?;
                 searches += rest.searches;
                 unsearched_from_s = rest.unsearched_from_s;
-                queue = rest.parts.into();
+                // The parts from the stroke's other end still follow.
+                let backward: Vec<StrokePart> = queue.drain(..).filter(|p| p.backward).collect();
+                queue = rest.parts.into_iter().chain(backward).collect();
             }
             let Placed {
                 timed,
@@ -282,6 +290,7 @@ pub fn plan_job(
                     stroke: oriented.stroke,
                     part: index,
                     from_s: part.from_s,
+                    backward: part.backward,
                 },
                 &timed.definition,
                 &timed.samples,
@@ -291,7 +300,7 @@ pub fn plan_job(
             let stretch = part_coverage(
                 robot,
                 &part.task,
-                part.from_s,
+                part.on_stroke(),
                 timed.samples.iter().map(|sample| &sample.q),
             );
             least.add_stroke(above_start, start, end, stretch.length_m());
@@ -457,8 +466,9 @@ fn ranked(
     from: Option<&JointVector>,
     limits: &DynamicLimits,
 ) -> Vec<StrokePart> {
-    let reach = planned.reached_s();
-    let as_far = |part: &StrokePart| part.reached_s() >= reach - SAME_LENGTH_M;
+    // Every candidate starts where the searched part does: the longer draws further.
+    let reach = planned.trajectory.path_length_m;
+    let as_far = |part: &StrokePart| part.trajectory.path_length_m >= reach - SAME_LENGTH_M;
     let time_from = |part: &StrokePart| {
         from.map_or(0.0, |from| {
             least_move_s(from, &part.trajectory.steps[0].q, limits)
@@ -468,7 +478,10 @@ fn ranked(
     candidates.sort_by(|a, b| {
         as_far(b).cmp(&as_far(a)).then_with(|| match as_far(a) {
             true => time_from(a).total_cmp(&time_from(b)),
-            false => b.reached_s().total_cmp(&a.reached_s()),
+            false => b
+                .trajectory
+                .path_length_m
+                .total_cmp(&a.trajectory.path_length_m),
         })
     });
     candidates
@@ -766,6 +779,7 @@ impl Connector<'_> {
         let planned = planner.plan(&part.task, &rollout).ok()?;
         (planned.trajectory.steps.len() > 1).then(|| StrokePart {
             from_s: part.from_s,
+            backward: part.backward,
             task: part.task.clone(),
             trajectory: planned.trajectory,
         })

@@ -4,8 +4,8 @@
 //! [`PlaceFrame`], [`Moving`]); the places of a [`Region`] are
 //!
 //! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
-//!    (the part under the strokes kept off, as the job plans; in the shortest order the better
-//!    of its two ways' bounds, as the job draws a short stroke the way that covers more),
+//!    (the part under the strokes kept off, as the job plans; in the shortest order the sum
+//!    of its two ways' bounds, as the job draws a short stroke from both ends),
 //!    Σ min(bound, length) / Σ length, from a coarse scan ([`PlaceSettings::coarse_grid_m`],
 //!    fewer restarts);
 //! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
@@ -488,14 +488,14 @@ pub fn place_score(
                 let bound_of =
                     |task: &Task| reach(robot, task, &constraints, config, &[]).reachable_m;
                 let mut bound = bound_of(&task);
-                // In the shortest order a stroke left short is drawn the way that covers more
-                // (`plan_job`): it scores the better of its two ways' bounds.
+                // In the shortest order a stroke left short is drawn from both ends (`plan_job`):
+                // it scores what one motion from each end could reach.
                 if bound < stroke.length_m() && moved.settings.order == Order::Shortest {
                     let reversed = stroke
                         .reversed()
                         .and_then(|path| Task::on_path(robot, path, None).ok());
                     if let Some(task) = reversed {
-                        bound = bound.max(bound_of(&task));
+                        bound += bound_of(&task);
                     }
                 }
                 reached += bound.min(stroke.length_m());

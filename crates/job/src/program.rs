@@ -27,7 +27,7 @@ pub const MAX_PROGRAM_S: f64 = 2e9;
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum SegmentKind {
     /// Pen down along part `part` of stroke `stroke` (the job's index), whose task is the
-    /// stroke's stretch from `from_s` on.
+    /// stroke's stretch from `from_s` on (back toward its start where `backward`).
     Stroke {
         /// The stroke's index in the job.
         stroke: usize,
@@ -35,6 +35,10 @@ pub enum SegmentKind {
         part: usize,
         /// Arc length along the stroke as drawn where the part's task starts (m).
         from_s: f64,
+        /// Whether the part is drawn from `from_s` back toward the stroke's start: a stroke
+        /// left short, finished from its other end. Absent (false) otherwise.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        backward: bool,
     },
     /// The tool lifted off the surface along −n.
     Retreat,

@@ -1,10 +1,12 @@
 //! The plan-strokes stage: each stroke planned by the search to the limit; where the arm cannot
 //! finish it in one motion, the rest is planned again from where it stopped (the tool set down
-//! a little behind, after a reconfiguration in free space), as often as that gains length.
+//! a little behind, after a reconfiguration in free space), as often as that gains length; what
+//! is left at its end may be planned from the other end back ([`finish_from_the_end`]).
 
 use emg_control::{ARRIVAL_M, Path, Task, Termination, Trajectory};
 use emg_planner::{PlanRequest, Planner};
 
+use crate::claims::{Coverage, OnStroke, Stretch};
 use crate::spec::JobSettings;
 use crate::watch::{Stopped, Watch};
 
@@ -13,6 +15,9 @@ use crate::watch::{Stopped, Watch};
 pub struct StrokePart {
     /// Arc length of the stroke where the part's stretch starts (m).
     pub from_s: f64,
+    /// Whether the part runs from `from_s` back toward the stroke's start (drawn from the
+    /// stroke's other end, [`finish_from_the_end`]).
+    pub backward: bool,
     /// The task of the stretch, as planned.
     pub task: Task,
     /// The planned motion along it.
@@ -20,9 +25,22 @@ pub struct StrokePart {
 }
 
 impl StrokePart {
+    /// Where the part's task lies on the stroke.
+    pub fn on_stroke(&self) -> OnStroke {
+        OnStroke {
+            from_s: self.from_s,
+            backward: self.backward,
+        }
+    }
+
     /// Arc length of the stroke the part reaches (m).
     pub fn reached_s(&self) -> f64 {
-        self.from_s + self.trajectory.path_length_m
+        self.on_stroke().stroke_s(self.trajectory.path_length_m)
+    }
+
+    /// The stretch of the stroke the part covers as planned.
+    pub fn planned(&self) -> Stretch {
+        self.on_stroke().stretch(0.0, self.trajectory.path_length_m)
     }
 }
 
@@ -45,13 +63,17 @@ impl StrokePlan {
     /// The length of the stroke its parts cover as planned, from where each starts to where it
     /// reaches, overlaps counted once (m).
     pub fn planned_m(&self) -> f64 {
-        let mut reached = f64::NEG_INFINITY;
-        let mut covered = 0.0;
-        for part in &self.parts {
-            covered += (part.reached_s() - part.from_s.max(reached)).max(0.0);
-            reached = reached.max(part.reached_s());
-        }
-        covered
+        let stretches: Vec<Stretch> = self.parts.iter().map(StrokePart::planned).collect();
+        Coverage::of(self.path.length_m(), &stretches).drawn_m
+    }
+
+    /// How far along the stroke its forward parts reach (m; 0 with none).
+    fn forward_reach_s(&self) -> f64 {
+        self.parts
+            .iter()
+            .filter(|part| !part.backward)
+            .map(StrokePart::reached_s)
+            .fold(0.0, f64::max)
     }
 }
 
@@ -108,6 +130,7 @@ pub fn plan_stroke(
                     .ok()?;
                 Some(StrokePart {
                     from_s,
+                    backward: false,
                     task,
                     trajectory: planned.trajectory,
                 })
@@ -139,6 +162,42 @@ pub fn plan_stroke(
             }
         }
     }
+    Ok(plan)
+}
+
+/// `plan` finished from its stroke's other end: where its forward parts stop short of the end by
+/// more than `settings.min_gain_m`, the stretch from there (`settings.overlap_m` back) to the
+/// end is planned from the end back ([`plan_stroke`] on the reversed stretch), and its parts
+/// are added as backward parts: the two sides meet where both reach. Its searches are counted;
+/// the plan is left as it is where that stretch cannot be reversed.
+pub fn finish_from_the_end(
+    planner: &Planner,
+    request: &PlanRequest,
+    mut plan: StrokePlan,
+    settings: &JobSettings,
+    watch: &dyn Watch,
+) -> Result<StrokePlan, Stopped> {
+    let length = plan.path.length_m();
+    let reached = plan.forward_reach_s();
+    if reached >= length - settings.min_gain_m {
+        return Ok(plan);
+    }
+    let from = (reached - settings.overlap_m).max(0.0);
+    let Some(back) = plan.path.stretch(from, length).and_then(|s| s.reversed()) else {
+        return Ok(plan);
+    };
+    let back_plan = plan_stroke(planner, request, &back, 0.0, settings, watch)?;
+    plan.searches += back_plan.searches;
+    if back_plan.unsearched_from_s.is_none() {
+        plan.unsearched_from_s = None;
+    }
+    // A part `from_s` along the reversed stretch starts `length − from_s` along the stroke.
+    plan.parts
+        .extend(back_plan.parts.into_iter().map(|part| StrokePart {
+            from_s: length - part.from_s,
+            backward: true,
+            ..part
+        }));
     Ok(plan)
 }
 

@@ -266,10 +266,16 @@ pub fn ur_program(
                 stroke,
                 part,
                 from_s,
+                backward,
             } => {
                 let task = segment.task.as_ref().ok_or(UrProgramError::NoTask(index))?;
                 writer.line(&format!(
-                    "# stroke {stroke}, part {part}: from {from_s:.4} m along it, {:.3} s",
+                    "# stroke {stroke}, part {part}: from {from_s:.4} m along it{}, {:.3} s",
+                    if backward {
+                        " back toward its start"
+                    } else {
+                        ""
+                    },
                     segment.end_s - segment.start_s
                 ));
                 writer.stroke(qs, task);

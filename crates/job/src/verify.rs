@@ -19,7 +19,7 @@ use emg_verify::{
 };
 use rayon::prelude::*;
 
-use crate::claims::{COVERAGE_SLACK_M, Coverage, Stretch};
+use crate::claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch};
 use crate::free_space::with_part;
 use crate::program::{JobFile, Segment, SegmentKind, StrokeReport};
 
@@ -228,7 +228,13 @@ impl SegmentContext<'_> {
             error,
         };
         match segment.kind {
-            SegmentKind::Stroke { stroke, from_s, .. } => {
+            SegmentKind::Stroke {
+                stroke,
+                from_s,
+                backward,
+                ..
+            } => {
+                let on = OnStroke { from_s, backward };
                 let task = segment.task.as_ref().ok_or(JobCheckError::NoTask(index))?;
                 let line: Line = task.into();
                 let report = check_replay(
@@ -247,16 +253,10 @@ impl SegmentContext<'_> {
                         stroke,
                         problem: format!("segment {index} draws it, but no stroke report has it"),
                     })?;
-                on_its_stroke(&self.file.strokes[place], task, from_s, index)?;
+                on_its_stroke(&self.file.strokes[place], task, on, index)?;
                 // What `Line::covered` gives of the samples' TCPs.
                 let (least, greatest) = report.progress_range_m;
-                Ok(Some((
-                    place,
-                    Stretch {
-                        from_s: from_s + least,
-                        to_s: from_s + greatest,
-                    },
-                )))
+                Ok(Some((place, on.stretch(least, greatest))))
             }
             _ => {
                 // The whole part is in `free`'s scene: one surface's task frames the replay.
@@ -278,14 +278,15 @@ impl SegmentContext<'_> {
 }
 
 /// Checks that `task`, the task of stroke part segment `segment`, is its stroke's stretch from
-/// `from_s`: their points agree along the whole task (to the pieces shorter than
-/// [`MIN_SEGMENT_M`] that a stretch leaves out).
+/// `on.from_s` (back toward its start where `on.backward`): their points agree along the whole
+/// task (to the pieces shorter than [`MIN_SEGMENT_M`] that a stretch leaves out).
 fn on_its_stroke(
     report: &StrokeReport,
     task: &Task,
-    from_s: f64,
+    on: OnStroke,
     segment: usize,
 ) -> Result<(), JobCheckError> {
+    let from_s = on.from_s;
     let claim = |problem: String| JobCheckError::Claim {
         stroke: report.stroke,
         problem,
@@ -296,7 +297,7 @@ fn on_its_stroke(
     const CHECKS: usize = 64;
     for k in 0..=CHECKS {
         let s = length * k as f64 / CHECKS as f64;
-        let off = (task.point_at(s) - path.point_at(from_s + s)).norm();
+        let off = (task.point_at(s) - path.point_at(on.stroke_s(s))).norm();
         if off > 2.0 * MIN_SEGMENT_M {
             return Err(claim(format!(
                 "segment {segment}'s task is not the stroke's stretch from {from_s:.4} m: {s:.4} m                  along it lies {off:.3e} m off the stroke"

@@ -226,21 +226,21 @@ fn a_stop_is_asked_for_between_a_searchs_rollouts_and_ends_the_job_at_once() {
     assert!(midway.asked.into_inner() <= 6);
 }
 
-#[test]
-fn each_stroke_is_drawn_the_way_that_draws_more() {
-    // The signature near the edge of the FR3's reach: its long stroke drawn from its end draws
-    // a tenth of what it draws from its start, the way the order stage would draw it for a
-    // shorter travel.
-    let (planner, timing, _, file) = common::setup("fr3");
+/// The signature 0.4 m wide at `origin_m` on the FR3, planned as `emg job` plans it (checked by
+/// the independent checker), and with the strokes' directions fixed as the file has them and
+/// reversed: the length each draws of every stroke, and the program.
+fn signature_each_way(origin_m: [f64; 3]) -> ([Vec<f64>; 3], emg_job::JobFile) {
+    let (planner, timing, checker, file) = common::setup("fr3");
     let robot = planner.robot();
     let placement = Placement {
-        origin_m: [0.6, 0.5, 0.05],
+        origin_m,
         width_m: Some(0.4),
         ..Placement::default()
     };
     let job = icon_job(robot, "signature", &placement);
-    let drawn = |job: &Job| -> Vec<f64> {
+    let plan = |job: &Job| {
         let program = common::plan(&planner, &timing, &file, job);
+        verify_job(&program, &checker, robot.joint_names()).expect("the checker passes it");
         assert!(
             program
                 .ordering
@@ -252,7 +252,7 @@ fn each_stroke_is_drawn_the_way_that_draws_more() {
         for report in &program.strokes {
             drawn[report.stroke] = report.drawn_m;
         }
-        drawn
+        (drawn, program)
     };
     let mut given = job.clone();
     given.settings.order = emg_job::Order::Given;
@@ -262,7 +262,8 @@ fn each_stroke_is_drawn_the_way_that_draws_more() {
         .iter()
         .map(|path| path.reversed().expect("reversible"))
         .collect();
-    let (chosen, forward, backward) = (drawn(&job), drawn(&given), drawn(&reversed));
+    let (chosen, program) = plan(&job);
+    let ((forward, _), (backward, _)) = (plan(&given), plan(&reversed));
     for k in 0..job.strokes.len() {
         assert!(
             chosen[k] >= forward[k].max(backward[k]) - emg_job::SAME_LENGTH_M,
@@ -272,15 +273,43 @@ fn each_stroke_is_drawn_the_way_that_draws_more() {
             backward[k]
         );
     }
-    let (whole, better) = (
-        job.strokes.iter().map(|p| p.length_m()).sum::<f64>(),
-        (0..job.strokes.len())
+    ([chosen, forward, backward], program)
+}
+
+#[test]
+fn each_stroke_is_drawn_the_way_that_draws_more() {
+    // Near the edge of the FR3's reach the signature's long stroke drawn from its end draws a
+    // tenth of what it draws from its start, the way the order stage would draw it for a
+    // shorter travel.
+    let ([chosen, forward, backward], program) = signature_each_way([0.6, 0.5, 0.05]);
+    let better: f64 = (0..chosen.len()).map(|k| forward[k].max(backward[k])).sum();
+    assert!(
+        backward.iter().sum::<f64>() < 0.5 * better
+            && program.summary.drawn_m >= 0.99 * program.summary.total_m,
+        "{forward:?} {backward:?} {chosen:?}"
+    );
+}
+
+#[test]
+fn a_stroke_left_short_is_finished_from_its_other_end() {
+    // Farther out, neither way draws the long stroke whole: the part from its other end
+    // draws on back toward where the first stopped.
+    let ([chosen, forward, backward], program) = signature_each_way([0.3, 0.75, 0.2]);
+    let from_the_end = program
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, SegmentKind::Stroke { backward: true, .. }))
+        .count();
+    assert!(from_the_end >= 1);
+    let (drawn, better) = (
+        chosen.iter().sum::<f64>(),
+        (0..chosen.len())
             .map(|k| forward[k].max(backward[k]))
             .sum::<f64>(),
     );
     assert!(
-        backward.iter().sum::<f64>() < 0.5 * better && chosen.iter().sum::<f64>() >= 0.99 * whole,
-        "{forward:?} {backward:?} {chosen:?} of {whole}"
+        drawn > better + 0.1,
+        "{drawn} m drawn, {better} m the better way of each stroke"
     );
 }
 

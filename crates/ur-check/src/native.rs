@@ -466,6 +466,8 @@ struct StrokePart {
     place: usize,
     /// Arc length along the stroke where its task starts (m).
     from_s: f64,
+    /// Whether its task runs from `from_s` back toward the stroke's start.
+    backward: bool,
     /// Its task as the checker reads it.
     line: Line,
     /// The bounds its samples keep (the part in the scene).
@@ -663,7 +665,13 @@ impl<'a> Reading<'a> {
             .map(|task| (task.into(), task_bounds(task, &free_config)));
         let mut parts = Vec::new();
         for (segment, s) in file.segments.iter().enumerate() {
-            let SegmentKind::Stroke { stroke, from_s, .. } = s.kind else {
+            let SegmentKind::Stroke {
+                stroke,
+                from_s,
+                backward,
+                ..
+            } = s.kind
+            else {
                 continue;
             };
             let Some(task) = &s.task else {
@@ -691,6 +699,7 @@ impl<'a> Reading<'a> {
                 segment,
                 place,
                 from_s,
+                backward,
                 line: task.into(),
                 bounds: task_bounds(task, &on_part),
                 start: tcp(first),
@@ -1113,9 +1122,17 @@ impl<'a> Reading<'a> {
         }
         state.tool_on = false;
         if let Some((least, greatest)) = part.line.covered(state.drawn.drain(..)) {
-            state.covered[part.place].push(Stretch {
-                from_s: part.from_s + least,
-                to_s: part.from_s + greatest,
+            // Along the stroke, the task runs on from `from_s`, or back toward its start.
+            state.covered[part.place].push(if part.backward {
+                Stretch {
+                    from_s: part.from_s - greatest,
+                    to_s: part.from_s - least,
+                }
+            } else {
+                Stretch {
+                    from_s: part.from_s + least,
+                    to_s: part.from_s + greatest,
+                }
             });
         }
         Ok(())
