@@ -504,6 +504,23 @@ impl Path {
         })
     }
 
+    /// Whether the path ends where it starts (within [`MIN_SEGMENT_M`]): a closed stroke, which
+    /// may be started anywhere on it ([`Path::started_at`]).
+    pub fn is_closed(&self) -> bool {
+        (self.point_at(self.length_m) - self.point_at(0.0)).norm() <= MIN_SEGMENT_M
+    }
+
+    /// The closed path started at arc length `s`: its stretch from `s` to its end, then from
+    /// its start to `s` ([`Path::joined`], moved by the closing gap); `None` where the path is
+    /// not closed or either stretch holds less than [`MIN_SEGMENT_M`].
+    pub fn started_at(&self, s: f64) -> Option<Self> {
+        if !self.is_closed() {
+            return None;
+        }
+        self.stretch(s, self.length_m)?
+            .joined(&self.stretch(0.0, s)?)
+    }
+
     /// The stretch of the path from arc length `from_s` to `to_s` (clamped to it), its pieces,
     /// blends included, as segments of their own (no blend radius: a blend is already an arc
     /// tangent to its neighbours); `None` where it holds less than [`MIN_SEGMENT_M`].

@@ -269,6 +269,26 @@ fn unit_circle() -> (Vec3, Vec3, Path) {
     (p, n, Path::new(circle).unwrap())
 }
 
+/// A closed path started elsewhere is the same curve from there round to there; an open one
+/// has no other start.
+#[test]
+fn a_closed_path_may_start_anywhere_on_it() {
+    let (p, n, circle) = unit_circle();
+    assert!(circle.is_closed());
+    let length = circle.length_m();
+    let third = length / 3.0;
+    let started = circle.started_at(third).expect("a closed path restarts");
+    assert!((started.length_m() - length).abs() < 1e-9);
+    for k in 0..=30 {
+        let s = length * k as f64 / 30.0;
+        let original = circle.point_at((s + third) % length);
+        assert_close(started.point_at(s), original, 1e-9, "restarted point");
+    }
+    let open = Path::new(spec(p, n, 0.0, vec![line(p + Vec3::new(0.1, 0.0, 0.0))])).unwrap();
+    assert!(!open.is_closed());
+    assert!(open.started_at(0.05).is_none());
+}
+
 /// A whole circle's stretch, its reverse and its rigid motions are paths again, of its length,
 /// whatever its radius (the sweep recomputed from the arc length may round past 360°).
 #[test]

@@ -34,7 +34,7 @@ use std::collections::VecDeque;
 use std::time::Instant;
 
 use emg_control::Path;
-use emg_kinematics::{JointVector, Vec3};
+use emg_kinematics::{JointVector, Robot, Vec3};
 use emg_planner::{
     DEFAULT_RATE_HZ, MotionTiming, PlanRequest, Planner, PlannerConfig, TimingSetupError,
 };
@@ -56,7 +56,7 @@ pub use program::{
     SegmentKind, StrokeReport,
 };
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
-pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke};
+pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke, reachable_start_s};
 pub use tool_output::{OutputBank, ToolOutput};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 pub use watch::{Stopped, StopsWith, Unwatched, Watch};
@@ -167,6 +167,10 @@ pub fn plan_job(
                             plan_stroke(&on_part, request, path, 0.0, settings, watch)
                         })?;
                     let plan = finish_from_the_end(&on_part, request, plan, settings, watch)?;
+                    let plan = started_where_it_draws(plan, robot, |path| {
+                        let plan = plan_stroke(&on_part, request, path, 0.0, settings, watch)?;
+                        finish_from_the_end(&on_part, request, plan, settings, watch)
+                    })?;
                     (oriented, plan)
                 }
                 Order::Given => (oriented, plan),
@@ -178,7 +182,14 @@ pub fn plan_job(
         .collect::<Result<_, Stopped>>()?;
     let (sequence, plans): (Vec<Oriented>, Vec<StrokePlan>) = planned.into_iter().unzip();
     ordering.sequence = sequence;
-    ordering.travel_m = ordering.travel_between(&drawn);
+    // Measured again between the strokes as they are drawn: their directions and starts taken.
+    ordering.travel_m = plans
+        .windows(2)
+        .map(|pair| {
+            let end = pair[0].path.point_at(pair[0].path.length_m());
+            (pair[1].path.point_at(0.0) - end).norm()
+        })
+        .fold(0.0, |total, leg| total + leg);
     let connector = Connector {
         free: &free,
         timing,
@@ -783,6 +794,45 @@ impl Connector<'_> {
             task: part.task.clone(),
             trajectory: planned.trajectory,
         })
+    }
+}
+
+/// `plan` of a closed stroke ([`Path::is_closed`]) whose start no part covers, started again
+/// elsewhere on it where that draws more by [`SAME_LENGTH_M`] (`replan`, both ends): a closed
+/// stroke may start anywhere, and one starting out of reach draws little from either end. The
+/// new start is the middle of the longest stretch a part covers, or where none covers any,
+/// [`reachable_start_s`]. The searches of both are counted.
+fn started_where_it_draws(
+    plan: StrokePlan,
+    robot: &Robot,
+    replan: impl Fn(&Path) -> Result<StrokePlan, Stopped>,
+) -> Result<StrokePlan, Stopped> {
+    let path = &plan.path;
+    let length = path.length_m();
+    let stretches: Vec<Stretch> = plan.parts.iter().map(StrokePart::planned).collect();
+    let whole = Coverage::of(length, &stretches).whole();
+    let start_covered = stretches.iter().any(|s| s.from_s <= COVERAGE_SLACK_M);
+    if !path.is_closed() || whole || start_covered {
+        return Ok(plan);
+    }
+    let longest = stretches
+        .iter()
+        .max_by(|a, b| a.length_m().total_cmp(&b.length_m()));
+    let start_s = match longest {
+        Some(stretch) => 0.5 * (stretch.from_s + stretch.to_s),
+        None => reachable_start_s(path, robot),
+    };
+    let Some(rotated) = path.started_at(start_s) else {
+        return Ok(plan);
+    };
+    let mut other = replan(&rotated)?;
+    if other.planned_m() >= plan.planned_m() + SAME_LENGTH_M {
+        other.searches += plan.searches;
+        Ok(other)
+    } else {
+        let mut plan = plan;
+        plan.searches += other.searches;
+        Ok(plan)
     }
 }
 

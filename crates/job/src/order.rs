@@ -90,13 +90,6 @@ impl Ordering {
             .collect()
     }
 
-    /// Σ straight distance from each drawn stroke's end to the next one's start in the
-    /// sequence, the strokes being `drawn` ([`Ordering::drawn_paths`]) (m).
-    pub fn travel_between(&self, drawn: &[Path]) -> f64 {
-        let ends: Vec<Ends> = drawn.iter().map(Ends::new).collect();
-        travel(&self.sequence, &ends)
-    }
-
     /// The job's strokes merged with others, and the drawn strokes they make.
     pub fn merged(&self) -> (usize, usize) {
         self.drawn

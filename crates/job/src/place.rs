@@ -5,7 +5,8 @@
 //!
 //! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
 //!    (the part under the strokes kept off, as the job plans; in the shortest order the sum
-//!    of its two ways' bounds, as the job draws a short stroke from both ends),
+//!    of its two ways' bounds, as the job draws a short stroke from both ends, for a closed
+//!    one the better of its start and [`reachable_start_s`]),
 //!    Σ min(bound, length) / Σ length, from a coarse scan ([`PlaceSettings::coarse_grid_m`],
 //!    fewer restarts);
 //! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
@@ -18,7 +19,7 @@
 //! Every score and plan is deterministic and independent of the number of threads; ties keep
 //! the grid's order.
 
-use emg_control::{ConstraintConfig, Task};
+use emg_control::{ConstraintConfig, Path, Task};
 use emg_kinematics::{Vec3, rotation_about};
 use emg_planner::{MotionTiming, PlanRequest, Planner, ReachConfig, reach, reachable_points};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
@@ -29,7 +30,7 @@ use crate::free_space::{job_part, with_part};
 use crate::program::JobFile;
 use crate::spec::{Job, JobError, Order, Transform};
 use crate::watch::{Stopped, StopsWith, Watch};
-use crate::{JobPlanError, SAME_LENGTH_M, plan_job};
+use crate::{JobPlanError, SAME_LENGTH_M, plan_job, reachable_start_s};
 
 /// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
 /// first.
@@ -485,17 +486,26 @@ pub fn place_score(
         };
         match score {
             Score::Bound => {
-                let bound_of =
-                    |task: &Task| reach(robot, task, &constraints, config, &[]).reachable_m;
-                let mut bound = bound_of(&task);
-                // In the shortest order a stroke left short is drawn from both ends (`plan_job`):
-                // it scores what one motion from each end could reach.
+                let bound_of = |path: &Path| {
+                    Task::on_path(robot, path.clone(), None).map_or(0.0, |task| {
+                        reach(robot, &task, &constraints, config, &[]).reachable_m
+                    })
+                };
+                // In the shortest order a stroke left short is drawn from both ends, and a closed
+                // one may be started where the arm reaches it (`plan_job`): it scores what one
+                // motion from each end could reach, from the better of those starts.
+                let both_ends = |path: &Path, forward: f64| {
+                    if forward >= path.length_m() {
+                        return forward;
+                    }
+                    forward + path.reversed().map_or(0.0, |reversed| bound_of(&reversed))
+                };
+                let mut bound = reach(robot, &task, &constraints, config, &[]).reachable_m;
                 if bound < stroke.length_m() && moved.settings.order == Order::Shortest {
-                    let reversed = stroke
-                        .reversed()
-                        .and_then(|path| Task::on_path(robot, path, None).ok());
-                    if let Some(task) = reversed {
-                        bound += bound_of(&task);
+                    bound = both_ends(stroke, bound);
+                    let restarted = stroke.started_at(reachable_start_s(stroke, robot));
+                    if let Some(restarted) = restarted.filter(|_| bound < stroke.length_m()) {
+                        bound = bound.max(both_ends(&restarted, bound_of(&restarted)));
                     }
                 }
                 reached += bound.min(stroke.length_m());

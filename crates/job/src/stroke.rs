@@ -4,6 +4,7 @@
 //! is left at its end may be planned from the other end back ([`finish_from_the_end`]).
 
 use emg_control::{ARRIVAL_M, Path, Task, Termination, Trajectory};
+use emg_kinematics::Robot;
 use emg_planner::{PlanRequest, Planner};
 
 use crate::claims::{Coverage, OnStroke, Stretch};
@@ -199,6 +200,19 @@ pub fn finish_from_the_end(
             ..part
         }));
     Ok(plan)
+}
+
+/// Where a closed stroke none of whose parts can start is started instead: its point nearest
+/// the centre of the arm's reach sphere (sampled every 5 mm), the likeliest to be reached.
+pub fn reachable_start_s(path: &Path, robot: &Robot) -> f64 {
+    let (centre, _) = robot.reach_sphere();
+    let length = path.length_m();
+    let away = |s: f64| (path.point_at(s) - centre).norm();
+    let samples = (length / 0.005).ceil().max(1.0) as usize;
+    (0..samples)
+        .map(|k| length * k as f64 / samples as f64)
+        .min_by(|a, b| away(*a).total_cmp(&away(*b)))
+        .unwrap_or(0.0)
 }
 
 /// Whether a part ends at the stroke's end.

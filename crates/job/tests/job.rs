@@ -349,3 +349,26 @@ fn a_stroke_longer_than_one_rollout_is_drawn_whole_and_what_is_not_searched_is_s
         Some(report.length_m)
     );
 }
+
+#[test]
+fn a_closed_stroke_starting_out_of_reach_is_started_where_the_arm_reaches_it() {
+    // A circle 0.2 m across, 0.9 m out at the height of the plate, starting at its far side,
+    // 1 m out: no part starts there, from either end; started on its near side, most of it
+    // is drawn.
+    let (planner, timing, checker, file) = common::setup("fr3");
+    let robot = planner.robot();
+    let circle = r#"{"version": 1, "strokes": [{"version": 1, "start": [1.0, 0, 0.05],
+        "normal": [0, 0, -1], "segments": [{"arc": {"centre": [0.9, 0, 0.05], "sweep_deg": 360}}]}]}"#;
+    let job = Job::from_json("circle.json", circle, robot).expect("a valid job");
+    let program = common::plan(&planner, &timing, &file, &job);
+    verify_job(&program, &checker, robot.joint_names()).expect("the checker passes it");
+    let report = &program.strokes[0];
+    assert!(
+        report.drawn_m >= 0.5 * report.length_m,
+        "{} of {} m",
+        report.drawn_m,
+        report.length_m
+    );
+    let start = report.path.start;
+    assert!(start[0] < 0.85, "started at {start:?}");
+}
