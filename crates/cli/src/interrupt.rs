@@ -96,6 +96,11 @@ impl<'a> Watched<'a> {
 impl emg_job::Watch for Watched<'_> {
     fn progress(&self, stage: &str, done: usize, total: usize) {
         self.bar.set_message(stage.to_string());
+        self.bar.set_prefix(match stage {
+            "planning" => "mm",
+            "screen" | "refine" | "certify" => "places",
+            _ => "strokes",
+        });
         self.bar.set_length(total as u64);
         self.bar.set_position(done as u64);
     }

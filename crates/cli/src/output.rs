@@ -13,15 +13,18 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
     write_atomically(path, text).with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// A progress bar of `length` `things` (strokes, places), its stage as its message.
+/// A progress bar of `length` `things` (strokes, places), its stage as its message and the unit
+/// it counts in as its prefix (set again per stage by [`crate::interrupt::Watched`]).
 pub fn progress_bar(length: u64, things: &str) -> indicatif::ProgressBar {
-    indicatif::ProgressBar::new(length).with_style(
-        indicatif::ProgressStyle::with_template(&format!(
-            "{{msg:>8}} [{{bar:40}}] {{pos}}/{{len}} {things}, {{elapsed}}"
-        ))
-        .expect("a valid template")
-        .progress_chars("=> "),
-    )
+    indicatif::ProgressBar::new(length)
+        .with_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg:>10} [{bar:40}] {pos}/{len} {prefix}, {elapsed}",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        )
+        .with_prefix(things.to_string())
 }
 
 /// Set once standard output refused a line (its reader has gone): nothing more is printed.

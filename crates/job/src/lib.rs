@@ -59,6 +59,7 @@ pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, T
 pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke, reachable_start_s};
 pub use tool_output::{OutputBank, ToolOutput};
 pub use verify::{JobCheck, JobCheckError, verify_job};
+use watch::PlanningProgress;
 pub use watch::{Stopped, StopsWith, Unwatched, Watch};
 
 /// Pen-down lengths closer than this (m) count as the same: of two starts of a stroke that draw
@@ -153,12 +154,14 @@ pub fn plan_job(
     let on_part = planner
         .with_config(on_part)
         .expect("the planner's configuration with obstacles added is valid");
-    let done = std::sync::atomic::AtomicUsize::new(0);
+    let progress = PlanningProgress::new(watch, drawn.iter().map(Path::length_m));
     let planned: Vec<(Oriented, StrokePlan)> = ordering
         .sequence
         .par_iter()
         .map(|&oriented| {
             let path = oriented.path(&drawn);
+            let stroke_progress = progress.stroke(path.length_m());
+            let watch = &stroke_progress;
             let plan = plan_stroke(&on_part, request, &path, 0.0, settings, watch)?;
             let planned = match settings.order {
                 Order::Shortest => {
@@ -175,8 +178,7 @@ pub fn plan_job(
                 }
                 Order::Given => (oriented, plan),
             };
-            let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            watch.progress("planning", finished, ordering.sequence.len());
+            stroke_progress.finish();
             Ok(planned)
         })
         .collect::<Result<_, Stopped>>()?;

@@ -149,6 +149,7 @@ pub fn plan_stroke(
                 )
             })
             .map_or(0.0, |part| part.reached_s() - done);
+        let before = done;
         match part {
             Some(part) if gained >= settings.min_gain_m || completes(&part, length) => {
                 done = part.reached_s();
@@ -162,6 +163,7 @@ pub fn plan_stroke(
                 done = (done + settings.min_gain_m).min(length);
             }
         }
+        watch.searched(done - before);
     }
     Ok(plan)
 }

@@ -372,3 +372,53 @@ fn a_closed_stroke_starting_out_of_reach_is_started_where_the_arm_reaches_it() {
     let start = report.path.start;
     assert!(start[0] < 0.85, "started at {start:?}");
 }
+
+/// A watch that records every progress it is told.
+#[derive(Default)]
+struct Recording(std::sync::Mutex<Vec<(String, usize, usize)>>);
+
+impl emg_job::Watch for Recording {
+    fn progress(&self, stage: &str, done: usize, total: usize) {
+        self.0
+            .lock()
+            .expect("not poisoned")
+            .push((stage.to_string(), done, total));
+    }
+}
+
+#[test]
+fn planning_a_long_stroke_shows_its_progress_in_millimetres() {
+    let (planner, timing, _, file) = common::setup("fr3");
+    // 28 turns round a circle 5 cm across: 8.8 m, one stroke of several searches.
+    let turn = r#"{"arc": {"centre": [0.45, 0, 0.25], "sweep_deg": 360}}"#;
+    let coil = format!(
+        r#"{{"version": 1, "strokes": [{{"version": 1, "start": [0.5, 0, 0.25],
+            "normal": [0, 0, -1], "segments": [{}]}}]}}"#,
+        vec![turn; 28].join(", ")
+    );
+    let job = Job::from_json("coil.json", &coil, planner.robot()).expect("a valid job");
+    let watch = Recording::default();
+    plan_job(
+        &planner,
+        &emg_planner::PlanRequest::default(),
+        &job,
+        &timing,
+        &file.display().to_string(),
+        &watch,
+    )
+    .expect("planned");
+    let planning: Vec<(usize, usize)> = watch
+        .0
+        .into_inner()
+        .expect("not poisoned")
+        .into_iter()
+        .filter(|(stage, _, _)| stage == "planning")
+        .map(|(_, done, total)| (done, total))
+        .collect();
+    let total = (job.strokes[0].length_m() * 1e3).round() as usize;
+    assert!(planning.len() >= 3, "{planning:?}");
+    assert!(planning.iter().all(|&(_, t)| t == total));
+    assert!(planning.windows(2).all(|w| w[0].0 < w[1].0), "{planning:?}");
+    assert_eq!(planning.first().map(|p| p.0), Some(0));
+    assert_eq!(planning.last().map(|p| p.0), Some(total));
+}
