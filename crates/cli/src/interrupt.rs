@@ -95,7 +95,7 @@ impl<'a> Watched<'a> {
 
 impl emg_job::Watch for Watched<'_> {
     fn progress(&self, stage: &str, done: usize, total: usize) {
-        self.bar.set_message(stage.to_string());
+        // The unit and the counts first: the bar redraws on each change.
         self.bar.set_prefix(match stage {
             "planning" => "mm",
             "screen" | "refine" | "certify" => "places",
@@ -103,6 +103,7 @@ impl emg_job::Watch for Watched<'_> {
         });
         self.bar.set_length(total as u64);
         self.bar.set_position(done as u64);
+        self.bar.set_message(stage.to_string());
     }
 
     fn stop_requested(&self) -> bool {
