@@ -154,35 +154,51 @@ pub fn plan_job(
     let on_part = planner
         .with_config(on_part)
         .expect("the planner's configuration with obstacles added is valid");
+    // Where the arm has a home and joints that turn further than a turn, strokes are planned
+    // with those joints within half a turn of it; the whole range only where a stroke draws
+    // more with it.
+    let near_home = job.home.and_then(|home| on_part.within_half_turn_of(&home));
     let progress = PlanningProgress::new(watch, drawn.iter().map(Path::length_m));
-    let planned: Vec<(Oriented, StrokePlan)> = ordering
+    let planned: Vec<(Oriented, StrokePlan, &Planner)> = ordering
         .sequence
         .par_iter()
         .map(|&oriented| {
             let path = oriented.path(&drawn);
             let stroke_progress = progress.stroke(path.length_m());
             let watch = &stroke_progress;
-            let plan = plan_stroke(&on_part, request, &path, 0.0, settings, watch)?;
-            let planned = match settings.order {
-                Order::Shortest => {
-                    let (oriented, plan) =
-                        the_way_drawing_more((oriented, plan), &drawn, |path| {
-                            plan_stroke(&on_part, request, path, 0.0, settings, watch)
-                        })?;
-                    let plan = finish_from_the_end(&on_part, request, plan, settings, watch)?;
-                    let plan = started_where_it_draws(plan, robot, |path| {
-                        let plan = plan_stroke(&on_part, request, path, 0.0, settings, watch)?;
-                        finish_from_the_end(&on_part, request, plan, settings, watch)
-                    })?;
-                    (oriented, plan)
+            let draw =
+                |planner| planned_stroke(planner, request, oriented, &drawn, settings, watch);
+            let planned = match &near_home {
+                Some(near_home) => {
+                    let (oriented, plan) = draw(near_home)?;
+                    if plan.planned_m() >= path.length_m() - SAME_LENGTH_M {
+                        (oriented, plan, near_home)
+                    } else {
+                        let (whole_oriented, whole_plan) = draw(&on_part)?;
+                        if whole_plan.planned_m() > plan.planned_m() + SAME_LENGTH_M {
+                            (whole_oriented, whole_plan, &on_part)
+                        } else {
+                            (oriented, plan, near_home)
+                        }
+                    }
                 }
-                Order::Given => (oriented, plan),
+                None => {
+                    let (oriented, plan) = draw(&on_part)?;
+                    (oriented, plan, &on_part)
+                }
             };
             stroke_progress.finish();
             Ok(planned)
         })
         .collect::<Result<_, Stopped>>()?;
-    let (sequence, plans): (Vec<Oriented>, Vec<StrokePlan>) = planned.into_iter().unzip();
+    let mut sequence = Vec::with_capacity(planned.len());
+    let mut plans = Vec::with_capacity(planned.len());
+    let mut planners = Vec::with_capacity(planned.len());
+    for (oriented, plan, planner) in planned {
+        sequence.push(oriented);
+        plans.push(plan);
+        planners.push(planner);
+    }
     ordering.sequence = sequence;
     // Measured again between the strokes as they are drawn: their directions and starts taken.
     ordering.travel_m = plans
@@ -203,7 +219,14 @@ pub fn plan_job(
     // The last part's lift, joined to the move after it.
     let mut retreat: Option<[JointVector; 2]> = None;
     let mut searches: usize = plans.iter().map(|plan| plan.searches).sum();
-    for (connected, (oriented, plan)) in ordering.sequence.iter().zip(&plans).enumerate() {
+    for (connected, ((oriented, plan), &stroke_planner)) in ordering
+        .sequence
+        .iter()
+        .zip(&plans)
+        .zip(&planners)
+        .enumerate()
+    {
+        let mut stroke_planner = stroke_planner;
         if watch.stop_requested() {
             return Err(Stopped.into());
         }
@@ -236,7 +259,9 @@ pub fn plan_job(
             let again: Vec<StrokePart> = [from, job.home]
                 .iter()
                 .flatten()
-                .filter_map(|start| connector.replanned_nearby(&on_part, request, &planned, start))
+                .filter_map(|start| {
+                    connector.replanned_nearby(stroke_planner, request, &planned, start)
+                })
                 .map(|part| toward(part, job.home.as_ref(), from.as_ref(), &free))
                 .collect();
             let candidates = ranked(planned.clone(), again, from.as_ref(), limits);
@@ -255,28 +280,49 @@ pub fn plan_job(
                 }
             }
             let placed = placed.ok_or_else(|| first_why.expect("the searched part is a candidate"));
-            let (part, placed) = match placed {
-                Ok(placed) => placed,
+            // Where a part planned near the home cannot be reached, the stroke is planned again
+            // from there with the joints' whole range; where a stand-in that draws less than the
+            // planned part was placed, the rest of the stroke is planned again from where it
+            // ends. The parts from the stroke's other end still follow.
+            let (resume_s, placed) = match placed {
+                Ok((part, placed)) => {
+                    let short = part.trajectory.path_length_m
+                        < planned.trajectory.path_length_m - SAME_LENGTH_M;
+                    let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
+                    (short.then_some(resume_s), Some((part, placed)))
+                }
                 Err(why) => {
-                    parts_left_out.push(format!("part {index}: {why}"));
-                    continue;
+                    let again = !std::ptr::eq(stroke_planner, &on_part)
+                        && !planned.backward
+                        && rest_plans < settings.max_parts;
+                    if again {
+                        stroke_planner = &on_part;
+                    } else {
+                        parts_left_out.push(format!("part {index}: {why}"));
+                    }
+                    (again.then_some(planned.from_s), None)
                 }
             };
-            // A stand-in that draws less than the planned part leaves the rest of the stroke
-            // to be planned again from where it ends.
-            if !planned.backward
-                && part.trajectory.path_length_m < planned.trajectory.path_length_m - SAME_LENGTH_M
+            if let Some(resume_s) = resume_s.filter(|_| !planned.backward)
                 && rest_plans < settings.max_parts
             {
                 rest_plans += 1;
-                let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
-                let rest = plan_stroke(&on_part, request, &plan.path, resume_s, settings, watch)?;
+                let rest = plan_stroke(
+                    stroke_planner,
+                    request,
+                    &plan.path,
+                    resume_s,
+                    settings,
+                    watch,
+                )?;
                 searches += rest.searches;
                 unsearched_from_s = rest.unsearched_from_s;
-                // The parts from the stroke's other end still follow.
                 let backward: Vec<StrokePart> = queue.drain(..).filter(|p| p.backward).collect();
                 queue = rest.parts.into_iter().chain(backward).collect();
             }
+            let Some((part, placed)) = placed else {
+                continue;
+            };
             let Placed {
                 timed,
                 above_start,
@@ -395,6 +441,41 @@ pub fn plan_job(
         rate_hz: timing.request().rate_hz,
         segments: program.segments().to_vec(),
     })
+}
+
+/// The plan-strokes stage for one stroke, `oriented` among `drawn`: planned by `planner` as
+/// `request` asks; in the shortest order also the other way where that draws more, finished
+/// from its other end, and a closed stroke started where it can be drawn.
+fn planned_stroke(
+    planner: &Planner,
+    request: &PlanRequest,
+    oriented: Oriented,
+    drawn: &[Path],
+    settings: &JobSettings,
+    watch: &dyn Watch,
+) -> Result<(Oriented, StrokePlan), Stopped> {
+    let plan = plan_stroke(
+        planner,
+        request,
+        &oriented.path(drawn),
+        0.0,
+        settings,
+        watch,
+    )?;
+    match settings.order {
+        Order::Shortest => {
+            let (oriented, plan) = the_way_drawing_more((oriented, plan), drawn, |path| {
+                plan_stroke(planner, request, path, 0.0, settings, watch)
+            })?;
+            let plan = finish_from_the_end(planner, request, plan, settings, watch)?;
+            let plan = started_where_it_draws(plan, planner.robot(), |path| {
+                let plan = plan_stroke(planner, request, path, 0.0, settings, watch)?;
+                finish_from_the_end(planner, request, plan, settings, watch)
+            })?;
+            Ok((oriented, plan))
+        }
+        Order::Given => Ok((oriented, plan)),
+    }
 }
 
 /// How far (rad) from the home's roll the tool's roll joint is held: a quarter turn.

@@ -1,12 +1,14 @@
 //! A job's program starts and ends at the arm's home, its joint values chosen among their whole
-//! turns nearest the home: the UR5e, whose joints span ±2π, drawing `../shared/cases/house.svg`.
+//! turns nearest the home: the UR5e, whose joints span ±2π, drawing `../shared/cases/house.svg`,
+//! and a drawing straight ahead of it, where its base joint turns half a turn from home on the
+//! branch the search finds first.
 
 mod common;
 
 use std::f64::consts::PI;
 
 use emg_io::Placement;
-use emg_job::{JobCheckError, verify_job};
+use emg_job::{JobCheckError, SegmentKind, verify_job};
 use emg_planner::ShippedRobot;
 
 #[test]
@@ -47,4 +49,52 @@ fn the_ur5e_house_starts_and_ends_at_home_every_joint_within_half_a_turn_of_it()
         matches!(&error, JobCheckError::Summary(why) if why.contains("does not start at its home")),
         "{error}"
     );
+}
+
+#[test]
+fn a_ur5e_drawing_half_a_turn_from_home_is_drawn_within_half_a_turn_and_no_move_turns_further() {
+    let (planner, timing, checker, file) = common::setup("ur5e");
+    let shipped = ShippedRobot::by_name("ur5e").expect("the UR5e");
+    let placement = Placement {
+        origin_m: [0.45, 0.0, 0.25],
+        width_m: Some(0.3),
+        ..Placement::default()
+    };
+    let pencil = common::workspace().join("crates/io/tests/data/icons/pencil.svg");
+    let job = common::drawing(planner.robot(), &pencil, &placement)
+        .with_home(shipped.home, planner.robot())
+        .expect("the home fits");
+    let program = common::plan(&planner, &timing, &file, &job);
+    let summary = &program.summary;
+    assert_eq!(summary.complete + summary.resumed, job.strokes.len());
+    assert!(summary.ends_at_home);
+    let home = shipped.home;
+    let points = program.points();
+    for point in &points {
+        for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
+            assert!((q - h).abs() <= PI, "joint {joint} at {q} rad");
+        }
+    }
+    // Every pen-up move turns each joint less than half a turn in all.
+    let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
+    for segment in &program.segments {
+        if matches!(segment.kind, SegmentKind::Stroke { .. }) {
+            continue;
+        }
+        let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
+        let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
+        let moved = &points[first..last];
+        for joint in 0..home.len() {
+            let turned: f64 = moved
+                .windows(2)
+                .map(|pair| (pair[1].positions[joint] - pair[0].positions[joint]).abs())
+                .sum();
+            assert!(
+                turned <= PI,
+                "a move at {} s turns joint {joint} by {turned} rad",
+                segment.start_s
+            );
+        }
+    }
+    verify_job(&program, &checker, planner.robot().joint_names()).expect("the program holds up");
 }

@@ -145,6 +145,19 @@ impl Planner {
         Self::new(self.robot.clone(), self.models.clone(), config)
     }
 
+    /// The same planner with the robot's joints kept within half a turn of `reference` where
+    /// their limits span more than a turn ([`Robot::within_half_turn_of`]): every pose the arm
+    /// can take, each joint at its value nearest the reference. `None` where no joint's limits
+    /// span more than a turn (nothing would change).
+    pub fn within_half_turn_of(&self, reference: &JointVector) -> Option<Self> {
+        let robot = self.robot.within_half_turn_of(reference);
+        (robot.limits() != self.robot.limits()).then(|| Self {
+            robot,
+            models: self.models.clone(),
+            config: self.config.clone(),
+        })
+    }
+
     /// The robot.
     pub fn robot(&self) -> &Robot {
         &self.robot
