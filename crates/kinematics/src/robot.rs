@@ -145,7 +145,7 @@ pub enum RobotError {
 /// How far inside half a turn of a reference [`JointLimits::within_half_turn_of`] keeps a joint
 /// (rad): a motion timed between its planned configurations may overshoot them by a little, and
 /// still lies within half a turn.
-pub const HALF_TURN_MARGIN_RAD: f64 = 1e-2;
+pub const HALF_TURN_MARGIN_RAD: f64 = 2e-3;
 
 /// Lower, upper and velocity limits of the joints; entries past the arm's joints (an arm of six)
 /// hold the range ±π and speed 1 rad/s, which no step uses (those joints never move).
