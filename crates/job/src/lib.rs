@@ -154,50 +154,55 @@ pub fn plan_job(
     let on_part = planner
         .with_config(on_part)
         .expect("the planner's configuration with obstacles added is valid");
-    // Where the arm has a home and joints that turn further than a turn, strokes are planned
-    // with those joints within half a turn of it; the whole range only where a stroke draws
-    // more with it.
-    let near_home = job.home.and_then(|home| on_part.within_half_turn_of(&home));
+    // The planners a stroke is tried with in turn: where the arm has a home and joints that
+    // turn further than a turn, those joints within each band about the home, narrowest first;
+    // then their whole range.
+    let bands: Vec<Planner> = job
+        .home
+        .iter()
+        .flat_map(|home| {
+            NEAR_HOME_BANDS_RAD
+                .iter()
+                .filter_map(|&band| on_part.within(home, band))
+        })
+        .collect();
+    let cascade: Vec<&Planner> = bands.iter().chain([&on_part]).collect();
     let progress = PlanningProgress::new(watch, drawn.iter().map(Path::length_m));
-    let planned: Vec<(Oriented, StrokePlan, &Planner)> = ordering
+    // Each stroke as the first planner of the cascade that draws it whole plans it, else as the
+    // narrowest that draws the most (to `SAME_LENGTH_M`), with that planner's place in it.
+    let planned: Vec<(Oriented, StrokePlan, usize)> = ordering
         .sequence
         .par_iter()
         .map(|&oriented| {
-            let path = oriented.path(&drawn);
-            let stroke_progress = progress.stroke(path.length_m());
+            let length = oriented.path(&drawn).length_m();
+            let stroke_progress = progress.stroke(length);
             let watch = &stroke_progress;
-            let draw =
-                |planner| planned_stroke(planner, request, oriented, &drawn, settings, watch);
-            let planned = match &near_home {
-                Some(near_home) => {
-                    let (oriented, plan) = draw(near_home)?;
-                    if plan.planned_m() >= path.length_m() - SAME_LENGTH_M {
-                        (oriented, plan, near_home)
-                    } else {
-                        let (whole_oriented, whole_plan) = draw(&on_part)?;
-                        if whole_plan.planned_m() > plan.planned_m() + SAME_LENGTH_M {
-                            (whole_oriented, whole_plan, &on_part)
-                        } else {
-                            (oriented, plan, near_home)
-                        }
-                    }
+            let mut best: Option<(Oriented, StrokePlan, usize)> = None;
+            for (rank, planner) in cascade.iter().enumerate() {
+                let (oriented, plan) =
+                    planned_stroke(planner, request, oriented, &drawn, settings, watch)?;
+                let drawn_m = plan.planned_m();
+                if best
+                    .as_ref()
+                    .is_none_or(|(_, best, _)| drawn_m > best.planned_m() + SAME_LENGTH_M)
+                {
+                    best = Some((oriented, plan, rank));
                 }
-                None => {
-                    let (oriented, plan) = draw(&on_part)?;
-                    (oriented, plan, &on_part)
+                if drawn_m >= length - SAME_LENGTH_M {
+                    break;
                 }
-            };
+            }
             stroke_progress.finish();
-            Ok(planned)
+            Ok(best.expect("the cascade holds the whole range"))
         })
         .collect::<Result<_, Stopped>>()?;
     let mut sequence = Vec::with_capacity(planned.len());
     let mut plans = Vec::with_capacity(planned.len());
-    let mut planners = Vec::with_capacity(planned.len());
-    for (oriented, plan, planner) in planned {
+    let mut ranks = Vec::with_capacity(planned.len());
+    for (oriented, plan, rank) in planned {
         sequence.push(oriented);
         plans.push(plan);
-        planners.push(planner);
+        ranks.push(rank);
     }
     ordering.sequence = sequence;
     // Measured again between the strokes as they are drawn: their directions and starts taken.
@@ -219,14 +224,11 @@ pub fn plan_job(
     // The last part's lift, joined to the move after it.
     let mut retreat: Option<[JointVector; 2]> = None;
     let mut searches: usize = plans.iter().map(|plan| plan.searches).sum();
-    for (connected, ((oriented, plan), &stroke_planner)) in ordering
-        .sequence
-        .iter()
-        .zip(&plans)
-        .zip(&planners)
-        .enumerate()
+    for (connected, ((oriented, plan), &rank)) in
+        ordering.sequence.iter().zip(&plans).zip(&ranks).enumerate()
     {
-        let mut stroke_planner = stroke_planner;
+        // The stroke's planner's place in the cascade.
+        let mut rank = rank;
         if watch.stop_requested() {
             return Err(Stopped.into());
         }
@@ -260,7 +262,7 @@ pub fn plan_job(
                 .iter()
                 .flatten()
                 .filter_map(|start| {
-                    connector.replanned_nearby(stroke_planner, request, &planned, start)
+                    connector.replanned_nearby(cascade[rank], request, &planned, start)
                 })
                 .map(|part| toward(part, job.home.as_ref(), from.as_ref(), &free))
                 .collect();
@@ -280,10 +282,10 @@ pub fn plan_job(
                 }
             }
             let placed = placed.ok_or_else(|| first_why.expect("the searched part is a candidate"));
-            // Where a part planned near the home cannot be reached, the stroke is planned again
-            // from there with the joints' whole range; where a stand-in that draws less than the
-            // planned part was placed, the rest of the stroke is planned again from where it
-            // ends. The parts from the stroke's other end still follow.
+            // Where a part planned within a band about the home cannot be reached, the stroke is
+            // planned again from there by the next planner of the cascade; where a stand-in that
+            // draws less than the planned part was placed, the rest of the stroke is planned
+            // again from where it ends. The parts from the stroke's other end still follow.
             let (resume_s, placed) = match placed {
                 Ok((part, placed)) => {
                     let short = part.trajectory.path_length_m
@@ -292,11 +294,11 @@ pub fn plan_job(
                     (short.then_some(resume_s), Some((part, placed)))
                 }
                 Err(why) => {
-                    let again = !std::ptr::eq(stroke_planner, &on_part)
+                    let again = rank + 1 < cascade.len()
                         && !planned.backward
                         && rest_plans < settings.max_parts;
                     if again {
-                        stroke_planner = &on_part;
+                        rank += 1;
                     } else {
                         parts_left_out.push(format!("part {index}: {why}"));
                     }
@@ -308,7 +310,7 @@ pub fn plan_job(
             {
                 rest_plans += 1;
                 let rest = plan_stroke(
-                    stroke_planner,
+                    cascade[rank],
                     request,
                     &plan.path,
                     resume_s,
@@ -442,6 +444,15 @@ pub fn plan_job(
         segments: program.segments().to_vec(),
     })
 }
+
+/// The bands (rad either side of the home) within which a job plans its strokes, narrowest
+/// first, on the joints whose range exceeds a turn (the UR5e's): a quarter turn, then half a turn
+/// less 2 mrad (a timed motion overshoots its planned configurations by a little and still lies
+/// within ±π of the home); past them, the joints' whole range. The narrower band keeps a joint
+/// that could sit on either of two branches (the wrist flipped or not) on the one nearer the
+/// home, so neighbouring strokes share it.
+pub const NEAR_HOME_BANDS_RAD: [f64; 2] =
+    [std::f64::consts::FRAC_PI_2, std::f64::consts::PI - 2e-3];
 
 /// The plan-strokes stage for one stroke, `oriented` among `drawn`: planned by `planner` as
 /// `request` asks; in the shortest order also the other way where that draws more, finished

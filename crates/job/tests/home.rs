@@ -52,49 +52,61 @@ fn the_ur5e_house_starts_and_ends_at_home_every_joint_within_half_a_turn_of_it()
 }
 
 #[test]
-fn a_ur5e_drawing_half_a_turn_from_home_is_drawn_within_half_a_turn_and_no_move_turns_further() {
+fn ur5e_drawings_half_a_turn_from_home_are_drawn_within_half_a_turn_and_no_move_turns_further() {
     let (planner, timing, checker, file) = common::setup("ur5e");
     let shipped = ShippedRobot::by_name("ur5e").expect("the UR5e");
-    let placement = Placement {
-        origin_m: [0.45, 0.0, 0.25],
-        width_m: Some(0.3),
-        ..Placement::default()
-    };
-    let pencil = common::workspace().join("crates/io/tests/data/icons/pencil.svg");
-    let job = common::drawing(planner.robot(), &pencil, &placement)
-        .with_home(shipped.home, planner.robot())
-        .expect("the home fits");
-    let program = common::plan(&planner, &timing, &file, &job);
-    let summary = &program.summary;
-    assert_eq!(summary.complete + summary.resumed, job.strokes.len());
-    assert!(summary.ends_at_home);
     let home = shipped.home;
-    let points = program.points();
-    for point in &points {
-        for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
-            assert!((q - h).abs() <= PI, "joint {joint} at {q} rad");
+    // Planned in the joints' whole range, the pencil's base joint stood 3.19 rad from home and no
+    // move back home was found; the anchor, planned within half a turn alone, flipped the wrist
+    // between strokes.
+    for (icon, width_m) in [("pencil.svg", 0.3), ("anchor.svg", 0.15)] {
+        let placement = Placement {
+            origin_m: [0.45, 0.0, 0.25],
+            width_m: Some(width_m),
+            ..Placement::default()
+        };
+        let svg = common::workspace()
+            .join("crates/io/tests/data/icons")
+            .join(icon);
+        let job = common::drawing(planner.robot(), &svg, &placement)
+            .with_home(home, planner.robot())
+            .expect("the home fits");
+        let program = common::plan(&planner, &timing, &file, &job);
+        let summary = &program.summary;
+        assert_eq!(
+            summary.complete + summary.resumed,
+            job.strokes.len(),
+            "{icon}"
+        );
+        assert!(summary.ends_at_home, "{icon}");
+        let points = program.points();
+        for point in &points {
+            for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
+                assert!((q - h).abs() <= PI, "{icon}: joint {joint} at {q} rad");
+            }
         }
+        // Every pen-up move turns each joint less than half a turn in all.
+        let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
+        for segment in &program.segments {
+            if matches!(segment.kind, SegmentKind::Stroke { .. }) {
+                continue;
+            }
+            let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
+            let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
+            let moved = &points[first..last];
+            for joint in 0..home.len() {
+                let turned: f64 = moved
+                    .windows(2)
+                    .map(|pair| (pair[1].positions[joint] - pair[0].positions[joint]).abs())
+                    .sum();
+                assert!(
+                    turned <= PI,
+                    "{icon}: a move at {} s turns joint {joint} by {turned} rad",
+                    segment.start_s
+                );
+            }
+        }
+        verify_job(&program, &checker, planner.robot().joint_names())
+            .expect("the program holds up");
     }
-    // Every pen-up move turns each joint less than half a turn in all.
-    let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
-    for segment in &program.segments {
-        if matches!(segment.kind, SegmentKind::Stroke { .. }) {
-            continue;
-        }
-        let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
-        let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
-        let moved = &points[first..last];
-        for joint in 0..home.len() {
-            let turned: f64 = moved
-                .windows(2)
-                .map(|pair| (pair[1].positions[joint] - pair[0].positions[joint]).abs())
-                .sum();
-            assert!(
-                turned <= PI,
-                "a move at {} s turns joint {joint} by {turned} rad",
-                segment.start_s
-            );
-        }
-    }
-    verify_job(&program, &checker, planner.robot().joint_names()).expect("the program holds up");
 }

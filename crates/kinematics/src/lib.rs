@@ -56,7 +56,7 @@ pub use projection::{
     pose_residual, project_to_point, project_to_pose,
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
-pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, HALF_TURN_MARGIN_RAD, JointLimits, Robot, RobotError};
+pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
 pub use rotation::{Transform, rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
 pub use scene::{
     ContactHit, Obstacle, ObstacleError, Plate, Scene, Shape, ToolContact, WorkSurface,

@@ -142,11 +142,6 @@ pub enum RobotError {
     },
 }
 
-/// How far inside half a turn of a reference [`JointLimits::within_half_turn_of`] keeps a joint
-/// (rad): a motion timed between its planned configurations may overshoot them by a little, and
-/// still lies within half a turn.
-pub const HALF_TURN_MARGIN_RAD: f64 = 2e-3;
-
 /// Lower, upper and velocity limits of the joints; entries past the arm's joints (an arm of six)
 /// hold the range ±π and speed 1 rad/s, which no step uses (those joints never move).
 #[derive(Clone, Debug, PartialEq)]
@@ -190,18 +185,17 @@ impl JointLimits {
         q.zip_zip_map(&self.lower, &self.upper, |v, lo, hi| v.clamp(lo, hi))
     }
 
-    /// These limits with every joint whose range is wider than a turn narrowed to within half a
-    /// turn of `reference`, less [`HALF_TURN_MARGIN_RAD`] (`h = π − margin`):
-    /// `[max(q_min, r − h), min(q_max, r + h)]`, where that interval is not empty. A joint that
-    /// may turn further than a turn reaches every angle of the arm within that band but the
-    /// margin, so the narrowed limits lose almost no pose the arm can take, only the second
-    /// joint value of it a turn away; other joints, and velocity limits, are kept.
-    pub fn within_half_turn_of(&self, reference: &JointVector) -> JointLimits {
-        let half_turn = std::f64::consts::PI - HALF_TURN_MARGIN_RAD;
+    /// These limits with every joint whose range is wider than a turn narrowed to within
+    /// `half_width_rad` of `reference`: `[max(q_min, r − w), min(q_max, r + w)]`, where that
+    /// interval is not empty. Such a joint reaches every angle of the arm within half a turn of
+    /// any value, so a band of half a turn loses no pose the arm can take, only its joint values
+    /// a turn away; a narrower band keeps the joint nearer `reference`. Other joints, and
+    /// velocity limits, are kept.
+    pub fn within(&self, reference: &JointVector, half_width_rad: f64) -> JointLimits {
         let mut narrowed = self.clone();
         for i in 0..MAX_DOF {
-            let lower = self.lower[i].max(reference[i] - half_turn);
-            let upper = self.upper[i].min(reference[i] + half_turn);
+            let lower = self.lower[i].max(reference[i] - half_width_rad);
+            let upper = self.upper[i].min(reference[i] + half_width_rad);
             if self.upper[i] - self.lower[i] > std::f64::consts::TAU && lower < upper {
                 narrowed.lower[i] = lower;
                 narrowed.upper[i] = upper;
@@ -559,11 +553,11 @@ impl Robot {
         &self.limits
     }
 
-    /// The same arm with its position limits narrowed to within half a turn of `reference`
-    /// where they span more than a turn ([`JointLimits::within_half_turn_of`]).
-    pub fn within_half_turn_of(&self, reference: &JointVector) -> Robot {
+    /// The same arm with its position limits narrowed to within `half_width_rad` of `reference`
+    /// where they span more than a turn ([`JointLimits::within`]).
+    pub fn within(&self, reference: &JointVector, half_width_rad: f64) -> Robot {
         Robot {
-            limits: self.limits.within_half_turn_of(reference),
+            limits: self.limits.within(reference, half_width_rad),
             ..self.clone()
         }
     }

@@ -3,7 +3,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use emg_kinematics::{HALF_TURN_MARGIN_RAD, JointLimits, JointVector, Robot};
+use emg_kinematics::{JointLimits, JointVector, Robot};
 
 /// The UR5e's ranges: ±2π for every joint but the elbow's ±π.
 fn ur5e_limits() -> JointLimits {
@@ -121,36 +121,39 @@ fn a_motion_sweeping_past_the_half_turn_is_turned_by_its_middle() {
 }
 
 #[test]
-fn limits_wider_than_a_turn_are_narrowed_to_half_a_turn_about_the_reference() {
+fn limits_wider_than_a_turn_are_narrowed_to_a_band_about_the_reference() {
     let limits = ur5e_limits();
     let home = configuration([0.0, -PI / 2.0, 0.0, -PI / 2.0, 5.0, 0.0]);
-    let band = limits.within_half_turn_of(&home);
-    // Every ±2π joint keeps half a turn (less the margin) either side of the home, cut by its
-    // limit (wrist 2's home lies near its upper limit); the elbow's ±π, no wider than a turn, is
-    // kept; so are the speeds.
-    let h = PI - HALF_TURN_MARGIN_RAD;
-    let lower = configuration([-h, -PI / 2.0 - h, -PI, -PI / 2.0 - h, 5.0 - h, -h]);
-    let upper = configuration([h, -PI / 2.0 + h, PI, -PI / 2.0 + h, TAU, h]);
-    for joint in 0..6 {
-        assert!(
-            (band.lower[joint] - lower[joint]).abs() < 1e-12,
-            "joint {joint}"
-        );
-        assert!(
-            (band.upper[joint] - upper[joint]).abs() < 1e-12,
-            "joint {joint}"
-        );
+    for w in [PI / 2.0, PI - 2e-3] {
+        let band = limits.within(&home, w);
+        // Every ±2π joint keeps w either side of the home, cut by its limit (wrist 2's home
+        // lies near its upper limit); the elbow's ±π, no wider than a turn, is kept; so are the
+        // speeds.
+        let lower = configuration([-w, -PI / 2.0 - w, -PI, -PI / 2.0 - w, 5.0 - w, -w]);
+        let upper = configuration([w, -PI / 2.0 + w, PI, -PI / 2.0 + w, TAU.min(5.0 + w), w]);
+        for joint in 0..6 {
+            assert!(
+                (band.lower[joint] - lower[joint]).abs() < 1e-12,
+                "joint {joint}, {w}"
+            );
+            assert!(
+                (band.upper[joint] - upper[joint]).abs() < 1e-12,
+                "joint {joint}, {w}"
+            );
+        }
+        assert_eq!(band.velocity, limits.velocity);
     }
-    assert_eq!(band.velocity, limits.velocity);
-    // Narrowing again about the same reference changes nothing.
-    assert_eq!(band.within_half_turn_of(&home), band);
+    // A band of half a turn narrowed again about the same reference stays as it is: its range
+    // is no wider than a turn.
+    let band = limits.within(&home, PI);
+    assert_eq!(band.within(&home, PI / 2.0), band);
     // A reference outside a joint's limits leaves that joint as it was.
     let away = configuration([0.0, 0.0, 0.0, 0.0, 0.0, 3.0 * TAU]);
-    assert_eq!(limits.within_half_turn_of(&away).lower[5], -TAU);
+    assert_eq!(limits.within(&away, PI).lower[5], -TAU);
     // An arm whose joints all span less than a turn keeps its limits.
     for name in ["fr3_pen.urdf", "iiwa14_pen.urdf"] {
         let robot = shipped(name);
-        let narrowed = robot.within_half_turn_of(&robot.mid_range());
+        let narrowed = robot.within(&robot.mid_range(), PI / 2.0);
         assert_eq!(narrowed.limits(), robot.limits(), "{name}");
     }
 }

@@ -145,12 +145,11 @@ impl Planner {
         Self::new(self.robot.clone(), self.models.clone(), config)
     }
 
-    /// The same planner with the robot's joints kept within half a turn of `reference` where
-    /// their limits span more than a turn ([`Robot::within_half_turn_of`]): every pose the arm
-    /// can take, each joint at its value nearest the reference. `None` where no joint's limits
-    /// span more than a turn (nothing would change).
-    pub fn within_half_turn_of(&self, reference: &JointVector) -> Option<Self> {
-        let robot = self.robot.within_half_turn_of(reference);
+    /// The same planner with the robot's joints kept within `half_width_rad` of `reference`
+    /// where their limits span more than a turn ([`Robot::within`]). `None` where no joint's
+    /// limits span more than a turn (nothing would change).
+    pub fn within(&self, reference: &JointVector, half_width_rad: f64) -> Option<Self> {
+        let robot = self.robot.within(reference, half_width_rad);
         (robot.limits() != self.robot.limits()).then(|| Self {
             robot,
             models: self.models.clone(),
