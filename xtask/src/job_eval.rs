@@ -492,8 +492,6 @@ struct MoveTurns {
 /// whole turn the way it went (`end − sign(Δ)·2π`) lies within `limits`: a shorter turn to the
 /// same angle existed.
 fn move_turns(program: &JobFile, limits: &emg_kinematics::JointLimits) -> MoveTurns {
-    let points = program.points();
-    let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
     let mut turns = MoveTurns {
         moves: 0,
         over_half: 0,
@@ -503,25 +501,22 @@ fn move_turns(program: &JobFile, limits: &emg_kinematics::JointLimits) -> MoveTu
         if matches!(segment.kind, SegmentKind::Stroke { .. }) {
             continue;
         }
-        let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
-        let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
-        let points = &points[first..last];
-        let (Some(start), Some(end)) = (points.first(), points.last()) else {
+        let samples = program.segment_samples(segment);
+        let (Some(start), Some(end)) = (samples.first(), samples.last()) else {
             continue;
         };
         turns.moves += 1;
-        let joints = start.positions.len();
-        let turned = |i: usize| -> f64 {
-            points
-                .windows(2)
-                .map(|pair| (pair[1].positions[i] - pair[0].positions[i]).abs())
-                .sum()
-        };
-        let over: Vec<usize> = (0..joints).filter(|&i| turned(i) > PI).collect();
+        let over: Vec<usize> = program
+            .joint_travel_rad(segment)
+            .iter()
+            .enumerate()
+            .filter(|(_, turned)| **turned > PI)
+            .map(|(joint, _)| joint)
+            .collect();
         turns.over_half += usize::from(!over.is_empty());
         turns.long_way += usize::from(over.iter().any(|&i| {
-            let net = end.positions[i] - start.positions[i];
-            let other_way = end.positions[i] - net.signum() * TAU;
+            let net = end.q[i] - start.q[i];
+            let other_way = end.q[i] - net.signum() * TAU;
             net.abs() > PI && other_way >= limits.lower[i] && other_way <= limits.upper[i]
         }));
     }

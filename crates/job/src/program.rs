@@ -270,6 +270,24 @@ impl JobFile {
             .samples(self.rate_hz)
     }
 
+    /// How far each joint turns over `segment`'s samples in all (rad): per joint, the sum of
+    /// `|Δq|` between consecutive samples, so a joint that turns and turns back counts both.
+    ///
+    /// # Panics
+    ///
+    /// If the segment's motion cannot be sampled ([`Self::check_motion`]).
+    pub fn joint_travel_rad(&self, segment: &Segment) -> Vec<f64> {
+        let samples = self.segment_samples(segment);
+        (0..self.joint_names.len())
+            .map(|joint| {
+                samples
+                    .windows(2)
+                    .map(|pair| (pair[1].q[joint] - pair[0].q[joint]).abs())
+                    .sum()
+            })
+            .collect()
+    }
+
     /// The `format` of a JSON text, if it has one.
     fn format_of(text: &str) -> Option<String> {
         #[derive(Deserialize)]

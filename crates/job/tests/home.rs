@@ -86,19 +86,11 @@ fn ur5e_drawings_half_a_turn_from_home_are_drawn_within_half_a_turn_and_no_move_
             }
         }
         // Every pen-up move turns each joint less than half a turn in all.
-        let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
         for segment in &program.segments {
             if matches!(segment.kind, SegmentKind::Stroke { .. }) {
                 continue;
             }
-            let first = times.partition_point(|t| *t < segment.start_s - 1e-9);
-            let last = times.partition_point(|t| *t <= segment.end_s + 1e-9);
-            let moved = &points[first..last];
-            for joint in 0..home.len() {
-                let turned: f64 = moved
-                    .windows(2)
-                    .map(|pair| (pair[1].positions[joint] - pair[0].positions[joint]).abs())
-                    .sum();
+            for (joint, turned) in program.joint_travel_rad(segment).into_iter().enumerate() {
                 assert!(
                     turned <= PI,
                     "{icon}: a move at {} s turns joint {joint} by {turned} rad",
