@@ -16,6 +16,7 @@
 //!
 //! [`plan_job`] runs them in order; [`place_job`] runs it at the best places for the part.
 
+pub mod branch;
 pub mod claims;
 pub mod free_space;
 pub mod motion;
@@ -41,6 +42,7 @@ use emg_planner::{
 use emg_timing::{DynamicLimits, least_move_s, time_blended_move};
 use rayon::prelude::*;
 
+pub use branch::{BRANCH_CHANGE_RAD, Branches, MAX_CARRIED_STROKES, choose_branches};
 pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use motion::Motion;
@@ -196,15 +198,30 @@ pub fn plan_job(
             Ok(best.expect("the cascade holds the whole range"))
         })
         .collect::<Result<_, Stopped>>()?;
-    let mut sequence = Vec::with_capacity(planned.len());
-    let mut plans = Vec::with_capacity(planned.len());
-    let mut ranks = Vec::with_capacity(planned.len());
-    for (oriented, plan, rank) in planned {
-        sequence.push(oriented);
-        plans.push(plan);
-        ranks.push(rank);
-    }
+    let connector = Connector {
+        free: &free,
+        timing,
+        settings,
+    };
+    let branches = JobBranches {
+        connector: &connector,
+        cascade: &cascade,
+        request,
+        home: job.home.as_ref(),
+    };
+    let (sequence, planned): (Vec<Oriented>, Vec<(StrokePlan, usize)>) = planned
+        .into_iter()
+        .map(|(oriented, plan, rank)| (oriented, (plan, rank)))
+        .unzip();
     ordering.sequence = sequence;
+    let (planned, _) = choose_branches(planned, job.home.as_ref(), &branches);
+    let (plans, ranks): (Vec<StrokePlan>, Vec<usize>) = planned.into_iter().unzip();
+    // Where each stroke's plan starts as the arm holds it, for the move to it from the stroke
+    // before.
+    let starts: Vec<Option<JointVector>> = plans
+        .iter()
+        .map(|plan| branches.ends(plan).map(|[start, _]| start))
+        .collect();
     // Measured again between the strokes as they are drawn: their directions and starts taken.
     ordering.travel_m = plans
         .windows(2)
@@ -213,11 +230,6 @@ pub fn plan_job(
             (pair[1].path.point_at(0.0) - end).norm()
         })
         .fold(0.0, |total, leg| total + leg);
-    let connector = Connector {
-        free: &free,
-        timing,
-        settings,
-    };
     let mut program = Program::default();
     let mut reports = Vec::new();
     let (mut straight_moves, mut sampled_moves) = (0, 0);
@@ -266,7 +278,19 @@ pub fn plan_job(
                 })
                 .map(|part| toward(part, job.home.as_ref(), from.as_ref(), &free))
                 .collect();
-            let candidates = ranked(planned.clone(), again, from.as_ref(), limits);
+            // Where the arm goes after the stroke's last part: the next stroke, else the home.
+            let next = queue
+                .is_empty()
+                .then(|| {
+                    starts[connected + 1..]
+                        .iter()
+                        .flatten()
+                        .next()
+                        .or(job.home.as_ref())
+                })
+                .flatten()
+                .map(|next| (next, |q: &JointVector| branches.held(q)));
+            let candidates = ranked(planned.clone(), again, from.as_ref(), next, limits);
             // The first candidate placed, else why the first one could not be.
             let mut placed = None;
             let mut first_why = None;
@@ -562,22 +586,28 @@ fn toward(
 }
 
 /// The parts that may draw a stretch, in the order they are tried: those drawing as far as the
-/// searched part `planned` (to [`SAME_LENGTH_M`]), the one the arm reaches soonest from `from`
-/// (where it is; [`least_move_s`] to the part's start within `limits`) first; then the others,
-/// the furthest-drawing first. Deterministic: ties keep the order given, `planned` first.
+/// searched part `planned` (to [`SAME_LENGTH_M`]), the one with the least pen-up time first
+/// ([`least_move_s`] within `limits` from `from`, where the arm is, to the part's start, and
+/// where the part is its stroke's last, from its end as `next` holds it to `next`'s
+/// configuration: where the arm goes next); then the others, the furthest-drawing first.
+/// Deterministic: ties keep the order given, `planned` first.
 fn ranked(
     planned: StrokePart,
     again: Vec<StrokePart>,
     from: Option<&JointVector>,
+    next: Option<(&JointVector, impl Fn(&JointVector) -> JointVector)>,
     limits: &DynamicLimits,
 ) -> Vec<StrokePart> {
     // Every candidate starts where the searched part does: the longer draws further.
     let reach = planned.trajectory.path_length_m;
     let as_far = |part: &StrokePart| part.trajectory.path_length_m >= reach - SAME_LENGTH_M;
     let time_from = |part: &StrokePart| {
-        from.map_or(0.0, |from| {
-            least_move_s(from, &part.trajectory.steps[0].q, limits)
-        })
+        let steps = &part.trajectory.steps;
+        let to_start = from.map_or(0.0, |from| least_move_s(from, &steps[0].q, limits));
+        let onward = next.as_ref().map_or(0.0, |(next, held)| {
+            least_move_s(&held(&steps[steps.len() - 1].q), next, limits)
+        });
+        to_start + onward
     };
     let mut candidates: Vec<StrokePart> = std::iter::once(planned).chain(again).collect();
     candidates.sort_by(|a, b| {
@@ -590,6 +620,59 @@ fn ranked(
         })
     });
     candidates
+}
+
+/// The job as the choose-branches stage ([`branch`]) sees it.
+struct JobBranches<'a> {
+    connector: &'a Connector<'a>,
+    /// The planners a stroke is tried with, by rank.
+    cascade: &'a [&'a Planner],
+    request: &'a PlanRequest,
+    home: Option<&'a JointVector>,
+}
+
+impl JobBranches<'_> {
+    /// `q` as the job holds it: each joint among its whole turns nearest the home (where there
+    /// is one), the tool's free roll, which the job holds still, left out (0).
+    fn held(&self, q: &JointVector) -> JointVector {
+        let robot = self.connector.free.robot();
+        let mut held = match self.home {
+            Some(home) => q + robot.limits().turns_toward(std::slice::from_ref(q), home),
+            None => *q,
+        };
+        if let Some(roll) = robot.tool_roll_joint() {
+            held[roll] = 0.0;
+        }
+        held
+    }
+}
+
+impl Branches for JobBranches<'_> {
+    fn ends(&self, plan: &StrokePlan) -> Option<[JointVector; 2]> {
+        let first = plan.parts.first()?.trajectory.steps.first()?;
+        let last = plan.parts.last()?.trajectory.steps.last()?;
+        Some([self.held(&first.q), self.held(&last.q)])
+    }
+
+    fn carried(&self, plan: &StrokePlan, rank: usize, from: &JointVector) -> Option<StrokePlan> {
+        let first = plan
+            .parts
+            .first()
+            .filter(|part| part.from_s == 0.0 && !part.backward)?;
+        let part =
+            self.connector
+                .replanned_nearby(self.cascade[rank], self.request, first, from)?;
+        Some(StrokePlan {
+            path: plan.path.clone(),
+            parts: vec![part],
+            searches: plan.searches,
+            unsearched_from_s: None,
+        })
+    }
+
+    fn move_s(&self, from: &JointVector, to: &JointVector) -> f64 {
+        least_move_s(from, to, &self.connector.timing.request().limits)
+    }
 }
 
 /// How far before a pen-up move's corner its rounding starts: this share of the shorter of the

@@ -1,15 +1,47 @@
 //! A job's program starts and ends at the arm's home, its joint values chosen among their whole
 //! turns nearest the home: the UR5e, whose joints span ±2π, drawing `../shared/cases/house.svg`,
-//! and a drawing straight ahead of it, where its base joint turns half a turn from home on the
-//! branch the search finds first.
+//! drawings straight ahead of it, where its base joint turns half a turn from home on the
+//! branch the search finds first, and seams that no one branch draws as each stroke's search
+//! finds it.
 
 mod common;
 
 use std::f64::consts::PI;
 
+use emg_control::{PATH_FORMAT_VERSION, PathSpec, SegmentSpec};
 use emg_io::Placement;
-use emg_job::{JobCheckError, SegmentKind, verify_job};
+use emg_job::{Job, JobCheckError, JobFile, SegmentKind, verify_job};
+use emg_kinematics::Vec3;
 use emg_planner::ShippedRobot;
+
+/// Asserts that every sample of `program` holds each joint within half a turn of `home`.
+fn assert_within_half_a_turn_of(home: &[f64], program: &JobFile, what: &str) {
+    for point in &program.points() {
+        for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
+            assert!(
+                (q - h).abs() <= PI,
+                "{what}: joint {joint} at {q} rad, {} rad from home",
+                q - h
+            );
+        }
+    }
+}
+
+/// Asserts that no pen-up move of `program` turns a joint more than half a turn in all.
+fn assert_no_move_turns_half_a_turn(program: &JobFile, what: &str) {
+    for segment in &program.segments {
+        if matches!(segment.kind, SegmentKind::Stroke { .. }) {
+            continue;
+        }
+        for (joint, turned) in program.joint_travel_rad(segment).into_iter().enumerate() {
+            assert!(
+                turned <= PI,
+                "{what}: a move at {} s turns joint {joint} by {turned} rad",
+                segment.start_s
+            );
+        }
+    }
+}
 
 #[test]
 fn the_ur5e_house_starts_and_ends_at_home_every_joint_within_half_a_turn_of_it() {
@@ -30,15 +62,7 @@ fn the_ur5e_house_starts_and_ends_at_home_every_joint_within_half_a_turn_of_it()
     let first = &points[0].positions;
     let last = &points[points.len() - 1].positions;
     assert_eq!((first.as_slice(), last.as_slice()), (home, home));
-    for point in &points {
-        for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
-            assert!(
-                (q - h).abs() <= PI,
-                "joint {joint} at {q} rad, {} rad from home",
-                q - h
-            );
-        }
-    }
+    assert_within_half_a_turn_of(home, &program, "house");
     let joints = planner.robot().joint_names();
     verify_job(&program, &checker, joints).expect("the program holds up");
     // A program said to start at home that starts elsewhere is refused.
@@ -79,26 +103,44 @@ fn ur5e_drawings_half_a_turn_from_home_are_drawn_within_half_a_turn_and_no_move_
             "{icon}"
         );
         assert!(summary.ends_at_home, "{icon}");
-        let points = program.points();
-        for point in &points {
-            for (joint, (q, h)) in point.positions.iter().zip(home).enumerate() {
-                assert!((q - h).abs() <= PI, "{icon}: joint {joint} at {q} rad");
-            }
-        }
-        // Every pen-up move turns each joint less than half a turn in all.
-        for segment in &program.segments {
-            if matches!(segment.kind, SegmentKind::Stroke { .. }) {
-                continue;
-            }
-            for (joint, turned) in program.joint_travel_rad(segment).into_iter().enumerate() {
-                assert!(
-                    turned <= PI,
-                    "{icon}: a move at {} s turns joint {joint} by {turned} rad",
-                    segment.start_s
-                );
-            }
-        }
+        assert_within_half_a_turn_of(home, &program, icon);
+        assert_no_move_turns_half_a_turn(&program, icon);
         verify_job(&program, &checker, planner.robot().joint_names())
             .expect("the program holds up");
     }
+}
+
+#[test]
+fn ur5e_seams_that_one_branch_draws_are_all_drawn_on_it() {
+    let (planner, timing, checker, file) = common::setup("ur5e");
+    let home = ShippedRobot::by_name("ur5e").expect("the UR5e").home;
+    // Five parallel 0.2 m seams 3 cm apart on a surface tilted 40°, as job-eval's. Each planned
+    // alone, the first four took the branch nearest the home, on which the fifth cannot be
+    // drawn whole: the wrist flipped before it, turning wrist 2 by 4.1 rad.
+    let tilt = 40_f64.to_radians();
+    let normal = Vec3::new(0.0, libm::sin(tilt), -libm::cos(tilt));
+    let along = normal.cross(&Vec3::x()).normalize();
+    let seams = (0..5)
+        .map(|k| {
+            let start = Vec3::new(0.39 + 0.03 * k as f64, 0.0, 0.25) - along * 0.1;
+            PathSpec {
+                version: PATH_FORMAT_VERSION,
+                start: start.into(),
+                normal: normal.into(),
+                blend_radius_m: 0.0,
+                segments: vec![SegmentSpec::Line {
+                    to: (start + along * 0.2).into(),
+                }],
+            }
+        })
+        .collect();
+    let job = Job::from_strokes(seams, planner.robot())
+        .and_then(|job| job.with_home(home, planner.robot()))
+        .expect("a valid job");
+    let program = common::plan(&planner, &timing, &file, &job);
+    assert_eq!(program.summary.complete, 5);
+    assert!(program.summary.ends_at_home);
+    assert_within_half_a_turn_of(home, &program, "seams");
+    assert_no_move_turns_half_a_turn(&program, "seams");
+    verify_job(&program, &checker, planner.robot().joint_names()).expect("the program holds up");
 }
