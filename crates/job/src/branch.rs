@@ -1,17 +1,20 @@
 //! The choose-branches stage: on which of the arm's branches (the wrist flipped or not, the
 //! elbow up or down, the base turned about) each stroke is drawn, chosen for the job as a whole.
 //!
-//! Each stroke's plan is found alone, and two neighbouring strokes may be planned on different
-//! branches: one that the next stroke cannot be drawn whole on, say. The arm then changes
-//! branch between them, a slow pen-up move that may turn a joint half a turn or more. Where
-//! consecutive plans lie on different branches (a joint more than [`BRANCH_CHANGE_RAD`] apart),
-//! the strokes before the change are planned again carried over from the branch after it, and
-//! those after it from the branch before it, stroke by stroke as long as each is drawn as far
-//! as its own plan (to [`crate::SAME_LENGTH_M`]), up to [`MAX_CARRIED_STROKES`] each way. A
-//! shortest path over these candidates (dynamic programming, exact) then picks one plan per
-//! stroke: the least estimated pen-up time of the whole job, from the home and back to it, at
-//! the arm's limits. Every candidate draws as far as the stroke's own plan, so the choice never
-//! draws less.
+//! Each stroke's plan is found alone, and the connect stage carries the arm's branch from one
+//! stroke to the next wherever the next can be drawn as far from it (a stand-in part planned
+//! from where the arm is). Where it cannot, the branch changes: a slow pen-up move that may turn
+//! a joint half a turn or more, onto a branch the strokes before could have shared, or off one
+//! that the strokes after could have kept. At each such change in a connected program (the
+//! parts on either side more than [`BRANCH_CHANGE_RAD`] apart on some joint), the branches known
+//! about it (the arm's on either side of the change, and those of the strokes' own plans within
+//! [`MAX_CARRIED_STROKES`] of it) are each carried to the strokes before and after them there:
+//! each stroke planned again from where the one next to it leaves the arm, stroke by stroke as
+//! long as it draws as far as its own plan (to [`crate::SAME_LENGTH_M`]) on a branch not yet
+//! known for it. A shortest path over these candidates and the strokes as placed (dynamic
+//! programming, exact) then picks one per stroke: the least estimated pen-up time of the whole
+//! job, from the home and back to it, at the arm's limits. Every candidate draws as far as the
+//! stroke's own plan, so the choice never draws less.
 
 use emg_kinematics::JointVector;
 use rayon::prelude::*;
@@ -19,14 +22,13 @@ use rayon::prelude::*;
 use crate::SAME_LENGTH_M;
 use crate::stroke::StrokePlan;
 
-/// Consecutive strokes whose plans lie further apart than this on some joint (rad, from the
-/// end of one to the start of the next) count as planned on different branches: about a sixth
-/// of a turn, more than neighbouring strokes of a drawing ask of one joint.
+/// Consecutive strokes placed further apart than this on some joint (rad, from the end of one
+/// to the start of the next) lie on different branches: about a sixth of a turn, more than
+/// neighbouring strokes of a drawing ask of one joint.
 pub const BRANCH_CHANGE_RAD: f64 = 1.0;
 
-/// How many strokes on each side of a branch change are planned again on the other side's
-/// branch at most.
-pub const MAX_CARRIED_STROKES: usize = 16;
+/// How many strokes on either side of a branch change its branches are carried to at most.
+pub const MAX_CARRIED_STROKES: usize = 8;
 
 /// A stroke's plan and the place in the job's cascade of planners of the planner that made it.
 pub type RankedPlan = (StrokePlan, usize);
@@ -47,77 +49,89 @@ pub trait Branches: Sync {
     fn move_s(&self, from: &JointVector, to: &JointVector) -> f64;
 }
 
+/// A stroke's plan as the stage chose it.
+#[derive(Clone, Debug)]
+pub struct BranchChoice {
+    /// The plan.
+    pub plan: StrokePlan,
+    /// The place in the job's cascade of planners of the planner that made it.
+    pub rank: usize,
+    /// Where it starts as the job holds it ([`Branches::ends`]), where it is on another branch
+    /// than the stroke was placed on; `None` where the stroke keeps its place.
+    pub moved_to: Option<JointVector>,
+}
+
 /// A candidate plan for one stroke, with where it starts and ends.
 struct Candidate {
     plan: RankedPlan,
     ends: [JointVector; 2],
 }
 
-/// `planned` (one plan per stroke, in the order drawn) with each stroke's branch chosen for the
-/// job as a whole (the module's description), the arm starting and ending at `home` where it
-/// has one; with how many strokes were planned again. Deterministic: the candidates are found
-/// in parallel but gathered in order, and ties keep the stroke's own plan.
+/// The plans to connect again for the strokes `planned` (one per stroke, in the order drawn),
+/// connected once with their parts placed as `placed` says (where each stroke's first part
+/// starts and its last ends, as [`Branches::ends`] holds them; `None` where none was placed):
+/// each stroke's branch chosen for the job as a whole (the module's description), the arm
+/// starting and ending at `home` where it has one. `None` where no stroke changes branch.
+/// Deterministic: the candidates are found in parallel but gathered in order, and ties keep the
+/// strokes as placed.
 pub fn choose_branches(
-    planned: Vec<RankedPlan>,
+    planned: &[RankedPlan],
+    placed: &[Option<[JointVector; 2]>],
     home: Option<&JointVector>,
     job: &impl Branches,
-) -> (Vec<RankedPlan>, usize) {
-    let ends: Vec<Option<[JointVector; 2]>> =
-        planned.par_iter().map(|(plan, _)| job.ends(plan)).collect();
+) -> Option<Vec<BranchChoice>> {
     // The strokes that have a part, in the order drawn: the others play no part in the choice.
-    let drawn: Vec<usize> = (0..planned.len()).filter(|&i| ends[i].is_some()).collect();
-    let end = |i: usize| ends[i].expect("a drawn stroke has ends");
-    let changes: Vec<usize> = (1..drawn.len())
-        .filter(|&k| apart(&end(drawn[k - 1])[1], &end(drawn[k])[0]) > BRANCH_CHANGE_RAD)
+    let drawn: Vec<usize> = (0..planned.len())
+        .filter(|&i| placed[i].is_some())
         .collect();
-    if changes.is_empty() {
-        return (planned, 0);
-    }
-    // Per change, the strokes before it carried over from the branch after it, then those after
-    // it from the branch before it.
+    let ends = |i: usize| placed[i].expect("a drawn stroke has ends");
+    let changes: Vec<usize> = (1..drawn.len())
+        .filter(|&k| apart(&ends(drawn[k - 1])[1], &ends(drawn[k])[0]) > BRANCH_CHANGE_RAD)
+        .collect();
+    // Per change, the branches known about it carried to the strokes about it.
     let carried: Vec<Vec<(usize, Candidate)>> = changes
         .par_iter()
-        .map(|&k| {
-            let before = drawn[..k].iter().rev().take(MAX_CARRIED_STROKES);
-            let after = drawn[k..].iter().take(MAX_CARRIED_STROKES);
-            let mut found = carry(&planned, &ends, before, drawn[k], Side::Before, job);
-            found.extend(carry(
-                &planned,
-                &ends,
-                after,
-                drawn[k - 1],
-                Side::After,
-                job,
-            ));
-            found
-        })
+        .map(|&k| carried_about(planned, placed, &drawn, k, job))
         .collect();
-    let mut candidates: Vec<Vec<Candidate>> = planned
+    let mut others: Vec<Vec<Candidate>> = (0..planned.len()).map(|_| Vec::new()).collect();
+    for (stroke, candidate) in carried.into_iter().flatten() {
+        others[stroke].push(candidate);
+    }
+    // Where each drawn stroke's candidates start and end: as placed first.
+    let candidate_ends: Vec<Vec<[JointVector; 2]>> = drawn
         .iter()
-        .zip(&ends)
-        .map(|(plan, ends)| {
-            ends.iter()
-                .map(|ends| Candidate {
-                    plan: plan.clone(),
-                    ends: *ends,
-                })
+        .map(|&stroke| {
+            std::iter::once(ends(stroke))
+                .chain(others[stroke].iter().map(|other| other.ends))
                 .collect()
         })
         .collect();
-    let mut replanned = 0;
-    for (stroke, candidate) in carried.into_iter().flatten() {
-        candidates[stroke].push(candidate);
-        replanned += 1;
+    let picks = least_pen_up(&candidate_ends, home, |from, to| job.move_s(from, to));
+    if picks.iter().all(|&pick| pick == 0) {
+        return None;
     }
-    let choice = least_pen_up(&drawn, &candidates, home, job);
-    let mut chosen: Vec<RankedPlan> = planned;
-    for (&stroke, pick) in drawn.iter().zip(choice) {
+    let mut chosen: Vec<BranchChoice> = planned
+        .iter()
+        .map(|(plan, rank)| BranchChoice {
+            plan: plan.clone(),
+            rank: *rank,
+            moved_to: None,
+        })
+        .collect();
+    for (&stroke, pick) in drawn.iter().zip(picks) {
         if pick > 0 {
-            let Candidate { plan, .. } = candidates[stroke].swap_remove(pick);
-            chosen[stroke] = plan;
+            let Candidate {
+                plan: (plan, rank),
+                ends: [start, _],
+            } = others[stroke].swap_remove(pick - 1);
+            chosen[stroke] = BranchChoice {
+                plan,
+                rank,
+                moved_to: Some(start),
+            };
         }
     }
-    (chosen, replanned)
+    Some(chosen)
 }
 
 /// The largest difference of one joint between two configurations (rad).
@@ -125,127 +139,209 @@ fn apart(a: &JointVector, b: &JointVector) -> f64 {
     (a - b).amax()
 }
 
-/// Which side of a branch change strokes are carried to.
-#[derive(Clone, Copy)]
-enum Side {
-    /// The strokes drawn before it, from the one just before back: each planned from where
-    /// the stroke after it starts.
-    Before,
-    /// The strokes drawn after it, from the one just after on: each planned from where the
-    /// stroke before it ends.
-    After,
+/// Whether `ends` lies on another branch than each of `known` (more than
+/// [`BRANCH_CHANGE_RAD`] from it at its start or its end).
+fn new_branch(known: &[[JointVector; 2]], ends: &[JointVector; 2]) -> bool {
+    known.iter().all(|other| {
+        apart(&other[0], &ends[0]) > BRANCH_CHANGE_RAD
+            || apart(&other[1], &ends[1]) > BRANCH_CHANGE_RAD
+    })
 }
 
-impl Side {
-    /// Where a plan with `ends` leaves the arm for the next stroke carried to this side.
-    fn seed(self, ends: &[JointVector; 2]) -> JointVector {
-        match self {
-            Self::Before => ends[0],
-            Self::After => ends[1],
-        }
-    }
-}
-
-/// The strokes `strokes` on `side` of a branch change (in the order they are carried to, away
-/// from it) planned again one after another by the planner of stroke `across` (the stroke on
-/// the change's other side), each from where the one before leaves the arm, the first from
-/// where `across`'s plan does: as long as each draws as far as the stroke's own plan and lies
-/// on another branch than it.
-fn carry<'a>(
+/// The candidates for the strokes within [`MAX_CARRIED_STROKES`] of the branch change before
+/// `drawn[k]` (`drawn`: the strokes placed, in the order drawn): the strokes' own plans where
+/// they lie on another branch than placed, then each branch known there carried to the strokes
+/// before and after it (the module's description). With the stroke each is for.
+fn carried_about(
     planned: &[RankedPlan],
-    ends: &[Option<[JointVector; 2]>],
-    strokes: impl Iterator<Item = &'a usize>,
-    across: usize,
-    side: Side,
+    placed: &[Option<[JointVector; 2]>],
+    drawn: &[usize],
+    k: usize,
     job: &impl Branches,
 ) -> Vec<(usize, Candidate)> {
-    let rank = planned[across].1;
-    let mut from = side.seed(&ends[across].expect("a drawn stroke has ends"));
-    let mut found = Vec::new();
-    for &stroke in strokes {
-        let (own, _) = &planned[stroke];
-        let own_ends = ends[stroke].expect("a drawn stroke has ends");
-        let Some(plan) = job
-            .carried(own, rank, &from)
-            .filter(|plan| plan.planned_m() >= own.planned_m() - SAME_LENGTH_M)
-        else {
-            break;
+    let window = k.saturating_sub(MAX_CARRIED_STROKES)..(k + MAX_CARRIED_STROKES).min(drawn.len());
+    let placed_ends = |position: usize| placed[drawn[position]].expect("a drawn stroke has ends");
+    // The branches known for each stroke of the window, as placed first.
+    let mut known: Vec<Vec<[JointVector; 2]>> =
+        window.clone().map(|p| vec![placed_ends(p)]).collect();
+    let mut found: Vec<(usize, Candidate)> = Vec::new();
+    // Each branch to carry: where it lies in the window, its ends there, the rank of its
+    // planner, and whether it is carried back (to earlier strokes) and on (to later ones).
+    let rank = |position: usize| planned[drawn[position]].1;
+    let mut seeds = vec![
+        (k, placed_ends(k), rank(k), true, false),
+        (k - 1, placed_ends(k - 1), rank(k - 1), false, true),
+    ];
+    for position in window.clone() {
+        let (own, own_rank) = &planned[drawn[position]];
+        let Some(ends) = job.ends(own) else {
+            continue;
         };
-        let Some(plan_ends) = job.ends(&plan) else {
-            break;
-        };
-        let same_branch = apart(&plan_ends[0], &own_ends[0]) <= BRANCH_CHANGE_RAD
-            && apart(&plan_ends[1], &own_ends[1]) <= BRANCH_CHANGE_RAD;
-        if same_branch {
-            break;
+        let slot = &mut known[position - window.start];
+        if new_branch(slot, &ends) {
+            slot.push(ends);
+            let plan = (own.clone(), *own_rank);
+            found.push((drawn[position], Candidate { plan, ends }));
+            seeds.push((position, ends, *own_rank, true, true));
         }
-        from = side.seed(&plan_ends);
+    }
+    // The stroke at `position` planned again from `from` on the branch of `rank`'s planner;
+    // where it draws as far on a branch not known for it, kept: its ends.
+    let mut extend = |position: usize, from: &JointVector, rank: usize| {
+        let stroke = drawn[position];
+        let own = &planned[stroke].0;
+        let plan = job
+            .carried(own, rank, from)
+            .filter(|plan| plan.planned_m() >= own.planned_m() - SAME_LENGTH_M)?;
+        let ends = job.ends(&plan)?;
+        let slot = &mut known[position - window.start];
+        if !new_branch(slot, &ends) {
+            return None;
+        }
+        slot.push(ends);
         found.push((
             stroke,
             Candidate {
                 plan: (plan, rank),
-                ends: plan_ends,
+                ends,
             },
         ));
+        Some(ends)
+    };
+    for (position, ends, rank, back, on) in seeds {
+        if back {
+            let mut from = ends[0];
+            for earlier in (window.start..position).rev() {
+                match extend(earlier, &from, rank) {
+                    Some([start, _]) => from = start,
+                    None => break,
+                }
+            }
+        }
+        if on {
+            let mut from = ends[1];
+            for later in position + 1..window.end {
+                match extend(later, &from, rank) {
+                    Some([_, end]) => from = end,
+                    None => break,
+                }
+            }
+        }
     }
     found
 }
 
-/// The candidate of each drawn stroke (`drawn`, in order) on the path of least total
-/// estimated pen-up time from `home` through one candidate per stroke and back to `home`
-/// (none where there is no home): the index into its candidates. Ties keep the lower index.
+/// The candidate of each stroke (`candidates`: where each of a stroke's candidates starts and
+/// ends, strokes in the order drawn, at least one each) on the way of least total estimated
+/// pen-up time (`move_s` per move) from `home` through one candidate per stroke and back to
+/// `home` (none where there is no home): the index into its candidates. Ties keep the lower
+/// index.
 fn least_pen_up(
-    drawn: &[usize],
-    candidates: &[Vec<Candidate>],
+    candidates: &[Vec<[JointVector; 2]>],
     home: Option<&JointVector>,
-    job: &impl Branches,
+    move_s: impl Fn(&JointVector, &JointVector) -> f64,
 ) -> Vec<usize> {
-    // The least time to reach each candidate of the current stroke, and the candidate of the
-    // stroke before on that way.
-    let mut time: Vec<f64> = Vec::new();
-    let mut back: Vec<Vec<usize>> = Vec::with_capacity(drawn.len());
-    for (k, &stroke) in drawn.iter().enumerate() {
-        let here = &candidates[stroke];
-        let (next_time, from): (Vec<f64>, Vec<usize>) = match k {
-            0 => here
-                .iter()
-                .map(|c| (home.map_or(0.0, |home| job.move_s(home, &c.ends[0])), 0))
-                .unzip(),
-            _ => {
-                let before = &candidates[drawn[k - 1]];
-                here.iter()
-                    .map(|c| {
-                        before
-                            .iter()
-                            .enumerate()
-                            .map(|(b, previous)| {
-                                (time[b] + job.move_s(&previous.ends[1], &c.ends[0]), b)
-                            })
-                            .fold((f64::INFINITY, 0), |best, next| {
-                                if next.0 < best.0 { next } else { best }
-                            })
+    let Some(first) = candidates.first() else {
+        return Vec::new();
+    };
+    // The least time to reach each candidate of the current stroke, and per stroke the
+    // candidate of the stroke before on that way.
+    let mut time: Vec<f64> = first
+        .iter()
+        .map(|[start, _]| home.map_or(0.0, |home| move_s(home, start)))
+        .collect();
+    let mut back: Vec<Vec<usize>> = vec![vec![0; first.len()]];
+    for pair in candidates.windows(2) {
+        let (before, here) = (&pair[0], &pair[1]);
+        let (next_time, from): (Vec<f64>, Vec<usize>) = here
+            .iter()
+            .map(|[start, _]| {
+                before
+                    .iter()
+                    .enumerate()
+                    .map(|(b, [_, end])| (time[b] + move_s(end, start), b))
+                    .fold((f64::INFINITY, 0), |best, next| {
+                        if next.0 < best.0 { next } else { best }
                     })
-                    .unzip()
-            }
-        };
+            })
+            .unzip();
         time = next_time;
         back.push(from);
     }
-    let last = &candidates[*drawn.last().expect("a branch change has drawn strokes")];
+    let last = candidates.last().expect("there is a first stroke");
     let (mut pick, _) = last
         .iter()
         .enumerate()
-        .map(|(c, candidate)| {
-            let home_s = home.map_or(0.0, |home| job.move_s(&candidate.ends[1], home));
-            (c, time[c] + home_s)
-        })
+        .map(|(c, [_, end])| (c, time[c] + home.map_or(0.0, |home| move_s(end, home))))
         .fold((0, f64::INFINITY), |best, next| {
             if next.1 < best.1 { next } else { best }
         });
-    let mut choice = vec![0; drawn.len()];
-    for k in (0..drawn.len()).rev() {
+    let mut choice = vec![0; candidates.len()];
+    for k in (0..candidates.len()).rev() {
         choice[k] = pick;
         pick = back[k][pick];
     }
     choice
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The total time of one pick per stroke, home to home.
+    fn total_s(
+        candidates: &[Vec<[JointVector; 2]>],
+        picks: &[usize],
+        home: &JointVector,
+        move_s: &impl Fn(&JointVector, &JointVector) -> f64,
+    ) -> f64 {
+        let ends: Vec<[JointVector; 2]> = picks
+            .iter()
+            .zip(candidates)
+            .map(|(&pick, candidates)| candidates[pick])
+            .collect();
+        let inner: f64 = ends
+            .windows(2)
+            .map(|pair| move_s(&pair[0][1], &pair[1][0]))
+            .sum();
+        move_s(home, &ends[0][0]) + inner + move_s(&ends[ends.len() - 1][1], home)
+    }
+
+    #[test]
+    fn the_least_pen_up_choice_is_the_best_of_every_choice() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        // The largest joint difference, as a move at one speed on every joint takes.
+        let move_s = |from: &JointVector, to: &JointVector| apart(from, to);
+        let home = JointVector::zeros();
+        for _ in 0..50 {
+            let strokes = rng.random_range(1..6);
+            let candidates: Vec<Vec<[JointVector; 2]>> = (0..strokes)
+                .map(|_| {
+                    (0..rng.random_range(1..4))
+                        .map(|_| {
+                            let start = JointVector::from_fn(|_, _| rng.random_range(-3.0..3.0));
+                            let end = start.map(|q| q + rng.random_range(-0.3..0.3));
+                            [start, end]
+                        })
+                        .collect()
+                })
+                .collect();
+            let picks = least_pen_up(&candidates, Some(&home), move_s);
+            // Every choice, enumerated.
+            let mut best = f64::INFINITY;
+            let mut choice = vec![0; strokes];
+            loop {
+                best = best.min(total_s(&candidates, &choice, &home, &move_s));
+                let Some(k) = (0..strokes).find(|&k| choice[k] + 1 < candidates[k].len()) else {
+                    break;
+                };
+                choice[k] += 1;
+                choice[..k].iter_mut().for_each(|c| *c = 0);
+            }
+            let found = total_s(&candidates, &picks, &home, &move_s);
+            assert!((found - best).abs() < 1e-12, "{found} against {best}");
+        }
+    }
 }

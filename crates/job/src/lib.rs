@@ -6,9 +6,11 @@
 //!    drawing order and directions that shorten the pen-up travel;
 //! 3. **plan strokes** ([`stroke`]): each stroke to the limit by the search, resumed after a
 //!    reconfiguration where one motion cannot finish it;
-//! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
+//! 4. **choose branches** ([`branch`]): strokes beside a branch change planned again from the
+//!    other side's branch, one plan per stroke by the least pen-up time of the whole job;
+//! 5. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
 //!    approach along n;
-//! 5. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
+//! 6. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
 //!    an `emg-job/3` file;
 //!
@@ -42,7 +44,7 @@ use emg_planner::{
 use emg_timing::{DynamicLimits, least_move_s, time_blended_move};
 use rayon::prelude::*;
 
-pub use branch::{BRANCH_CHANGE_RAD, Branches, MAX_CARRIED_STROKES, choose_branches};
+pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES, choose_branches};
 pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
 pub use motion::Motion;
@@ -149,8 +151,6 @@ pub fn plan_job(
         &planner.config().rollout.constraints,
     );
     let constraints = &planner.config().rollout.constraints;
-    let limits = &timing.request().limits;
-    let mut least = LeastDuration::new(timing.request(), job.home);
     let mut on_part = planner.config().clone();
     on_part.rollout.constraints = free.constraints().clone();
     let on_part = planner
@@ -214,14 +214,43 @@ pub fn plan_job(
         .map(|(oriented, plan, rank)| (oriented, (plan, rank)))
         .unzip();
     ordering.sequence = sequence;
-    let (planned, _) = choose_branches(planned, job.home.as_ref(), &branches);
-    let (plans, ranks): (Vec<StrokePlan>, Vec<usize>) = planned.into_iter().unzip();
-    // Where each stroke's plan starts as the arm holds it, for the move to it from the stroke
-    // before.
-    let starts: Vec<Option<JointVector>> = plans
-        .iter()
-        .map(|plan| branches.ends(plan).map(|[start, _]| start))
-        .collect();
+    let (plans, ranks): (Vec<StrokePlan>, Vec<usize>) = planned.iter().cloned().unzip();
+    let first = connect_strokes(
+        &branches,
+        &ordering.sequence,
+        &plans,
+        &ranks,
+        &vec![None; plans.len()],
+        watch,
+    )?;
+    // The strokes' branches chosen for the job as a whole, connected again, and kept where
+    // that draws as much in less time.
+    let home_held = job.home.map(|home| branches.held(&home));
+    let chosen = choose_branches(&planned, &first.placed_ends, home_held.as_ref(), &branches);
+    let (plans, connected) = match chosen {
+        None => (plans, first),
+        Some(chosen) => {
+            let moved_to: Vec<Option<JointVector>> =
+                chosen.iter().map(|choice| choice.moved_to).collect();
+            let (chosen_plans, chosen_ranks): (Vec<StrokePlan>, Vec<usize>) = chosen
+                .into_iter()
+                .map(|choice| (choice.plan, choice.rank))
+                .unzip();
+            let again = connect_strokes(
+                &branches,
+                &ordering.sequence,
+                &chosen_plans,
+                &chosen_ranks,
+                &moved_to,
+                watch,
+            )?;
+            if again.is_better_than(&first) {
+                (chosen_plans, again)
+            } else {
+                (plans, first)
+            }
+        }
+    };
     // Measured again between the strokes as they are drawn: their directions and starts taken.
     ordering.travel_m = plans
         .windows(2)
@@ -230,21 +259,120 @@ pub fn plan_job(
             (pair[1].path.point_at(0.0) - end).norm()
         })
         .fold(0.0, |total, leg| total + leg);
+    let Connected {
+        program,
+        reports,
+        moves: (straight_moves, sampled_moves),
+        searches,
+        least,
+        ends_at_home,
+        ..
+    } = connected;
+    if program.segments().is_empty() {
+        let why = reports
+            .iter()
+            .flat_map(|r| r.parts_left_out.first())
+            .next()
+            .cloned()
+            .unwrap_or_else(|| "no stroke has a reachable start".to_string());
+        return Err(JobPlanError::NothingDrawn(why));
+    }
+    let mut summary = summarise(
+        &reports,
+        &program,
+        &ordering,
+        (straight_moves, sampled_moves),
+        searches,
+        started,
+    );
+    summary.ends_at_home = ends_at_home;
+    (summary.least_pen_down_s, summary.least_pen_up_s) = least;
+    if program.duration_s() > MAX_PROGRAM_S {
+        return Err(JobPlanError::TooLong);
+    }
+    Ok(JobFile {
+        format: JOB_FILE_FORMAT.to_string(),
+        robot: robot_file.to_string(),
+        joint_names: robot.joint_names().to_vec(),
+        constraints: constraints.clone(),
+        limits: timing.record(),
+        settings: settings.clone().resolved(),
+        home: job.home.map(|home| home.as_slice()[..dof].to_vec()),
+        ordering,
+        strokes: reports,
+        summary,
+        surfaces: free.surfaces().to_vec(),
+        rate_hz: timing.request().rate_hz,
+        segments: program.segments().to_vec(),
+    })
+}
+
+/// A job's strokes joined into one program by the connect stage.
+struct Connected {
+    program: Program,
+    /// One per stroke, in the order drawn.
+    reports: Vec<StrokeReport>,
+    /// Pen-up moves whose edges are straight, and those the sampling planner found a stretch of.
+    moves: (usize, usize),
+    /// Searches run: the strokes' plans' and the rest plans'.
+    searches: usize,
+    /// The least duration the arm's limits allow for the same parts: pen down, pen up (s).
+    least: (f64, f64),
+    /// Whether the program ends at the home.
+    ends_at_home: bool,
+    /// Where each stroke's first placed part starts and its last ends, as the job holds them
+    /// ([`JobBranches::held`]); `None` where none was placed.
+    placed_ends: Vec<Option<[JointVector; 2]>>,
+}
+
+impl Connected {
+    /// Whether this program draws as much as `other` (to [`SAME_LENGTH_M`]) in less time.
+    fn is_better_than(&self, other: &Connected) -> bool {
+        let drawn = |c: &Connected| c.reports.iter().map(|r| r.drawn_m).sum::<f64>();
+        drawn(self) >= drawn(other) - SAME_LENGTH_M
+            && self.program.duration_s() < other.program.duration_s()
+    }
+}
+
+/// The connect stage: the strokes `sequence` planned as `plans` (each by the cascade's planner
+/// of its rank in `ranks`) placed one after another into one program, from the home and back
+/// to it; where a stroke's plan was carried over to another branch (`moved_to`: where it
+/// starts), the stroke before it ends the way nearest it.
+fn connect_strokes(
+    branches: &JobBranches<'_>,
+    sequence: &[Oriented],
+    plans: &[StrokePlan],
+    ranks: &[usize],
+    moved_to: &[Option<JointVector>],
+    watch: &dyn Watch,
+) -> Result<Connected, JobPlanError> {
+    let connector = branches.connector;
+    let (free, settings, cascade, request) = (
+        connector.free,
+        connector.settings,
+        branches.cascade,
+        branches.request,
+    );
+    let home = branches.home.copied();
+    let robot = free.robot();
+    let dof = robot.dof();
+    let limits = &connector.timing.request().limits;
+    let mut least = LeastDuration::new(connector.timing.request(), home);
+    let mut placed_ends = Vec::with_capacity(sequence.len());
     let mut program = Program::default();
     let mut reports = Vec::new();
     let (mut straight_moves, mut sampled_moves) = (0, 0);
     // The last part's lift, joined to the move after it.
     let mut retreat: Option<[JointVector; 2]> = None;
     let mut searches: usize = plans.iter().map(|plan| plan.searches).sum();
-    for (connected, ((oriented, plan), &rank)) in
-        ordering.sequence.iter().zip(&plans).zip(&ranks).enumerate()
+    for (connected, ((oriented, plan), &rank)) in sequence.iter().zip(plans).zip(ranks).enumerate()
     {
         // The stroke's planner's place in the cascade.
         let mut rank = rank;
         if watch.stop_requested() {
             return Err(Stopped.into());
         }
-        watch.progress("connecting", connected, ordering.sequence.len());
+        watch.progress("connecting", connected, sequence.len());
         let mut parts_left_out = Vec::new();
         // The stretches of the stroke the placed parts' samples cover.
         let mut covered = Vec::new();
@@ -252,43 +380,39 @@ pub fn plan_job(
         let mut rest_plans = 0;
         let mut unsearched_from_s = plan.unsearched_from_s;
         let mut next_index = 0;
+        // Where the stroke's first placed part starts and its last ends.
+        let mut stroke_ends: Option<[JointVector; 2]> = None;
         while let Some(planned) = queue.pop_front() {
             let index = next_index;
             next_index += 1;
-            let from = retreat
-                .map(|[_, above]| above)
-                .or(program.last())
-                .or(job.home);
+            let from = retreat.map(|[_, above]| above).or(program.last()).or(home);
             // The way the tool rose off the last part, which it may rise further along.
             let risen = retreat.and_then(|[end, above]| {
                 (robot.forward(&above).tcp() - robot.forward(&end).tcp()).try_normalize(1e-12)
             });
             // Each joint among its whole turns nearest the home (else where the arm is), the
             // tool's free roll centred on it.
-            let planned = toward(planned, job.home.as_ref(), from.as_ref(), &free);
+            let planned = toward(planned, home.as_ref(), from.as_ref(), free);
             let seed = settings.seed.wrapping_add(program.segments().len() as u64);
             // The part planned again from the configuration the arm is in and from the home,
             // each moved above the part's start and set down there: tried first where it draws
             // as far from a start nearer the arm, and where the searched start cannot be reached.
-            let again: Vec<StrokePart> = [from, job.home]
+            let again: Vec<StrokePart> = [from, home]
                 .iter()
                 .flatten()
                 .filter_map(|start| {
                     connector.replanned_nearby(cascade[rank], request, &planned, start)
                 })
-                .map(|part| toward(part, job.home.as_ref(), from.as_ref(), &free))
+                .map(|part| toward(part, home.as_ref(), from.as_ref(), free))
                 .collect();
-            // Where the arm goes after the stroke's last part: the next stroke, else the home.
+            // Where the arm goes after the stroke's last part, where the next stroke was
+            // carried over to another branch.
             let next = queue
                 .is_empty()
-                .then(|| {
-                    starts[connected + 1..]
-                        .iter()
-                        .flatten()
-                        .next()
-                        .or(job.home.as_ref())
-                })
-                .flatten()
+                .then(|| moved_to.get(connected + 1).copied().flatten())
+                .flatten();
+            let next = next
+                .as_ref()
                 .map(|next| (next, |q: &JointVector| branches.held(q)));
             let candidates = ranked(planned.clone(), again, from.as_ref(), next, limits);
             // The first candidate placed, else why the first one could not be.
@@ -389,9 +513,11 @@ pub fn plan_job(
                 timed.samples.iter().map(|sample| &sample.q),
             );
             least.add_stroke(above_start, start, end, stretch.length_m());
+            stroke_ends = Some([stroke_ends.map_or(start, |[first, _]| first), end]);
             covered.push(stretch);
             retreat = Some([end, above_end]);
         }
+        placed_ends.push(stroke_ends.map(|ends| ends.map(|q| branches.held(&q))));
         let length_m = plan.path.length_m();
         let coverage = Coverage::of(length_m, &covered);
         reports.push(StrokeReport {
@@ -412,7 +538,7 @@ pub fn plan_job(
         });
     }
     let last = retreat.map(|[_, above]| above).or(program.last());
-    let home_travel = job.home.zip(last).and_then(|(home, last)| {
+    let home_travel = home.zip(last).and_then(|(home, last)| {
         free.connect(
             &last,
             &home,
@@ -428,44 +554,15 @@ pub fn plan_job(
         None,
         dof,
     );
-    if program.segments().is_empty() {
-        let why = reports
-            .iter()
-            .flat_map(|r| r.parts_left_out.first())
-            .next()
-            .cloned()
-            .unwrap_or_else(|| "no stroke has a reachable start".to_string());
-        return Err(JobPlanError::NothingDrawn(why));
-    }
     least.end_at(program.last());
-    let mut summary = summarise(
-        &reports,
-        &program,
-        &ordering,
-        (straight_moves, sampled_moves),
+    Ok(Connected {
+        program,
+        reports,
+        moves: (straight_moves, sampled_moves),
         searches,
-        started,
-    );
-    summary.ends_at_home = ends_at_home;
-    summary.least_pen_down_s = least.pen_down_s;
-    summary.least_pen_up_s = least.pen_up_s;
-    if program.duration_s() > MAX_PROGRAM_S {
-        return Err(JobPlanError::TooLong);
-    }
-    Ok(JobFile {
-        format: JOB_FILE_FORMAT.to_string(),
-        robot: robot_file.to_string(),
-        joint_names: robot.joint_names().to_vec(),
-        constraints: constraints.clone(),
-        limits: timing.record(),
-        settings: settings.clone().resolved(),
-        home: job.home.map(|home| home.as_slice()[..dof].to_vec()),
-        ordering,
-        strokes: reports,
-        summary,
-        surfaces: free.surfaces().to_vec(),
-        rate_hz: timing.request().rate_hz,
-        segments: program.segments().to_vec(),
+        least: (least.pen_down_s, least.pen_up_s),
+        ends_at_home,
+        placed_ends,
     })
 }
 
