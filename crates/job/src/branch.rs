@@ -31,7 +31,7 @@ pub const BRANCH_CHANGE_RAD: f64 = 1.0;
 pub const MAX_CARRIED_STROKES: usize = 8;
 
 /// A stroke's plan and the place in the job's cascade of planners of the planner that made it.
-pub type RankedPlan = (StrokePlan, usize);
+type RankedPlan = (StrokePlan, usize);
 
 /// What the stage asks of the job about its strokes' plans.
 pub trait Branches: Sync {
@@ -67,33 +67,35 @@ struct Candidate {
     ends: [JointVector; 2],
 }
 
-/// The plans to connect again for the strokes `planned` (one per stroke, in the order drawn),
-/// connected once with their parts placed as `placed` says (where each stroke's first part
+/// The plans to connect again for the strokes planned as `plans` (one per stroke, in the order
+/// drawn; each by the job's cascade's planner of its rank in `ranks`), connected once with their parts placed as `placed` says (where each stroke's first part
 /// starts and its last ends, as [`Branches::ends`] holds them; `None` where none was placed):
 /// each stroke's branch chosen for the job as a whole (the module's description), the arm
 /// starting and ending at `home` where it has one. `None` where no stroke changes branch.
 /// Deterministic: the candidates are found in parallel but gathered in order, and ties keep the
 /// strokes as placed.
 pub fn choose_branches(
-    planned: &[RankedPlan],
+    plans: &[StrokePlan],
+    ranks: &[usize],
     placed: &[Option<[JointVector; 2]>],
     home: Option<&JointVector>,
     job: &impl Branches,
 ) -> Option<Vec<BranchChoice>> {
     // The strokes that have a part, in the order drawn: the others play no part in the choice.
-    let drawn: Vec<usize> = (0..planned.len())
-        .filter(|&i| placed[i].is_some())
-        .collect();
+    let drawn: Vec<usize> = (0..plans.len()).filter(|&i| placed[i].is_some()).collect();
     let ends = |i: usize| placed[i].expect("a drawn stroke has ends");
     let changes: Vec<usize> = (1..drawn.len())
         .filter(|&k| apart(&ends(drawn[k - 1])[1], &ends(drawn[k])[0]) > BRANCH_CHANGE_RAD)
         .collect();
+    if changes.is_empty() {
+        return None;
+    }
     // Per change, the branches known about it carried to the strokes about it.
     let carried: Vec<Vec<(usize, Candidate)>> = changes
         .par_iter()
-        .map(|&k| carried_about(planned, placed, &drawn, k, job))
+        .map(|&k| carried_about((plans, ranks), placed, &drawn, k, job))
         .collect();
-    let mut others: Vec<Vec<Candidate>> = (0..planned.len()).map(|_| Vec::new()).collect();
+    let mut others: Vec<Vec<Candidate>> = (0..plans.len()).map(|_| Vec::new()).collect();
     for (stroke, candidate) in carried.into_iter().flatten() {
         others[stroke].push(candidate);
     }
@@ -110,8 +112,9 @@ pub fn choose_branches(
     if picks.iter().all(|&pick| pick == 0) {
         return None;
     }
-    let mut chosen: Vec<BranchChoice> = planned
+    let mut chosen: Vec<BranchChoice> = plans
         .iter()
+        .zip(ranks)
         .map(|(plan, rank)| BranchChoice {
             plan: plan.clone(),
             rank: *rank,
@@ -153,7 +156,7 @@ fn new_branch(known: &[[JointVector; 2]], ends: &[JointVector; 2]) -> bool {
 /// they lie on another branch than placed, then each branch known there carried to the strokes
 /// before and after it (the module's description). With the stroke each is for.
 fn carried_about(
-    planned: &[RankedPlan],
+    (plans, ranks): (&[StrokePlan], &[usize]),
     placed: &[Option<[JointVector; 2]>],
     drawn: &[usize],
     k: usize,
@@ -167,29 +170,29 @@ fn carried_about(
     let mut found: Vec<(usize, Candidate)> = Vec::new();
     // Each branch to carry: where it lies in the window, its ends there, the rank of its
     // planner, and whether it is carried back (to earlier strokes) and on (to later ones).
-    let rank = |position: usize| planned[drawn[position]].1;
+    let rank = |position: usize| ranks[drawn[position]];
     let mut seeds = vec![
         (k, placed_ends(k), rank(k), true, false),
         (k - 1, placed_ends(k - 1), rank(k - 1), false, true),
     ];
     for position in window.clone() {
-        let (own, own_rank) = &planned[drawn[position]];
+        let (own, own_rank) = (&plans[drawn[position]], ranks[drawn[position]]);
         let Some(ends) = job.ends(own) else {
             continue;
         };
         let slot = &mut known[position - window.start];
         if new_branch(slot, &ends) {
             slot.push(ends);
-            let plan = (own.clone(), *own_rank);
+            let plan = (own.clone(), own_rank);
             found.push((drawn[position], Candidate { plan, ends }));
-            seeds.push((position, ends, *own_rank, true, true));
+            seeds.push((position, ends, own_rank, true, true));
         }
     }
     // The stroke at `position` planned again from `from` on the branch of `rank`'s planner;
     // where it draws as far on a branch not known for it, kept: its ends.
     let mut extend = |position: usize, from: &JointVector, rank: usize| {
         let stroke = drawn[position];
-        let own = &planned[stroke].0;
+        let own = &plans[stroke];
         let plan = job
             .carried(own, rank, from)
             .filter(|plan| plan.planned_m() >= own.planned_m() - SAME_LENGTH_M)?;

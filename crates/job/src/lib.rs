@@ -6,10 +6,11 @@
 //!    drawing order and directions that shorten the pen-up travel;
 //! 3. **plan strokes** ([`stroke`]): each stroke to the limit by the search, resumed after a
 //!    reconfiguration where one motion cannot finish it;
-//! 4. **choose branches** ([`branch`]): strokes beside a branch change planned again from the
-//!    other side's branch, one plan per stroke by the least pen-up time of the whole job;
-//! 5. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
+//! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
 //!    approach along n;
+//! 5. **choose branches** ([`branch`]): where the arm changes branch between strokes, the
+//!    branches known there carried to the strokes around, one plan per stroke by the least
+//!    pen-up time of the whole job, and the strokes connected again where that is quicker;
 //! 6. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
 //!    an `emg-job/3` file;
@@ -209,12 +210,16 @@ pub fn plan_job(
         request,
         home: job.home.as_ref(),
     };
-    let (sequence, planned): (Vec<Oriented>, Vec<(StrokePlan, usize)>) = planned
+    let mut plans = Vec::with_capacity(planned.len());
+    let mut ranks = Vec::with_capacity(planned.len());
+    ordering.sequence = planned
         .into_iter()
-        .map(|(oriented, plan, rank)| (oriented, (plan, rank)))
-        .unzip();
-    ordering.sequence = sequence;
-    let (plans, ranks): (Vec<StrokePlan>, Vec<usize>) = planned.iter().cloned().unzip();
+        .map(|(oriented, plan, rank)| {
+            plans.push(plan);
+            ranks.push(rank);
+            oriented
+        })
+        .collect();
     let first = connect_strokes(
         &branches,
         &ordering.sequence,
@@ -226,7 +231,13 @@ pub fn plan_job(
     // The strokes' branches chosen for the job as a whole, connected again, and kept where
     // that draws as much in less time.
     let home_held = job.home.map(|home| branches.held(&home));
-    let chosen = choose_branches(&planned, &first.placed_ends, home_held.as_ref(), &branches);
+    let chosen = choose_branches(
+        &plans,
+        &ranks,
+        &first.placed_ends,
+        home_held.as_ref(),
+        &branches,
+    );
     let (plans, connected) = match chosen {
         None => (plans, first),
         Some(chosen) => {
@@ -685,8 +696,9 @@ fn toward(
 /// The parts that may draw a stretch, in the order they are tried: those drawing as far as the
 /// searched part `planned` (to [`SAME_LENGTH_M`]), the one with the least pen-up time first
 /// ([`least_move_s`] within `limits` from `from`, where the arm is, to the part's start, and
-/// where the part is its stroke's last, from its end as `next` holds it to `next`'s
-/// configuration: where the arm goes next); then the others, the furthest-drawing first.
+/// where the part is its stroke's last before a stroke the branch choice moved, from its end as
+/// `next` holds it to `next`'s configuration, that stroke's start); then the others, the
+/// furthest-drawing first.
 /// Deterministic: ties keep the order given, `planned` first.
 fn ranked(
     planned: StrokePart,
