@@ -121,7 +121,8 @@ pub enum JobPlanError {
 /// Plans `job` with `planner` as `request` asks (the search; its constraints and scene) and
 /// times it with `timing`;
 /// `robot_file` is recorded in the file; `watch` is told each stage's progress ("ordering",
-/// "planning" and "connecting", in strokes) and asked between strokes whether to stop
+/// "planning", "connecting" and, where the strokes are connected again on the branches chosen
+/// for the job, "branches", in strokes) and asked between strokes whether to stop
 /// ([`JobPlanError::Stopped`]). Strokes are planned in parallel; the result does not depend on
 /// the number of threads.
 pub fn plan_job(
@@ -226,7 +227,7 @@ pub fn plan_job(
         &plans,
         &ranks,
         &vec![None; plans.len()],
-        watch,
+        (watch, "connecting"),
     )?;
     // The strokes' branches chosen for the job as a whole, connected again, and kept where
     // that draws as much in less time.
@@ -253,7 +254,7 @@ pub fn plan_job(
                 &chosen_plans,
                 &chosen_ranks,
                 &moved_to,
-                watch,
+                (watch, "branches"),
             )?;
             if again.is_better_than(&first) {
                 (chosen_plans, again)
@@ -348,14 +349,15 @@ impl Connected {
 /// The connect stage: the strokes `sequence` planned as `plans` (each by the cascade's planner
 /// of its rank in `ranks`) placed one after another into one program, from the home and back
 /// to it; where a stroke's plan was carried over to another branch (`moved_to`: where it
-/// starts), the stroke before it ends the way nearest it.
+/// starts), the stroke before it ends the way nearest it. `watch` is told the strokes connected
+/// as `stage`.
 fn connect_strokes(
     branches: &JobBranches<'_>,
     sequence: &[Oriented],
     plans: &[StrokePlan],
     ranks: &[usize],
     moved_to: &[Option<JointVector>],
-    watch: &dyn Watch,
+    (watch, stage): (&dyn Watch, &str),
 ) -> Result<Connected, JobPlanError> {
     let connector = branches.connector;
     let (free, settings, cascade, request) = (
@@ -383,7 +385,7 @@ fn connect_strokes(
         if watch.stop_requested() {
             return Err(Stopped.into());
         }
-        watch.progress("connecting", connected, sequence.len());
+        watch.progress(stage, connected, sequence.len());
         let mut parts_left_out = Vec::new();
         // The stretches of the stroke the placed parts' samples cover.
         let mut covered = Vec::new();

@@ -6,7 +6,9 @@
 pub trait Watch: Sync {
     /// `done` of `total` units of `stage` are finished ("ordering" counts the job's strokes,
     /// "planning" the millimetres of the strokes searched along, "connecting" the strokes drawn
-    /// once those meeting end to end are merged; "screen", "refine" and "certify" count places).
+    /// once those meeting end to end are merged, and "branches" them again where they are
+    /// connected again on the branches chosen for the job; "screen", "refine" and "certify"
+    /// count places).
     fn progress(&self, stage: &str, done: usize, total: usize);
 
     /// A stroke's searches have looked `metres` further along it (drawn, or skipped as out of
