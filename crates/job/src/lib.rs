@@ -227,7 +227,8 @@ pub fn plan_job(
         &plans,
         &ranks,
         &vec![None; plans.len()],
-        (watch, "connecting"),
+        watch,
+        "connecting",
     )?;
     // The strokes' branches chosen for the job as a whole, connected again, and kept where
     // that draws as much in less time.
@@ -254,7 +255,8 @@ pub fn plan_job(
                 &chosen_plans,
                 &chosen_ranks,
                 &moved_to,
-                (watch, "branches"),
+                watch,
+                "branches",
             )?;
             if again.is_better_than(&first) {
                 (chosen_plans, again)
@@ -357,7 +359,8 @@ fn connect_strokes(
     plans: &[StrokePlan],
     ranks: &[usize],
     moved_to: &[Option<JointVector>],
-    (watch, stage): (&dyn Watch, &str),
+    watch: &dyn Watch,
+    stage: &str,
 ) -> Result<Connected, JobPlanError> {
     let connector = branches.connector;
     let (free, settings, cascade, request) = (
