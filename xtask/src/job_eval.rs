@@ -17,7 +17,7 @@ use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, SvgOptions, read_svg_file};
 use emg_job::{
     FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, Unwatched, job_part,
-    order_strokes, part_coverage, plan_job, plan_stroke, verify_job,
+    order_strokes, part_coverage, plan_job, plan_stroke, valley_seams, verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{MotionTiming, PlanRequest, Planner, ShippedRobot};
@@ -237,6 +237,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             with_home(seams(tilt_deg))?,
         ));
     }
+    jobs.push((VALLEY.to_string(), with_home(valley_seams())?));
     let hundreds = [
         (GRID, grid_of_circles(10, 10, [0.45, 0.0, 0.25])),
         (HATCH, hatch()),
@@ -382,6 +383,9 @@ fn seams(tilt_deg: f64) -> Vec<PathSpec> {
         })
         .collect()
 }
+
+/// The name of the job of [`valley_seams`].
+const VALLEY: &str = "12 seams across a valley, 6 on each face";
 
 /// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e (`ur_arm`)
 /// its program exported both ways and read back.

@@ -1,13 +1,11 @@
 //! The order stage: strokes that meet end to end merged into one ([`merge`]), then the
 //! sequence and directions the drawn strokes are drawn in, chosen to shorten the pen-up travel:
-//! nearest neighbour over a grid of the stroke ends ([`near`]), then 2-opt moves (a run
-//! of strokes reversed, each stroke's direction with it) and Or-opt moves (a run of up to
+//! nearest neighbour over a grid of the stroke ends ([`near`]), then ([`tour`]) 2-opt moves (a
+//! run of strokes reversed, each stroke's direction with it) and Or-opt moves (a run of up to
 //! [`MAX_RUN`] strokes moved elsewhere, either way round) among each end's [`NEIGHBOURS`]
 //! nearest ends, spanning [`MAX_SPAN`] strokes at most, each stroke looked at [`MAX_ROUNDS`]
 //! times at most on average. The work grows near-linearly with the strokes and is counted
 //! ([`order_strokes_counted`]).
-
-use std::collections::VecDeque;
 
 use emg_control::Path;
 use emg_kinematics::Vec3;
@@ -17,9 +15,11 @@ use crate::spec::Order;
 
 pub mod merge;
 pub mod near;
+pub mod tour;
 
 pub use merge::{Chain, merge_strokes};
 use near::Grid;
+use tour::{Legs, Tour};
 
 /// The ends of another stroke each stroke end keeps as candidates for a move.
 pub const NEIGHBOURS: usize = 10;
@@ -185,9 +185,11 @@ pub fn order_strokes_counted(
         Order::Given => given,
         Order::Shortest => {
             let (sequence, nearest_work) = nearest_neighbour(&ends);
-            let mut tour = Tour::new(&ends, sequence);
+            let (neighbours, neighbours_work) = nearest_ends(&ends);
+            let legs = Travel(&ends);
+            let mut tour = Tour::new(&legs, sequence, neighbours);
             tour.improve();
-            work += nearest_work + tour.work;
+            work += nearest_work + neighbours_work + tour.work;
             tour.sequence
         }
     };
@@ -207,6 +209,44 @@ fn travel(sequence: &[Oriented], ends: &[Ends]) -> f64 {
         .windows(2)
         .map(|pair| (Ends::of(pair[1], ends).0 - Ends::of(pair[0], ends).1).norm())
         .fold(0.0, |total, leg| total + leg)
+}
+
+/// The pen-up travel between strokes drawn in the directions chosen: the straight distance from
+/// where one is lifted to where the next is set down (none before the first or after the last).
+struct Travel<'a>(&'a [Ends]);
+
+impl Legs for Travel<'_> {
+    fn cost(&self, from: Option<usize>, to: Option<usize>) -> f64 {
+        let point = |end: usize| {
+            let e = &self.0[end / 2];
+            if end.is_multiple_of(2) {
+                e.start
+            } else {
+                e.end
+            }
+        };
+        from.zip(to)
+            .map_or(0.0, |(a, b)| (point(b) - point(a)).norm())
+    }
+
+    fn reversible(&self, stroke: usize) -> bool {
+        self.0[stroke].reversible
+    }
+}
+
+/// Each stroke end's [`NEIGHBOURS`] nearest ends of other strokes, nearest first, with their
+/// distances, and the grid's work.
+fn nearest_ends(ends: &[Ends]) -> (Vec<Vec<(f64, usize)>>, usize) {
+    let mut grid = ends_grid(ends);
+    let neighbours = (0..2 * ends.len())
+        .map(|point| {
+            let at = grid.point(point);
+            grid.nearest(at, NEIGHBOURS, f64::INFINITY, |other| {
+                other / 2 != point / 2
+            })
+        })
+        .collect();
+    (neighbours, grid.work())
 }
 
 /// The grid of the strokes' ends: point 2i is stroke i's start, 2i + 1 its end.
@@ -236,283 +276,6 @@ fn nearest_neighbour(ends: &[Ends]) -> (Vec<Oriented>, usize) {
             .map(|&(_, point)| point);
     }
     (sequence, grid.work())
-}
-
-/// A sequence of strokes being improved by moves among near ends.
-struct Tour<'a> {
-    ends: &'a [Ends],
-    sequence: Vec<Oriented>,
-    /// Each stroke's place in `sequence`.
-    position: Vec<usize>,
-    /// Each stroke end's nearest ends of other strokes (point 2i is stroke i's start, 2i + 1
-    /// its end), nearest first, with their distances.
-    neighbours: Vec<Vec<(f64, usize)>>,
-    work: usize,
-}
-
-/// Gains smaller than this (m) are not taken.
-const MIN_GAIN_M: f64 = 1e-12;
-
-impl<'a> Tour<'a> {
-    fn new(ends: &'a [Ends], sequence: Vec<Oriented>) -> Self {
-        let mut grid = ends_grid(ends);
-        let neighbours = (0..2 * ends.len())
-            .map(|point| {
-                let at = grid.point(point);
-                grid.nearest(at, NEIGHBOURS, f64::INFINITY, |other| {
-                    other / 2 != point / 2
-                })
-            })
-            .collect();
-        let mut position = vec![0; ends.len()];
-        for (place, oriented) in sequence.iter().enumerate() {
-            position[oriented.stroke] = place;
-        }
-        Self {
-            ends,
-            sequence,
-            position,
-            neighbours,
-            work: grid.work(),
-        }
-    }
-
-    /// Where the stroke at `place` is set down (`None` past the sequence's end).
-    fn entry(&self, place: usize) -> Option<Vec3> {
-        let oriented = self.sequence.get(place)?;
-        Some(Ends::of(*oriented, self.ends).0)
-    }
-
-    /// Where the stroke at `place` is lifted (`None` before the sequence's start).
-    fn exit(&self, place: Option<usize>) -> Option<Vec3> {
-        let oriented = self.sequence.get(place?)?;
-        Some(Ends::of(*oriented, self.ends).1)
-    }
-
-    /// The travel from `from` to `to`; none where either is missing (the sequence's ends).
-    fn link(&mut self, from: Option<Vec3>, to: Option<Vec3>) -> f64 {
-        self.work += 1;
-        from.zip(to).map_or(0.0, |(a, b)| (b - a).norm())
-    }
-
-    /// Whether stroke end `point` is where its stroke is lifted as it is drawn now.
-    fn is_exit(&self, point: usize) -> bool {
-        let oriented = self.sequence[self.position[point / 2]];
-        (point % 2 == 1) != oriented.reversed
-    }
-
-    /// Whether every stroke at `places` may be reversed (counted as work).
-    fn reversible(&mut self, places: std::ops::RangeInclusive<usize>) -> bool {
-        self.work += places.clone().count();
-        self.sequence[places]
-            .iter()
-            .all(|o| self.ends[o.stroke].reversible)
-    }
-
-    /// Moves until none among near ends shortens the travel, or the rounds are spent.
-    fn improve(&mut self) {
-        let n = self.sequence.len();
-        let mut queue: VecDeque<usize> = self.sequence.iter().map(|o| o.stroke).collect();
-        let mut queued = vec![true; n];
-        let mut looks = 0;
-        while let Some(stroke) = queue.pop_front() {
-            queued[stroke] = false;
-            looks += 1;
-            if looks > MAX_ROUNDS * n {
-                break;
-            }
-            let touched = self.improve_at(self.position[stroke]);
-            for stroke in touched {
-                if !queued[stroke] {
-                    queued[stroke] = true;
-                    queue.push_back(stroke);
-                }
-            }
-        }
-    }
-
-    /// The first move found at the stroke at `place` that shortens the travel, made; the
-    /// strokes whose links it changed.
-    fn improve_at(&mut self, place: usize) -> Vec<usize> {
-        self.two_opt_at(place)
-            .or_else(|| (1..=MAX_RUN).find_map(|run| self.or_opt_at(place, run)))
-            .unwrap_or_default()
-    }
-
-    /// The strokes at `places` (those that are in the sequence).
-    fn strokes_at(&self, places: &[Option<usize>]) -> Vec<usize> {
-        places
-            .iter()
-            .filter_map(|p| self.sequence.get((*p)?))
-            .map(|o| o.stroke)
-            .collect()
-    }
-
-    /// A 2-opt move making a link between the stroke at `place`'s exit and another's exit, or
-    /// its entry and another's entry, nearer than the link it has; the strokes whose links
-    /// changed.
-    fn two_opt_at(&mut self, place: usize) -> Option<Vec<usize>> {
-        let oriented = self.sequence[place];
-        for exit in [true, false] {
-            let point = 2 * oriented.stroke + usize::from(exit != oriented.reversed);
-            let current = if exit {
-                let here = self.exit(Some(place));
-                let there = self.entry(place + 1);
-                self.link(here, there)
-            } else {
-                let before = self.exit(place.checked_sub(1));
-                let here = self.entry(place);
-                self.link(before, here)
-            };
-            for slot in 0..self.neighbours[point].len() {
-                let (distance, other) = self.neighbours[point][slot];
-                if distance >= current {
-                    break;
-                }
-                if self.is_exit(other) != exit {
-                    continue;
-                }
-                let there = self.position[other / 2];
-                let (low, high) = (place.min(there), place.max(there));
-                let (i, j) = if exit {
-                    (low + 1, high)
-                } else {
-                    (low, high - 1)
-                };
-                if self.reverse_gain(i, j) > MIN_GAIN_M
-                    && j - i < MAX_SPAN
-                    && self.reversible(i..=j)
-                {
-                    self.work += j - i + 1;
-                    self.sequence[i..=j].reverse();
-                    for k in i..=j {
-                        let o = &mut self.sequence[k];
-                        o.reversed = !o.reversed;
-                        self.position[o.stroke] = k;
-                    }
-                    return Some(self.strokes_at(&[
-                        i.checked_sub(1),
-                        Some(i),
-                        Some(j),
-                        Some(j + 1),
-                    ]));
-                }
-            }
-        }
-        None
-    }
-
-    /// How much reversing the run `i..=j` shortens the travel.
-    fn reverse_gain(&mut self, i: usize, j: usize) -> f64 {
-        let before = self.exit(i.checked_sub(1));
-        let after = self.entry(j + 1);
-        let (first, last) = (self.entry(i), self.exit(Some(j)));
-        let now = self.link(before, first) + self.link(last, after);
-        let then = self.link(before, last) + self.link(first, after);
-        now - then
-    }
-
-    /// An Or-opt move of the run of `run` strokes from `place` to between two strokes whose
-    /// ends lie near the run's, either way round; the strokes whose links changed.
-    fn or_opt_at(&mut self, place: usize, run: usize) -> Option<Vec<usize>> {
-        let last = place + run - 1;
-        if last >= self.sequence.len() {
-            return None;
-        }
-        let (run_in, run_out) = (self.entry(place), self.exit(Some(last)));
-        let before = self.exit(place.checked_sub(1));
-        let after = self.entry(last + 1);
-        let removed =
-            self.link(before, run_in) + self.link(run_out, after) - self.link(before, after);
-        if removed <= MIN_GAIN_M {
-            return None;
-        }
-        let run_points = [
-            2 * self.sequence[place].stroke + usize::from(self.sequence[place].reversed),
-            2 * self.sequence[last].stroke + usize::from(!self.sequence[last].reversed),
-        ];
-        for (side, &point) in run_points.iter().enumerate() {
-            for slot in 0..self.neighbours[point].len() {
-                let other = self.neighbours[point][slot].1;
-                let there = self.position[other / 2];
-                if (place..=last).contains(&there) {
-                    continue;
-                }
-                // After the stroke lifted near the run's end it joins, before the one set down
-                // near it; flipped where the ends meeting are both entries or both exits.
-                let other_exit = self.is_exit(other);
-                let after_place = if other_exit {
-                    Some(there)
-                } else {
-                    there.checked_sub(1)
-                };
-                let flipped = other_exit == (side == 1);
-                // Just before the run or within it: where it is already.
-                if after_place.map_or(place == 0, |a| a + 1 >= place && a <= last) {
-                    continue;
-                }
-                let (into_in, into_out) = if flipped {
-                    (run_out, run_in)
-                } else {
-                    (run_in, run_out)
-                };
-                let from = self.exit(after_place);
-                let to = self.entry(after_place.map_or(0, |p| p + 1));
-                let added =
-                    self.link(from, into_in) + self.link(into_out, to) - self.link(from, to);
-                if removed - added > MIN_GAIN_M && (!flipped || self.reversible(place..=last)) {
-                    return self.shift_run(place, run, after_place, flipped);
-                }
-            }
-        }
-        None
-    }
-
-    /// Moves the run of `run` strokes at `place` to just after `after_place` (`None`: to the
-    /// front), reversed where `flipped`, if it spans [`MAX_SPAN`] strokes at most; the strokes
-    /// whose links changed.
-    fn shift_run(
-        &mut self,
-        place: usize,
-        run: usize,
-        after_place: Option<usize>,
-        flipped: bool,
-    ) -> Option<Vec<usize>> {
-        let (range, landed) = match after_place {
-            Some(target) if target > place => (place..=target, target + 1 - run),
-            target => {
-                let first = target.map_or(0, |t| t + 1);
-                (first..=place + run - 1, first)
-            }
-        };
-        if range.end() - range.start() >= MAX_SPAN {
-            return None;
-        }
-        let (start, end) = (*range.start(), *range.end());
-        let mut touched = self.strokes_at(&[place.checked_sub(1), Some(place + run)]);
-        if landed > place {
-            self.sequence[range].rotate_left(run);
-        } else {
-            self.sequence[range].rotate_right(run);
-        }
-        if flipped {
-            self.sequence[landed..landed + run].reverse();
-            for o in &mut self.sequence[landed..landed + run] {
-                o.reversed = !o.reversed;
-            }
-        }
-        self.work += end - start + 1;
-        for k in start..=end {
-            self.position[self.sequence[k].stroke] = k;
-        }
-        touched.extend(self.strokes_at(&[
-            landed.checked_sub(1),
-            Some(landed),
-            Some(landed + run - 1),
-            Some(landed + run),
-        ]));
-        Some(touched)
-    }
 }
 
 #[cfg(test)]

@@ -1,11 +1,12 @@
 //! Cycle time: short strokes close together on the FR3, drawn with a pen's lift and hopped
 //! between, against the same job with a torch's lift; every program no shorter than the least
-//! time the arm's limits allow, and the pen clear of the paper between strokes.
+//! time the arm's limits allow, and the pen clear of the paper between strokes; seams on two
+//! faces drawn in the order of least pen-up time, not of least travel.
 
 mod common;
 
 use emg_control::PathSpec;
-use emg_job::{Job, JobFile, SegmentKind, Tool, verify_job};
+use emg_job::{Job, JobFile, Order, SegmentKind, Tool, order_strokes, valley_seams, verify_job};
 use emg_kinematics::{JointVector, Vec3};
 
 /// Twelve 6 mm strokes in a 4 × 3 grid 8 mm apart, on the plate in front of the arm.
@@ -24,10 +25,10 @@ fn short_strokes() -> Vec<PathSpec> {
         .collect()
 }
 
-/// The job of [`short_strokes`] with `tool` and the FR3's home, planned and checked.
-fn planned(tool: Tool) -> (JobFile, emg_kinematics::Robot) {
+/// The job of `strokes` with `tool` and the FR3's home, planned and checked.
+fn planned(strokes: Vec<PathSpec>, tool: Tool) -> (JobFile, emg_kinematics::Robot) {
     let (planner, timing, checker, file) = common::setup("fr3");
-    let mut job = Job::from_strokes(short_strokes(), planner.robot()).expect("a valid job");
+    let mut job = Job::from_strokes(strokes, planner.robot()).expect("a valid job");
     job.settings.tool = tool;
     let job = job
         .with_home(
@@ -43,8 +44,8 @@ fn planned(tool: Tool) -> (JobFile, emg_kinematics::Robot) {
 
 #[test]
 fn a_pen_hops_between_close_strokes_within_the_least_time_the_limits_allow() {
-    let (pen, robot) = planned(Tool::Pen);
-    let (torch, _) = planned(Tool::Torch);
+    let (pen, robot) = planned(short_strokes(), Tool::Pen);
+    let (torch, _) = planned(short_strokes(), Tool::Torch);
     for program in [&pen, &torch] {
         let s = &program.summary;
         assert_eq!(s.complete, 12, "{s:?}");
@@ -99,4 +100,30 @@ fn a_pen_hops_between_close_strokes_within_the_least_time_the_limits_allow() {
             }
         }
     }
+}
+
+#[test]
+fn seams_on_two_faces_are_drawn_one_face_then_the_other() {
+    // Listed (and, by the shortest travel, ordered) back and forth across the edge: even
+    // strokes on the level face, odd ones on the rising face.
+    let (program, robot) = planned(valley_seams(), Tool::Pen);
+    let s = &program.summary;
+    assert_eq!(s.complete, 12, "{s:?}");
+    let faces: Vec<usize> = program
+        .ordering
+        .sequence
+        .iter()
+        .map(|oriented| oriented.stroke % 2)
+        .collect();
+    let changes = faces.windows(2).filter(|pair| pair[0] != pair[1]).count();
+    assert_eq!(changes, 1, "the tool turns over {changes} times: {faces:?}");
+    // The order of least travel crosses the edge at every other move: the order drawn travels
+    // further.
+    let job = Job::from_strokes(valley_seams(), &robot).expect("a valid job");
+    let shortest = order_strokes(&job.strokes, Order::Shortest);
+    assert!(
+        s.travel_m > shortest.travel_m + 0.05,
+        "{s:?} against {shortest:?}"
+    );
+    assert!(s.pen_up_s >= s.least_pen_up_s, "{s:?}");
 }
