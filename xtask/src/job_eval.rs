@@ -237,7 +237,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             with_home(seams(tilt_deg))?,
         ));
     }
-    jobs.push((VALLEY.to_string(), with_home(valley_seams())?));
+    let valley = with_home(valley_seams())?;
+    jobs.push((
+        format!("{VALLEY}, in the order of least travel"),
+        in_travel_order(&valley),
+    ));
+    jobs.push((VALLEY.to_string(), valley));
     let hundreds = [
         (GRID, grid_of_circles(10, 10, [0.45, 0.0, 0.25])),
         (HATCH, hatch()),
@@ -386,6 +391,20 @@ fn seams(tilt_deg: f64) -> Vec<PathSpec> {
 
 /// The name of the job of [`valley_seams`].
 const VALLEY: &str = "12 seams across a valley, 6 on each face";
+
+/// `job` with its strokes listed in the order and directions of least pen-up travel (the order
+/// stage's, without merging) and drawn as listed: the order the reorder stage starts from.
+fn in_travel_order(job: &Job) -> Job {
+    let ordering = order_strokes(&job.strokes, Order::Shortest);
+    let mut listed = job.clone();
+    listed.strokes = ordering
+        .sequence
+        .iter()
+        .map(|oriented| oriented.path(&job.strokes))
+        .collect();
+    listed.settings.order = Order::Given;
+    listed
+}
 
 /// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e (`ur_arm`)
 /// its program exported both ways and read back.
