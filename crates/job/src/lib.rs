@@ -8,12 +8,12 @@
 //!    reconfiguration where one motion cannot finish it;
 //! 4. **connect** ([`free_space`]): retreat along −n, a collision-free joint-space move,
 //!    approach along n;
-//! 5. **choose branches** ([`branch`]): where the arm changes branch between strokes, the
-//!    branches known there carried to the strokes around, one plan per stroke by the least
-//!    pen-up time of the whole job, and the strokes connected again where that is quicker;
-//! 6. **reorder** ([`reorder`]): where the order stage chose the order, runs of strokes moved
+//! 5. **reorder** ([`reorder`]): where the order stage chose the order, runs of strokes moved
 //!    to lower the estimated pen-up time between their planned configurations, not the travel,
 //!    and the strokes connected again in that order where that is quicker;
+//! 6. **choose branches** ([`branch`]): where the arm changes branch between strokes, the
+//!    branches known there carried to the strokes around, one plan per stroke by the least
+//!    pen-up time of the whole job, and the strokes connected again where that is quicker;
 //! 7. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
 //!    an `emg-job/3` file;
@@ -128,8 +128,8 @@ pub enum JobPlanError {
 /// Plans `job` with `planner` as `request` asks (the search; its constraints and scene) and
 /// times it with `timing`;
 /// `robot_file` is recorded in the file; `watch` is told each stage's progress ("ordering",
-/// "planning", "connecting", "branches" where the strokes are connected again on the branches
-/// chosen for the job, and "reordering", in strokes) and asked between strokes whether to stop
+/// "planning", "connecting", "reordering", and "branches" where the strokes are connected
+/// again on the branches chosen for the job, in strokes) and asked between strokes whether to stop
 /// ([`JobPlanError::Stopped`]). Strokes are planned in parallel; the result does not depend on
 /// the number of threads.
 pub fn plan_job(
@@ -228,7 +228,7 @@ pub fn plan_job(
             oriented
         })
         .collect();
-    let first = connect_strokes(
+    let mut connected = connect_strokes(
         &branches,
         &ordering.sequence,
         &plans,
@@ -237,39 +237,7 @@ pub fn plan_job(
         watch,
         "connecting",
     )?;
-    // The strokes' branches chosen for the job as a whole, connected again, and kept where
-    // that draws as much in less time.
     let home_held = job.home.map(|home| branches.held(&home));
-    let chosen = choose_branches(
-        &plans,
-        &ranks,
-        &first.placed_ends,
-        home_held.as_ref(),
-        &branches,
-    );
-    let mut moved_to = vec![None; plans.len()];
-    let (mut plans, mut ranks, mut connected) = (plans, ranks, first);
-    if let Some(chosen) = chosen {
-        let chosen_moved_to: Vec<Option<JointVector>> =
-            chosen.iter().map(|choice| choice.moved_to).collect();
-        let (chosen_plans, chosen_ranks): (Vec<StrokePlan>, Vec<usize>) = chosen
-            .into_iter()
-            .map(|choice| (choice.plan, choice.rank))
-            .unzip();
-        let again = connect_strokes(
-            &branches,
-            &ordering.sequence,
-            &chosen_plans,
-            &chosen_ranks,
-            &chosen_moved_to,
-            watch,
-            "branches",
-        )?;
-        if again.is_better_than(&connected) {
-            (plans, ranks, moved_to, connected) =
-                (chosen_plans, chosen_ranks, chosen_moved_to, again);
-        }
-    }
     // Unless the order is the job's own, the strokes reordered by estimated pen-up time,
     // connected again, and kept where that draws as much in less time.
     let reordered = match settings.order {
@@ -295,18 +263,49 @@ pub fn plan_job(
     };
     if let Some((order, _)) = reordered {
         let sequence = in_order(&ordering.sequence, &order);
-        let reordered_plans = in_order(&plans, &order);
+        let (reordered_plans, reordered_ranks) =
+            (in_order(&plans, &order), in_order(&ranks, &order));
         let again = connect_strokes(
             &branches,
             &sequence,
             &reordered_plans,
-            &in_order(&ranks, &order),
-            &in_order(&moved_to, &order),
+            &reordered_ranks,
+            &vec![None; plans.len()],
             watch,
             "reordering",
         )?;
         if again.is_better_than(&connected) {
-            (ordering.sequence, plans, connected) = (sequence, reordered_plans, again);
+            (ordering.sequence, plans, ranks, connected) =
+                (sequence, reordered_plans, reordered_ranks, again);
+        }
+    }
+    // The strokes' branches chosen for the job as a whole, connected again, and kept where
+    // that draws as much in less time.
+    let chosen = choose_branches(
+        &plans,
+        &ranks,
+        &connected.placed_ends,
+        home_held.as_ref(),
+        &branches,
+    );
+    if let Some(chosen) = chosen {
+        let moved_to: Vec<Option<JointVector>> =
+            chosen.iter().map(|choice| choice.moved_to).collect();
+        let (chosen_plans, chosen_ranks): (Vec<StrokePlan>, Vec<usize>) = chosen
+            .into_iter()
+            .map(|choice| (choice.plan, choice.rank))
+            .unzip();
+        let again = connect_strokes(
+            &branches,
+            &ordering.sequence,
+            &chosen_plans,
+            &chosen_ranks,
+            &moved_to,
+            watch,
+            "branches",
+        )?;
+        if again.is_better_than(&connected) {
+            (plans, connected) = (chosen_plans, again);
         }
     }
     // Measured again between the strokes as they are drawn: their directions and starts taken.

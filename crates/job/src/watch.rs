@@ -6,10 +6,10 @@
 pub trait Watch: Sync {
     /// `done` of `total` units of `stage` are finished ("ordering" counts the job's strokes,
     /// "planning" the millimetres of the strokes searched along, "connecting" the strokes drawn
-    /// once those meeting end to end are merged, "branches" them again where they are
-    /// connected again on the branches chosen for the job, and "reordering" them again where
-    /// they are connected again in the order of least estimated pen-up time (from 0, as the
-    /// order is sought); "screen", "refine" and "certify"
+    /// once those meeting end to end are merged, "reordering" them again where they are
+    /// connected again in the order of least estimated pen-up time (from 0, as the order is
+    /// sought), and "branches" them again where they are connected again on the branches chosen
+    /// for the job; "screen", "refine" and "certify"
     /// count places).
     fn progress(&self, stage: &str, done: usize, total: usize);
 

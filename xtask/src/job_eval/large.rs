@@ -22,8 +22,8 @@ pub struct LargeRow {
     /// Threads it was planned on.
     pub threads: usize,
     /// Each stage's time (s) as the planner reports its progress (`ordering`, `planning`,
-    /// `connecting`, `branches` where the job is connected again on the branches chosen for
-    /// it, and `reordering`), then `writing` (the program serialised as its file holds it).
+    /// `connecting`, `reordering`, and `branches` where the job is connected again on the
+    /// branches chosen for it), then `writing` (the program serialised as its file holds it).
     pub stages: Vec<(String, f64)>,
     /// Planning and writing (s), the stages' sum.
     pub total_s: f64,
@@ -166,7 +166,7 @@ pub fn markdown(rows: &[LargeRow]) -> String {
          checked by the independent checker. Stages as the planner reports them; peak memory \
          is the process's while planning and writing; the least duration is what the arm's \
          limits allow for the same parts (docs/jobs.md, \"Cycle time\").\n\n\
-         | strokes | threads | ordering / planning / connecting / branches / reordering / writing (s) | planned and written (s) | peak memory (MB) | file (MB) | drawn (m) | program (s): pen down / pen up | least (s): pen down / pen up | program / least | check (s) | checker |\n\
+         | strokes | threads | ordering / planning / connecting / reordering / branches / writing (s) | planned and written (s) | peak memory (MB) | file (MB) | drawn (m) | program (s): pen down / pen up | least (s): pen down / pen up | program / least | check (s) | checker |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
@@ -184,8 +184,8 @@ pub fn markdown(rows: &[LargeRow]) -> String {
             stage("ordering"),
             stage("planning"),
             stage("connecting"),
-            stage("branches"),
             stage("reordering"),
+            stage("branches"),
             stage("writing"),
             r.total_s,
             r.peak_memory_mb
