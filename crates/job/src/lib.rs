@@ -10,10 +10,11 @@
 //!    approach along n;
 //! 5. **reorder** ([`reorder`]): where the order stage chose the order, runs of strokes moved
 //!    to lower the estimated pen-up time between their planned configurations, not the travel,
-//!    and the strokes connected again in that order where that is quicker;
+//!    and the strokes connected again in that order;
 //! 6. **choose branches** ([`branch`]): where the arm changes branch between strokes, the
 //!    branches known there carried to the strokes around, one plan per stroke by the least
-//!    pen-up time of the whole job, and the strokes connected again where that is quicker;
+//!    pen-up time of the whole job, and the strokes connected again where that is quicker; in
+//!    both orders, the quicker program kept;
 //! 7. **time** and **write** ([`program`]): one rest-to-rest joint trajectory (a pen-up move
 //!    blended through its corners where that stays free), every segment with its time span, as
 //!    an `emg-job/3` file;
@@ -228,23 +229,29 @@ pub fn plan_job(
             oriented
         })
         .collect();
-    let mut connected = connect_strokes(
-        &branches,
-        &ordering.sequence,
-        &plans,
-        &ranks,
-        &vec![None; plans.len()],
-        watch,
-        "connecting",
-    )?;
+    let first = ConnectedOrder {
+        connected: connect_strokes(
+            &branches,
+            &ordering.sequence,
+            &plans,
+            &ranks,
+            &vec![None; plans.len()],
+            watch,
+            "connecting",
+        )?,
+        sequence: std::mem::take(&mut ordering.sequence),
+        plans,
+        ranks,
+    };
     let home_held = job.home.map(|home| branches.held(&home));
-    // Unless the order is the job's own, the strokes reordered by estimated pen-up time,
-    // connected again, and kept where that draws as much in less time.
-    let reordered = match settings.order {
+    // Unless the order is the job's own, the strokes reordered by estimated pen-up time and
+    // connected again.
+    let reorder = match settings.order {
         Order::Given => None,
         Order::Shortest => {
-            watch.progress("reordering", 0, plans.len());
-            let points: Vec<[Vec3; 2]> = plans
+            watch.progress("reordering", 0, first.plans.len());
+            let points: Vec<[Vec3; 2]> = first
+                .plans
                 .iter()
                 .map(|plan| {
                     [
@@ -254,60 +261,54 @@ pub fn plan_job(
                 })
                 .collect();
             reorder_by_move_time(
-                &connected.placed_ends,
+                &first.connected.placed_ends,
                 &points,
                 home_held.as_ref(),
                 &branches,
             )
         }
     };
-    if let Some((order, _)) = reordered {
-        let sequence = in_order(&ordering.sequence, &order);
-        let (reordered_plans, reordered_ranks) =
-            (in_order(&plans, &order), in_order(&ranks, &order));
-        let again = connect_strokes(
-            &branches,
-            &sequence,
-            &reordered_plans,
-            &reordered_ranks,
-            &vec![None; plans.len()],
-            watch,
-            "reordering",
-        )?;
-        if again.is_better_than(&connected) {
-            (ordering.sequence, plans, ranks, connected) =
-                (sequence, reordered_plans, reordered_ranks, again);
+    let reordered = match reorder {
+        None => None,
+        Some((order, _)) => {
+            let (sequence, plans, ranks) = (
+                in_order(&first.sequence, &order),
+                in_order(&first.plans, &order),
+                in_order(&first.ranks, &order),
+            );
+            let connected = connect_strokes(
+                &branches,
+                &sequence,
+                &plans,
+                &ranks,
+                &vec![None; plans.len()],
+                watch,
+                "reordering",
+            )?;
+            Some(ConnectedOrder {
+                sequence,
+                plans,
+                ranks,
+                connected,
+            })
+        }
+    };
+    // Each order on the branches chosen for it, and of the two the one that draws as much in
+    // less time.
+    let mut best = on_chosen_branches(first, &branches, home_held.as_ref(), watch)?;
+    if let Some(reordered) = reordered {
+        let reordered = on_chosen_branches(reordered, &branches, home_held.as_ref(), watch)?;
+        if reordered.connected.is_better_than(&best.connected) {
+            best = reordered;
         }
     }
-    // The strokes' branches chosen for the job as a whole, connected again, and kept where
-    // that draws as much in less time.
-    let chosen = choose_branches(
-        &plans,
-        &ranks,
-        &connected.placed_ends,
-        home_held.as_ref(),
-        &branches,
-    );
-    if let Some(chosen) = chosen {
-        let moved_to: Vec<Option<JointVector>> =
-            chosen.iter().map(|choice| choice.moved_to).collect();
-        let (chosen_plans, chosen_ranks): (Vec<StrokePlan>, Vec<usize>) = chosen
-            .into_iter()
-            .map(|choice| (choice.plan, choice.rank))
-            .unzip();
-        let again = connect_strokes(
-            &branches,
-            &ordering.sequence,
-            &chosen_plans,
-            &chosen_ranks,
-            &moved_to,
-            watch,
-            "branches",
-        )?;
-        if again.is_better_than(&connected) {
-            (plans, connected) = (chosen_plans, again);
-        }
-    }
+    let ConnectedOrder {
+        sequence,
+        plans,
+        connected,
+        ..
+    } = best;
+    ordering.sequence = sequence;
     // Measured again between the strokes as they are drawn: their directions and starts taken.
     ordering.travel_m = plans
         .windows(2)
@@ -389,6 +390,59 @@ impl Connected {
         drawn(self) >= drawn(other) - SAME_LENGTH_M
             && self.program.duration_s() < other.program.duration_s()
     }
+}
+
+/// A job's strokes in the order drawn, their plans, and the program connecting them.
+struct ConnectedOrder {
+    sequence: Vec<Oriented>,
+    plans: Vec<StrokePlan>,
+    /// Each plan's planner's place in the job's cascade.
+    ranks: Vec<usize>,
+    connected: Connected,
+}
+
+/// The choose-branches stage ([`branch`]) on `drawing`: its strokes' branches chosen for the
+/// job as a whole (the arm starting and ending at `home`), connected again, and kept where
+/// that draws as much in less time.
+fn on_chosen_branches(
+    drawing: ConnectedOrder,
+    branches: &JobBranches<'_>,
+    home: Option<&JointVector>,
+    watch: &dyn Watch,
+) -> Result<ConnectedOrder, JobPlanError> {
+    let Some(chosen) = choose_branches(
+        &drawing.plans,
+        &drawing.ranks,
+        &drawing.connected.placed_ends,
+        home,
+        branches,
+    ) else {
+        return Ok(drawing);
+    };
+    let moved_to: Vec<Option<JointVector>> = chosen.iter().map(|choice| choice.moved_to).collect();
+    let (plans, ranks): (Vec<StrokePlan>, Vec<usize>) = chosen
+        .into_iter()
+        .map(|choice| (choice.plan, choice.rank))
+        .unzip();
+    let connected = connect_strokes(
+        branches,
+        &drawing.sequence,
+        &plans,
+        &ranks,
+        &moved_to,
+        watch,
+        "branches",
+    )?;
+    Ok(if connected.is_better_than(&drawing.connected) {
+        ConnectedOrder {
+            plans,
+            ranks,
+            connected,
+            ..drawing
+        }
+    } else {
+        drawing
+    })
 }
 
 /// The connect stage: the strokes `sequence` planned as `plans` (each by the cascade's planner
