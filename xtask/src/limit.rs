@@ -409,7 +409,8 @@ fn markdown(record: &Record) -> String {
          ℓ* is the search planner with a large budget ({} steps, {} diffusion samples, cone IK from \
          {} restarts, {} finalists, the best {} starts repaired, up to {} of the scan's chains \
          followed from `p0`, then, where the plan still ends below {} × the bound, motions \
-         planned backwards to `p0` from {} followed forwards, then where it still ends below {} × \
+         planned backwards to `p0` from {} read and followed forwards, then where it still ends \
+         below {} × \
          the bound, a beam search over action sequences: {} members, up to {} more steps), \
          every trajectory re-checked by the independent checker; the bound is the reachability \
          scan (a necessary condition, so an upper bound as good as its IK sampling), raised to ℓ* \

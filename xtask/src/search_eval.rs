@@ -338,8 +338,9 @@ fn row_name(row: &Row, config: &SearchConfig) -> String {
     name + ")"
 }
 
-/// The points the far-end stage of `config` plans back from, as words: "95 %, 80 % and 50 % of
-/// the scan".
+/// The points the far-end stage of `config` plans back from, as words: "3 and 10 grid steps
+/// past the plan's end, halfway to the bound, half a grid step before it, and 95 %, 80 % and
+/// 50 % of the scan".
 pub(crate) fn far_end_points(config: &SearchConfig) -> String {
     let percents: Vec<String> = config
         .far_end_shares
@@ -350,7 +351,10 @@ pub(crate) fn far_end_points(config: &SearchConfig) -> String {
         Some((last, rest)) if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
         _ => percents.join(""),
     };
-    format!("{listed} of the scan")
+    format!(
+        "3 and 10 grid steps past the plan's end, halfway to the bound, half a grid step before \
+         it, and {listed} of the scan"
+    )
 }
 
 /// What the search (`config`) does where its plan ends short of its bound, as a clause of
@@ -368,8 +372,9 @@ fn shortfall_clause(config: &SearchConfig) -> String {
         let when = if clause.is_empty() { "then" } else { "still" };
         clause += &format!(
             "; where its plan {when} ends below {SHORTFALL_SHARE} × the bound, it plans the line \
-             backwards to `p0` from {} (the search's first pass on the reversed line) and \
-             follows each motion that gets there forwards from `p0`",
+             backwards to `p0` from {} (the whole planner on the reversed line, its own far \
+             end left out) and takes each motion that gets past `p0`, read forwards and followed \
+             from `p0`, asking again beyond each new end until no motion back passes `p0`",
             far_end_points(config)
         );
     }

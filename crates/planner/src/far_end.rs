@@ -7,13 +7,114 @@
 //! out to `s_far`. Planned from the far end, the search starts where the arm has the fewest
 //! configurations left, and the branch it keeps is one that reaches that far; planned from
 //! `p0`, it must guess that branch at the start. The search's far-end stage
-//! (`crate::search`) plans such motions and follows them forwards from `p0`.
+//! (`crate::search`) plans such motions ([`motion_back`]) from the points gap-eval asks from
+//! ([`probe_starts`]) and takes each that passes `p0` read forwards ([`read_forwards`]) and
+//! followed from `p0` ([`forward_reference`]); `crate::gap` asks the same motions what lies
+//! beyond a plan's end.
 
-use emg_control::{Task, Trajectory};
-use emg_kinematics::{Plate, Robot, WorkSurface};
+use emg_control::{
+    ActingController, RolloutConfig, StepRecord, Task, Trajectory, first_violation, tool_angle_deg,
+};
+use emg_kinematics::{
+    JointVector, Plate, PoseTarget, ProjectionConfig, Robot, WorkSurface, project_to_pose,
+};
 
+use crate::planner::{PlanRequest, Planner};
 use crate::reach::Reach;
 use crate::track::Reference;
+
+/// Grid steps of the scan beyond a plan's end from which the first two motions back start.
+const NEAR_PROBES_GRID_STEPS: [f64; 2] = [3.0, 10.0];
+
+/// Where the motions back that ask the line beyond a plan ending `end_m` along it start
+/// (m along the line): 3 and 10 grid steps of the scan `reach` past the plan's end, halfway
+/// to the bound, and half a grid step before the bound; those not between the plan's end and
+/// the bound are left out.
+pub(crate) fn probe_starts(end_m: f64, reach: &Reach) -> Vec<f64> {
+    let grid_m = reach.grid_m;
+    NEAR_PROBES_GRID_STEPS
+        .map(|steps| end_m + steps * grid_m)
+        .into_iter()
+        .chain([
+            0.5 * (end_m + reach.reachable_m),
+            reach.reachable_m - 0.5 * grid_m,
+        ])
+        .filter(|&from_m| from_m > end_m && from_m < reach.reachable_m)
+        .collect()
+}
+
+/// The motion `planner` plans back from `from_m` along `task`'s line: the whole planner (its
+/// seed, its scan, its search) on the reversed task, its work surface seen from there, its own
+/// far-end stage left out (a motion back does not ask for motions back in turn). `None` on a
+/// path task, where the point lies out of reach, or where no motion starts there.
+pub(crate) fn motion_back(planner: &Planner, task: &Task, from_m: f64) -> Option<Trajectory> {
+    let reversed = reversed_task(planner.robot(), task, from_m)?;
+    let mut config = planner.config().clone();
+    config.rollout.constraints.work_surface =
+        reversed_surface(&config.rollout.constraints.work_surface, from_m);
+    config.search.far_end_shares.clear();
+    let backward = planner.with_config(config).ok()?;
+    let plan = backward.plan(&reversed, &PlanRequest::default()).ok()?;
+    (plan.trajectory.steps.len() >= 2).then_some(plan.trajectory)
+}
+
+/// `back`, a motion of the reversed task from `s_far_m` along `task`'s line that got back past
+/// `p0`, read forwards as far as its start: its last configuration not yet past `p0`, put on
+/// `p0` with its own tool axis (the seed), then its steps in reverse order up to the one before
+/// its first, each recorded as the forward task sees it. Each reversed step lasts what the step
+/// it reverses lasted (the seed's one control period: it moves the arm less than a step), so
+/// every joint speed is one the motion back had. `None` where `back` does not pass `p0` or its
+/// seed is not a valid configuration on `p0`. The configuration `back` started from
+/// (`back.steps[0]`) is where the forward motion goes on.
+pub(crate) fn read_forwards(
+    robot: &Robot,
+    task: &Task,
+    back: &Trajectory,
+    s_far_m: f64,
+    config: &RolloutConfig,
+) -> Option<(JointVector, Vec<StepRecord>)> {
+    if back.path_length_m < s_far_m || back.steps.len() < 2 {
+        return None;
+    }
+    // The last step of the motion back still on `p0`'s side of the line.
+    let last = back
+        .steps
+        .iter()
+        .rposition(|step| task.progress(&step.tcp) >= 0.0)?;
+    let near_p0 = back.steps[last].q;
+    let target = PoseTarget {
+        position: task.p0,
+        tool_axis: robot.forward(&near_p0).tool_axis(),
+        roll_axis: None,
+    };
+    let (seed, _) = project_to_pose(robot, &near_p0, &target, &ProjectionConfig::default()).ok()?;
+    let kinematics = robot.forward(&seed);
+    if first_violation(robot, task, &kinematics, &config.constraints).is_some() {
+        return None;
+    }
+    let record = |time_s: f64, q: JointVector| {
+        let kinematics = robot.forward(&q);
+        StepRecord {
+            time_s,
+            q,
+            tcp: kinematics.tcp(),
+            tool_angle_deg: tool_angle_deg(&kinematics.tool_axis(), &task.n),
+            rho: robot.limits().limit_proximity(&q),
+            controller: Some(ActingController::Search),
+        }
+    };
+    let mut time_s = 0.0;
+    let mut steps = vec![record(time_s, seed)];
+    for k in (1..=last).rev() {
+        time_s += if k == last {
+            config.dt_s
+        } else {
+            back.steps[k + 1].time_s - back.steps[k].time_s
+        };
+        steps.push(record(time_s, back.steps[k].q));
+    }
+    Some((seed, steps))
+}
 
 /// The task of the motion back from `s_far_m` along `task`'s line: it starts at that point and
 /// runs along `−d`, with the same normal and no generating configuration. `None` on a path
@@ -39,21 +140,6 @@ pub(crate) fn reversed_surface(surface: &WorkSurface, s_far_m: f64) -> WorkSurfa
         }),
         other => *other,
     }
-}
-
-/// The scan `reach` of the forward task, cut at grid point `far` and read from there back to
-/// `p0`: the reversed task's scan up to `p0` (its bound is the distance to `p0`; what lies
-/// behind `p0` is not scanned). `None` when the scan holds no configuration at `far`.
-pub(crate) fn reversed_reach(reach: &Reach, far: usize) -> Option<Reach> {
-    let witnesses: Vec<_> = reach.witnesses.get(..=far)?.iter().rev().copied().collect();
-    let s_far_m = far as f64 * reach.grid_m;
-    Some(Reach {
-        reachable_m: s_far_m,
-        scanned_m: s_far_m,
-        reachable_p0: true,
-        grid_m: reach.grid_m,
-        witnesses,
-    })
 }
 
 /// The forward reference that `backward`, a motion of the reversed task from `s_far_m` along

@@ -5,7 +5,9 @@
 //! where a plan ends well short of it, either the search missed a motion or the configurations
 //! beyond lie on branches no motion from `p0` reaches. [`gap_probes`] asks the line from the
 //! far side: from a few points between the plan's end and the bound it plans the reversed task
-//! (the full search, as [`Planner::plan`] does) and sees where each motion back gets to:
+//! (the whole planner, as [`Planner::plan`] plans, its far-end stage left out:
+//! `crate::far_end::motion_back`, the motions the search's own far-end stage asks for from the
+//! same points) and sees where each motion back gets to:
 //! - past `p0`: read forwards, a motion from `p0` to that point exists, longer than the plan;
 //! - past the plan's end but not to `p0`: both motions cover the points between, and
 //!   [`in_place_motion`] tries to join, at one of them, the plan's configuration to the motion
@@ -22,9 +24,9 @@ use emg_control::{Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
 use serde::{Deserialize, Serialize};
 
-use crate::far_end::{reversed_surface, reversed_task};
+use crate::far_end::{motion_back, probe_starts};
 use crate::in_place::{InPlaceConfig, in_place_motion, motion_along_line};
-use crate::planner::{Plan, PlanRequest, Planner};
+use crate::planner::{Plan, Planner};
 
 /// Where a motion planned back from a point beyond a plan's end got to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -66,17 +68,15 @@ pub struct GapProbe {
     pub outcome: GapProbeOutcome,
 }
 
-/// Grid steps of the scan beyond the plan's end at which the first two probes start.
-const NEAR_PROBES_GRID_STEPS: [f64; 2] = [3.0, 10.0];
-
 /// Grid steps of the scan on each side of the plan's end within which an overlap is compared.
 const OVERLAP_GRID_STEPS: f64 = 4.0;
 
 /// Motions planned back to `task`'s line from points beyond `plan`'s end, with `planner`'s
 /// configuration (its work surface seen from each point), and what each says of the gap
-/// between the plan and its bound (module documentation). The points: 3 and 10 grid steps of
-/// the scan past the plan's end, halfway to the bound, and half a grid step before the bound;
-/// those not between the plan's end and the bound are left out. Empty on a path task.
+/// between the plan and its bound (module documentation). The points
+/// (`crate::far_end::probe_starts`): 3 and 10 grid steps of the scan past the plan's end,
+/// halfway to the bound, and half a grid step before the bound; those not between the plan's
+/// end and the bound are left out. Empty on a path task.
 pub fn gap_probes(
     planner: &Planner,
     task: &Task,
@@ -87,17 +87,8 @@ pub fn gap_probes(
         return Vec::new();
     }
     let reach = planner.reach_of(task, plan);
-    let end_m = plan.trajectory.path_length_m;
-    let grid_m = reach.grid_m;
-    let starts = NEAR_PROBES_GRID_STEPS
-        .map(|steps| end_m + steps * grid_m)
+    probe_starts(plan.trajectory.path_length_m, &reach)
         .into_iter()
-        .chain([
-            0.5 * (end_m + reach.reachable_m),
-            reach.reachable_m - 0.5 * grid_m,
-        ])
-        .filter(|&from_m| from_m > end_m && from_m < reach.reachable_m);
-    starts
         .map(|from_m| GapProbe {
             from_m,
             ..probe_from(planner, task, &plan.trajectory, from_m, in_place)
@@ -120,22 +111,10 @@ fn probe_from(
         outcome: GapProbeOutcome::NoStart,
     };
     let robot = planner.robot();
-    let Some(reversed) = reversed_task(robot, task, from_m) else {
+    let Some(back) = motion_back(planner, task, from_m) else {
         return no_start;
     };
-    let mut config = planner.config().clone();
-    config.rollout.constraints.work_surface =
-        reversed_surface(&config.rollout.constraints.work_surface, from_m);
-    let Ok(backward_planner) = planner.with_config(config) else {
-        return no_start;
-    };
-    let Ok(back) = backward_planner.plan(&reversed, &PlanRequest::default()) else {
-        return no_start;
-    };
-    if back.trajectory.steps.len() < 2 {
-        return no_start;
-    }
-    let back_to_m = from_m - back.trajectory.path_length_m;
+    let back_to_m = from_m - back.path_length_m;
     let end_m = forward.path_length_m;
     let outcome = if back_to_m <= 0.0 {
         GapProbeOutcome::PassesP0
@@ -145,8 +124,8 @@ fn probe_from(
         let grid_m = planner.config().reach.grid_m;
         let at_m = 0.5 * (back_to_m.max(end_m - OVERLAP_GRID_STEPS * grid_m) + end_m);
         let point = task.point_at(at_m);
-        let ends = [forward, &back.trajectory]
-            .map(|trajectory| on_point(robot, task, trajectory, at_m, &point));
+        let ends =
+            [forward, &back].map(|trajectory| on_point(robot, task, trajectory, at_m, &point));
         let joint_gap_rad = match ends {
             [Some(a), Some(b)] => Some((a - b).amax()),
             _ => None,
@@ -187,7 +166,7 @@ fn probe_from(
             0.0,
             from_m,
             &configurations(forward),
-            &configurations(&back.trajectory),
+            &configurations(&back),
             in_place,
         )
         .is_some()

@@ -212,6 +212,7 @@ impl Planner {
                 Err(error) => return Err(error.into()),
             };
             let context = SearchContext {
+                planner: self,
                 robot: &self.robot,
                 rollout: &self.config.rollout,
                 reach: &self.config.reach,

@@ -26,11 +26,11 @@
 //! [`SHORTFALL_SHARE`] × the bound, the budget grows ([`SearchConfig::widened_budget_steps`])
 //! and the search goes on wider: more chains, diffusion samples and IK restarts, the starts not
 //! rolled out yet ranked and re-rolled, the leaders not yet settled repaired. Where it still
-//! ends short, the far-end stage plans the line backwards, from points far along it back to
-//! `p0`, and follows each motion that gets there forwards from `p0`
-//! ([`SearchConfig::far_end_shares`], `crate::far_end`): planned from `p0`, the search must
-//! guess at the start the branch that survives far along the line; planned from there, it
-//! starts on one. Where it still ends below [`SearchConfig::beam_below_share`] × the bound, a
+//! ends short, the far-end stage plans the line backwards, from points beyond the plan's end
+//! back to `p0`, and takes each motion that gets past `p0` read forwards and followed forwards
+//! from `p0`, asking again beyond each new end ([`SearchConfig::far_end_shares`],
+//! `crate::far_end`): planned from `p0`, the search must guess at the start the branch that
+//! survives far along the line; planned from there, it starts on one. Where it still ends below [`SearchConfig::beam_below_share`] × the bound, a
 //! beam search over action sequences from every start rolled out goes last
 //! ([`SearchConfig::beam_width`], `crate::beam`).
 //!
@@ -46,8 +46,8 @@
 
 use emg_control::{
     ARRIVAL_M, ActingController, ClassicalController, ClassicalGains, Episode, NullAction,
-    NullSpaceController, OutOfRange, RolloutConfig, StepContext, Task, Termination, Trajectory,
-    continue_rollout, first_violation,
+    NullSpaceController, OutOfRange, RolloutConfig, StepContext, StepRecord, Task, Termination,
+    Trajectory, continue_rollout, first_violation,
 };
 use emg_diffusion::{DpSeeder, SeedWorkspace};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
@@ -60,7 +60,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::beam::{BeamLimits, beam_search, null_actions};
 use crate::controller::Executor;
-use crate::far_end::{forward_reference, reversed_reach, reversed_surface, reversed_task};
+use crate::far_end::{forward_reference, motion_back, probe_starts, read_forwards};
+use crate::planner::Planner;
 use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
 use crate::seed::Seed;
 use crate::track::{Reference, progress_per_step, tracking_action};
@@ -138,18 +139,19 @@ pub struct SearchConfig {
     /// the first 1,000, 0.99 gave FR3 ≥ 1 m 0.9177 (0.9169 at 0.95) at nearly twice the time.
     pub beam_below_share: f64,
     /// Shares of the scan's reach from which the far-end stage plans back to `p0` (default
-    /// 0.95, 0.8, 0.65 and 0.5; empty: never), run before the beam where the longest rollout
-    /// still ends below [`SHORTFALL_SHARE`] × the bound: from the grid point at each share
-    /// beyond the longest rollout, the first pass of a search with these settings plans the
-    /// motion back to `p0` (`crate::far_end`; its own budget of
-    /// [`SearchConfig::budget_steps`]), and where that motion gets back to `p0`, rollouts from
-    /// `p0` follow it forwards, each tail taking over where it ends. Measured on the first
-    /// 1,000 evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over
-    /// the lines whose bound is 1 m or more, without and with the default shares, and the mean
-    /// time per plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa 0.948 → 0.958 (45.7 → 45.9 ms),
-    /// UR5e 0.866 → 0.886 (55.3 → 59.7 ms). On the 39 FR3 tasks of those whose best-known
-    /// length ended below 0.9 × their bound, a backward search with its own widened pass and
-    /// beam found no more than its first pass alone, at twice the time.
+    /// 0.95, 0.8, 0.65 and 0.5; empty: no far-end stage), run before the beam where the longest
+    /// rollout still ends below [`SHORTFALL_SHARE`] × the bound: from the grid point at each
+    /// share beyond the longest rollout, and from the points gap-eval asks from beyond it (3
+    /// and 10 grid steps past its end, halfway to the bound, half a grid step before it), the
+    /// whole planner plans the motion back to `p0` (`crate::far_end::motion_back`, its own
+    /// far-end stage left out), and each motion that gets back past `p0` is taken read
+    /// forwards and followed from `p0`, each tail going on where it ends; while that takes the
+    /// plan further, the points beyond its new end are asked in turn. Measured, when the stage
+    /// planned back by the search's first pass from the shares alone, on the first 1,000
+    /// evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over the
+    /// lines whose bound is 1 m or more, without and with the stage, and the mean time per
+    /// plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa 0.948 → 0.958 (45.7 → 45.9 ms), UR5e
+    /// 0.866 → 0.886 (55.3 → 59.7 ms).
     pub far_end_shares: Vec<f64>,
 }
 
@@ -336,6 +338,8 @@ struct Candidate {
 
 /// Everything the search needs besides the task and the controller.
 pub(crate) struct SearchContext<'a> {
+    /// The planner the search plans for; the far-end stage plans motions back with it.
+    pub planner: &'a Planner,
     pub robot: &'a Robot,
     pub rollout: &'a RolloutConfig,
     pub reach: &'a ReachConfig,
@@ -754,67 +758,116 @@ impl Search<'_> {
         }
     }
 
-    /// The far-end stage ([`SearchConfig::far_end_shares`]): from each share of the scan's
-    /// grid points beyond the longest rollout, the motion planned back to `p0`
-    /// ([`Search::planned_back`]) followed forwards from its configuration there.
+    /// The far-end stage: the line asked from its far side. From the points beyond the longest
+    /// rollout that gap-eval asks from (`crate::far_end::probe_starts`) and from each share of
+    /// the scan ([`SearchConfig::far_end_shares`]) beyond it, the planner plans the motion back
+    /// to `p0` (`crate::far_end::motion_back`). Each one that gets back past `p0`, read
+    /// forwards, is a motion from `p0` to where it started: it is offered as it is with each
+    /// tail going on from its end ([`Search::read_forwards`]), and followed from `p0` by
+    /// rollouts of each tail ([`Search::track`]); its rollouts have a budget of their own,
+    /// [`SearchConfig::budget_steps`]. While that takes the longest rollout further, the line
+    /// beyond its new end is asked in turn: the stage ends where no motion back from the points
+    /// beyond the plan's end passes `p0`.
     fn far_end(&mut self, reach: &Reach, tails: &mut [Executor; 2]) {
         let context = self.context;
-        // The backward search is the first pass alone: no widened pass, beam or far end.
-        let backward = SearchConfig {
-            widened_budget_steps: 0,
-            beam_width: 0,
-            far_end_shares: Vec::new(),
-            ..context.config.clone()
-        };
-        for &share in &context.config.far_end_shares {
-            let far = ((reach.witnesses.len().saturating_sub(1)) as f64 * share) as usize;
-            if far as f64 * reach.grid_m <= self.longest_m() {
-                continue;
+        let scanned = reach.witnesses.len().saturating_sub(1) as f64;
+        let mut asked: Vec<f64> = Vec::new();
+        loop {
+            let end_m = self.longest_m();
+            let shares = context.config.far_end_shares.iter().map(|&share| {
+                // The scan's grid point at that share.
+                (scanned * share) as usize as f64 * reach.grid_m
+            });
+            let starts: Vec<f64> = probe_starts(end_m, reach)
+                .into_iter()
+                .chain(shares.filter(|&s_m| s_m > end_m))
+                .collect();
+            for from_m in starts {
+                if asked.contains(&from_m) {
+                    continue;
+                }
+                if (context.stop)() || self.arrived() {
+                    return;
+                }
+                asked.push(from_m);
+                let Some(back) = motion_back(context.planner, self.task, from_m) else {
+                    continue;
+                };
+                if back.path_length_m < from_m {
+                    continue;
+                }
+                self.budget = self.budget.max(self.spent) + context.config.budget_steps;
+                self.read_forwards(&back, from_m, tails);
+                if let Some((start, reference)) = self.forward_start(&back, from_m) {
+                    self.track(start, &reference, FAR_END_SOURCE, tails);
+                }
             }
-            if let Some((start, reference)) = self.planned_back(reach, far, &backward, &tails[0]) {
-                self.track(start, &reference, FAR_END_SOURCE, tails);
+            if self.longest_m() <= end_m {
+                return;
             }
         }
     }
 
-    /// The motion a search with `config` (`finalist` its requested controller) plans on the
-    /// reversed task from the scan's grid point `far` back to `p0` (`crate::far_end`), read
-    /// forwards: its configuration at `p0`, put on `p0` with its own tool axis, and the
-    /// reference that follows it from there; `None` where it does not get back to `p0`.
-    fn planned_back(
-        &self,
-        reach: &Reach,
-        far: usize,
-        config: &SearchConfig,
-        finalist: &Executor,
-    ) -> Option<(JointVector, Reference)> {
+    /// `back`, a motion planned back from `s_far_m` past `p0`, read forwards
+    /// (`crate::far_end::read_forwards`) and each tail going on from where it started: offered
+    /// like any rollout, its actions not kept (nothing replays it).
+    fn read_forwards(&mut self, back: &Trajectory, s_far_m: f64, tails: &mut [Executor; 2]) {
         let context = self.context;
-        let s_far_m = far as f64 * reach.grid_m;
-        let task = reversed_task(context.robot, self.task, s_far_m)?;
-        let scan = reversed_reach(reach, far)?;
-        let mut rollout = context.rollout.clone();
-        rollout.constraints.work_surface =
-            reversed_surface(&rollout.constraints.work_surface, s_far_m);
-        let backward_context = SearchContext {
-            rollout: &rollout,
-            config,
-            ..*context
+        let Some((seed, prefix)) =
+            read_forwards(context.robot, self.task, back, s_far_m, context.rollout)
+        else {
+            return;
         };
         let seed = Seed {
-            q: scan.witnesses[0],
+            q: seed,
             source: FAR_END_SOURCE,
             projection_iterations: None,
         };
-        let (_, backward) = search(&backward_context, &task, seed, finalist.clone(), &scan);
-        let reference = forward_reference(self.task, &backward, s_far_m)?;
+        // The motion goes on from the configuration the motion back started at, a step after
+        // the last one read forwards, as long as one rollout may.
+        let step_s = back.steps[1].time_s - back.steps[0].time_s;
+        let onward_from_s = prefix.last().map_or(0.0, |step| step.time_s) + step_s;
+        let mut rollout = context.rollout.clone();
+        rollout.max_steps = rollout.max_steps.saturating_sub(prefix.len()).max(1);
+        for tail in tails.iter_mut() {
+            if self.done() {
+                return;
+            }
+            let episode = Episode::start(context.robot, self.task, &back.steps[0].q, &rollout);
+            let mut branch = Branch {
+                lead: None,
+                tail,
+                issued: Vec::new(),
+            };
+            let onward = continue_rollout(episode, &mut branch);
+            self.spent += steps_evaluated(&onward);
+            let mut steps = prefix.clone();
+            steps.extend(onward.steps.into_iter().map(|step| StepRecord {
+                time_s: onward_from_s + step.time_s,
+                ..step
+            }));
+            self.offer(Best {
+                seed: seed.clone(),
+                trajectory: Trajectory { steps, ..onward },
+                issued: Vec::new(),
+            });
+        }
+    }
+
+    /// The reference `back`, a motion planned back from `s_far_m` past `p0`, gives read
+    /// forwards (`crate::far_end::forward_reference`), and its configuration at `p0` put on
+    /// `p0` with its own tool axis; `None` where it does not get back to `p0`.
+    fn forward_start(&self, back: &Trajectory, s_far_m: f64) -> Option<(JointVector, Reference)> {
+        let robot = self.context.robot;
+        let reference = forward_reference(self.task, back, s_far_m)?;
         let at_p0 = reference.at(0.0)?;
         let target = PoseTarget {
             position: self.task.p0,
-            tool_axis: context.robot.forward(&at_p0).tool_axis(),
+            tool_axis: robot.forward(&at_p0).tool_axis(),
             roll_axis: None,
         };
         let (start, _) =
-            project_to_pose(context.robot, &at_p0, &target, &ProjectionConfig::default()).ok()?;
+            project_to_pose(robot, &at_p0, &target, &ProjectionConfig::default()).ok()?;
         Some((start, reference))
     }
 

@@ -4,15 +4,16 @@
 //! pipeline's rollout gives exactly the pipeline's plan; with the work surface and an obstacle on
 //! the way, every plan still passes the checker told of them; a plan short of its bound is
 //! searched wider and goes further, one near its bound is left as it is; the far-end stage finds
-//! a motion the search from `p0` misses; the beam stage goes on where the widened search still
-//! ends short.
+//! a motion the search from `p0` misses, and no motion planned back from beyond a plan's end
+//! passes `p0`; the beam stage goes on where the widened search still ends short.
 
 use emg_control::{ActingController, CheckRollout, Task};
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
 use emg_planner::{
-    CHAIN_SOURCE, DataDir, FAR_END_SOURCE, Models, Plan, PlanRequest, Planner, PlannerConfig,
-    PlannerKind, SHORTFALL_SHARE, SearchConfig, ShippedRobot,
+    CHAIN_SOURCE, DataDir, FAR_END_SOURCE, GapProbeOutcome, InPlaceConfig, Models, Plan,
+    PlanRequest, Planner, PlannerConfig, PlannerKind, SHORTFALL_SHARE, SearchConfig, ShippedRobot,
+    gap_probes,
 };
 use emg_verify::ReferenceModel;
 
@@ -338,4 +339,46 @@ fn a_plan_short_of_its_bound_is_searched_wider() {
         widened > 0,
         "no short plan reached 0.9 × its bound when widened"
     );
+}
+
+#[test]
+fn no_motion_planned_back_from_beyond_the_plan_passes_p0() {
+    // Evaluation task 221 as gap-eval plans it (the corrected step at 0.5 mm, no surface):
+    // the search from `p0` used to end at 0.239 m of a 1.13 m bound, while the motion the
+    // planner plans back from 3 grid steps past that end passes `p0`. The far-end stage now
+    // asks the line from the same points and takes such a motion read forwards.
+    let mut config = PlannerConfig::default();
+    config.rollout.constraints.line_tolerance_m = 0.5e-3;
+    config.rollout.tracking = emg_control::Tracking::Corrected;
+    let planner = planner(config);
+    let task = tasks(planner.robot(), 222).swap_remove(221);
+    let plan = planner.plan(&task, &PlanRequest::default()).expect("plans");
+    let reached = plan.trajectory.path_length_m;
+    assert!(reached > 0.269, "{reached} m");
+    let probes = gap_probes(
+        &planner,
+        &task,
+        &plan,
+        &InPlaceConfig {
+            samples: 200,
+            ..InPlaceConfig::default()
+        },
+    );
+    assert!(!probes.is_empty());
+    for probe in &probes {
+        assert_ne!(
+            probe.outcome,
+            GapProbeOutcome::PassesP0,
+            "from {} m back to {} m, the plan {reached} m",
+            probe.from_m,
+            probe.back_to_m
+        );
+    }
+    checker(planner.robot())
+        .check(
+            &task,
+            &plan.trajectory,
+            &planner.config().rollout.constraints,
+        )
+        .expect("the plan passes the checker");
 }
