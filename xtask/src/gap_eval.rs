@@ -349,9 +349,10 @@ fn markdown(record: &Record) -> String {
          plan ends below 0.9 of its bound and the bound's continuity test finds no chain of \
          valid configurations joining `p0` to 95 % of it (`emg plan`'s note \"the bound is \
          likely loose here\"): {:.2} m planned of their Σ {:.2} m bound. Each is asked from the \
-         far side (`emg_planner::gap_probes`): the same search plans the line backwards from 3 \
-         and 10 grid steps past the plan's end, from halfway to the bound and from half a grid \
-         step before it, and where a motion back passes the plan's end without reaching `p0`, \
+         far side (`emg_planner::gap_probes`): the same planner, its far-end stage left out, \
+         plans the line backwards from 3 and 10 grid steps past the plan's end, from halfway to \
+         the bound and from half a grid step before it (the motions the search's own far-end \
+         stage asks for from the same points, so none should pass `p0`), and where a motion back passes the plan's end without reaching `p0`, \
          a motion in place (`emg_planner::in_place_motion`, RRT-Connect on the configurations \
          that hold the TCP on one point, {} draws, seed {}) tries to join the plan's \
          configuration there to the motion back's. Where a motion back does not pass `p0`, a \
