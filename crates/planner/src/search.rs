@@ -30,9 +30,9 @@
 //! back to `p0`, and takes each motion that gets past `p0` read forwards and followed forwards
 //! from `p0`, asking again beyond each new end ([`SearchConfig::far_end_shares`],
 //! `crate::far_end`): planned from `p0`, the search must guess at the start the branch that
-//! survives far along the line; planned from there, it starts on one. Where it still ends below [`SearchConfig::beam_below_share`] × the bound, a
-//! beam search over action sequences from every start rolled out goes last
-//! ([`SearchConfig::beam_width`], `crate::beam`).
+//! survives far along the line; planned from there, it starts on one. Where it still ends
+//! below [`SearchConfig::beam_below_share`] × the bound, a beam search over action sequences
+//! from every start rolled out goes last ([`SearchConfig::beam_width`], `crate::beam`).
 //!
 //! The repair replays the actions of the rollout it branches from once per round (so its states
 //! recur exactly), keeps snapshots of the episode at the branch points, and continues each
@@ -763,7 +763,7 @@ impl Search<'_> {
     /// the scan ([`SearchConfig::far_end_shares`]) beyond it, the planner plans the motion back
     /// to `p0` (`crate::far_end::motion_back`). Each one that gets back past `p0`, read
     /// forwards, is a motion from `p0` to where it started: it is offered as it is with each
-    /// tail going on from its end ([`Search::read_forwards`]), and followed from `p0` by
+    /// tail going on from its end ([`Search::offer_read_forwards`]), and followed from `p0` by
     /// rollouts of each tail ([`Search::track`]); its rollouts have a budget of their own,
     /// [`SearchConfig::budget_steps`]. While that takes the longest rollout further, the line
     /// beyond its new end is asked in turn: the stage ends where no motion back from the points
@@ -797,7 +797,7 @@ impl Search<'_> {
                     continue;
                 }
                 self.budget = self.budget.max(self.spent) + context.config.budget_steps;
-                self.read_forwards(&back, from_m, tails);
+                self.offer_read_forwards(&back, from_m, tails);
                 if let Some((start, reference)) = self.forward_start(&back, from_m) {
                     self.track(start, &reference, FAR_END_SOURCE, tails);
                 }
@@ -811,7 +811,7 @@ impl Search<'_> {
     /// `back`, a motion planned back from `s_far_m` past `p0`, read forwards
     /// (`crate::far_end::read_forwards`) and each tail going on from where it started: offered
     /// like any rollout, its actions not kept (nothing replays it).
-    fn read_forwards(&mut self, back: &Trajectory, s_far_m: f64, tails: &mut [Executor; 2]) {
+    fn offer_read_forwards(&mut self, back: &Trajectory, s_far_m: f64, tails: &mut [Executor; 2]) {
         let context = self.context;
         let Some((seed, prefix)) =
             read_forwards(context.robot, self.task, back, s_far_m, context.rollout)
