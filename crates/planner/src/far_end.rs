@@ -62,8 +62,8 @@ pub(crate) fn motion_back(planner: &Planner, task: &Task, from_m: f64) -> Option
 /// `p0`, read forwards as far as its start: its last configuration not yet past `p0`, put on
 /// `p0` with its own tool axis (the seed), then its steps in reverse order up to the one before
 /// its first, each recorded as the forward task sees it. Each reversed step lasts what the step
-/// it reverses lasted (the seed's one control period: it moves the arm less than a step), so
-/// every joint speed is one the motion back had. `None` where `back` does not pass `p0` or its
+/// it reverses lasted, so every joint speed is one the motion back had; the seed's lasts a
+/// control period, stretched where a joint would otherwise move faster than its limit. `None` where `back` does not pass `p0` or its
 /// seed is not a valid configuration on `p0`. The configuration `back` started from
 /// (`back.steps[0]`) is where the forward motion goes on.
 pub(crate) fn read_forwards(
@@ -103,11 +103,22 @@ pub(crate) fn read_forwards(
             controller: Some(ActingController::Search),
         }
     };
+    // The step from the seed lasts a control period, longer where a joint would move faster
+    // than its speed limit allows (as a rollout's step does).
+    let moved = back.steps[last].q - seed;
+    let limits = &robot.limits().velocity;
+    let fraction = config
+        .constraints
+        .velocity_limit_fraction
+        .map_or(1.0, |fraction| fraction.get());
+    let first_s = (0..robot.dof())
+        .map(|i| moved[i].abs() / (fraction * limits[i]))
+        .fold(config.dt_s, f64::max);
     let mut time_s = 0.0;
     let mut steps = vec![record(time_s, seed)];
     for k in (1..=last).rev() {
         time_s += if k == last {
-            config.dt_s
+            first_s
         } else {
             back.steps[k + 1].time_s - back.steps[k].time_s
         };
@@ -140,6 +151,21 @@ pub(crate) fn reversed_surface(surface: &WorkSurface, s_far_m: f64) -> WorkSurfa
         }),
         other => *other,
     }
+}
+
+/// The scan `reach` of the forward task, cut at grid point `far` and read from there back to
+/// `p0`: the reversed task's scan up to `p0` (its bound is the distance to `p0`; what lies
+/// behind `p0` is not scanned). `None` when the scan holds no configuration at `far`.
+pub(crate) fn reversed_reach(reach: &Reach, far: usize) -> Option<Reach> {
+    let witnesses: Vec<_> = reach.witnesses.get(..=far)?.iter().rev().copied().collect();
+    let s_far_m = far as f64 * reach.grid_m;
+    Some(Reach {
+        reachable_m: s_far_m,
+        scanned_m: s_far_m,
+        reachable_p0: true,
+        grid_m: reach.grid_m,
+        witnesses,
+    })
 }
 
 /// The forward reference that `backward`, a motion of the reversed task from `s_far_m` along

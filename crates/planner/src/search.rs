@@ -60,7 +60,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::beam::{BeamLimits, beam_search, null_actions};
 use crate::controller::Executor;
-use crate::far_end::{forward_reference, motion_back, probe_starts, read_forwards};
+use crate::far_end::{
+    forward_reference, motion_back, probe_starts, read_forwards, reversed_reach, reversed_surface,
+    reversed_task,
+};
 use crate::planner::Planner;
 use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
 use crate::seed::Seed;
@@ -141,12 +144,13 @@ pub struct SearchConfig {
     /// Shares of the scan's reach from which the far-end stage plans back to `p0` (default
     /// 0.95, 0.8, 0.65 and 0.5; empty: no far-end stage), run before the beam where the longest
     /// rollout still ends below [`SHORTFALL_SHARE`] × the bound: from the grid point at each
-    /// share beyond the longest rollout, and from the points gap-eval asks from beyond it (3
-    /// and 10 grid steps past its end, halfway to the bound, half a grid step before it), the
-    /// whole planner plans the motion back to `p0` (`crate::far_end::motion_back`, its own
-    /// far-end stage left out), and each motion that gets back past `p0` is taken read
-    /// forwards and followed from `p0`, each tail going on where it ends; while that takes the
-    /// plan further, the points beyond its new end are asked in turn. Measured, when the stage
+    /// share beyond the longest rollout, the search's first pass plans the motion back to `p0`
+    /// on the scan read backwards, and from the points gap-eval asks from beyond it (3 and 10
+    /// grid steps past its end, halfway to the bound, half a grid step before it) the whole
+    /// planner does (`crate::far_end::motion_back`, its own far-end stage left out); each
+    /// motion that gets back past `p0` is taken read forwards and followed from `p0`, each tail
+    /// going on where it ends; while the probes take the plan further, the points beyond its
+    /// new end are asked in turn. Measured, when the stage
     /// planned back by the search's first pass from the shares alone, on the first 1,000
     /// evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over the
     /// lines whose bound is 1 m or more, without and with the stage, and the mean time per
@@ -758,31 +762,41 @@ impl Search<'_> {
         }
     }
 
-    /// The far-end stage: the line asked from its far side. From the points beyond the longest
-    /// rollout that gap-eval asks from (`crate::far_end::probe_starts`) and from each share of
-    /// the scan ([`SearchConfig::far_end_shares`]) beyond it, the planner plans the motion back
-    /// to `p0` (`crate::far_end::motion_back`). Each one that gets back past `p0`, read
-    /// forwards, is a motion from `p0` to where it started: it is offered as it is with each
-    /// tail going on from its end ([`Search::offer_read_forwards`]), and followed from `p0` by
-    /// rollouts of each tail ([`Search::track`]); its rollouts have a budget of their own,
-    /// [`SearchConfig::budget_steps`]. While that takes the longest rollout further, the line
-    /// beyond its new end is asked in turn: the stage ends where no motion back from the points
-    /// beyond the plan's end passes `p0`.
+    /// The far-end stage: the line asked from its far side. First, from each share of the
+    /// scan's grid points ([`SearchConfig::far_end_shares`]) beyond the longest rollout, the
+    /// search's first pass plans the motion back to `p0` ([`Search::searched_back`]); then,
+    /// from the points beyond the longest rollout that gap-eval asks from
+    /// (`crate::far_end::probe_starts`), the whole planner does (`crate::far_end::motion_back`).
+    /// Each motion back that gets past `p0`, read forwards, is a motion from `p0` to where it
+    /// started ([`Search::take_motion_back`]). While the probes take the longest rollout
+    /// further, the line beyond its new end is asked in turn: the stage ends where no motion
+    /// back from gap-eval's points beyond the plan's end passes `p0`.
     fn far_end(&mut self, reach: &Reach, tails: &mut [Executor; 2]) {
         let context = self.context;
-        let scanned = reach.witnesses.len().saturating_sub(1) as f64;
+        // From the shares, the search's first pass alone on the scan read backwards: no
+        // widened pass, beam or far end.
+        let first_pass = SearchConfig {
+            widened_budget_steps: 0,
+            beam_width: 0,
+            far_end_shares: Vec::new(),
+            ..context.config.clone()
+        };
+        for &share in &context.config.far_end_shares {
+            let far = ((reach.witnesses.len().saturating_sub(1)) as f64 * share) as usize;
+            let s_far_m = far as f64 * reach.grid_m;
+            if s_far_m <= self.longest_m() {
+                continue;
+            }
+            if let Some(back) = self.searched_back(reach, far, &first_pass, &tails[0]) {
+                self.take_motion_back(&back, s_far_m, tails);
+            }
+        }
+        // From gap-eval's points, the whole planner's motion back, asked again beyond each new
+        // end.
         let mut asked: Vec<f64> = Vec::new();
         loop {
             let end_m = self.longest_m();
-            let shares = context.config.far_end_shares.iter().map(|&share| {
-                // The scan's grid point at that share.
-                (scanned * share) as usize as f64 * reach.grid_m
-            });
-            let starts: Vec<f64> = probe_starts(end_m, reach)
-                .into_iter()
-                .chain(shares.filter(|&s_m| s_m > end_m))
-                .collect();
-            for from_m in starts {
+            for from_m in probe_starts(end_m, reach) {
                 if asked.contains(&from_m) {
                     continue;
                 }
@@ -790,22 +804,59 @@ impl Search<'_> {
                     return;
                 }
                 asked.push(from_m);
-                let Some(back) = motion_back(context.planner, self.task, from_m) else {
-                    continue;
-                };
-                if back.path_length_m < from_m {
-                    continue;
-                }
-                self.budget = self.budget.max(self.spent) + context.config.budget_steps;
-                self.offer_read_forwards(&back, from_m, tails);
-                if let Some((start, reference)) = self.forward_start(&back, from_m) {
-                    self.track(start, &reference, FAR_END_SOURCE, tails);
+                if let Some(back) = motion_back(context.planner, self.task, from_m) {
+                    self.take_motion_back(&back, from_m, tails);
                 }
             }
             if self.longest_m() <= end_m {
                 return;
             }
         }
+    }
+
+    /// `back`, a motion planned back from `s_far_m` along the line, where it gets back past
+    /// `p0`: offered read forwards ([`Search::offer_read_forwards`]) and followed from `p0`
+    /// ([`Search::track`]), with a budget of [`SearchConfig::budget_steps`] for its rollouts.
+    fn take_motion_back(&mut self, back: &Trajectory, s_far_m: f64, tails: &mut [Executor; 2]) {
+        if back.path_length_m < s_far_m {
+            return;
+        }
+        self.budget = self.budget.max(self.spent) + self.context.config.budget_steps;
+        self.offer_read_forwards(back, s_far_m, tails);
+        if let Some((start, reference)) = self.forward_start(back, s_far_m) {
+            self.track(start, &reference, FAR_END_SOURCE, tails);
+        }
+    }
+
+    /// The motion the search's first pass (`config`, `finalist` its requested controller)
+    /// plans on the reversed task from the scan's grid point `far` back to `p0`, the scan read
+    /// backwards its scan and its configuration there its first start (`crate::far_end`).
+    fn searched_back(
+        &self,
+        reach: &Reach,
+        far: usize,
+        config: &SearchConfig,
+        finalist: &Executor,
+    ) -> Option<Trajectory> {
+        let context = self.context;
+        let s_far_m = far as f64 * reach.grid_m;
+        let task = reversed_task(context.robot, self.task, s_far_m)?;
+        let scan = reversed_reach(reach, far)?;
+        let mut rollout = context.rollout.clone();
+        rollout.constraints.work_surface =
+            reversed_surface(&rollout.constraints.work_surface, s_far_m);
+        let backward_context = SearchContext {
+            rollout: &rollout,
+            config,
+            ..*context
+        };
+        let seed = Seed {
+            q: scan.witnesses[0],
+            source: FAR_END_SOURCE,
+            projection_iterations: None,
+        };
+        let (_, back) = search(&backward_context, &task, seed, finalist.clone(), &scan);
+        Some(back)
     }
 
     /// `back`, a motion planned back from `s_far_m` past `p0`, read forwards
