@@ -155,7 +155,11 @@ pub struct SearchConfig {
     /// evaluation tasks of each shipped arm at the default budget, Σ length / Σ bound over the
     /// lines whose bound is 1 m or more, without and with the stage, and the mean time per
     /// plan: FR3 0.907 → 0.916 (47.1 → 47.2 ms), iiwa 0.948 → 0.958 (45.7 → 45.9 ms), UR5e
-    /// 0.866 → 0.886 (55.3 → 59.7 ms).
+    /// 0.866 → 0.886 (55.3 → 59.7 ms). The motions back from gap-eval's points, read forwards
+    /// and asked again beyond each new end, then raised it on the 10,000 evaluation tasks of
+    /// each arm at the default budget (`cargo xtask search-eval`): FR3 0.921 → 0.928 (49.0 →
+    /// 53.2 ms), iiwa 0.950 → 0.955 (47.3 → 45.2 ms), UR5e 0.882 → 0.893 (54.4 → 72.6 ms), the
+    /// slowest plan from about 0.4 s to about 3.5 s (each motion back is a whole plan).
     pub far_end_shares: Vec<f64>,
 }
 
