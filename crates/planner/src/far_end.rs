@@ -63,9 +63,9 @@ pub(crate) fn motion_back(planner: &Planner, task: &Task, from_m: f64) -> Option
 /// `p0` with its own tool axis (the seed), then its steps in reverse order up to the one before
 /// its first, each recorded as the forward task sees it. Each reversed step lasts what the step
 /// it reverses lasted, so every joint speed is one the motion back had; the seed's lasts a
-/// control period, stretched where a joint would otherwise move faster than its limit. `None` where `back` does not pass `p0` or its
-/// seed is not a valid configuration on `p0`. The configuration `back` started from
-/// (`back.steps[0]`) is where the forward motion goes on.
+/// control period, stretched where a joint would otherwise move faster than its limit. `None`
+/// where `back` does not pass `p0` or its seed is not a valid configuration on `p0`. The
+/// configuration `back` started from (`back.steps[0]`) is where the forward motion goes on.
 pub(crate) fn read_forwards(
     robot: &Robot,
     task: &Task,
