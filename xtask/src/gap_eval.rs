@@ -352,7 +352,8 @@ fn markdown(record: &Record) -> String {
          far side (`emg_planner::gap_probes`): the same planner, its far-end stage left out, \
          plans the line backwards from 3 and 10 grid steps past the plan's end, from halfway to \
          the bound and from half a grid step before it (the motions the search's own far-end \
-         stage asks for from the same points, so none should pass `p0`), and where a motion back passes the plan's end without reaching `p0`, \
+         stage asks for from the same points, so none should pass `p0`), and where a motion \
+         back passes the plan's end without reaching `p0`, \
          a motion in place (`emg_planner::in_place_motion`, RRT-Connect on the configurations \
          that hold the TCP on one point, {} draws, seed {}) tries to join the plan's \
          configuration there to the motion back's. Where a motion back does not pass `p0`, a \
