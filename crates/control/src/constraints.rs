@@ -4,7 +4,7 @@ use emg_kinematics::{Kinematics, Robot, ToolContact, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::config::ConstraintConfig;
-use crate::task::Task;
+use crate::task::{Along, Task};
 
 /// A broken constraint, naming the joint or capsule pair involved.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -167,6 +167,20 @@ pub(crate) fn admit(
         Some(violation) => Err(violation),
         None => Ok(angle),
     }
+}
+
+/// Whether the TCP lies within the line tolerance of the point of the line or path its progress
+/// has reached (`along`, [`Task::along`]): on a path, a stricter measure than [`admit`]'s
+/// distance from the nearest point of the whole path, which a TCP near both legs of a
+/// reversal holds on either.
+pub(crate) fn within_reached(along: &Along, cfg: &ConstraintConfig) -> Result<(), Violation> {
+    let distance = along.lateral.norm();
+    if distance.is_nan() || distance > cfg.line_tolerance_m {
+        return Err(Violation::LineTolerance {
+            distance_m: distance,
+        });
+    }
+    Ok(())
 }
 
 /// The first contact of the arm at `kin`: a capsule pair closer than the collision margin, a

@@ -55,8 +55,8 @@ pub use rollout::{
 pub use sampler::{SamplerConfig, TaskSampler, candidate, surface_clears};
 pub use step::{NullAction, StepContext};
 pub use task::{
-    ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task,
-    TaskError,
+    ARRIVAL_M, Along, PERPENDICULAR_TOLERANCE, PROGRESS_PER_DISTANCE, PROGRESS_SLACK_M,
+    SEED_POSITION_TOLERANCE_M, TRACKING_WINDOW_M, Task, TaskError, progress_window_m,
 };
 pub use tracking::{
     CORRECTION_DAMPING, CORRECTION_TRIGGER, MAX_CORRECTIONS, correct_onto_task, onto_task,

@@ -701,13 +701,14 @@ impl Path {
         (piece, (s - piece.start_s).min(piece.length_m))
     }
 
-    /// The point of the path nearest `p` among those within `window_m` of arc length of
-    /// `s_hint`, each metre of arc length away from `s_hint` counting as
-    /// [`PROGRESS_CONTINUITY`] m of distance: the path's progress is followed locally and
-    /// continuously, so that a path passing near itself (a full circle at its start, the two
-    /// ends of a closed stroke) is never taken for its other part.
+    /// The point of the path nearest `p` among those from `s_hint` to `window_m` of arc length
+    /// beyond it, each metre of arc length away from `s_hint` counting as
+    /// [`PROGRESS_CONTINUITY`] m of distance: the path's progress is followed locally,
+    /// continuously and never back, so that a path passing near itself (a full circle at its
+    /// start, the two ends of a closed stroke, the legs of a reversal) is never taken for its
+    /// other part.
     pub fn locate(&self, p: &Vec3, s_hint: f64, window_m: f64) -> Located {
-        let low = (s_hint - window_m).max(0.0);
+        let low = s_hint.clamp(0.0, self.length_m);
         let high = (s_hint + window_m).min(self.length_m);
         self.nearest_between(p, s_hint, low, high)
             .unwrap_or_else(|| self.located(s_hint.clamp(0.0, self.length_m)))

@@ -4,7 +4,7 @@ use emg_kinematics::{JointVector, Robot};
 use serde::{Deserialize, Serialize};
 
 use crate::config::{RolloutConfig, Tracking};
-use crate::constraints::{Violation, admit, first_violation, tool_angle_deg};
+use crate::constraints::{Violation, admit, first_violation, tool_angle_deg, within_reached};
 use crate::controller::{ActingController, NullSpaceController};
 use crate::step::{NullAction, StepContext};
 use crate::task::Task;
@@ -228,8 +228,9 @@ impl<'a> Episode<'a> {
             velocity = (next - self.current.q) / step_s;
             derived = self.current.derive();
         }
-        let tool_angle_deg = match admit(robot, task, &self.current.kinematics, &config.constraints)
-        {
+        let admitted = admit(robot, task, &self.current.kinematics, &config.constraints)
+            .and_then(|angle| within_reached(&derived.along, &config.constraints).map(|()| angle));
+        let tool_angle_deg = match admitted {
             Ok(tool_angle_deg) => tool_angle_deg,
             Err(violation) => {
                 // The state stays at the last accepted configuration, kinematics included.

@@ -64,10 +64,30 @@ pub struct Along {
 /// Arc length (m) within which the TCP counts as at a corner or at the end of its path.
 pub const ARRIVAL_M: f64 = 1e-4;
 
-/// Arc length (m) around the last known progress that a path task searches for the TCP's
-/// nearest path point: far more than one step goes, far less than any path takes to come back
-/// near itself.
+/// Arc length (m) beyond the last known progress that a path task searches for the TCP's
+/// nearest path point at most: far more than one step goes.
 pub const TRACKING_WINDOW_M: f64 = 0.05;
+
+/// How far (m of arc length per m of distance) the progress along a path may advance from the
+/// last known progress `s` for a TCP at `p`: `PROGRESS_PER_DISTANCE · |p − P(s)| +`
+/// [`PROGRESS_SLACK_M`]; it never goes back. A TCP on the path that moves by `δ` advances by
+/// about `δ` (a little more on a curve: the arc of a chord `δ` on a circle of radius `r ≥ δ/2`
+/// is at most `π/2 · δ`, for the half-turn; 1.05 `δ` at `δ = r/2`), so the progress keeps up
+/// with any motion along the path; but it cannot jump from one leg of a reversal (or of a path
+/// that comes back near itself) to the other, which lie near in space and far apart along the
+/// path, nor slip back along the leg it came by: the TCP must travel the stretch between them
+/// to be measured against the second.
+pub const PROGRESS_PER_DISTANCE: f64 = 1.6;
+
+/// The progress's move allowed for a TCP exactly at its last known path point (m): the
+/// rounding of the nearest-point search, far less than a tolerance.
+pub const PROGRESS_SLACK_M: f64 = 1e-5;
+
+/// The arc length (m) beyond the last known progress `s_hint` that a path task searches for a
+/// TCP at distance `distance_m` from the path point at `s_hint` ([`PROGRESS_PER_DISTANCE`]).
+pub fn progress_window_m(distance_m: f64) -> f64 {
+    (PROGRESS_PER_DISTANCE * distance_m + PROGRESS_SLACK_M).min(TRACKING_WINDOW_M)
+}
 
 /// Why a task was rejected; names the field and what is wrong.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -198,7 +218,8 @@ impl Task {
     }
 
     /// Where the TCP at `p` stands along the task; on a path, its nearest path point within
-    /// [`TRACKING_WINDOW_M`] of the progress `s_hint` it last had.
+    /// [`progress_window_m`] of the progress `s_hint` it last had: the progress follows the
+    /// TCP's travel, so each point is measured against the stretch of the path it has reached.
     #[inline]
     pub fn along(&self, p: &Vec3, s_hint: f64) -> Along {
         match &self.path {
@@ -208,7 +229,8 @@ impl Task {
                 lateral: self.lateral_error(p),
             },
             Some(path) => {
-                let located = path.locate(p, s_hint, TRACKING_WINDOW_M);
+                let window = progress_window_m((path.point_at(s_hint) - p).norm());
+                let located = path.locate(p, s_hint, window);
                 let at_corner = path
                     .next_corner_m(located.s - ARRIVAL_M)
                     .filter(|&corner| corner <= located.s + ARRIVAL_M);

@@ -61,8 +61,14 @@ impl SmoothPath {
     /// breaks a constraint gets back the middle waypoint
     /// it skipped, or, between consecutive waypoints, their chord midpoint (moved onto the line
     /// or path where it lies more than half the tolerance off, [`onto_task`]) moved likewise as a
-    /// new knot (when that holds the constraints, up to [`MAX_REFINEMENTS`] midpoints in all),
+    /// new knot (when that holds the constraints and the two lie [`MIN_KNOT_STEP_M`] apart at
+    /// least twice over, up to [`MAX_REFINEMENTS`] midpoints in all),
     /// else the path ends at the segment's first waypoint.
+    ///
+    /// On a path the TCP's distance is measured from the path point its progress has reached
+    /// ([`Task::along`]), followed from `from_s` (the first waypoint's progress) knot by knot,
+    /// so that no point of the spline counts as on the path by lying near a stretch of it the
+    /// motion has not yet reached (the other leg of a reversal).
     ///
     /// # Panics
     ///
@@ -72,6 +78,7 @@ impl SmoothPath {
         task: &Task,
         constraints: &ConstraintConfig,
         waypoints: &[JointVector],
+        from_s: f64,
     ) -> Self {
         assert!(!waypoints.is_empty(), "a path needs a waypoint");
         let valid = |q: &JointVector| {
@@ -120,7 +127,7 @@ impl SmoothPath {
         while values.len() >= 2 {
             let spline = JointSpline::natural(knots.clone(), values.clone());
             let Some((segment, violation)) =
-                first_failing_segment(robot, task, constraints, &spline)
+                first_failing_segment(robot, task, constraints, &spline, from_s)
             else {
                 return Self {
                     spline: Some(spline),
@@ -140,7 +147,8 @@ impl SmoothPath {
                 refined_knots += 1;
                 continue;
             }
-            let midpoint = (midpoints < MAX_REFINEMENTS)
+            let splittable = knots[segment + 1] - knots[segment] >= 2.0 * MIN_KNOT_STEP_M;
+            let midpoint = (midpoints < MAX_REFINEMENTS && splittable)
                 .then(|| (values[segment] + values[segment + 1]) / 2.0)
                 .map(|chord| onto_task(robot, task, &chord, constraints.line_tolerance_m))
                 .and_then(|chord| inset(robot, task, constraints, &chord))
@@ -201,15 +209,18 @@ pub const LINE_CHECK_MARGIN_M: f64 = 2e-6;
 const PEAK_BISECTIONS: usize = 24;
 
 /// The first segment of `spline` with a checked inside point that breaks a constraint (the line
-/// tolerance less [`LINE_CHECK_MARGIN_M`]).
+/// tolerance less [`LINE_CHECK_MARGIN_M`]), the spline's start standing `from_s` along the task.
 /// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points, every joint's turning points (where
 /// a joint's extreme values inside the segment lie, so the joint limits hold on the whole
-/// segment) and the peaks of the tool angle and of the distance from the line or path ([`peaks`]).
+/// segment) and the peaks of the tool angle and of the distance from the line or path ([`peaks`]);
+/// the distance both from the nearest point of the whole path ([`first_violation`]) and from
+/// the path point reached from the segment's first knot's progress ([`Task::along`]).
 fn first_failing_segment(
     robot: &Robot,
     task: &Task,
     constraints: &ConstraintConfig,
     spline: &JointSpline,
+    from_s: f64,
 ) -> Option<(usize, Violation)> {
     let constraints = &ConstraintConfig {
         line_tolerance_m: (constraints.line_tolerance_m - LINE_CHECK_MARGIN_M)
@@ -217,20 +228,37 @@ fn first_failing_segment(
         ..constraints.clone()
     };
     let knots = spline.knots();
+    // Each knot's progress, followed from the start knot by knot.
+    let mut s = from_s;
+    let reached: Vec<f64> = knots
+        .iter()
+        .map(|&knot| {
+            s = task
+                .along(&robot.forward(&spline.eval(knot).q).tcp(), s)
+                .s_m;
+            s
+        })
+        .collect();
     (0..knots.len() - 1).find_map(|k| {
         let even: Vec<f64> = (1..CHECKS_PER_SEGMENT + 1)
             .map(|j| {
                 knots[k] + (knots[k + 1] - knots[k]) * j as f64 / (CHECKS_PER_SEGMENT + 1) as f64
             })
             .collect();
-        let peaks = peaks(robot, task, spline, k, &even);
+        let peaks = peaks(robot, task, spline, k, &even, reached[k]);
         even.iter()
             .copied()
             .chain(spline.turning_points(k))
             .chain(peaks)
             .find_map(|s| {
-                let q = spline.eval(s).q;
-                first_violation(robot, task, &robot.forward(&q), constraints).map(|v| (k, v))
+                let kinematics = robot.forward(&spline.eval(s).q);
+                first_violation(robot, task, &kinematics, constraints)
+                    .or_else(|| {
+                        let distance_m = task.along(&kinematics.tcp(), reached[k]).lateral.norm();
+                        (distance_m > constraints.line_tolerance_m)
+                            .then_some(Violation::LineTolerance { distance_m })
+                    })
+                    .map(|v| (k, v))
             })
     })
 }
@@ -238,7 +266,8 @@ fn first_failing_segment(
 /// Where the tool angle `θ(s) = ∠(z(q(s)), n)` and the TCP's distance `δ(s)` from the line or
 /// path peak inside segment `k` of `spline`: in each interval between consecutive points of the
 /// segment's knots and `inner` (increasing) where a rate (`θ' = ∇θ · q'`, and `(δ²/2)' = −e ·
-/// J q'` with `e` the TCP's offset to the nearest line or path point) turns from rising to
+/// J q'` with `e` the TCP's offset to the line, or to the path point reached from the
+/// progress `reached` of the segment's first knot, [`Task::along`]) turns from rising to
 /// falling, or rises at the start and ends lower (found then among [`PEAK_SCAN`] points of the
 /// interval, narrowed [`PEAK_ZOOMS`] times onto its last stretch where it rises to the end: the
 /// distance to a path is not smooth where its nearest point jumps from one piece to the next),
@@ -246,12 +275,19 @@ fn first_failing_segment(
 /// interval lies at one of its ends or at such a peak, unless the rate changes sign more than
 /// once inside it; so a spline that holds the cone and the tolerance at its check points and
 /// peaks holds them between them, where the timed samples fall.
-fn peaks(robot: &Robot, task: &Task, spline: &JointSpline, k: usize, inner: &[f64]) -> Vec<f64> {
+fn peaks(
+    robot: &Robot,
+    task: &Task,
+    spline: &JointSpline,
+    k: usize,
+    inner: &[f64],
+    reached: f64,
+) -> Vec<f64> {
     // The rates and the values themselves (the tool angle's cosine falls as the angle rises).
     let measures = |s: f64| {
         let point = spline.eval(s);
         let kinematics = robot.forward(&point.q);
-        let offset = task.offset(&kinematics.tcp());
+        let offset = task.along(&kinematics.tcp(), reached).lateral;
         let angle = tool_angle_gradient(&kinematics, &task.n).map_or(0.0, |g| g.dot(&point.dq));
         let distance = -offset.dot(&(kinematics.jacobian() * point.dq));
         let angle_value = -kinematics.tool_axis().dot(&task.n);

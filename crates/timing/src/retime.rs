@@ -174,9 +174,10 @@ pub fn time_motion(
     request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
     request.validate()?;
-    let rests = rest_waypoints(robot, task, waypoints);
+    let progress = waypoint_progress(robot, task, waypoints);
+    let rests = rest_waypoints(task, &progress);
     if rests.is_empty() {
-        return time_stretch(robot, task, constraints, waypoints, request);
+        return time_stretch(robot, task, constraints, waypoints, 0.0, request);
     }
     let mut bounds = vec![0];
     bounds.extend(rests);
@@ -188,6 +189,7 @@ pub fn time_motion(
             task,
             constraints,
             &waypoints[pair[0]..=pair[1]],
+            progress[pair[0]],
             request,
         )?;
         let cut = stretch.report.cut.is_some();
@@ -202,35 +204,37 @@ pub fn time_motion(
     Ok(joined.expect("a path task's motion has a stretch"))
 }
 
-/// The interior waypoints at which a path task's motion comes to rest: for each corner the
-/// path does not blend, the waypoint nearest it along the path, when that lies within
-/// [`REST_SNAP_M`] of it (a rollout's step lands on a corner, to the step's linearisation).
-/// None on a line.
-pub fn rest_waypoints(robot: &Robot, task: &Task, waypoints: &[JointVector]) -> Vec<usize> {
-    let Some(path) = &task.path else {
-        return Vec::new();
-    };
+/// Each waypoint's progress along the task, followed from the start ([`Task::along`]).
+pub fn waypoint_progress(robot: &Robot, task: &Task, waypoints: &[JointVector]) -> Vec<f64> {
     let mut s = 0.0;
-    let along: Vec<f64> = waypoints
+    waypoints
         .iter()
         .map(|q| {
             s = task.along(&robot.forward(q).tcp(), s).s_m;
             s
         })
-        .collect();
-    let interior = 1..waypoints.len().saturating_sub(1);
-    let mut rests: Vec<usize> = path
-        .corners_m()
-        .filter_map(|corner| {
-            interior
-                .clone()
-                .map(|k| (k, (along[k] - corner).abs()))
-                .min_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|&(_, gap)| gap <= REST_SNAP_M)
-                .map(|(k, _)| k)
-        })
-        .collect();
-    rests.dedup();
+        .collect()
+}
+
+/// The interior waypoints at which a path task's motion comes to rest, the waypoints standing
+/// `progress` along it ([`waypoint_progress`]): for each corner the path does not blend, in
+/// order along the path, the waypoint nearest it along the path among those after the last
+/// rest, when that lies within [`REST_SNAP_M`] of it (a rollout's step lands on a corner, to
+/// the step's linearisation). Strictly increasing, so that the stretches between rests follow
+/// one another; none on a line.
+pub fn rest_waypoints(task: &Task, progress: &[f64]) -> Vec<usize> {
+    let Some(path) = &task.path else {
+        return Vec::new();
+    };
+    let mut rests: Vec<usize> = Vec::new();
+    for corner in path.corners_m() {
+        let after = rests.last().map_or(1, |last| last + 1);
+        let nearest = (after..progress.len().saturating_sub(1))
+            .map(|k| (k, (progress[k] - corner).abs()))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|&(_, gap)| gap <= REST_SNAP_M);
+        rests.extend(nearest.map(|(k, _)| k));
+    }
     rests
 }
 
@@ -317,7 +321,8 @@ impl TimedMotion {
     }
 }
 
-/// One stretch from rest to rest through `waypoints`: the smooth path, then TOPP-RA on a grid of
+/// One stretch from rest to rest through `waypoints` (the first `from_s` along the task): the
+/// smooth path, then TOPP-RA on a grid of
 /// at most [`GRID_STEP_M`], the moving average over `w = 2 max_j a_j / j_j`, samples at the
 /// requested rate, and, while a sample breaks a limit, the speed and acceleration bounds around
 /// it lowered by [`SLOWDOWN`].
@@ -326,9 +331,10 @@ fn time_stretch(
     task: &Task,
     constraints: &ConstraintConfig,
     waypoints: &[JointVector],
+    from_s: f64,
     request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
-    let path = SmoothPath::fit(robot, task, constraints, waypoints);
+    let path = SmoothPath::fit(robot, task, constraints, waypoints, from_s);
     let cut = path
         .cut
         .as_ref()

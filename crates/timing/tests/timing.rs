@@ -272,7 +272,8 @@ fn a_path_motion_comes_to_rest_at_every_unblended_corner_within_every_limit() {
     );
     assert_eq!(trajectory.termination, emg_control::Termination::Completed);
     let waypoints: Vec<JointVector> = trajectory.steps.iter().map(|s| s.q).collect();
-    let rests = emg_timing::rest_waypoints(&robot, &task, &waypoints);
+    let progress = emg_timing::waypoint_progress(&robot, &task, &waypoints);
+    let rests = emg_timing::rest_waypoints(&task, &progress);
     assert_eq!(rests.len(), 3, "three corners inside a closed rectangle");
     let request = TimingRequest {
         limits: shipped_limits(&robot),

@@ -549,6 +549,8 @@ struct State {
     parts_on: usize,
     /// The TCP samples of the stroke part being drawn.
     drawn: Vec<Vec3>,
+    /// How far along its task the last of them stands (m, [`emg_verify::Line::follow`]).
+    progress_m: f64,
     /// Per stroke (its place), the stretches covered.
     covered: Vec<Vec<Stretch>>,
     /// The pending `movep` run: each target, its radius and its line.
@@ -577,6 +579,7 @@ pub fn read_native(
         tool_on: false,
         parts_on: 0,
         drawn: Vec::new(),
+        progress_m: 0.0,
         covered: vec![Vec::new(); file.strokes.len()],
         run: Vec::new(),
         joint_run: Vec::new(),
@@ -1034,7 +1037,8 @@ impl<'a> Reading<'a> {
     /// and the tool axis within the cone round its normal, as the checker measures them.
     fn check_on_task(&self, state: &mut State, pose: &Pose, line: usize) -> Result<(), ReadError> {
         let part = &self.parts[state.parts_on - 1];
-        let deviation = part.line.distance(&pose.position);
+        let (progress_m, deviation) = part.line.follow(&pose.position, state.progress_m);
+        state.progress_m = progress_m;
         let angle = angle_deg(&pose.rotation.column(2), &part.line.n);
         let report = &mut state.report;
         report.worst_deviation_m = report.worst_deviation_m.max(deviation);
@@ -1100,6 +1104,7 @@ impl<'a> Reading<'a> {
         state.parts_on += 1;
         state.report.stroke_parts += 1;
         state.drawn.clear();
+        state.progress_m = 0.0;
         self.check_on_task(state, &pose, line)
     }
 

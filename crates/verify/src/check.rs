@@ -156,6 +156,9 @@ impl ReferenceModel {
         let scene = Scene::new(line, bounds);
         let mut placement = self.placement();
         let mut tcps = Vec::with_capacity(count);
+        // Each point's progress, followed from the start: its distance from the task is
+        // measured there.
+        let mut progress = Vec::with_capacity(count);
         let mut max_line_deviation_m = 0.0_f64;
         let mut max_tool_angle_deg = 0.0_f64;
         let mut min_clearance: (f64, Option<usize>) = (f64::INFINITY, None);
@@ -176,7 +179,8 @@ impl ReferenceModel {
             self.place(q, &mut placement);
             let (tcp, z) = placement.tcp_pose();
             tcps.push(tcp);
-            let lateral = line.distance(&tcp);
+            let (s, lateral) = line.follow(&tcp, progress.last().copied().unwrap_or(0.0));
+            progress.push(s);
             let angle = angle_deg(&z, &line.n);
             let clearance = self.placed_clearance(&placement);
             max_line_deviation_m = max_line_deviation_m.max(lateral);
@@ -281,7 +285,6 @@ impl ReferenceModel {
                 }
             }
         }
-        let progress = line.progresses(tcps.iter().copied());
         let (length, claimed) = match points {
             Points::Recorded(recording) => (
                 line.reached(recording.steps.iter().map(|step| step.tcp)),
@@ -315,7 +318,13 @@ impl ReferenceModel {
             Ending::Stopped | Ending::Completed => None,
         };
         if let Some((blame, q)) = blamed
-            && !self.breaks(line, &q, blame, bounds)
+            && !self.breaks(
+                line,
+                &q,
+                blame,
+                bounds,
+                progress.last().copied().unwrap_or(0.0),
+            )
         {
             return fail(
                 count,
@@ -331,8 +340,16 @@ impl ReferenceModel {
         })
     }
 
-    /// Whether configuration `q` breaks the constraint named by `blame`.
-    fn breaks(&self, line: &Line, q: &Joints, blame: &Blame, bounds: &Bounds) -> bool {
+    /// Whether configuration `q` breaks the constraint named by `blame`, the motion's last
+    /// point having stood `reached` along the task.
+    fn breaks(
+        &self,
+        line: &Line,
+        q: &Joints,
+        blame: &Blame,
+        bounds: &Bounds,
+        reached: f64,
+    ) -> bool {
         let (tcp, z) = self.tcp_pose(q);
         match blame {
             // NaN breaks every bound (as in the rollout); a joint number out of range breaks none.
@@ -345,7 +362,10 @@ impl ReferenceModel {
                     None => false,
                 }
             }
-            Blame::LineTolerance => !within(line.distance(&tcp), bounds.line_tolerance_m - SLACK),
+            Blame::LineTolerance => !within(
+                line.follow(&tcp, reached).1,
+                bounds.line_tolerance_m - SLACK,
+            ),
             Blame::ToolCone => !within(
                 angle_deg(&z, &line.n),
                 bounds.theta_max_deg - ANGLE_SLACK_DEG,

@@ -149,6 +149,17 @@ pub const PATH_WINDOW_M: f64 = 0.05;
 /// passed (the start and the end of a closed stroke) the TCP is placed where it came from.
 pub const PATH_CONTINUITY: f64 = 0.01;
 
+/// How far (m of arc length per m of distance) a recorded TCP's progress along a path may
+/// advance from its last known place `s`, for a TCP at `p`: `PATH_PROGRESS_PER_DISTANCE ·
+/// |p − P(s)| +` [`PATH_PROGRESS_SLACK_M`], at most [`PATH_WINDOW_M`]; it never goes back. A
+/// TCP that moves along the path keeps its progress (an arc is at most π/2 times its chord up
+/// to a half-turn); one near both legs of a reversal, or near a stretch the path comes back
+/// over, is measured against the leg it has travelled to, never against the other.
+pub const PATH_PROGRESS_PER_DISTANCE: f64 = 1.6;
+
+/// The move of the progress allowed for a TCP exactly at its last known path point (m).
+pub const PATH_PROGRESS_SLACK_M: f64 = 1e-5;
+
 impl Line {
     /// A straight-line task.
     pub fn straight(p0: Vector3<f64>, d: Vector3<f64>, n: Vector3<f64>) -> Self {
@@ -176,7 +187,7 @@ impl Line {
         if self.path.is_empty() {
             return self.lateral_distance(point);
         }
-        let (s, _) = self.nearest_on_path(point, 0.0, f64::INFINITY, 0.0);
+        let (s, _) = self.nearest_on_path(point, 0.0, 0.0, f64::INFINITY, 0.0);
         (self.point_on_path(s) - point).norm()
     }
 
@@ -186,8 +197,7 @@ impl Line {
     }
 
     /// How far `points` (a motion's TCPs in order) get: on a line the last one's progress, on
-    /// a path the arc length of its nearest point, followed from the start within
-    /// [`PATH_WINDOW_M`] per point (and [`PATH_CONTINUITY`]).
+    /// a path the arc length of its nearest point, followed from the start ([`Line::follow`]).
     pub fn reached(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> f64 {
         self.progresses(points).last().copied().unwrap_or(0.0)
     }
@@ -201,40 +211,52 @@ impl Line {
     }
 
     /// Each point's progress: on a line `(p − p0)·d`, on a path the arc length of its nearest
-    /// point, followed from the start.
+    /// point, followed from the start ([`Line::follow`]).
     pub(crate) fn progresses(&self, points: impl IntoIterator<Item = Vector3<f64>>) -> Vec<f64> {
         let mut s = 0.0;
         points
             .into_iter()
             .map(|point| {
-                if self.path.is_empty() {
-                    self.progress(&point)
-                } else {
-                    s = self
-                        .nearest_on_path(&point, s, PATH_WINDOW_M, PATH_CONTINUITY)
-                        .0;
-                    s
-                }
+                s = self.follow(&point, s).0;
+                s
             })
             .collect()
     }
 
-    /// The arc length within `window` of `hint` whose path point lies nearest `point`, each
-    /// metre of arc length from `hint` adding `continuity` m to its distance, and that
-    /// distance (with what was added).
+    /// Where `point` stands along the task, the point before it having stood at `hint`, and
+    /// its distance (m) from the task there: on a line its progress `(p − p0)·d` and lateral
+    /// distance; on a path the arc length of its nearest path point within the window the
+    /// point's distance from the path point at `hint` allows
+    /// ([`PATH_PROGRESS_PER_DISTANCE`]), and the distance from that path point, so that every
+    /// point is measured against the stretch of the path it has reached.
+    pub fn follow(&self, point: &Vector3<f64>, hint: f64) -> (f64, f64) {
+        if self.path.is_empty() {
+            return (self.progress(point), self.lateral_distance(point));
+        }
+        let from_hint = (self.point_on_path(hint) - point).norm();
+        let window =
+            (PATH_PROGRESS_PER_DISTANCE * from_hint + PATH_PROGRESS_SLACK_M).min(PATH_WINDOW_M);
+        let (s, _) = self.nearest_on_path(point, hint, hint, hint + window, PATH_CONTINUITY);
+        (s, (self.point_on_path(s) - point).norm())
+    }
+
+    /// The arc length in `[from, to]` whose path point lies nearest `point`, each metre of arc
+    /// length from `hint` adding `continuity` m to its distance, and that distance (with what
+    /// was added).
     fn nearest_on_path(
         &self,
         point: &Vector3<f64>,
         hint: f64,
-        window: f64,
+        from: f64,
+        to: f64,
         continuity: f64,
     ) -> (f64, f64) {
         let mut best = (hint, f64::INFINITY);
         let mut start = 0.0;
         for piece in &self.path {
             let length = piece.length();
-            let low = (hint - window - start).max(0.0);
-            let high = (hint + window - start).min(length);
+            let low = (from - start).max(0.0);
+            let high = (to - start).min(length);
             if low <= high {
                 let (candidates, count) = piece.nearest(point, low, high);
                 for &along in &candidates[..count] {
