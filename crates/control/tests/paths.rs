@@ -428,13 +428,15 @@ fn a_tcp_on_a_path_of_many_pieces_is_located_at_the_least_cost_in_the_window() {
         let p = path.point_at(near) + offset;
         let located = path.locate(&p, hint, window);
         let found = cost(&p, hint, located.s);
-        // No point of the window, sampled every 10 µm, costs less (each piece offers its point
-        // nearest `p` and its ends, which miss the least cost by about PROGRESS_CONTINUITY² / 2
-        // of the distance).
-        let (low, high) = (
-            (hint - window).max(0.0),
-            (hint + window).min(path.length_m()),
+        // The progress never goes back: no point of the window, from the hint on, sampled
+        // every 10 µm, costs less (each piece offers its point nearest `p` and its ends, which
+        // miss the least cost by about PROGRESS_CONTINUITY² / 2 of the distance).
+        assert!(
+            located.s >= hint,
+            "located {} behind the hint {hint}",
+            located.s
         );
+        let (low, high) = (hint, (hint + window).min(path.length_m()));
         let samples = ((high - low) / 1e-5) as usize;
         for k in 0..=samples {
             let s = low + (high - low) * k as f64 / samples as f64;

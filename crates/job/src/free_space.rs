@@ -23,6 +23,11 @@ const RRT_EXTEND_RAD: f64 = 0.1;
 /// Shortcut attempts on a sampled move.
 const SHORTCUTS: usize = 200;
 
+/// Share of the lift that the tool's tip keeps above the part all along a pen-up move, but on
+/// the lift and the set-down themselves: within as much of the normal through where the tool
+/// leaves the part and where it meets it again (`emg check` measures the same).
+pub const PEN_UP_CLEARANCE_SHARE: f64 = 0.5;
+
 /// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
 const SAME_PLANE: f64 = 1e-6;
 
@@ -305,10 +310,57 @@ impl<'a> FreeSpace<'a> {
     /// [`FreeSpace::edge_free`] step of joint-space length (`Σ|Δq_i|`), those with half
     /// [`MAX_POINT_TRAVEL_M`] more clearance, as an edge is checked.
     pub fn path_free(&self, path: &[JointVector]) -> bool {
+        self.path_free_where(path, |_| true)
+    }
+
+    /// Whether the pen-up move through `path` (from where the tool leaves the part, or from
+    /// above it, to where it meets the next part, or above it) is free ([`FreeSpace::path_free`])
+    /// and keeps the tool's tip `clearance_m` above the part at every configuration checked,
+    /// but within `clearance_m` of the normals through the tips of its first and last
+    /// configurations (the lift and the set-down): a move that sags between two lifted
+    /// configurations would drag the tool across the part.
+    pub fn move_free(&self, path: &[JointVector], clearance_m: f64) -> bool {
         let (Some(first), Some(last)) = (path.first(), path.last()) else {
             return true;
         };
-        if !(self.free(first) && self.free(last)) {
+        let ends = [first, last].map(|q| self.robot.forward(q).tcp());
+        self.path_free_where(path, |q| {
+            self.tip_clear(&self.robot.forward(q).tcp(), &ends, clearance_m)
+        })
+    }
+
+    /// Whether the tool's tip at `tip` lies `clearance_m` above every plate of the part it lies
+    /// over, or within `clearance_m` of the normal (of the plate it lies over) through one of
+    /// `ends`.
+    fn tip_clear(&self, tip: &Vec3, ends: &[Vec3], clearance_m: f64) -> bool {
+        self.surfaces.iter().all(|task| {
+            let emg_kinematics::WorkSurface::Plate(plate) =
+                task.work_surface(&self.constraints.work_surface)
+            else {
+                return true;
+            };
+            let offset = tip - task.p0;
+            let (along, height) = (offset.dot(&task.d), -offset.dot(&task.n));
+            let across = offset.dot(&task.n.cross(&task.d));
+            let over = along >= -plate.behind_m
+                && along <= plate.ahead_m
+                && across.abs() <= plate.half_width_m;
+            let on_a_lift = || {
+                ends.iter().any(|end| {
+                    let beside = tip - end;
+                    (beside - task.n * beside.dot(&task.n)).norm() <= clearance_m
+                })
+            };
+            !over || height >= clearance_m || on_a_lift()
+        })
+    }
+
+    /// [`FreeSpace::path_free`], every configuration checked also passing `also`.
+    fn path_free_where(&self, path: &[JointVector], also: impl Fn(&JointVector) -> bool) -> bool {
+        let (Some(first), Some(last)) = (path.first(), path.last()) else {
+            return true;
+        };
+        if !(self.free(first) && self.free(last) && also(first) && also(last)) {
             return false;
         }
         // Joint-space length walked since the last configuration checked.
@@ -318,10 +370,8 @@ impl<'a> FreeSpace<'a> {
             let length = chord.abs().sum();
             let mut along = self.step_l1_rad - since;
             while along < length {
-                if !self.free_by(
-                    &(pair[0] + chord * (along / length)),
-                    MAX_POINT_TRAVEL_M / 2.0,
-                ) {
+                let q = pair[0] + chord * (along / length);
+                if !(self.free_by(&q, MAX_POINT_TRAVEL_M / 2.0) && also(&q)) {
                     return false;
                 }
                 along += self.step_l1_rad;

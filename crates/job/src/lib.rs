@@ -54,7 +54,9 @@ use rayon::prelude::*;
 pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES, choose_branches};
 pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use demo_jobs::valley_seams;
-pub use free_space::{FreeSpace, MAX_POINT_TRAVEL_M, PART, job_part, part_surfaces, with_part};
+pub use free_space::{
+    FreeSpace, MAX_POINT_TRAVEL_M, PART, PEN_UP_CLEARANCE_SHARE, job_part, part_surfaces, with_part,
+};
 pub use motion::Motion;
 pub use order::merge::{Chain, merge_strokes};
 pub use order::{Ordering, Oriented, merge_and_order, order_strokes, order_strokes_counted};
@@ -997,7 +999,8 @@ impl Connector<'_> {
         up: &Vec3,
         seed: u64,
     ) -> Option<(Vec<JointVector>, bool)> {
-        if self.free.edge_free(from, to) {
+        let clear = |path: &[JointVector]| self.free.move_free(path, self.pen_up_clearance_m());
+        if clear(&[*from, *to]) {
             return Some((vec![*from, *to], false));
         }
         let robot = self.free.robot();
@@ -1016,20 +1019,26 @@ impl Connector<'_> {
             let sampled = between.len() > 2;
             Some(([vec![*from], between, vec![*to]].concat(), sampled))
         };
-        over().or_else(|| {
+        over().filter(|(path, _)| clear(path)).or_else(|| {
             let path = self
                 .free
                 .connect(from, to, seed, self.settings.rrt_max_samples)?;
-            Some((path, true))
+            clear(&path).then_some((path, true))
         })
+    }
+
+    /// How high (m) the tool's tip stays above the part along a pen-up move, but on the lift
+    /// and the set-down ([`PEN_UP_CLEARANCE_SHARE`] of the lift).
+    fn pen_up_clearance_m(&self) -> f64 {
+        PEN_UP_CLEARANCE_SHARE * self.settings.lift()
     }
 
     /// Appends the pen-up move between two parts (or after the last): `retreat` (the lift off
     /// the last part), `travel` (the free move from above it, or from the program's start) and
     /// `approach` (the set-down onto the next part) as one motion through their vertices with
     /// its corners rounded ([`time_blended_move`], each corner's arc starting
-    /// [`BLEND_SHARE`] of the shorter edge before it), where that motion is free
-    /// ([`FreeSpace::path_free`]) and holds the limits: one `travel` segment, at rest only where
+    /// [`BLEND_SHARE`] of the shorter edge before it), where that motion is free and keeps the
+    /// pen-up clearance ([`FreeSpace::move_free`]) and holds the limits: one `travel` segment, at rest only where
     /// the tool leaves and meets the part. Else each of them rest to rest, at rest at every
     /// vertex.
     fn join(
@@ -1056,8 +1065,8 @@ impl Connector<'_> {
             .then(|| time_blended_move(&vertices, request, BLEND_SHARE))
             .flatten()
             .filter(|timed| {
-                self.free
-                    .path_free(&timed.samples.iter().map(|s| s.q).collect::<Vec<_>>())
+                let path: Vec<JointVector> = timed.samples.iter().map(|s| s.q).collect();
+                self.free.move_free(&path, self.pen_up_clearance_m())
             });
         let hop = match (retreat, travel, approach) {
             (Some(retreat), [_, _], Some(approach)) => self.hop(retreat, approach),
@@ -1090,9 +1099,8 @@ impl Connector<'_> {
     /// them and straight down, the corner rounded ([`time_blended_move`]), the tool rising
     /// [`HOP_RISE`] of the lateral distance (at least the lift `retreat` and `approach` take,
     /// at most [`MAX_HOP_RISE_LIFTS`] lifts); `None` where the parts lie on different surfaces,
-    /// lie further apart, or the hop is not free ([`FreeSpace::path_free`]) or comes nearer
-    /// the surface (the nearer end's height) than half of its rise or of its lateral distance
-    /// from that end.
+    /// lie further apart, or the hop is not free or comes nearer the part than the pen-up
+    /// clearance off the lift and the set-down ([`FreeSpace::move_free`]).
     fn hop(
         &self,
         [end, above_end]: [JointVector; 2],
@@ -1127,16 +1135,9 @@ impl Connector<'_> {
             .reach_point(&middle, &((from + to) / 2.0 + up * rise))?;
         let timed = time_blended_move(&[end, top, start], self.timing.request(), BLEND_SHARE)?;
         let path: Vec<JointVector> = timed.samples.iter().map(|s| s.q).collect();
-        let clear = path.iter().all(|q| {
-            let point = tcp(q);
-            let (off_end, off_start) = (lateral(&point, &from), lateral(&point, &to));
-            let (nearer, off) = match off_end <= off_start {
-                true => (from, off_end),
-                false => (to, off_start),
-            };
-            up.dot(&(point - nearer)) >= 0.5 * off.min(rise) - 1e-9
-        });
-        (clear && self.free.path_free(&path)).then_some(timed)
+        self.free
+            .move_free(&path, self.pen_up_clearance_m())
+            .then_some(timed)
     }
 
     /// `part`'s stretch planned again by one rollout from the configuration reached from

@@ -20,7 +20,7 @@ use emg_verify::{
 use rayon::prelude::*;
 
 use crate::claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch};
-use crate::free_space::with_part;
+use crate::free_space::{PEN_UP_CLEARANCE_SHARE, with_part};
 use crate::program::{JobFile, Segment, SegmentKind, StrokeReport};
 
 /// How much (m) a length a program claims may differ from what the checker measures of its
@@ -71,6 +71,29 @@ pub enum JobCheckError {
     /// The summary's totals or counts are not the strokes'.
     #[error("summary: {0}")]
     Summary(String),
+    /// A pen-up move brings the tool's tip near the part away from its lift and set-down.
+    #[error(
+        "segment {segment} ({kind}), sample at {time_s:.3} s: the tool's tip is {:.3} mm above \
+         the part and {:.3} mm from where the tool lifts off or sets down; a pen-up move keeps \
+         it {:.3} mm above the part (half the lift) but on its lift and set-down",
+        height_m * 1e3,
+        off_m * 1e3,
+        clearance_m * 1e3
+    )]
+    PenUp {
+        /// The segment's index.
+        segment: usize,
+        /// What it does.
+        kind: String,
+        /// When.
+        time_s: f64,
+        /// The tip's height above the part there (m; negative inside it).
+        height_m: f64,
+        /// Its distance across the part from the nearer of the lift-off and set-down points (m).
+        off_m: f64,
+        /// The clearance a pen-up move keeps (m).
+        clearance_m: f64,
+    },
     /// A segment breaks a constraint.
     #[error("segment {segment} ({kind}, {start_s:.3} s to {end_s:.3} s): {error}")]
     Segment {
@@ -217,12 +240,7 @@ impl SegmentContext<'_> {
         };
         let fail = |error| JobCheckError::Segment {
             segment: index,
-            kind: match segment.kind {
-                SegmentKind::Stroke { stroke, part, .. } => format!("stroke {stroke} part {part}"),
-                SegmentKind::Retreat => "retreat".to_string(),
-                SegmentKind::Travel => "travel".to_string(),
-                SegmentKind::Approach => "approach".to_string(),
-            },
+            kind: segment_kind(&segment.kind),
             start_s: segment.start_s,
             end_s: segment.end_s,
             error,
@@ -271,9 +289,96 @@ impl SegmentContext<'_> {
                     )
                     .map_err(fail)?;
                 }
+                self.verify_pen_up(index, segment, &samples, all_points, times)?;
                 Ok(None)
             }
         }
+    }
+}
+
+impl SegmentContext<'_> {
+    /// Checks that the pen-up move segment `index` (`segment`, its samples `samples` among
+    /// `points`, whose times are `times`) keeps the
+    /// tool's tip [`PEN_UP_CLEARANCE_SHARE`] of the lift above every plate of the part it passes
+    /// over, but within as much of the normal through where the run of moves it belongs to
+    /// leaves the part and meets it again (the lift and the set-down): a move that sags would
+    /// drag the tool across the part.
+    fn verify_pen_up(
+        &self,
+        index: usize,
+        segment: &Segment,
+        samples: &JointSamples,
+        points: &[JointTrajectoryPoint],
+        times: &[f64],
+    ) -> Result<(), JobCheckError> {
+        let clearance_m = PEN_UP_CLEARANCE_SHARE * self.file.settings.lift();
+        let is_move = |k: usize| !matches!(self.file.segments[k].kind, SegmentKind::Stroke { .. });
+        let first = (0..index)
+            .rev()
+            .take_while(|&k| is_move(k))
+            .last()
+            .unwrap_or(index);
+        let last = (index + 1..self.file.segments.len())
+            .take_while(|&k| is_move(k))
+            .last()
+            .unwrap_or(index);
+        let tip_at = |time_s: f64| {
+            let k = times
+                .partition_point(|t| *t < time_s - 1e-9)
+                .min(points.len() - 1);
+            self.model.tcp_pose(&joints(&points[k].positions)).0
+        };
+        let ends = [
+            tip_at(self.file.segments[first].start_s),
+            tip_at(self.file.segments[last].end_s),
+        ];
+        for (q, &time_s) in samples.q.iter().zip(&samples.time_s) {
+            let tip = self.model.tcp_pose(q).0;
+            for task in &self.file.surfaces {
+                let (p0, d, n) = (task.p0, task.d, task.n);
+                let emg_kinematics::WorkSurface::Plate(plate) =
+                    task.work_surface(&self.on_part.work_surface)
+                else {
+                    continue;
+                };
+                let offset = tip - p0;
+                let (along, across, height_m) =
+                    (offset.dot(&d), offset.dot(&n.cross(&d)), -offset.dot(&n));
+                let over = (-plate.behind_m..=plate.ahead_m).contains(&along)
+                    && across.abs() <= plate.half_width_m;
+                if !over || height_m >= clearance_m - CLAIM_TOLERANCE_M {
+                    continue;
+                }
+                let off_m = ends
+                    .iter()
+                    .map(|end| {
+                        let beside = tip - end;
+                        (beside - n * beside.dot(&n)).norm()
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                if off_m > clearance_m + CLAIM_TOLERANCE_M {
+                    return Err(JobCheckError::PenUp {
+                        segment: index,
+                        kind: segment_kind(&segment.kind),
+                        time_s,
+                        height_m,
+                        off_m,
+                        clearance_m,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What a segment of kind `kind` does, as the check names it.
+fn segment_kind(kind: &SegmentKind) -> String {
+    match kind {
+        SegmentKind::Stroke { stroke, part, .. } => format!("stroke {stroke} part {part}"),
+        SegmentKind::Retreat => "retreat".to_string(),
+        SegmentKind::Travel => "travel".to_string(),
+        SegmentKind::Approach => "approach".to_string(),
     }
 }
 

@@ -177,3 +177,126 @@ fn a_job_left_short_lists_what_it_misses_and_inflated_claims_are_refused() {
         "{error}"
     );
 }
+
+/// Every corner of each stroke that its program claims drawn lies within the tolerance of a
+/// pen-down sample of that stroke, measured with the checker's kinematics: a corner the pen
+/// turns back short of is undrawn, whatever the claim.
+fn every_claimed_corner_is_drawn(program: &JobFile, checker: &ReferenceModel) {
+    let points = program.points();
+    let tolerance = program.constraints.line_tolerance_m;
+    for (place, report) in program.strokes.iter().enumerate() {
+        let path = emg_control::Path::new(report.path.clone()).expect("the stroke's path");
+        let tips: Vec<emg_kinematics::Vec3> = program
+            .segments
+            .iter()
+            .filter(
+                |s| matches!(s.kind, SegmentKind::Stroke { stroke, .. } if stroke == report.stroke),
+            )
+            .flat_map(|s| {
+                points.iter().filter(move |p| {
+                    let t = p.time_from_start.seconds();
+                    t >= s.start_s - 1e-9 && t <= s.end_s + 1e-9
+                })
+            })
+            .map(|p| {
+                let mut q = emg_verify::Joints::zeros();
+                q.as_mut_slice()[..p.positions.len()].copy_from_slice(&p.positions);
+                checker.tcp_pose(&q).0
+            })
+            .collect();
+        for corner in path.corners_m() {
+            let claimed_undrawn = report
+                .unreached
+                .iter()
+                .any(|u| corner >= u.from_s - 1e-6 && corner <= u.to_s + 1e-6);
+            if claimed_undrawn {
+                continue;
+            }
+            let vertex = path.point_at(corner);
+            let nearest = tips
+                .iter()
+                .map(|tip| (tip - vertex).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest <= tolerance + 1e-6,
+                "stroke {place}: the corner {corner:.4} m along it is claimed drawn, but no \
+                 sample comes nearer it than {:.3} mm",
+                nearest * 1e3
+            );
+        }
+    }
+}
+
+#[test]
+fn a_zigzag_of_reversals_is_drawn_to_every_corner_it_claims() {
+    // 173° reversals: a sample near one leg once counted for the other, so that the pen turned
+    // back 4.65 mm short of a corner while the program claimed the stroke whole.
+    let placement = Placement {
+        width_m: Some(0.1),
+        ..Placement::default()
+    };
+    let (program, planner, checker) = planned("fr3", "zigzag.svg", &placement);
+    claims_are_measured(&program, &planner, &checker);
+    every_claimed_corner_is_drawn(&program, &checker);
+}
+
+#[test]
+fn a_path_that_retraces_itself_is_planned_and_drawn_as_it_claims() {
+    // A map outline's short back-and-forth segments: a small closed stroke that goes out and
+    // back over itself. The progress once jumped back along the retraced stretch, the motion
+    // went round it again and again, and the timing's rests came out of order (a panic).
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 40 40">
+        <path fill="none" stroke="black"
+              d="M5,5 l10,0 l-6,0.2 l8,0.4 l0.5,6 l-0.5,-3 l-12,2 l-4,-5.6 l4,0 l-4,0 z"/>
+        <path fill="none" stroke="black" d="M5,30 l30,0 l-30,0.3 l30,0.3"/>
+    </svg>"#;
+    let dir = std::env::temp_dir().join(format!("emg-retrace-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let file = dir.join("retrace.svg");
+    std::fs::write(&file, svg).expect("the drawing is written");
+    let (planner, timing, checker, robot_file) = common::setup("fr3");
+    let placement = Placement {
+        width_m: Some(0.1),
+        ..Placement::default()
+    };
+    let job = common::drawing(planner.robot(), &file, &placement);
+    let program = common::plan(&planner, &timing, &robot_file, &job);
+    std::fs::remove_dir_all(&dir).ok();
+    claims_are_measured(&program, &planner, &checker);
+    every_claimed_corner_is_drawn(&program, &checker);
+    assert!(
+        program.summary.drawn_m > 0.9 * program.summary.total_m,
+        "{} m of {} m drawn",
+        program.summary.drawn_m,
+        program.summary.total_m
+    );
+}
+
+#[test]
+fn pen_up_moves_keep_clear_of_the_part_and_a_program_that_does_not_is_refused() {
+    // The blended pen-up move between the two strokes once sagged 0.12 mm into the part and
+    // slid 32 mm across it, and the check passed it.
+    let (program, planner, checker) = planned("fr3", "pen-drag-house.svg", &Placement::default());
+    claims_are_measured(&program, &planner, &checker);
+    // The same motion said to lift 1 cm: its moves come nearer the part than half of that
+    // away from their lifts and set-downs.
+    let mut higher = program.clone();
+    higher.settings.lift_m = Some(0.01);
+    match verify_job(&higher, &checker, planner.robot().joint_names()) {
+        Err(JobCheckError::PenUp {
+            segment,
+            height_m,
+            off_m,
+            clearance_m,
+            ..
+        }) => {
+            assert!(!matches!(
+                higher.segments[segment].kind,
+                SegmentKind::Stroke { .. }
+            ));
+            assert!(height_m < clearance_m && off_m > clearance_m);
+            assert!((clearance_m - 0.005).abs() < 1e-12);
+        }
+        other => panic!("a program whose moves skim the part passes: {other:?}"),
+    }
+}
