@@ -28,6 +28,10 @@ const SHORTCUTS: usize = 200;
 /// leaves the part and where it meets it again (`emg check` measures the same).
 pub const PEN_UP_CLEARANCE_SHARE: f64 = 0.5;
 
+/// The tool's tip is checked this many times per edge step ([`MAX_POINT_TRAVEL_M`] of any
+/// point's travel) along a pen-up move ([`FreeSpace::move_free`]).
+pub const TIP_CHECKS_PER_STEP: f64 = 10.0;
+
 /// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
 const SAME_PLANE: f64 = 1e-6;
 
@@ -310,9 +314,31 @@ impl<'a> FreeSpace<'a> {
     /// [`FreeSpace::edge_free`] step of joint-space length (`Σ|Δq_i|`), those with half
     /// [`MAX_POINT_TRAVEL_M`] more clearance, as an edge is checked.
     pub fn path_free(&self, path: &[JointVector]) -> bool {
-        self.path_free_where(path, |_| true)
+        let (Some(first), Some(last)) = (path.first(), path.last()) else {
+            return true;
+        };
+        if !(self.free(first) && self.free(last)) {
+            return false;
+        }
+        // Joint-space length walked since the last configuration checked.
+        let mut since = 0.0;
+        for pair in path.windows(2) {
+            let chord = pair[1] - pair[0];
+            let length = chord.abs().sum();
+            let mut along = self.step_l1_rad - since;
+            while along < length {
+                if !self.free_by(
+                    &(pair[0] + chord * (along / length)),
+                    MAX_POINT_TRAVEL_M / 2.0,
+                ) {
+                    return false;
+                }
+                along += self.step_l1_rad;
+            }
+            since = length - (along - self.step_l1_rad);
+        }
+        true
     }
-
     /// Whether the pen-up move through `path` (from where the tool leaves the part, or from
     /// above it, to where it meets the next part, or above it) is free ([`FreeSpace::path_free`])
     /// and keeps the tool's tip `clearance_m` above the part at every configuration checked,
@@ -324,9 +350,18 @@ impl<'a> FreeSpace<'a> {
             return true;
         };
         let ends = [first, last].map(|q| self.robot.forward(q).tcp());
-        self.path_free_where(path, |q| {
-            self.tip_clear(&self.robot.forward(q).tcp(), &ends, clearance_m)
-        })
+        let clear =
+            |q: &JointVector| self.tip_clear(&self.robot.forward(q).tcp(), &ends, clearance_m);
+        // The tip is checked at every point of `path` and, between two points further apart,
+        // every [`TIP_CHECKS_PER_STEP`]th of an edge step: a sag is shallow and short.
+        let step = self.step_l1_rad / TIP_CHECKS_PER_STEP;
+        let tips_clear = path.iter().all(clear)
+            && path.windows(2).all(|pair| {
+                let checks = ((pair[1] - pair[0]).abs().sum() / step).ceil() as usize;
+                (1..checks)
+                    .all(|k| clear(&(pair[0] + (pair[1] - pair[0]) * (k as f64 / checks as f64))))
+            });
+        tips_clear && self.path_free(path)
     }
 
     /// Whether the tool's tip at `tip` lies `clearance_m` above every plate of the part it lies
@@ -353,32 +388,6 @@ impl<'a> FreeSpace<'a> {
             };
             !over || height >= clearance_m || on_a_lift()
         })
-    }
-
-    /// [`FreeSpace::path_free`], every configuration checked also passing `also`.
-    fn path_free_where(&self, path: &[JointVector], also: impl Fn(&JointVector) -> bool) -> bool {
-        let (Some(first), Some(last)) = (path.first(), path.last()) else {
-            return true;
-        };
-        if !(self.free(first) && self.free(last) && also(first) && also(last)) {
-            return false;
-        }
-        // Joint-space length walked since the last configuration checked.
-        let mut since = 0.0;
-        for pair in path.windows(2) {
-            let chord = pair[1] - pair[0];
-            let length = chord.abs().sum();
-            let mut along = self.step_l1_rad - since;
-            while along < length {
-                let q = pair[0] + chord * (along / length);
-                if !(self.free_by(&q, MAX_POINT_TRAVEL_M / 2.0) && also(&q)) {
-                    return false;
-                }
-                along += self.step_l1_rad;
-            }
-            since = length - (along - self.step_l1_rad);
-        }
-        true
     }
 
     /// Whether the joint-space triangle with corners `a`, `w` and `b` is free all over: its

@@ -889,8 +889,9 @@ impl Branches for JobBranches<'_> {
 }
 
 /// How far before a pen-up move's corner its rounding starts: this share of the shorter of the
-/// corner's edges (half: the tool has risen half its lift before it moves aside).
-pub const BLEND_SHARE: f64 = 0.5;
+/// corner's edges (the tool has risen 60 % of its lift before it moves aside, clear of the
+/// [`PEN_UP_CLEARANCE_SHARE`] it keeps off the lift and the set-down).
+pub const BLEND_SHARE: f64 = 0.4;
 
 /// How high a pen-up hop between close parts rises for each metre of lateral distance: half,
 /// so that the tool leaves and meets the surface at about 45°.
@@ -899,6 +900,10 @@ pub const HOP_RISE: f64 = 0.5;
 /// A hop rises at most this many lifts; parts further apart are joined by the lift, the move
 /// and the set-down.
 pub const MAX_HOP_RISE_LIFTS: f64 = 4.0;
+
+/// Halvings at most of a pen-up move's straight edge that sags toward the part
+/// (`Connector::held_up`): up to 8 edges, each held at the lift at its ends.
+pub const MAX_HELD_UP_DEPTH: usize = 3;
 
 /// How much further (m) the tool rises where no straight free move joins two parts at its lift:
 /// a torch's lift, clear of what lies on the part.
@@ -1000,8 +1005,10 @@ impl Connector<'_> {
         seed: u64,
     ) -> Option<(Vec<JointVector>, bool)> {
         let clear = |path: &[JointVector]| self.free.move_free(path, self.pen_up_clearance_m());
-        if clear(&[*from, *to]) {
-            return Some((vec![*from, *to], false));
+        if let Some(path) = self.held_up(from, to, MAX_HELD_UP_DEPTH)
+            && clear(&path)
+        {
+            return Some((path, false));
         }
         let robot = self.free.robot();
         let rise = |q: &JointVector, up: &Vec3| {
@@ -1025,6 +1032,35 @@ impl Connector<'_> {
                 .connect(from, to, seed, self.settings.rrt_max_samples)?;
             clear(&path).then_some((path, true))
         })
+    }
+
+    /// The joint-space polyline from `from` to `to` (both lifted the same height above the
+    /// part) whose edges are free and keep the pen-up clearance ([`FreeSpace::move_free`]): the
+    /// straight edge where it does; else, where the edge sags, through the configuration near
+    /// the middle of the edge whose tip lies midway between the two tips ([`FreeSpace::
+    /// reach_point`]), each half held up the same way, `depth` halvings at most.
+    fn held_up(
+        &self,
+        from: &JointVector,
+        to: &JointVector,
+        depth: usize,
+    ) -> Option<Vec<JointVector>> {
+        if self
+            .free
+            .move_free(&[*from, *to], self.pen_up_clearance_m())
+        {
+            return Some(vec![*from, *to]);
+        }
+        if depth == 0 {
+            return None;
+        }
+        let robot = self.free.robot();
+        let tips = (robot.forward(from).tcp() + robot.forward(to).tcp()) / 2.0;
+        let middle = self.free.reach_point(&((from + to) / 2.0), &tips)?;
+        let mut path = self.held_up(from, &middle, depth - 1)?;
+        path.pop();
+        path.extend(self.held_up(&middle, to, depth - 1)?);
+        Some(path)
     }
 
     /// How high (m) the tool's tip stays above the part along a pen-up move, but on the lift

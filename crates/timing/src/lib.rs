@@ -50,7 +50,7 @@ pub use path::{
 };
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
-    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_SAMPLES, MAX_SLOWDOWNS,
+    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_FORCED_RESTS, MAX_SAMPLES, MAX_SLOWDOWNS,
     MIN_GRID_INTERVALS, PASSING_WINDOW_RAD, REST_SNAP_M, SLOWDOWN, TimedMotion, TimingError,
     TimingReport, TimingRequest, rest_waypoints, time_motion, waypoint_progress,
 };

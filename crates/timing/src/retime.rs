@@ -75,8 +75,9 @@ pub struct TimingReport {
     pub grid_points: usize,
     /// Rounds of local slow-down the limits needed.
     pub slowdowns: usize,
-    /// Times (s) at which the motion rests inside its path, at the corners a path task does not
-    /// blend ([`rest_waypoints`]); empty on a line.
+    /// Times (s) at which the motion rests inside its path: at the corners a path task does not
+    /// blend ([`rest_waypoints`]), and where a limit forced a rest ([`time_motion`]); empty on a
+    /// line timed without one.
     pub rests_s: Vec<f64>,
 }
 
@@ -128,8 +129,12 @@ pub enum TimingError {
         /// The rate asked for.
         rate_hz: f64,
     },
-    /// The samples still broke a limit after [`MAX_SLOWDOWNS`] rounds.
-    #[error("the motion still breaks a limit after {MAX_SLOWDOWNS} slow-downs: {0}")]
+    /// The samples still broke a limit after [`MAX_SLOWDOWNS`] rounds, with
+    /// [`MAX_FORCED_RESTS`] rests added or at a stretch between two consecutive waypoints.
+    #[error(
+        "the motion still breaks a limit after {MAX_SLOWDOWNS} slow-downs, resting at its \
+         waypoints: {0}"
+    )]
     LimitsNotMet(LimitBreach),
 }
 
@@ -162,10 +167,18 @@ impl TimingRequest {
     }
 }
 
+/// Rests at most that the timing adds inside a motion where a stretch between rests still
+/// breaks a limit after [`MAX_SLOWDOWNS`] slow-downs ([`time_motion`]).
+pub const MAX_FORCED_RESTS: usize = 32;
+
 /// The rest-to-rest motion through `waypoints` (each holding `constraints` for `task`, the
 /// first the start). On a path task the motion also comes to rest at every corner the path
 /// does not blend ([`rest_waypoints`]): each stretch between rests is timed on its own and the
-/// stretches follow one another on the sample grid.
+/// stretches follow one another on the sample grid. Where a stretch still breaks a limit after
+/// [`MAX_SLOWDOWNS`] slow-downs (a cusp the spline turns through too fast, say), the motion
+/// also rests at the stretch's inner waypoint nearest (in joint space) the first sample that
+/// breaks it, and the stretches are timed again: a motion is slowed to rest where a limit forces
+/// it rather than given up, up to [`MAX_FORCED_RESTS`] such rests.
 pub fn time_motion(
     robot: &Robot,
     task: &Task,
@@ -175,13 +188,71 @@ pub fn time_motion(
 ) -> Result<TimedMotion, TimingError> {
     request.validate()?;
     let progress = waypoint_progress(robot, task, waypoints);
-    let rests = rest_waypoints(task, &progress);
-    if rests.is_empty() {
-        return time_stretch(robot, task, constraints, waypoints, 0.0, request);
+    let mut rests = rest_waypoints(task, &progress);
+    for forced in 0..=MAX_FORCED_RESTS {
+        let unmet = match time_through(
+            robot,
+            task,
+            constraints,
+            waypoints,
+            &progress,
+            &rests,
+            request,
+        ) {
+            Ok(motion) => return Ok(motion),
+            Err(StretchError::Timing(error)) => return Err(error),
+            Err(StretchError::Unmet(unmet)) => unmet,
+        };
+        let (from, to) = unmet.between;
+        let nearest = (from + 1..to).min_by(|&a, &b| {
+            (waypoints[a] - unmet.at)
+                .amax()
+                .total_cmp(&(waypoints[b] - unmet.at).amax())
+        });
+        match nearest {
+            Some(k) if forced < MAX_FORCED_RESTS => {
+                rests.insert(rests.partition_point(|&r| r < k), k);
+            }
+            _ => return Err(TimingError::LimitsNotMet(unmet.breach)),
+        }
     }
-    let mut bounds = vec![0];
-    bounds.extend(rests);
-    bounds.push(waypoints.len() - 1);
+    unreachable!("the loop returns by its last round")
+}
+
+/// Why a stretch between rests could not be timed.
+enum StretchError {
+    /// The request or the motion's length.
+    Timing(TimingError),
+    /// A limit still broken after [`MAX_SLOWDOWNS`] slow-downs.
+    Unmet(Unmet),
+}
+
+/// A stretch whose samples still break a limit after [`MAX_SLOWDOWNS`] slow-downs.
+struct Unmet {
+    /// The first breach.
+    breach: LimitBreach,
+    /// The configuration of the sample that breaks it.
+    at: JointVector,
+    /// The stretch's first and last waypoints (indices into the whole motion's).
+    between: (usize, usize),
+}
+
+/// The motion through `waypoints` (standing `progress` along the task) at rest at each of
+/// `rests` (increasing inner waypoints): each stretch between rests timed on its own, the
+/// stretches one after another on the sample grid, up to the first one the smooth path cuts.
+fn time_through(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    waypoints: &[JointVector],
+    progress: &[f64],
+    rests: &[usize],
+    request: &TimingRequest,
+) -> Result<TimedMotion, StretchError> {
+    let bounds: Vec<usize> = std::iter::once(0)
+        .chain(rests.iter().copied())
+        .chain(std::iter::once(waypoints.len() - 1))
+        .collect();
     let mut joined: Option<TimedMotion> = None;
     for pair in bounds.windows(2) {
         let stretch = time_stretch(
@@ -191,7 +262,14 @@ pub fn time_motion(
             &waypoints[pair[0]..=pair[1]],
             progress[pair[0]],
             request,
-        )?;
+        )
+        .map_err(|error| match error {
+            StretchError::Unmet(unmet) => StretchError::Unmet(Unmet {
+                between: (pair[0], pair[1]),
+                ..unmet
+            }),
+            timing => timing,
+        })?;
         let cut = stretch.report.cut.is_some();
         joined = Some(match joined {
             None => stretch,
@@ -201,7 +279,7 @@ pub fn time_motion(
             break;
         }
     }
-    Ok(joined.expect("a path task's motion has a stretch"))
+    Ok(joined.expect("a motion has a stretch"))
 }
 
 /// Each waypoint's progress along the task, followed from the start ([`Task::along`]).
@@ -333,7 +411,7 @@ fn time_stretch(
     waypoints: &[JointVector],
     from_s: f64,
     request: &TimingRequest,
-) -> Result<TimedMotion, TimingError> {
+) -> Result<TimedMotion, StretchError> {
     let path = SmoothPath::fit(robot, task, constraints, waypoints, from_s);
     let cut = path
         .cut
@@ -408,11 +486,11 @@ fn time_stretch(
         let profile = definition.smoothed();
         let samples = profile.duration() * request.rate_hz;
         if samples > MAX_SAMPLES {
-            return Err(TimingError::TooManySamples {
+            return Err(StretchError::Timing(TimingError::TooManySamples {
                 duration_s: profile.duration(),
                 samples,
                 rate_hz: request.rate_hz,
-            });
+            }));
         }
         let (samples, states) = sample(spline, &profile, request.rate_hz);
         let found = breaches(&samples, limits);
@@ -444,7 +522,11 @@ fn time_stretch(
             });
         };
         if slowdowns == MAX_SLOWDOWNS {
-            return Err(TimingError::LimitsNotMet(first.clone()));
+            return Err(StretchError::Unmet(Unmet {
+                breach: first.clone(),
+                at: samples[first.sample].q,
+                between: (0, waypoints.len() - 1),
+            }));
         }
         slow_down(
             &mut factor,

@@ -85,8 +85,9 @@ impl PathPiece {
         }
     }
 
-    /// The lengths along the piece, each within `[low, high]`, of its point nearest `point`:
-    /// on a closed circle, also that point one turn on (the first `count` entries).
+    /// The lengths along the piece, each within `[low, high]`, of its point nearest `point` and
+    /// of its ends (the window's ends where they lie inside it): on a closed circle, also that
+    /// point one turn on (the first `count` entries).
     fn nearest(&self, point: &Vector3<f64>, low: f64, high: f64) -> ([f64; 4], usize) {
         match *self {
             Self::Straight { start, end } => (
@@ -94,11 +95,11 @@ impl PathPiece {
                     (point - start)
                         .dot(&(end - start).normalize())
                         .clamp(low, high),
-                    0.0,
-                    0.0,
+                    low.max(0.0),
+                    high.min(self.length()),
                     0.0,
                 ],
-                1,
+                3,
             ),
             Self::Arc {
                 centre,
