@@ -24,9 +24,16 @@ const RRT_EXTEND_RAD: f64 = 0.1;
 const SHORTCUTS: usize = 200;
 
 /// Share of the lift that the tool's tip keeps above the part all along a pen-up move, but on
-/// the lift and the set-down themselves: within as much of the normal through where the tool
-/// leaves the part and where it meets it again (`emg check` measures the same).
+/// the lift and the set-down themselves: within [`LIFT_CONE_RUN`] times its height across the
+/// part from where the tool leaves it and where it meets it again (`emg check` measures the
+/// same).
 pub const PEN_UP_CLEARANCE_SHARE: f64 = 0.5;
+
+/// How far across the part (m per m of height) the tool's tip may lie from where it lifts off
+/// or sets down while it is lower than the pen-up clearance: a lift or set-down rises at least
+/// half as fast as it moves aside (one along the normal, a hop at about 45°); a move that sags
+/// back toward the part away from its ends does not.
+pub const LIFT_CONE_RUN: f64 = 2.0;
 
 /// The tool's tip is checked this many times per edge step ([`MAX_POINT_TRAVEL_M`] of any
 /// point's travel) along a pen-up move ([`FreeSpace::move_free`]).
@@ -342,7 +349,7 @@ impl<'a> FreeSpace<'a> {
     /// Whether the pen-up move through `path` (from where the tool leaves the part, or from
     /// above it, to where it meets the next part, or above it) is free ([`FreeSpace::path_free`])
     /// and keeps the tool's tip `clearance_m` above the part at every configuration checked,
-    /// but within `clearance_m` of the normals through the tips of its first and last
+    /// but within the lift cones ([`LIFT_CONE_RUN`]) of the tips of its first and last
     /// configurations (the lift and the set-down): a move that sags between two lifted
     /// configurations would drag the tool across the part.
     pub fn move_free(&self, path: &[JointVector], clearance_m: f64) -> bool {
@@ -365,8 +372,8 @@ impl<'a> FreeSpace<'a> {
     }
 
     /// Whether the tool's tip at `tip` lies `clearance_m` above every plate of the part it lies
-    /// over, or within `clearance_m` of the normal (of the plate it lies over) through one of
-    /// `ends`.
+    /// over, or across that plate from one of `ends` by at most [`LIFT_CONE_RUN`] times its
+    /// height above that end.
     fn tip_clear(&self, tip: &Vec3, ends: &[Vec3], clearance_m: f64) -> bool {
         self.surfaces.iter().all(|task| {
             let emg_kinematics::WorkSurface::Plate(plate) =
@@ -383,7 +390,8 @@ impl<'a> FreeSpace<'a> {
             let on_a_lift = || {
                 ends.iter().any(|end| {
                     let beside = tip - end;
-                    (beside - task.n * beside.dot(&task.n)).norm() <= clearance_m
+                    let risen = -beside.dot(&task.n);
+                    (beside + task.n * risen).norm() <= LIFT_CONE_RUN * risen.max(0.0) + 1e-9
                 })
             };
             !over || height >= clearance_m || on_a_lift()

@@ -55,7 +55,8 @@ pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES,
 pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use demo_jobs::valley_seams;
 pub use free_space::{
-    FreeSpace, MAX_POINT_TRAVEL_M, PART, PEN_UP_CLEARANCE_SHARE, job_part, part_surfaces, with_part,
+    FreeSpace, LIFT_CONE_RUN, MAX_POINT_TRAVEL_M, PART, PEN_UP_CLEARANCE_SHARE, job_part,
+    part_surfaces, with_part,
 };
 pub use motion::Motion;
 pub use order::merge::{Chain, merge_strokes};
@@ -893,6 +894,10 @@ impl Branches for JobBranches<'_> {
 /// [`PEN_UP_CLEARANCE_SHARE`] it keeps off the lift and the set-down).
 pub const BLEND_SHARE: f64 = 0.4;
 
+/// How far before a hop's top its rounding starts: this share of the shorter of its two edges
+/// (the hop leaves and meets the part along them, [`LIFT_CONE_RUN`]).
+pub const HOP_BLEND_SHARE: f64 = 0.5;
+
 /// How high a pen-up hop between close parts rises for each metre of lateral distance: half,
 /// so that the tool leaves and meets the surface at about 45°.
 pub const HOP_RISE: f64 = 0.5;
@@ -1005,7 +1010,7 @@ impl Connector<'_> {
         seed: u64,
     ) -> Option<(Vec<JointVector>, bool)> {
         let clear = |path: &[JointVector]| self.free.move_free(path, self.pen_up_clearance_m());
-        if let Some(path) = self.held_up(from, to, MAX_HELD_UP_DEPTH)
+        if let Some(path) = self.held_up(from, to, up, MAX_HELD_UP_DEPTH)
             && clear(&path)
         {
             return Some((path, false));
@@ -1034,15 +1039,17 @@ impl Connector<'_> {
         })
     }
 
-    /// The joint-space polyline from `from` to `to` (both lifted the same height above the
-    /// part) whose edges are free and keep the pen-up clearance ([`FreeSpace::move_free`]): the
-    /// straight edge where it does; else, where the edge sags, through the configuration near
-    /// the middle of the edge whose tip lies midway between the two tips ([`FreeSpace::
-    /// reach_point`]), each half held up the same way, `depth` halvings at most.
+    /// The joint-space polyline from `from` to `to` (both lifted above the part, which the tool
+    /// leaves along `up`) whose edges are free and keep the pen-up clearance
+    /// ([`FreeSpace::move_free`]): the straight edge where it does; else, where the edge sags,
+    /// through the configuration near the middle of the edge whose tip lies midway between the
+    /// two tips and the clearance higher ([`FreeSpace::reach_point`]), so that a blend rounding
+    /// it keeps clear too, each half held up the same way, `depth` halvings at most.
     fn held_up(
         &self,
         from: &JointVector,
         to: &JointVector,
+        up: &Vec3,
         depth: usize,
     ) -> Option<Vec<JointVector>> {
         if self
@@ -1055,11 +1062,12 @@ impl Connector<'_> {
             return None;
         }
         let robot = self.free.robot();
-        let tips = (robot.forward(from).tcp() + robot.forward(to).tcp()) / 2.0;
+        let tips = (robot.forward(from).tcp() + robot.forward(to).tcp()) / 2.0
+            + up * self.pen_up_clearance_m();
         let middle = self.free.reach_point(&((from + to) / 2.0), &tips)?;
-        let mut path = self.held_up(from, &middle, depth - 1)?;
+        let mut path = self.held_up(from, &middle, up, depth - 1)?;
         path.pop();
-        path.extend(self.held_up(&middle, to, depth - 1)?);
+        path.extend(self.held_up(&middle, to, up, depth - 1)?);
         Some(path)
     }
 
@@ -1169,7 +1177,7 @@ impl Connector<'_> {
         let top = self
             .free
             .reach_point(&middle, &((from + to) / 2.0 + up * rise))?;
-        let timed = time_blended_move(&[end, top, start], self.timing.request(), BLEND_SHARE)?;
+        let timed = time_blended_move(&[end, top, start], self.timing.request(), HOP_BLEND_SHARE)?;
         let path: Vec<JointVector> = timed.samples.iter().map(|s| s.q).collect();
         self.free
             .move_free(&path, self.pen_up_clearance_m())
@@ -1222,17 +1230,22 @@ impl Connector<'_> {
     }
 }
 
+/// Starts a closed stroke none of whose parts draws anything is tried at: [`reachable_start_s`]
+/// and as many more evenly spaced round the loop from it.
+pub const CLOSED_STARTS: usize = 8;
+
 /// `plan` of a closed stroke ([`Path::is_closed`]) whose start no part covers, started again
 /// elsewhere on it where that draws more by [`SAME_LENGTH_M`] (`replan`, both ends): a closed
 /// stroke may start anywhere, and one starting out of reach draws little from either end. The
-/// new start is the middle of the longest stretch a part covers, or where none covers any,
-/// [`reachable_start_s`]. The searches of both are counted.
+/// new start is the middle of the longest stretch a part covers; where none covers any, the
+/// [`CLOSED_STARTS`] points from [`reachable_start_s`] round the loop in turn, until one draws
+/// half the loop, the one that draws most kept. The searches of all are counted.
 fn started_where_it_draws(
     plan: StrokePlan,
     robot: &Robot,
     replan: impl Fn(&Path) -> Result<StrokePlan, Stopped>,
 ) -> Result<StrokePlan, Stopped> {
-    let path = &plan.path;
+    let path = &plan.path.clone();
     let length = path.length_m();
     let stretches: Vec<Stretch> = plan.parts.iter().map(StrokePart::planned).collect();
     let whole = Coverage::of(length, &stretches).whole();
@@ -1243,22 +1256,32 @@ fn started_where_it_draws(
     let longest = stretches
         .iter()
         .max_by(|a, b| a.length_m().total_cmp(&b.length_m()));
-    let start_s = match longest {
-        Some(stretch) => 0.5 * (stretch.from_s + stretch.to_s),
-        None => reachable_start_s(path, robot),
+    let starts: Vec<f64> = match longest {
+        Some(stretch) => vec![0.5 * (stretch.from_s + stretch.to_s)],
+        None => {
+            let first = reachable_start_s(path, robot);
+            (0..CLOSED_STARTS)
+                .map(|k| (first + length * k as f64 / CLOSED_STARTS as f64) % length)
+                .collect()
+        }
     };
-    let Some(rotated) = path.started_at(start_s) else {
-        return Ok(plan);
-    };
-    let mut other = replan(&rotated)?;
-    if other.planned_m() >= plan.planned_m() + SAME_LENGTH_M {
-        other.searches += plan.searches;
-        Ok(other)
-    } else {
-        let mut plan = plan;
-        plan.searches += other.searches;
-        Ok(plan)
+    let mut best = plan;
+    for start_s in starts {
+        let Some(rotated) = path.started_at(start_s) else {
+            continue;
+        };
+        let mut other = replan(&rotated)?;
+        if other.planned_m() >= best.planned_m() + SAME_LENGTH_M {
+            other.searches += best.searches;
+            best = other;
+        } else {
+            best.searches += other.searches;
+        }
+        if best.planned_m() >= 0.5 * length {
+            break;
+        }
     }
+    Ok(best)
 }
 
 /// The stroke `planned` drawn the way that draws more: where its plan leaves some of it

@@ -20,7 +20,7 @@ use emg_verify::{
 use rayon::prelude::*;
 
 use crate::claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch};
-use crate::free_space::{PEN_UP_CLEARANCE_SHARE, with_part};
+use crate::free_space::{LIFT_CONE_RUN, PEN_UP_CLEARANCE_SHARE, with_part};
 use crate::program::{JobFile, Segment, SegmentKind, StrokeReport};
 
 /// How much (m) a length a program claims may differ from what the checker measures of its
@@ -74,8 +74,9 @@ pub enum JobCheckError {
     /// A pen-up move brings the tool's tip near the part away from its lift and set-down.
     #[error(
         "segment {segment} ({kind}), sample at {time_s:.3} s: the tool's tip is {:.3} mm above \
-         the part and {:.3} mm from where the tool lifts off or sets down; a pen-up move keeps \
-         it {:.3} mm above the part (half the lift) but on its lift and set-down",
+         the part and {:.3} mm across it from where the tool lifts off or sets down; a pen-up \
+         move keeps it {:.3} mm above the part (half the lift) but on its lift and set-down \
+         (within {LIFT_CONE_RUN} times its height across)",
         height_m * 1e3,
         off_m * 1e3,
         clearance_m * 1e3
@@ -298,11 +299,11 @@ impl SegmentContext<'_> {
 
 impl SegmentContext<'_> {
     /// Checks that the pen-up move segment `index` (`segment`, its samples `samples` among
-    /// `points`, whose times are `times`) keeps the
-    /// tool's tip [`PEN_UP_CLEARANCE_SHARE`] of the lift above every plate of the part it passes
-    /// over, but within as much of the normal through where the run of moves it belongs to
-    /// leaves the part and meets it again (the lift and the set-down): a move that sags would
-    /// drag the tool across the part.
+    /// `points`, whose times are `times`) keeps the tool's tip [`PEN_UP_CLEARANCE_SHARE`] of the
+    /// lift above every plate of the part it passes over, but on the lift and the set-down:
+    /// across the plate by at most [`LIFT_CONE_RUN`] times its height above where the run of
+    /// moves it belongs to leaves the part or meets it again, from that point. A move that sags would drag the
+    /// tool across the part.
     fn verify_pen_up(
         &self,
         index: usize,
@@ -349,14 +350,22 @@ impl SegmentContext<'_> {
                 if !over || height_m >= clearance_m - CLAIM_TOLERANCE_M {
                     continue;
                 }
-                let off_m = ends
+                // Across the plate from each end, and the room the lift cone leaves there.
+                let (off_m, room_m) = ends
                     .iter()
                     .map(|end| {
                         let beside = tip - end;
-                        (beside - n * beside.dot(&n)).norm()
+                        let risen = -beside.dot(&n);
+                        ((beside + n * risen).norm(), LIFT_CONE_RUN * risen.max(0.0))
                     })
-                    .fold(f64::INFINITY, f64::min);
-                if off_m > clearance_m + CLAIM_TOLERANCE_M {
+                    .fold((f64::INFINITY, 0.0), |nearer, end| {
+                        if end.0 - end.1 < nearer.0 - nearer.1 {
+                            end
+                        } else {
+                            nearer
+                        }
+                    });
+                if off_m > room_m + CLAIM_TOLERANCE_M {
                     return Err(JobCheckError::PenUp {
                         segment: index,
                         kind: segment_kind(&segment.kind),
