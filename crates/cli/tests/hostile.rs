@@ -33,7 +33,7 @@ fn hostile_path(rng: &mut ChaCha8Rng, scale: f64) -> String {
             // An arc of a full half-turn and a degenerate one.
             4 => format!(
                 " a{0:.6},{0:.6} 0 0 1 {dx:.6},{dy:.6} a0,0 0 0 0 {dx:.6},0",
-                dx.hypot(dy) / 2.0
+                (dx * dx + dy * dy).sqrt() / 2.0
             ),
             // A jagged run of short segments, as a flattened coastline.
             5 => (0..rng.random_range(200..1000))
