@@ -218,8 +218,10 @@ impl Task {
     }
 
     /// Where the TCP at `p` stands along the task; on a path, its nearest path point within
-    /// [`progress_window_m`] of the progress `s_hint` it last had: the progress follows the
-    /// TCP's travel, so each point is measured against the stretch of the path it has reached.
+    /// [`progress_window_m`] of the progress `s_hint` it last had, and not past the next
+    /// unblended corner unless `s_hint` lies within [`ARRIVAL_M`] of it: the progress follows
+    /// the TCP's travel, so each point is measured against the stretch of the path it has
+    /// reached, and no corner counts as passed that the TCP did not come to.
     #[inline]
     pub fn along(&self, p: &Vec3, s_hint: f64) -> Along {
         match &self.path {
@@ -229,7 +231,12 @@ impl Task {
                 lateral: self.lateral_error(p),
             },
             Some(path) => {
+                // An unblended corner is passed only from within ARRIVAL_M of it: the TCP must
+                // come to the corner (be measured against it) before it counts as beyond.
                 let window = progress_window_m((path.point_at(s_hint) - p).norm());
+                let window = path
+                    .next_corner_m(s_hint + ARRIVAL_M)
+                    .map_or(window, |corner| window.min(corner - s_hint));
                 let located = path.locate(p, s_hint, window);
                 let at_corner = path
                     .next_corner_m(located.s - ARRIVAL_M)

@@ -35,6 +35,10 @@ pub const PEN_UP_CLEARANCE_SHARE: f64 = 0.5;
 /// back toward the part away from its ends does not.
 pub const LIFT_CONE_RUN: f64 = 2.0;
 
+/// How much higher (m) than the pen-up clearance a pen-up move's tip is kept where it is
+/// checked ([`FreeSpace::move_free`]): between two checks a smooth move dips by far less.
+pub const TIP_CLEARANCE_MARGIN_M: f64 = 5e-5;
+
 /// The tool's tip is checked this many times per edge step ([`MAX_POINT_TRAVEL_M`] of any
 /// point's travel) along a pen-up move ([`FreeSpace::move_free`]).
 pub const TIP_CHECKS_PER_STEP: f64 = 10.0;
@@ -348,7 +352,8 @@ impl<'a> FreeSpace<'a> {
     }
     /// Whether the pen-up move through `path` (from where the tool leaves the part, or from
     /// above it, to where it meets the next part, or above it) is free ([`FreeSpace::path_free`])
-    /// and keeps the tool's tip `clearance_m` above the part at every configuration checked,
+    /// and keeps the tool's tip `clearance_m` (and [`TIP_CLEARANCE_MARGIN_M`]) above the part at
+    /// every configuration checked,
     /// but within the lift cones ([`LIFT_CONE_RUN`]) of the tips of its first and last
     /// configurations (the lift and the set-down): a move that sags between two lifted
     /// configurations would drag the tool across the part.
@@ -357,6 +362,7 @@ impl<'a> FreeSpace<'a> {
             return true;
         };
         let ends = [first, last].map(|q| self.robot.forward(q).tcp());
+        let clearance_m = clearance_m + TIP_CLEARANCE_MARGIN_M;
         let clear =
             |q: &JointVector| self.tip_clear(&self.robot.forward(q).tcp(), &ends, clearance_m);
         // The tip is checked at every point of `path` and, between two points further apart,

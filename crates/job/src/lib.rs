@@ -655,12 +655,7 @@ fn connect_strokes(
     }
     let last = retreat.map(|[_, above]| above).or(program.last());
     let home_travel = home.zip(last).and_then(|(home, last)| {
-        free.connect(
-            &last,
-            &home,
-            settings.seed.wrapping_add(u64::MAX / 2),
-            settings.rrt_max_samples,
-        )
+        connector.home_move(&last, &home, settings.seed.wrapping_add(u64::MAX / 2))
     });
     let ends_at_home = home_travel.is_some();
     connector.join(
@@ -1037,6 +1032,39 @@ impl Connector<'_> {
                 .connect(from, to, seed, self.settings.rrt_max_samples)?;
             clear(&path).then_some((path, true))
         })
+    }
+
+    /// The free move from `last` (above the last part) back to `home` that keeps the pen-up
+    /// clearance ([`FreeSpace::move_free`]): the sampled move between them, else from `last`
+    /// risen [`CLEARANCE_LIFT_M`] further; `None` where neither is found.
+    fn home_move(
+        &self,
+        last: &JointVector,
+        home: &JointVector,
+        seed: u64,
+    ) -> Option<Vec<JointVector>> {
+        let clear = |path: &Vec<JointVector>| self.free.move_free(path, self.pen_up_clearance_m());
+        let samples = self.settings.rrt_max_samples;
+        self.free
+            .connect(last, home, seed, samples)
+            .filter(clear)
+            .or_else(|| {
+                let robot = self.free.robot();
+                let tip = robot.forward(last).tcp();
+                let up = self
+                    .free
+                    .surfaces()
+                    .iter()
+                    .min_by(|a, b| {
+                        ((tip - a.p0).dot(&a.n).abs()).total_cmp(&(tip - b.p0).dot(&b.n).abs())
+                    })
+                    .map(|surface| -surface.n)?;
+                let high = self
+                    .free
+                    .reach_point(last, &(tip + up * CLEARANCE_LIFT_M))?;
+                let path = self.free.connect(&high, home, seed, samples)?;
+                Some([vec![*last], path].concat()).filter(clear)
+            })
     }
 
     /// The joint-space polyline from `from` to `to` (both lifted above the part, which the tool

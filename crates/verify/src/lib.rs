@@ -42,8 +42,8 @@ pub use dynamics::{
 pub use model::{ModelError, ReferenceModel};
 pub use record::{
     Blame, Bounds, Ending, Joints, Line, MAX_JOINTS, MIN_JOINTS, Obstacle, PATH_CONTINUITY,
-    PATH_PROGRESS_PER_DISTANCE, PATH_PROGRESS_SLACK_M, PATH_WINDOW_M, PathPiece, RecordedStep,
-    Recording, Solid, Surface,
+    PATH_CORNER_PASS_M, PATH_CORNER_RAD, PATH_PROGRESS_PER_DISTANCE, PATH_PROGRESS_SLACK_M,
+    PATH_WINDOW_M, PathPiece, RecordedStep, Recording, Solid, Surface,
 };
 pub use replay::{
     DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,

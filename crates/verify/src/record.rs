@@ -52,6 +52,44 @@ pub enum PathPiece {
 }
 
 impl PathPiece {
+    /// The unit tangents at the piece's start and end.
+    fn end_tangents(&self) -> [Vector3<f64>; 2] {
+        match *self {
+            Self::Straight { start, end } => [(end - start).normalize(); 2],
+            Self::Arc { .. } => {
+                let ahead = |length: f64| {
+                    let turned = self.point(length) - self.centre();
+                    self.axis().cross(&turned).normalize() * self.sweep().signum()
+                };
+                [ahead(0.0), ahead(self.length())]
+            }
+        }
+    }
+
+    /// An arc's centre, axis and sweep (rad); a straight piece has none.
+    fn centre(&self) -> Vector3<f64> {
+        match *self {
+            Self::Arc { centre, .. } => centre,
+            Self::Straight { start, .. } => start,
+        }
+    }
+
+    /// See [`PathPiece::centre`].
+    fn axis(&self) -> Vector3<f64> {
+        match *self {
+            Self::Arc { axis, .. } => axis,
+            Self::Straight { .. } => Vector3::zeros(),
+        }
+    }
+
+    /// See [`PathPiece::centre`].
+    fn sweep(&self) -> f64 {
+        match *self {
+            Self::Arc { sweep_rad, .. } => sweep_rad,
+            Self::Straight { .. } => 0.0,
+        }
+    }
+
     /// Length of the piece (m).
     fn length(&self) -> f64 {
         match *self {
@@ -161,6 +199,14 @@ pub const PATH_PROGRESS_PER_DISTANCE: f64 = 1.6;
 /// The move of the progress allowed for a TCP exactly at its last known path point (m).
 pub const PATH_PROGRESS_SLACK_M: f64 = 1e-5;
 
+/// How near (m of arc length) its last known place must lie to a corner of the path (a join
+/// where the tangent turns by more than [`PATH_CORNER_RAD`]) for a recorded TCP's progress to
+/// pass it: a TCP that never came to a corner is measured against it.
+pub const PATH_CORNER_PASS_M: f64 = 1e-4;
+
+/// Smallest turn (rad) of the tangent between two pieces that makes their join a corner.
+pub const PATH_CORNER_RAD: f64 = 1e-6;
+
 impl Line {
     /// A straight-line task.
     pub fn straight(p0: Vector3<f64>, d: Vector3<f64>, n: Vector3<f64>) -> Self {
@@ -237,7 +283,10 @@ impl Line {
         let from_hint = (self.point_on_path(hint) - point).norm();
         let window =
             (PATH_PROGRESS_PER_DISTANCE * from_hint + PATH_PROGRESS_SLACK_M).min(PATH_WINDOW_M);
-        let (s, _) = self.nearest_on_path(point, hint, hint, hint + window, PATH_CONTINUITY);
+        let to = self
+            .corner_after(hint + PATH_CORNER_PASS_M)
+            .map_or(hint + window, |corner| corner.min(hint + window));
+        let (s, _) = self.nearest_on_path(point, hint, hint, to, PATH_CONTINUITY);
         (s, (self.point_on_path(s) - point).norm())
     }
 
@@ -271,6 +320,22 @@ impl Line {
             start += length;
         }
         best
+    }
+
+    /// The arc length of the first corner of the path after `s`, if any: a join of two pieces
+    /// whose tangents differ by more than [`PATH_CORNER_RAD`].
+    fn corner_after(&self, s: f64) -> Option<f64> {
+        let mut start = 0.0;
+        for pair in self.path.windows(2) {
+            start += pair[0].length();
+            let (before, after) = (pair[0].end_tangents()[1], pair[1].end_tangents()[0]);
+            if start > s
+                && libm::atan2(before.cross(&after).norm(), before.dot(&after)) > PATH_CORNER_RAD
+            {
+                return Some(start);
+            }
+        }
+        None
     }
 
     /// The path point at arc length `s`.
