@@ -204,6 +204,12 @@ const PEAK_ZOOMS: usize = 6;
 /// 0.1 mm and 0.5 mm tolerances).
 pub const LINE_CHECK_MARGIN_M: f64 = 2e-6;
 
+/// How much closer still (m) the spline's checked points must lie to the path point their
+/// progress reached from their segment's first knot: the checker follows the progress sample
+/// by sample, which near a corner or a tight turn places a sample a few micrometres further
+/// from the path than the knot's progress does.
+pub const PROGRESS_CHECK_MARGIN_M: f64 = 1e-5;
+
 /// Bisection steps that place a peak of the tool angle or of the distance inside a check interval (an interval of
 /// a few millimetres shrinks below a nanometre).
 const PEAK_BISECTIONS: usize = 24;
@@ -255,7 +261,8 @@ fn first_failing_segment(
                 first_violation(robot, task, &kinematics, constraints)
                     .or_else(|| {
                         let distance_m = task.along(&kinematics.tcp(), reached[k]).lateral.norm();
-                        (distance_m > constraints.line_tolerance_m)
+                        (task.path.is_some()
+                            && distance_m > constraints.line_tolerance_m - PROGRESS_CHECK_MARGIN_M)
                             .then_some(Violation::LineTolerance { distance_m })
                     })
                     .map(|v| (k, v))

@@ -179,7 +179,68 @@ pub const MAX_FORCED_RESTS: usize = 32;
 /// also rests at the stretch's inner waypoint nearest (in joint space) the first sample that
 /// breaks it, and the stretches are timed again: a motion is slowed to rest where a limit forces
 /// it rather than given up, up to [`MAX_FORCED_RESTS`] such rests.
+///
+/// On a path, every sample is then measured as the checker measures it: its TCP followed
+/// along the path sample by sample ([`Task::along`]) within the line tolerance of the point it
+/// reached. Where one is not, the motion is timed again through the waypoints before it only,
+/// and its report says where and why it was cut.
 pub fn time_motion(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    waypoints: &[JointVector],
+    request: &TimingRequest,
+) -> Result<TimedMotion, TimingError> {
+    let mut end = waypoints.len();
+    let mut cut = None;
+    loop {
+        let mut motion = time_rested(robot, task, constraints, &waypoints[..end], request)?;
+        let Some((time_s, distance_m)) = first_sample_off(robot, task, constraints, &motion) else {
+            if motion.report.cut.is_none() {
+                motion.report.cut = cut;
+            }
+            return Ok(motion);
+        };
+        let passing = motion.passing_times_s(&waypoints[..end]);
+        let before = passing
+            .iter()
+            .rposition(|t| *t < time_s)
+            .unwrap_or(0)
+            .min(end.saturating_sub(2));
+        end = before + 1;
+        cut = Some((
+            before,
+            format!(
+                "a timed sample left the line tolerance ({:.2} mm off the path where it \
+                 reached)",
+                distance_m * 1e3
+            ),
+        ));
+    }
+}
+
+/// The time (s) of the first sample of `motion` whose TCP, followed along a path task sample by
+/// sample, lies farther than the line tolerance from the path point it reached, and that
+/// distance (m); `None` on a line, or where every sample lies within it.
+fn first_sample_off(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    motion: &TimedMotion,
+) -> Option<(f64, f64)> {
+    task.path.as_ref()?;
+    let mut s = 0.0;
+    motion.samples.iter().find_map(|sample| {
+        let along = task.along(&robot.forward(&sample.q).tcp(), s);
+        s = along.s_m;
+        let distance_m = along.lateral.norm();
+        (distance_m > constraints.line_tolerance_m).then(|| (sample.time_s(), distance_m))
+    })
+}
+
+/// [`time_motion`] before its samples are measured: the stretches between rests timed, with
+/// the rests a limit forces.
+fn time_rested(
     robot: &Robot,
     task: &Task,
     constraints: &ConstraintConfig,

@@ -204,8 +204,10 @@ pub const PATH_PROGRESS_SLACK_M: f64 = 1e-5;
 /// pass it: a TCP that never came to a corner is measured against it.
 pub const PATH_CORNER_PASS_M: f64 = 1e-4;
 
-/// Smallest turn (rad) of the tangent between two pieces that makes their join a corner.
-pub const PATH_CORNER_RAD: f64 = 1e-6;
+/// Smallest turn (rad) of the tangent between two pieces that makes their join a corner: far
+/// above the rounding of a join made tangent (a biarc's, a blend's), far below any corner a
+/// drawing holds.
+pub const PATH_CORNER_RAD: f64 = 1e-3;
 
 impl Line {
     /// A straight-line task.
