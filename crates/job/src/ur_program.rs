@@ -452,7 +452,18 @@ impl Writer<'_> {
     /// its targets, the tool off.
     fn stroke(&mut self, qs: &[JointVector], task: &Task) {
         let poses: Vec<Pose> = qs.iter().map(|q| Pose::of(self.robot, q)).collect();
-        let (kept, worst) = stroke_targets(&poses, qs, task, self.tolerance, self.cone_deg);
+        // Each sample's progress along the task, followed from its start as the reader follows
+        // the program's poses.
+        let mut s = 0.0;
+        let progress: Vec<f64> = poses
+            .iter()
+            .map(|pose| {
+                s = task.along(&pose.position, s).s_m;
+                s
+            })
+            .collect();
+        let (kept, worst) =
+            stroke_targets(&poses, &progress, qs, task, self.tolerance, self.cone_deg);
         self.program.worst_chord_m = self.program.worst_chord_m.max(worst);
         self.program.stroke_parts += 1;
         self.switch(true);
@@ -464,6 +475,7 @@ impl Writer<'_> {
             let radius = kept.get(n + 2).map_or(0.0, |&m| {
                 blend_radius(
                     [&poses[i], &poses[j], &poses[m]],
+                    progress[i],
                     task,
                     self.tolerance,
                     self.cone_deg,
@@ -521,10 +533,12 @@ fn furthest(i: usize, last: usize, mut fits: impl FnMut(usize) -> bool) -> usize
 /// The indices of the stroke's samples kept as targets (the first and the last among them) and
 /// the largest distance from the stroke found on the lines between them: each line within
 /// [`CHORD_SHARE`] of the `tolerance` of `task` and its slerped tool axis within `cone_deg` at
-/// every sample between its ends (taken at the sample's projection on it), and no joint turning
-/// more than [`MAX_TARGET_TURN_RAD`] from its start to any sample up to its end.
+/// every sample between its ends (taken at the sample's projection on it, and measured from the
+/// path point the sample before it reached, `progress`, as well as from the whole path), and no
+/// joint turning more than [`MAX_TARGET_TURN_RAD`] from its start to any sample up to its end.
 fn stroke_targets(
     poses: &[Pose],
+    progress: &[f64],
     qs: &[JointVector],
     task: &Task,
     tolerance: f64,
@@ -551,7 +565,10 @@ fn stroke_targets(
             } else {
                 0.0
             };
-            let distance = task.distance(&(a + chord * u));
+            let point = a + chord * u;
+            let distance = task
+                .distance(&point)
+                .max(task.along(&point, progress[k - 1]).lateral.norm());
             let rotation = poses[i]
                 .rotation
                 .try_slerp(&poses[j].rotation, u, 1e-12)
@@ -576,16 +593,27 @@ fn stroke_targets(
 
 /// The radius of the blend at target `j` between the lines from target `i` and to target `m`
 /// (m): at most [`BLEND_LENGTH_SHARE`] of the shorter line, halved until its arc ([`blend_arc`])
-/// lies within [`CHORD_SHARE`] of the `tolerance` of `task` and its tool axis within `cone_deg`
-/// of the task's normal; 0 (no blend) where no radius tried does.
-fn blend_radius([a, b, c]: [&Pose; 3], task: &Task, tolerance: f64, cone_deg: f64) -> f64 {
+/// lies within [`CHORD_SHARE`] of the `tolerance` of `task` (measured from the path point
+/// reached, followed along the arc from `from_s`, the progress at `a`, and from the whole path)
+/// and its tool axis within `cone_deg` of the task's normal; 0 (no blend) where no radius tried
+/// does.
+fn blend_radius(
+    [a, b, c]: [&Pose; 3],
+    from_s: f64,
+    task: &Task,
+    tolerance: f64,
+    cone_deg: f64,
+) -> f64 {
     let shorter = (b.position - a.position)
         .norm()
         .min((c.position - b.position).norm());
     let mut radius = BLEND_LENGTH_SHARE * shorter;
     for _ in 0..BLEND_HALVINGS {
+        let mut s = from_s;
         let fits = blend_arc([a, b, c], radius).iter().all(|pose| {
-            task.distance(&pose.position) <= CHORD_SHARE * tolerance
+            let along = task.along(&pose.position, s);
+            s = along.s_m;
+            task.distance(&pose.position).max(along.lateral.norm()) <= CHORD_SHARE * tolerance
                 && tool_angle_deg(&(pose.rotation * Vec3::z()), &task.n) <= cone_deg
         });
         if fits {
