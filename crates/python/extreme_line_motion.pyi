@@ -300,10 +300,12 @@ class Planner:
         placement: Optional[dict] = None,
         tolerance_mm: float = 0.5,
         home: Optional[JointAngles] = None,
+        corner_tolerance_mm: Optional[float] = None,
     ) -> JobPlan:
         """Plans a job (a job file, an SVG drawing placed by ``placement``, or a dict in the job
         file's layout) as ``emg job`` does; the program starts and ends at ``home``, by default
-        the job's, else the shipped arm's (``Robot.home``)."""
+        the job's, else the shipped arm's (``Robot.home``); an SVG drawing's corners are rounded
+        within ``corner_tolerance_mm`` of ``tolerance_mm`` (by default none)."""
     def place_job(
         self,
         job: Union[PathLike, dict],
@@ -315,6 +317,7 @@ class Planner:
         certify: int = 5,
         score: Literal["bound", "point_ik"] = "bound",
         home: Optional[JointAngles] = None,
+        corner_tolerance_mm: Optional[float] = None,
     ) -> JobPlacement:
         """Finds where to put a job's part as ``emg place`` does; ``home`` as for ``plan_job``."""
     def reach(self, p0: Vector3, d: Vector3, n: Vector3) -> float:

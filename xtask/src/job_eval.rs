@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec};
-use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_io::{Placement, read_svg_file};
 use emg_job::{
     FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, Unwatched, job_part,
     order_strokes, part_coverage, plan_job, plan_stroke, valley_seams, verify_job,
@@ -212,6 +212,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let mut jobs: Vec<(String, Job)> = Vec::new();
     let icons = icon_files(&args.icons)?;
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     for icon in &icons {
         for (origin, width) in PLACES {
             let placement = Placement {
@@ -219,7 +220,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 width_m: Some(width),
                 ..Placement::default()
             };
-            let drawing = read_svg_file(icon, &placement, &SvgOptions::default())?;
+            let drawing = read_svg_file(icon, &placement, &tolerance.svg_options())?;
             let name = format!(
                 "{} at ({}, {}, {}), {} m wide",
                 icon.file_name().unwrap_or_default().to_string_lossy(),
@@ -228,7 +229,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 origin[2],
                 width
             );
-            jobs.push((name, with_home(drawing.strokes)?));
+            let job = tolerance.job(drawing, planner.robot())?;
+            jobs.push((name, job.with_home(home, planner.robot())?));
         }
     }
     for tilt_deg in [0.0, 20.0, 40.0] {

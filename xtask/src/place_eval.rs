@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use emg_io::{Placement as SvgPlacement, SvgOptions, read_svg_file};
+use emg_io::{Placement as SvgPlacement, read_svg_file};
 use emg_job::{
     Job, Moving, Place, PlaceFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE,
     Score, Unwatched, place_job, plan_job, verify_job,
@@ -156,13 +156,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot_name = args.robot.display().to_string();
     let icons = icon_files(&args.icons)?;
     let mut jobs: Vec<(String, Job)> = Vec::new();
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     for icon in &icons {
         let placement = SvgPlacement {
             origin_m: FAR.0,
             width_m: Some(FAR.1),
             ..SvgPlacement::default()
         };
-        let drawing = read_svg_file(icon, &placement, &SvgOptions::default())?;
+        let drawing = read_svg_file(icon, &placement, &tolerance.svg_options())?;
         jobs.push((
             format!(
                 "{} at ({}, {}, {}), {} m wide",
@@ -172,7 +173,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 FAR.0[2],
                 FAR.1
             ),
-            Job::from_strokes(drawing.strokes, planner.robot())?,
+            tolerance.job(drawing, planner.robot())?,
         ));
     }
     let twenty = Job::from_strokes(grid_of_circles(4, 5, [0.75, 0.0, 0.25]), planner.robot())?;

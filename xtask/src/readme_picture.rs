@@ -100,12 +100,13 @@ fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
     let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
     let timing = emg_job::job_timing(&robot, &robot_path, &config)?;
     let planner = Planner::new(robot, models, config)?;
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = emg_io::read_svg_file(
         &workspace::root().join(file),
         &emg_io::Placement::default(),
-        &emg_io::SvgOptions::default(),
+        &tolerance.svg_options(),
     )?;
-    let job = emg_job::Job::from_strokes(drawing.strokes, planner.robot())?;
+    let job = tolerance.job(drawing, planner.robot())?;
     let program = emg_job::plan_job(
         &planner,
         &PlanRequest::default(),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
-use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_io::{Placement, read_svg_file};
 use emg_job::{Job, JobPlanError, Order, Tool, plan_job};
 use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
 
@@ -42,6 +42,11 @@ pub struct JobInput {
     /// the job file's.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub lift: Option<f64>,
+    /// SVG only: how far the rounding of a corner may leave it (mm), out of --tolerance: the
+    /// strokes are followed within the rest (docs/jobs.md#corner-rounding). 0 keeps every
+    /// corner, passed at rest.
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub corner_tolerance: Option<f64>,
     /// SVG only: where the drawing's centre goes (m, base frame).
     #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
@@ -125,7 +130,8 @@ impl JobInput {
     /// The job read and its planner set up.
     pub fn ready(&self) -> Result<Ready> {
         let robot = robot::load_robot(&self.robot, None, None)?;
-        let mut job = read_job(self, &robot)?;
+        let drawing = self.drawing_tolerance()?;
+        let mut job = read_job(self, drawing.as_ref(), &robot)?;
         let shipped_home = robot::shipped(&self.robot).map(|shipped| shipped.home);
         match (&self.home, shipped_home) {
             (Some(values), _) => {
@@ -158,6 +164,32 @@ impl JobInput {
             timing,
             request,
         })
+    }
+
+    /// Whether the job is an SVG drawing (else a job file).
+    fn is_svg(&self) -> bool {
+        self.file
+            .extension()
+            .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"))
+    }
+
+    /// A drawing's tolerance, shared between its corners and its strokes; `None` for a job
+    /// file, whose strokes are followed as they are within --tolerance.
+    fn drawing_tolerance(&self) -> Result<Option<emg_job::DrawingTolerance>> {
+        if !self.is_svg() {
+            if self.corner_tolerance.is_some() {
+                anyhow::bail!(
+                    "--corner-tolerance rounds the corners of an SVG drawing; {} is a job file, \
+                     whose strokes are followed as they are",
+                    self.file.display()
+                );
+            }
+            return Ok(None);
+        }
+        let corner_m = self.corner_tolerance.unwrap_or(0.0) * 1e-3;
+        emg_job::DrawingTolerance::new(self.tolerance * 1e-3, corner_m)
+            .map(Some)
+            .map_err(|e| anyhow::anyhow!("--corner-tolerance: {e}"))
     }
 }
 
@@ -343,23 +375,25 @@ pub fn print_summary(file: &emg_job::JobFile) {
 }
 
 /// The job of a job file, or of an SVG drawing placed as the options say.
-fn read_job(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Job> {
-    let is_svg = args
-        .file
-        .extension()
-        .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"));
-    let mut job = if is_svg {
+/// `tolerance` is the drawing's, for an SVG drawing.
+fn read_job(
+    args: &JobInput,
+    tolerance: Option<&emg_job::DrawingTolerance>,
+    robot: &emg_kinematics::Robot,
+) -> Result<Job> {
+    let mut job = if let Some(tolerance) = tolerance {
         let placement = placement(args)?;
-        let drawing = read_svg_file(&args.file, &placement, &SvgOptions::default())?;
+        let options = tolerance.svg_options();
+        let drawing = read_svg_file(&args.file, &placement, &options)?;
         if drawing.dropped_tiny > 0 {
             println!(
                 "{}: {} shorter than {} mm dropped",
                 args.file.display(),
                 count(drawing.dropped_tiny, "stroke"),
-                SvgOptions::default().min_stroke_m * 1e3
+                options.min_stroke_m * 1e3
             );
         }
-        Job::from_strokes(drawing.strokes, robot)?
+        tolerance.job(drawing, robot)?
     } else {
         if [&args.origin, &args.normal, &args.x_axis]
             .iter()

@@ -35,6 +35,7 @@ pub mod program;
 pub mod reorder;
 pub mod spec;
 pub mod stroke;
+pub mod tolerance;
 pub mod tool_output;
 pub mod ur_program;
 pub mod verify;
@@ -73,6 +74,7 @@ pub use program::{
 pub use reorder::{MIN_SAVED_S, in_order, reorder_by_move_time};
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
 pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke, reachable_start_s};
+pub use tolerance::DrawingTolerance;
 pub use tool_output::{OutputBank, ToolOutput};
 pub use verify::{JobCheck, JobCheckError, verify_job};
 use watch::PlanningProgress;
@@ -127,6 +129,9 @@ pub enum JobPlanError {
     /// The watcher asked the job to stop.
     #[error(transparent)]
     Stopped(#[from] Stopped),
+    /// The job's corner tolerance leaves nothing of the planner's line tolerance.
+    #[error(transparent)]
+    Job(#[from] JobError),
 }
 
 /// Plans `job` with `planner` as `request` asks (the search; its constraints and scene) and
@@ -146,6 +151,8 @@ pub fn plan_job(
 ) -> Result<JobFile, JobPlanError> {
     let started = Instant::now();
     let settings = &job.settings;
+    let following = tolerance::following(planner, settings.corner_tolerance_m)?;
+    let planner = following.as_ref().unwrap_or(planner);
     let robot = planner.robot();
     let dof = robot.dof();
     let strokes = job.strokes.len();

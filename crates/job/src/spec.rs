@@ -100,6 +100,11 @@ pub struct JobSettings {
     pub rrt_max_samples: usize,
     /// The output that switches the tool on along each stroke.
     pub tool_output: ToolOutput,
+    /// How far (m) the strokes' corners were rounded from the drawing's, out of the line
+    /// tolerance (docs/jobs.md, "Corner rounding"): the strokes are followed within the line
+    /// tolerance less it, so that the pen stays within the line tolerance of the drawing; 0
+    /// (the default) for strokes taken as they are.
+    pub corner_tolerance_m: f64,
 }
 
 impl Default for JobSettings {
@@ -114,6 +119,7 @@ impl Default for JobSettings {
             seed: 20_261_127,
             rrt_max_samples: 4000,
             tool_output: ToolOutput::default(),
+            corner_tolerance_m: 0.0,
         }
     }
 }
@@ -170,6 +176,18 @@ pub enum JobError {
     /// The home configuration does not fit the arm.
     #[error("job field 'home': {0}")]
     Home(String),
+    /// A drawing's corner tolerance does not fit within its line tolerance.
+    #[error(
+        "the corner tolerance is {} mm; it must be at least 0 and less than the line tolerance, {} mm",
+        corner_m * 1e3,
+        line_m * 1e3
+    )]
+    CornerTolerance {
+        /// The corner tolerance asked for (m).
+        corner_m: f64,
+        /// The line tolerance (m).
+        line_m: f64,
+    },
 }
 
 impl JobSettings {
@@ -219,6 +237,12 @@ impl JobSettings {
             self.max_parts as f64,
             "in [1, 100]",
             (1..=100).contains(&self.max_parts),
+        )?;
+        require(
+            "corner_tolerance_m",
+            self.corner_tolerance_m,
+            "0 or more (m)",
+            self.corner_tolerance_m >= 0.0,
         )?;
         require(
             "rrt_max_samples",

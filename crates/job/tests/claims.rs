@@ -186,24 +186,7 @@ fn every_claimed_corner_is_drawn(program: &JobFile, checker: &ReferenceModel) {
     let tolerance = program.constraints.line_tolerance_m;
     for (place, report) in program.strokes.iter().enumerate() {
         let path = emg_control::Path::new(report.path.clone()).expect("the stroke's path");
-        let tips: Vec<emg_kinematics::Vec3> = program
-            .segments
-            .iter()
-            .filter(
-                |s| matches!(s.kind, SegmentKind::Stroke { stroke, .. } if stroke == report.stroke),
-            )
-            .flat_map(|s| {
-                points.iter().filter(move |p| {
-                    let t = p.time_from_start.seconds();
-                    t >= s.start_s - 1e-9 && t <= s.end_s + 1e-9
-                })
-            })
-            .map(|p| {
-                let mut q = emg_verify::Joints::zeros();
-                q.as_mut_slice()[..p.positions.len()].copy_from_slice(&p.positions);
-                checker.tcp_pose(&q).0
-            })
-            .collect();
+        let tips = pen_down_tips(program, &points, report.stroke, checker);
         for corner in path.corners_m() {
             let claimed_undrawn = report
                 .unreached
@@ -225,6 +208,163 @@ fn every_claimed_corner_is_drawn(program: &JobFile, checker: &ReferenceModel) {
             );
         }
     }
+}
+
+/// The tool tip of every pen-down sample of `stroke` in `program`, by the checker's kinematics.
+fn pen_down_tips(
+    program: &JobFile,
+    points: &[emg_io::JointTrajectoryPoint],
+    stroke: usize,
+    checker: &ReferenceModel,
+) -> Vec<emg_kinematics::Vec3> {
+    program
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, SegmentKind::Stroke { stroke: k, .. } if k == stroke))
+        .flat_map(|s| {
+            points.iter().filter(move |p| {
+                let t = p.time_from_start.seconds();
+                t >= s.start_s - 1e-9 && t <= s.end_s + 1e-9
+            })
+        })
+        .map(|p| {
+            let mut q = emg_verify::Joints::zeros();
+            q.as_mut_slice()[..p.positions.len()].copy_from_slice(&p.positions);
+            checker.tcp_pose(&q).0
+        })
+        .collect()
+}
+
+/// The distance from `p` to the polyline through `vertices`.
+fn polyline_distance(p: &emg_kinematics::Vec3, vertices: &[emg_kinematics::Vec3]) -> f64 {
+    vertices
+        .windows(2)
+        .map(|w| {
+            let ab = w[1] - w[0];
+            let t = ((p - w[0]).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+            (p - (w[0] + ab * t)).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn rounded_corners_keep_the_pen_within_the_tolerance_of_the_drawing_as_given() {
+    // Lettering as a single-stroke font gives it: a curve flattened into 24° turns, a W of
+    // sharp turns, and a closed star of 144° turns.
+    let arc: Vec<String> = (0..=12)
+        .map(|k| {
+            let a = (k as f64 * 24.0).to_radians();
+            format!(
+                "{:.4},{:.4}",
+                10.0 + 8.0 * libm::cos(a),
+                10.0 + 8.0 * libm::sin(a)
+            )
+        })
+        .collect();
+    let star: Vec<String> = (0..5)
+        .map(|k| {
+            let a = (90.0 + k as f64 * 144.0).to_radians();
+            format!(
+                "{:.4},{:.4}",
+                60.0 + 8.0 * libm::cos(a),
+                10.0 + 8.0 * libm::sin(a)
+            )
+        })
+        .collect();
+    let svg = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 72 20">
+        <polyline fill="none" stroke="black" points="{}"/>
+        <polyline fill="none" stroke="black" points="24,2 28,18 32,6 36,18 40,2"/>
+        <polygon fill="none" stroke="black" points="{}"/>
+        </svg>"#,
+        arc.join(" "),
+        star.join(" ")
+    );
+    let dir = std::env::temp_dir().join(format!("emg-lettering-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let file = dir.join("lettering.svg");
+    std::fs::write(&file, svg).expect("the drawing is written");
+    let (planner, timing, checker, robot_file) = common::setup("fr3");
+    let placement = Placement {
+        width_m: Some(0.12),
+        ..Placement::default()
+    };
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 1.25e-4).unwrap();
+    let sharp = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0).unwrap();
+    let read = |tolerance: &emg_job::DrawingTolerance| {
+        let drawing = emg_io::read_svg_file(&file, &placement, &tolerance.svg_options())
+            .expect("the drawing");
+        tolerance
+            .job(drawing, planner.robot())
+            .expect("a valid job")
+    };
+    let (job, at_corners) = (read(&tolerance), read(&sharp));
+    // The polylines exactly: no joint made smooth, no corner rounded.
+    let exact = emg_io::SvgOptions {
+        smooth_join_deg: 0.0,
+        ..sharp.svg_options()
+    };
+    let as_given = emg_io::read_svg_file(&file, &placement, &exact).expect("the drawing");
+    std::fs::remove_dir_all(&dir).ok();
+    let program = common::plan(&planner, &timing, &robot_file, &job);
+    claims_are_measured(&program, &planner, &checker);
+    every_claimed_corner_is_drawn(&program, &checker);
+    assert!(
+        program.summary.drawn_m > 0.99 * program.summary.total_m,
+        "{} m of {} m drawn",
+        program.summary.drawn_m,
+        program.summary.total_m
+    );
+    assert_eq!(
+        program.constraints.line_tolerance_m,
+        tolerance.line_m - tolerance.corner_m
+    );
+    // Against the drawing as given (its polylines with their corners): every pen-down sample
+    // within the line tolerance, and every vertex of a stroke drawn whole within it of one.
+    let points = program.points();
+    for report in &program.strokes {
+        let given = &as_given.strokes[report.stroke];
+        let vertices: Vec<emg_kinematics::Vec3> = std::iter::once(given.start)
+            .chain(given.segments.iter().map(|segment| match segment {
+                emg_control::SegmentSpec::Line { to } => *to,
+                other => panic!("a polyline has only lines: {other:?}"),
+            }))
+            .map(emg_kinematics::Vec3::from)
+            .collect();
+        let tips = pen_down_tips(&program, &points, report.stroke, &checker);
+        let farthest = tips
+            .iter()
+            .map(|tip| polyline_distance(tip, &vertices))
+            .fold(0.0, f64::max);
+        assert!(
+            farthest <= tolerance.line_m + 1e-6,
+            "stroke {}: a pen-down sample {:.3} mm from the drawing",
+            report.stroke,
+            farthest * 1e3
+        );
+        if report.unreached.is_empty() {
+            for vertex in &vertices {
+                let nearest = tips
+                    .iter()
+                    .map(|tip| (tip - vertex).norm())
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    nearest <= tolerance.line_m + 1e-6,
+                    "stroke {}: no sample within {:.3} mm of a vertex",
+                    report.stroke,
+                    nearest * 1e3
+                );
+            }
+        }
+    }
+    // Rounded, the lettering is drawn faster than with every corner passed at rest.
+    let at_rest = common::plan(&planner, &timing, &robot_file, &at_corners);
+    assert!(
+        program.summary.pen_down_s < 0.9 * at_rest.summary.pen_down_s,
+        "{} s pen down rounded, {} s at rest",
+        program.summary.pen_down_s,
+        at_rest.summary.pen_down_s
+    );
 }
 
 #[test]

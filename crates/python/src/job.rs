@@ -25,13 +25,20 @@ pub struct JobPlan {
 
 /// The job of `job`: a job file or an SVG drawing (`str` or `os.PathLike`; an SVG is placed by
 /// `placement`, a dict of `origin_m`, `normal`, `x_axis`, `width_m` or `scale_m_per_unit`), or
-/// a `dict` in the job file's layout.
+/// a `dict` in the job file's layout. An SVG drawing's corners are rounded within
+/// `corner_tolerance_mm` (none by default), as `emg job --corner-tolerance` rounds them.
 pub(crate) fn read_job(
     py: Python<'_>,
     robot: &emg_kinematics::Robot,
     job: &Bound<'_, PyAny>,
     placement: Option<&Bound<'_, PyDict>>,
+    (tolerance_mm, corner_tolerance_mm): (f64, Option<f64>),
 ) -> PyResult<Job> {
+    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
+        return Err(InputError::new_err(format!(
+            "tolerance_mm: must be a positive number, got {tolerance_mm}"
+        )));
+    }
     let dumps = |value: &Bound<'_, PyAny>| -> PyResult<String> {
         py.import("json")?
             .call_method1("dumps", (value,))?
@@ -40,6 +47,12 @@ pub(crate) fn read_job(
     let invalid =
         |e: &(dyn std::error::Error + 'static)| InputError::new_err(format!("job: {}", message(e)));
     if job.is_instance_of::<PyDict>() {
+        if corner_tolerance_mm.is_some() {
+            return Err(InputError::new_err(
+                "corner_tolerance_mm: rounds an SVG drawing's corners; a job's strokes are \
+                 followed as they are",
+            ));
+        }
         return Job::from_json("job", &dumps(job)?, robot).map_err(|e| invalid(&e));
     }
     let path: PathBuf = job
@@ -53,13 +66,24 @@ pub(crate) fn read_job(
             Some(dict) => placement_of(&dumps(dict.as_any())?)?,
             None => emg_io::Placement::default(),
         };
-        let drawing = emg_io::read_svg_file(&path, &placement, &emg_io::SvgOptions::default())
+        let tolerance = emg_job::DrawingTolerance::new(
+            tolerance_mm * 1e-3,
+            corner_tolerance_mm.unwrap_or(0.0) * 1e-3,
+        )
+        .map_err(|e| input_error("corner_tolerance_mm", &e))?;
+        let drawing = emg_io::read_svg_file(&path, &placement, &tolerance.svg_options())
             .map_err(|e| invalid(&e))?;
-        return Job::from_strokes(drawing.strokes, robot).map_err(|e| invalid(&e));
+        return tolerance.job(drawing, robot).map_err(|e| invalid(&e));
     }
     if placement.is_some() {
         return Err(InputError::new_err(
             "placement: places an SVG drawing; a job file's strokes are already placed",
+        ));
+    }
+    if corner_tolerance_mm.is_some() {
+        return Err(InputError::new_err(
+            "corner_tolerance_mm: rounds an SVG drawing's corners; a job file's strokes are \
+             followed as they are",
         ));
     }
     let text = std::fs::read_to_string(&path)
@@ -96,18 +120,14 @@ pub(crate) fn with_home(
     })
 }
 
-/// What a job plans with at `tolerance_mm`: `planner` at that tolerance, its timing and the
+/// What a job plans with at `tolerance_mm` (positive, as [`read_job`] checks it): `planner` at
+/// that tolerance, its timing and the
 /// request (the search, the best shipped controller), as `emg job` plans.
 fn job_planner(
     planner: &emg_planner::Planner,
     robot_file: &std::path::Path,
     tolerance_mm: f64,
 ) -> PyResult<(emg_planner::Planner, emg_planner::MotionTiming, PlanRequest)> {
-    if !(tolerance_mm.is_finite() && tolerance_mm > 0.0) {
-        return Err(InputError::new_err(format!(
-            "tolerance_mm: must be a positive number, got {tolerance_mm}"
-        )));
-    }
     let mut config = planner.config().clone();
     config.rollout.constraints.line_tolerance_m = tolerance_mm * 1e-3;
     let planner = planner

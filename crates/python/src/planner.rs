@@ -383,9 +383,11 @@ impl Planner {
     /// `emg job --home`: by default the job's `home`, else the shipped arm's (`Robot.home`);
     /// a robot file with neither starts above its first stroke and ends above its last. A
     /// malformed job or home raises `InputError` naming the field; one of which no stroke can
-    /// be drawn raises `PlanningError`.
+    /// be drawn raises `PlanningError`. `corner_tolerance_mm` (SVG only) is how far the rounding
+    /// of a corner may leave it, out of `tolerance_mm`, as `emg job --corner-tolerance`
+    /// (by default none: every corner kept).
     // Literal defaults, which `help()` shows (an expression shows as `...`): `emg job`'s.
-    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5, home = None))]
+    #[pyo3(signature = (job, placement = None, tolerance_mm = 0.5, home = None, corner_tolerance_mm = None))]
     fn plan_job(
         &self,
         py: Python<'_>,
@@ -393,9 +395,11 @@ impl Planner {
         placement: Option<&Bound<'_, PyDict>>,
         tolerance_mm: f64,
         home: Option<&Bound<'_, PyAny>>,
+        corner_tolerance_mm: Option<f64>,
     ) -> PyResult<crate::job::JobPlan> {
         let robot = self.robot.get();
-        let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        let tolerances = (tolerance_mm, corner_tolerance_mm);
+        let job = crate::job::read_job(py, self.inner.robot(), job, placement, tolerances)?;
         let job = crate::job::with_home(job, robot, home)?;
         crate::job::plan(py, &self.inner, robot, &job, tolerance_mm)
     }
@@ -407,10 +411,10 @@ impl Planner {
     /// default, or `"base"`: the robot's base on its mount); `positions² × 3 × rotations` places
     /// screened by `score` (`"bound"`, each stroke's reachability bound, or `"point_ik"`,
     /// the share of stroke points with an IK solution), the best `certify` planned as full jobs,
-    /// each starting and ending at `home` as for `plan_job`. Returns a `JobPlacement`; a bad
+    /// each starting and ending at `home` (and the corners rounded) as for `plan_job`. Returns a `JobPlacement`; a bad
     /// region, setting or home raises `InputError` naming it, a region the arm cannot reach
     /// `PlanningError`.
-    #[pyo3(signature = (job, region, placement = None, tolerance_mm = 0.5, positions = 10, rotations = 5, certify = 5, score = "bound", home = None))]
+    #[pyo3(signature = (job, region, placement = None, tolerance_mm = 0.5, positions = 10, rotations = 5, certify = 5, score = "bound", home = None, corner_tolerance_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn place_job(
         &self,
@@ -424,9 +428,11 @@ impl Planner {
         certify: usize,
         score: &str,
         home: Option<&Bound<'_, PyAny>>,
+        corner_tolerance_mm: Option<f64>,
     ) -> PyResult<crate::job::JobPlacement> {
         let robot = self.robot.get();
-        let job = crate::job::read_job(py, self.inner.robot(), job, placement)?;
+        let tolerances = (tolerance_mm, corner_tolerance_mm);
+        let job = crate::job::read_job(py, self.inner.robot(), job, placement, tolerances)?;
         let job = crate::job::with_home(job, robot, home)?;
         crate::job::place(
             py,

@@ -6,8 +6,8 @@
 use std::sync::Mutex;
 use std::time::Instant;
 
-use emg_io::{Placement, SvgOptions, read_svg, scattered_strokes_svg};
-use emg_job::{Job, Watch, plan_job, verify_job};
+use emg_io::{Placement, read_svg, scattered_strokes_svg};
+use emg_job::{Watch, plan_job, verify_job};
 use emg_planner::{MotionTiming, PlanRequest, Planner};
 use serde::{Deserialize, Serialize};
 
@@ -83,13 +83,15 @@ pub fn evaluate(
     strokes: usize,
     threads: Option<usize>,
 ) -> anyhow::Result<LargeRow> {
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = read_svg(
         &scattered_strokes_svg(strokes),
         &Placement::default(),
-        &SvgOptions::default(),
+        &tolerance.svg_options(),
     )?;
-    let job =
-        Job::from_strokes(drawing.strokes, planner.robot())?.with_home(home, planner.robot())?;
+    let job = tolerance
+        .job(drawing, planner.robot())?
+        .with_home(home, planner.robot())?;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(threads) = threads {
         pool = pool.num_threads(threads);

@@ -49,6 +49,13 @@ pub struct SvgOptions {
     /// `curve_tolerance_m / 0.2 mm` radians stays a corner whatever this says (14° at the
     /// default tolerance, 0.3° at 1 µm). `0` keeps every corner of the drawing.
     pub smooth_join_deg: f64,
+    /// How far (m) the rounding of a corner may leave it (default 0: every corner the drawing
+    /// means stays one, passed at rest). Above 0, corners of polylines and joins of curves are
+    /// rounded by arcs tangent to both sides within it (each taking at most half of each side),
+    /// so a flattened curve, an outline or a letter is drawn without a stop at every vertex; a
+    /// corner whose rounding would be shorter than [`emg_control::MIN_SEGMENT_M`] (a reversal)
+    /// stays one.
+    pub corner_tolerance_m: f64,
 }
 
 impl Default for SvgOptions {
@@ -57,6 +64,7 @@ impl Default for SvgOptions {
             curve_tolerance_m: 5e-5,
             min_stroke_m: 1e-3,
             smooth_join_deg: 15.0,
+            corner_tolerance_m: 0.0,
         }
     }
 }
@@ -84,6 +92,13 @@ impl SvgOptions {
                 problem: format!(
                     "is {smooth}; it must be within [0, {MAX_SMOOTH_JOIN_DEG}] degrees"
                 ),
+            });
+        }
+        let corner = self.corner_tolerance_m;
+        if !(corner.is_finite() && corner >= 0.0) {
+            return Err(SvgError::Options {
+                field: "corner_tolerance_m",
+                problem: format!("is {corner}; it must be 0 or more (m)"),
             });
         }
         Ok(())
@@ -172,7 +187,8 @@ impl Drawing {
 ///   fitted to one tangent, still within the tolerance, and two lines are joined by the arc
 ///   tangent to both that leaves their corner by at most the tolerance (taking at most half
 ///   of each line), so a polyline that flattens a curve is drawn without a stop at every
-///   vertex. A `Z` adds
+///   vertex. Sharper corners are rounded too, within [`SvgOptions::corner_tolerance_m`]
+///   where it is above 0. A `Z` adds
 ///   the closing line when it is at least the path format's shortest segment
 ///   ([`emg_control::MIN_SEGMENT_M`], 0.1 mm) long, and leaves a shorter gap open. Shorter
 ///   pieces are merged with a neighbour: where a drawing has features that fine (an `h.04`
@@ -222,6 +238,7 @@ pub fn read_svg(
             &plane,
             options.curve_tolerance_m,
             options.smooth_join_deg.to_radians(),
+            options.corner_tolerance_m,
         );
         let length: f64 = pieces.iter().map(Piece::length).sum();
         let too_short = pieces

@@ -133,6 +133,33 @@ impl Piece {
         }
     }
 
+    /// The piece less `head` of its length at its start and `tail` at its end (`head + tail`
+    /// at most its length).
+    pub fn trimmed(&self, head: f64, tail: f64) -> Piece {
+        match *self {
+            Piece::Line { from, to } => {
+                let direction = (to - from).normalize();
+                Piece::Line {
+                    from: from + direction * head,
+                    to: to - direction * tail,
+                }
+            }
+            Piece::Arc {
+                from,
+                centre,
+                sweep,
+            } => {
+                let radius = (from - centre).norm();
+                let sign = sweep.signum();
+                Piece::Arc {
+                    from: centre + rotated(from - centre, sign * head / radius),
+                    centre,
+                    sweep: sweep - sign * (head + tail) / radius,
+                }
+            }
+        }
+    }
+
     /// The same points travelled the other way.
     pub fn reversed(&self) -> Piece {
         match *self {
@@ -257,6 +284,26 @@ mod tests {
         let line = arc_from(V2::zeros(), V2::new(1.0, 0.0), V2::new(2.0, 0.0)).unwrap();
         assert!(matches!(line, Piece::Line { .. }));
         assert!(arc_from(V2::zeros(), V2::new(1.0, 0.0), V2::new(-2.0, 0.0)).is_none());
+    }
+
+    #[test]
+    fn a_trimmed_piece_loses_its_lengths_at_each_end() {
+        let arc = Piece::Arc {
+            from: V2::new(1.0, 0.0),
+            centre: V2::zeros(),
+            sweep: -PI / 2.0,
+        };
+        let trimmed = arc.trimmed(0.1, 0.2);
+        assert!((trimmed.length() - (PI / 2.0 - 0.3)).abs() < 1e-12);
+        assert!(close(trimmed.start(), arc.point(0.1 / (PI / 2.0))));
+        assert!(close(trimmed.end(), arc.point(1.0 - 0.2 / (PI / 2.0))));
+        let line = Piece::Line {
+            from: V2::zeros(),
+            to: V2::new(0.0, 2.0),
+        };
+        let trimmed = line.trimmed(0.5, 0.25);
+        assert!(close(trimmed.start(), V2::new(0.0, 0.5)));
+        assert!(close(trimmed.end(), V2::new(0.0, 1.75)));
     }
 
     #[test]

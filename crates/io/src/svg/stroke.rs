@@ -8,6 +8,10 @@
 //!   the path passes there without a corner. Where two lines meet so, the corner is rounded by
 //!   the arc tangent to both that leaves it by at most the tolerance, taking at most half of
 //!   each line (a polyline that flattens a curve is drawn without a stop at every vertex).
+//! * Every other corner is rounded within the corner tolerance (0 keeps it): two lines by the
+//!   arc tangent to both, a corner where an arc meets by the biarc between points of its two
+//!   sides, each rounding taking at most half of each piece; a corner whose rounding would be
+//!   shorter than the shortest piece (a reversal) stays one.
 //! * A `Z` adds the closing line back to the start when it is at least [`MIN_SEGMENT_M`]
 //!   long; a shorter gap stays open (the stroke ends that close to its start).
 //! * An arc of radius under [`MIN_SEGMENT_M`] (a dot) becomes its chord; a piece shorter than
@@ -60,11 +64,17 @@ pub(crate) fn smooth_join_limit(tolerance: f64, smooth_join_rad: f64) -> f64 {
 
 /// The pieces of `subpath` (plane coordinates in metres), each at least [`MIN_SEGMENT_M`]
 /// long, following it within `tolerance`, joints turning less than `smooth_join_rad` made
-/// smooth (see the module documentation). Empty when nothing of it is that long; a lone piece
-/// shorter than that may remain.
-pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) -> Vec<Piece> {
+/// smooth and corners rounded within `corner_tolerance` (see the module documentation). Empty
+/// when nothing of it is that long; a lone piece shorter than that may remain.
+pub(crate) fn pieces(
+    subpath: &Subpath,
+    tolerance: f64,
+    smooth_join_rad: f64,
+    corner_tolerance: f64,
+) -> Vec<Piece> {
     let mut items = items(subpath);
-    smooth_joints(&mut items, smooth_join_limit(tolerance, smooth_join_rad));
+    let smooth_limit = smooth_join_limit(tolerance, smooth_join_rad);
+    smooth_joints(&mut items, smooth_limit);
     let mut raw = Vec::new();
     for item in &items {
         match *item {
@@ -90,63 +100,128 @@ pub(crate) fn pieces(subpath: &Subpath, tolerance: f64, smooth_join_rad: f64) ->
         out.push(without_dot(piece));
         settle(&mut out, tolerance);
     }
-    filleted(&out, tolerance, smooth_join_rad)
+    let allowance = JoinAllowance {
+        smooth_rad: smooth_join_rad,
+        smooth_m: tolerance.max(corner_tolerance),
+        corner_m: corner_tolerance,
+    };
+    rounded(&out, &allowance)
 }
 
-/// `pieces` with every corner where two lines meet turning by less than `limit` (rad) rounded
-/// by the arc tangent to both lines that leaves the corner by at most `tolerance`; each arc
-/// takes at most half of each line less half the shortest piece, so the lines keep a length.
-/// A corner whose arc would be shorter than the shortest piece keeps its corner.
-fn filleted(pieces: &[Piece], tolerance: f64, limit: f64) -> Vec<Piece> {
-    // How far each corner's arc reaches along its two lines (0 where it keeps its corner).
-    let mut reach = vec![0.0; pieces.len()];
-    for index in 1..pieces.len() {
-        if let (Piece::Line { .. }, Piece::Line { .. }) = (pieces[index - 1], pieces[index]) {
-            reach[index] = fillet_reach(&pieces[index - 1], &pieces[index], tolerance, limit);
+/// The smallest radius (m) a corner is rounded with: through a tighter arc the tool must slow
+/// almost to rest (its speed there at most `√(a r)` for the acceleration `a` it can reach), and
+/// a stop at the corner itself is as quick.
+pub(crate) const MIN_CORNER_RADIUS_M: f64 = 1e-3;
+
+/// How far the rounding of a joint may leave it: joints turning less than `smooth_rad` are
+/// ones the drawing means smooth and may be left by `smooth_m` (m), sharper ones (corners) by
+/// `corner_m` (0 keeps them) with arcs of [`MIN_CORNER_RADIUS_M`] or more.
+struct JoinAllowance {
+    smooth_rad: f64,
+    smooth_m: f64,
+    corner_m: f64,
+}
+
+impl JoinAllowance {
+    /// How far the joint turning by `turn` (rad) may be left (m), and the smallest radius its
+    /// rounding may have.
+    fn at(&self, turn: f64) -> (f64, f64) {
+        if turn < self.smooth_rad {
+            (self.smooth_m, SHORTEST)
+        } else {
+            (self.corner_m, MIN_CORNER_RADIUS_M)
         }
     }
+}
+
+/// A joint's rounding: how far along each of its two pieces it reaches from the joint, and the
+/// arcs in place of what it takes of them.
+struct Rounding {
+    reach: f64,
+    arcs: Vec<Piece>,
+}
+
+/// `pieces` with each joint where they turn rounded within its allowance ([`rounding`]); the
+/// chain's ends stay where they are.
+fn rounded(pieces: &[Piece], allowance: &JoinAllowance) -> Vec<Piece> {
+    let roundings: Vec<Option<Rounding>> = (0..pieces.len())
+        .map(|index| {
+            (index > 0)
+                .then(|| rounding(&pieces[index - 1], &pieces[index], allowance))
+                .flatten()
+        })
+        .collect();
+    let reach = |index: usize| {
+        roundings
+            .get(index)
+            .and_then(Option::as_ref)
+            .map_or(0.0, |r| r.reach)
+    };
     let mut out = Vec::with_capacity(pieces.len());
     for (index, piece) in pieces.iter().enumerate() {
-        let Piece::Line { from, to } = *piece else {
-            out.push(*piece);
-            continue;
-        };
-        let direction = (to - from).normalize();
-        let (head, tail) = (reach[index], reach.get(index + 1).copied().unwrap_or(0.0));
-        if head > 0.0 {
-            let previous = pieces[index - 1].start_tangent();
-            let start = from - previous * head;
-            out.extend(arc_from(start, previous, from + direction * head));
+        if let Some(rounding) = &roundings[index] {
+            out.extend(rounding.arcs.iter().copied());
         }
-        out.push(Piece::Line {
-            from: from + direction * head,
-            to: to - direction * tail,
-        });
+        out.push(piece.trimmed(reach(index), reach(index + 1)));
     }
     out
 }
 
-/// How far from the corner where `before` meets `after` (two lines) their rounding arc starts
-/// and ends along each (see [`filleted`]); 0 when the corner is kept.
+/// The rounding of the joint where `before` ends and `after` starts, leaving it by at most its
+/// allowance, taking at most half of each piece less half the shortest piece (so each keeps a
+/// length); `None` where the joint is smooth already, its allowance is 0, or the rounding would
+/// be shorter than the shortest piece or tighter than its least radius (a reversal, a sharp
+/// corner, or no room): the corner stays.
 ///
-/// An arc of radius `r` tangent to lines turning by `θ` reaches `r tan(θ/2)` along each and
-/// passes `r (1/cos(θ/2) − 1) = r 2 sin²(θ/4) / cos(θ/2)` inside the corner.
-fn fillet_reach(before: &Piece, after: &Piece, tolerance: f64, limit: f64) -> f64 {
+/// Two lines are joined by the arc tangent to both: one of radius `r` on lines turning by `θ`
+/// reaches `r tan(θ/2)` along each and passes `r (1/cos(θ/2) − 1) = r 2 sin²(θ/4) / cos(θ/2)`
+/// inside the corner, so the allowance `e` lets it reach `e sin(θ/2) / (2 sin²(θ/4))`. Where an
+/// arc meets, the two pieces are trimmed by that reach and their new ends joined by the biarc
+/// between them (their tangents kept), the reach halved until the biarc lies within the
+/// allowance of what it replaces.
+fn rounding(before: &Piece, after: &Piece, allowance: &JoinAllowance) -> Option<Rounding> {
     let (a, b) = (before.end_tangent(), after.start_tangent());
     let turn = libm::acos(a.dot(&b).clamp(-1.0, 1.0));
-    if turn <= emg_control::CORNER_RAD || turn >= limit {
-        return 0.0;
+    let (allowed, least_radius) = allowance.at(turn);
+    if turn <= emg_control::CORNER_RAD || allowed <= 0.0 {
+        return None;
     }
     let half = 0.5 * turn;
     let quarter_sin = libm::sin(0.5 * half);
-    let within_tolerance = tolerance * libm::cos(half) / (2.0 * quarter_sin * quarter_sin);
+    let within = allowed * libm::sin(half) / (2.0 * quarter_sin * quarter_sin);
     let room = 0.5 * (before.length().min(after.length()) - SHORTEST);
-    let reach = (within_tolerance * libm::tan(half)).min(room);
-    let radius = reach / libm::tan(half);
-    if radius * turn < SHORTEST {
-        return 0.0;
+    let mut reach = within.min(room);
+    if let (Piece::Line { .. }, Piece::Line { .. }) = (before, after) {
+        let radius = reach / libm::tan(half);
+        if radius < least_radius || radius * turn < SHORTEST {
+            return None;
+        }
+        let arc = arc_from(before.end() - a * reach, a, after.start() + b * reach)?;
+        return Some(Rounding {
+            reach,
+            arcs: vec![arc],
+        });
     }
-    reach
+    while reach >= SHORTEST {
+        let taken = [
+            before.trimmed(before.length() - reach, 0.0),
+            after.trimmed(0.0, after.length() - reach),
+        ];
+        let (from, to) = (taken[0].start(), taken[1].end());
+        if let Some(pair) = biarc(from, taken[0].start_tangent(), to, taken[1].end_tangent())
+            && pair
+                .iter()
+                .all(|p| !is_short(p) && p.radius().is_none_or(|radius| radius >= least_radius))
+            && apart(&pair, &taken) <= allowed
+        {
+            return Some(Rounding {
+                reach,
+                arcs: pair.to_vec(),
+            });
+        }
+        reach *= 0.5;
+    }
+    None
 }
 
 /// The segments of `subpath` that have a length and a direction, with their own tangents.
@@ -311,7 +386,7 @@ mod tests {
             vec![line(0.01, 0.0), line(0.01, 0.01), line(0.0, 0.01)],
             true,
         );
-        let pieces = pieces(&square, 5e-5, 0.1);
+        let pieces = pieces(&square, 5e-5, 0.1, 0.0);
         assert_eq!(pieces.len(), 4);
         assert!(chained(&pieces));
         assert_eq!(pieces[3].end(), V2::new(0.0, 0.0));
@@ -321,7 +396,7 @@ mod tests {
             vec![line(0.01, 0.0), line(0.01, 0.01), line(0.0, 0.0)],
             true,
         );
-        assert_eq!(super::pieces(&closed, 5e-5, 0.1).len(), 3);
+        assert_eq!(super::pieces(&closed, 5e-5, 0.1, 0.0).len(), 3);
         // A gap of 20 µm is too short for a closing line: it stays open.
         let nearly = subpath(
             (0.0, 0.0),
@@ -333,7 +408,7 @@ mod tests {
             ],
             true,
         );
-        let pieces = super::pieces(&nearly, 5e-5, 0.1);
+        let pieces = super::pieces(&nearly, 5e-5, 0.1, 0.0);
         assert_eq!(pieces.len(), 4);
         assert_eq!(pieces[3].end(), V2::new(0.0, 2e-5));
     }
@@ -351,14 +426,14 @@ mod tests {
             ],
             false,
         );
-        let pieces = pieces(&jagged, 5e-5, 0.1);
+        let pieces = pieces(&jagged, 5e-5, 0.1, 0.0);
         assert!(chained(&pieces));
         assert!(pieces.iter().all(|p| p.length() >= MIN_SEGMENT_M));
         assert_eq!(pieces[0].start(), V2::new(0.0, 0.0));
         assert!((pieces.last().unwrap().end() - V2::new(0.02, 5e-5)).norm() < 1e-12);
         // A path shorter than the shortest segment leaves one short piece.
         let tiny = subpath((0.0, 0.0), vec![line(5e-5, 0.0)], false);
-        let pieces = super::pieces(&tiny, 5e-5, 0.1);
+        let pieces = super::pieces(&tiny, 5e-5, 0.1, 0.0);
         assert_eq!(pieces.len(), 1);
         assert!(pieces[0].length() < MIN_SEGMENT_M);
     }
@@ -390,23 +465,160 @@ mod tests {
             vec![line(0.01, 0.0), Segment::Cubic(curve)],
             false,
         );
-        let pieces = pieces(&path, 5e-5, 0.1);
+        let pieces = pieces(&path, 5e-5, 0.1, 0.0);
         assert!(chained(&pieces));
         assert!(turns(&pieces).iter().all(|t| *t < emg_control::CORNER_RAD));
         let curve_pieces: Vec<Piece> = pieces[1..].to_vec();
         assert!(super::super::biarc::deviation(&curve, &curve_pieces) <= 5e-5);
         // Below the threshold asked for, the joint stays a corner.
-        let pieces = super::pieces(&path, 5e-5, 0.04);
+        let pieces = super::pieces(&path, 5e-5, 0.04, 0.0);
         assert!((turns(&pieces)[0] - 0.05).abs() < 1e-9);
         // At 1 µm there is no room to bend the curve by 0.05 rad: the limit is 0.005 rad.
         assert!((smooth_join_limit(1e-6, 0.1) - 0.005).abs() < 1e-15);
-        let pieces = super::pieces(&path, 1e-6, 0.1);
+        let pieces = super::pieces(&path, 1e-6, 0.1, 0.0);
         assert!((turns(&pieces)[0] - 0.05).abs() < 1e-9);
         // A real corner stays one.
         let corner = subpath((0.0, 0.0), vec![line(0.01, 0.0), line(0.01, 0.01)], false);
-        let pieces = super::pieces(&corner, 5e-5, 0.1);
+        let pieces = super::pieces(&corner, 5e-5, 0.1, 0.0);
         let turn = libm::acos(pieces[0].end_tangent().dot(&pieces[1].start_tangent()));
         assert!((turn - PI / 2.0).abs() < 1e-12);
+    }
+
+    /// The largest distance from a point of `pieces` to `polyline` and from a vertex of
+    /// `polyline` to `pieces`, each sampled.
+    fn deviation_from(pieces: &[Piece], polyline: &[V2]) -> (f64, f64) {
+        let lines: Vec<Piece> = polyline
+            .windows(2)
+            .map(|w| Piece::Line {
+                from: w[0],
+                to: w[1],
+            })
+            .collect();
+        let outward = pieces
+            .iter()
+            .flat_map(|piece| (0..=64).map(|i| piece.point(i as f64 / 64.0)))
+            .map(|p| distance_to(&lines, p))
+            .fold(0.0, f64::max);
+        let vertices = polyline
+            .iter()
+            .map(|v| distance_to(pieces, *v))
+            .fold(0.0, f64::max);
+        (outward, vertices)
+    }
+
+    fn polyline(points: &[V2]) -> Subpath {
+        subpath(
+            (points[0].x, points[0].y),
+            points[1..].iter().map(|p| line(p.x, p.y)).collect(),
+            false,
+        )
+    }
+
+    #[test]
+    fn corners_are_rounded_within_the_corner_tolerance() {
+        let corner = 2.5e-4;
+        // A flattened circle of 5 mm radius (a vertex every 20°), a square of 1 cm sides, and
+        // random polylines with legs of 0.3 mm to 5 mm turning up to 170°.
+        let mut cases: Vec<Vec<V2>> = vec![
+            (0..=18)
+                .map(|k| {
+                    let a = k as f64 * PI / 9.0;
+                    V2::new(5e-3 * libm::cos(a), 5e-3 * libm::sin(a))
+                })
+                .collect(),
+            vec![
+                V2::new(0.0, 0.0),
+                V2::new(0.01, 0.0),
+                V2::new(0.01, 0.01),
+                V2::new(0.0, 0.01),
+                V2::new(0.0, 0.0),
+            ],
+        ];
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(78);
+        for _ in 0..40 {
+            let mut at = V2::zeros();
+            let mut heading: f64 = 0.0;
+            let mut points = vec![at];
+            for _ in 0..12 {
+                heading += rng.random_range(-170f64..170.0).to_radians();
+                at +=
+                    V2::new(libm::cos(heading), libm::sin(heading)) * rng.random_range(3e-4..5e-3);
+                points.push(at);
+            }
+            cases.push(points);
+        }
+        for points in &cases {
+            let sharp = pieces(&polyline(points), 5e-5, 0.0, 0.0);
+            let round = pieces(&polyline(points), 5e-5, 0.0, corner);
+            assert!(chained(&round));
+            assert!(round.iter().all(|p| p.length() >= MIN_SEGMENT_M));
+            assert_eq!(round[0].start(), sharp[0].start());
+            assert!((round.last().unwrap().end() - sharp.last().unwrap().end()).norm() < 1e-12);
+            let (outward, vertices) = deviation_from(&round, points);
+            assert!(outward <= corner + 1e-12, "{outward}");
+            assert!(vertices <= corner + 1e-9, "{vertices}");
+            let sharp_turns = turns(&sharp);
+            assert!(
+                turns(&round)
+                    .iter()
+                    .filter(|t| **t > emg_control::CORNER_RAD)
+                    .count()
+                    <= sharp_turns
+                        .iter()
+                        .filter(|t| **t > emg_control::CORNER_RAD)
+                        .count()
+            );
+        }
+        // The flattened circle and the square are passed without a corner.
+        for points in &cases[..2] {
+            let round = pieces(&polyline(points), 5e-5, 0.0, corner);
+            assert!(turns(&round).iter().all(|t| *t <= emg_control::CORNER_RAD));
+        }
+        // A 173° reversal stays a corner: its rounding would be shorter than a piece.
+        let back = 173f64.to_radians();
+        let zigzag = [
+            V2::zeros(),
+            V2::new(0.01, 0.0),
+            V2::new(0.01 + 0.01 * libm::cos(back), 0.01 * libm::sin(back)),
+        ];
+        let round = pieces(&polyline(&zigzag), 5e-5, 0.0, corner);
+        assert_eq!(round.len(), 2);
+        assert!((turns(&round)[0] - back).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_corner_where_an_arc_meets_is_rounded_by_a_biarc_within_the_tolerance() {
+        // A line, then a quarter circle of 5 mm radius leaving it at a right angle.
+        let line_to = V2::new(0.01, 0.0);
+        let arc = Piece::Arc {
+            from: line_to,
+            centre: line_to + V2::new(-5e-3, 0.0),
+            sweep: PI / 2.0,
+        };
+        let chain = [
+            Piece::Line {
+                from: V2::zeros(),
+                to: line_to,
+            },
+            arc,
+        ];
+        let allowance = JoinAllowance {
+            smooth_rad: 0.0,
+            smooth_m: 0.0,
+            corner_m: 2.5e-4,
+        };
+        let round = rounded(&chain, &allowance);
+        assert!(chained(&round));
+        assert!(turns(&round).iter().all(|t| *t <= 1e-9));
+        assert!(apart(&round, &chain) <= 2.5e-4);
+        assert!(distance_to(&round, line_to) > 1e-5);
+        // No allowance, no rounding.
+        let none = JoinAllowance {
+            corner_m: 0.0,
+            ..allowance
+        };
+        assert_eq!(rounded(&chain, &none), chain.to_vec());
     }
 
     #[test]

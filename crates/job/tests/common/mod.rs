@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use emg_io::{Placement, SvgOptions, read_svg_file};
+use emg_io::{Placement, read_svg_file};
 use emg_job::{Job, JobFile, plan_job};
 use emg_kinematics::Robot;
 use emg_planner::{DataDir, Models, MotionTiming, PlanRequest, Planner, ShippedRobot};
@@ -36,12 +36,13 @@ pub fn setup(name: &str) -> (Planner, MotionTiming, ReferenceModel, PathBuf) {
     (planner, timing, checker, file)
 }
 
-/// The job of the drawing `svg` placed as `placement` says.
+/// The job of the drawing `svg` placed as `placement` says, its corners rounded as `emg job`
+/// rounds them at the job's tolerance.
 pub fn drawing(robot: &Robot, svg: &std::path::Path, placement: &Placement) -> Job {
-    let strokes = read_svg_file(svg, placement, &SvgOptions::default())
-        .expect("the drawing")
-        .strokes;
-    Job::from_strokes(strokes, robot).expect("a valid job")
+    let tolerance =
+        emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0).expect("a tolerance");
+    let drawing = read_svg_file(svg, placement, &tolerance.svg_options()).expect("the drawing");
+    tolerance.job(drawing, robot).expect("a valid job")
 }
 
 /// `job` planned as `emg job` plans it.
