@@ -120,6 +120,32 @@ fn a_circle_a_blended_rectangle_and_a_long_line_are_planned_and_checked_at_a_ten
 }
 
 #[test]
+fn a_round_letter_gone_round_twice_is_timed_from_its_start() {
+    // The `o` of a serif single-stroke font (Hershey's `timesr`) with its corners rounded: two
+    // loops 2.3 mm across, the second a fraction of a millimetre inside the first and meeting
+    // it at the start. The timing's refinement once moved a chord midpoint toward the nearest
+    // point of the whole path (on the other loop), and the motion was cut at its first point.
+    let dir = temp_dir("double-loop");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/double-loop.path.json");
+    let out = dir.path().join("loop");
+    let output = emg(&[
+        "plan",
+        "--tolerance",
+        "0.375",
+        "--path",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", text(&output.stderr));
+    let trajectory = dir.path().join("loop.joint_trajectory.json");
+    let points = read_json(&trajectory)["points"].as_array().unwrap().len();
+    assert!(points > 300, "the motion is cut to {points} samples");
+    let output = emg(&["check", trajectory.to_str().unwrap()]);
+    assert!(output.status.success(), "{}", text(&output.stdout));
+}
+
+#[test]
 fn a_malformed_path_file_is_refused_naming_the_field() {
     let dir = temp_dir("bad-path");
     let cases = [

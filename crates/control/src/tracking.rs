@@ -50,15 +50,18 @@ pub fn correct_onto_task(
 
 /// `q` moved onto the task's line or path where its TCP lies more than [`CORRECTION_TRIGGER`]
 /// of `tolerance_m` off it ([`correct_onto_task`]); `q` itself where it lies closer or the
-/// corrections do not get it there.
-pub fn onto_task(robot: &Robot, task: &Task, q: &JointVector, tolerance_m: f64) -> JointVector {
+/// corrections do not get it there. On a path, the TCP is measured from, and moved toward, the
+/// point its progress reaches from `s_hint` ([`Task::along`]): not a nearer stretch of the path
+/// it has not reached (the other leg of a reversal, the next turn of a loop).
+pub fn onto_task(
+    robot: &Robot,
+    task: &Task,
+    q: &JointVector,
+    tolerance_m: f64,
+    s_hint: f64,
+) -> JointVector {
     let target_m = CORRECTION_TRIGGER * tolerance_m;
     let mut kinematics = robot.forward(q);
-    // A line needs no hint; on a path, the nearest point of the whole path.
-    let s_hint = task
-        .path
-        .as_ref()
-        .map_or(0.0, |path| path.nearest_point(&kinematics.tcp()).s);
     if task.along(&kinematics.tcp(), s_hint).lateral.norm() <= target_m {
         return *q;
     }

@@ -271,13 +271,31 @@ fn rounded_corners_keep_the_pen_within_the_tolerance_of_the_drawing_as_given() {
             )
         })
         .collect();
+    // A round letter of a serif font: a loop of 2.3 mm radius gone round twice, 0.4 mm inside
+    // itself the second time (rounded, its first timing once looked for the path's nearest
+    // point on the other turn and cut the stroke at its start).
+    let double_loop: Vec<String> = (0..=24)
+        .map(|k| {
+            let (a, r) = (
+                (k as f64 * 30.0).to_radians(),
+                if k <= 12 { 1.4 } else { 1.16 },
+            );
+            format!(
+                "{:.4},{:.4}",
+                48.0 + r * libm::cos(a),
+                10.0 + r * libm::sin(a)
+            )
+        })
+        .collect();
     let svg = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 72 20">
         <polyline fill="none" stroke="black" points="{}"/>
         <polyline fill="none" stroke="black" points="24,2 28,18 32,6 36,18 40,2"/>
+        <polyline fill="none" stroke="black" points="{}"/>
         <polygon fill="none" stroke="black" points="{}"/>
         </svg>"#,
         arc.join(" "),
+        double_loop.join(" "),
         star.join(" ")
     );
     let dir = std::env::temp_dir().join(format!("emg-lettering-{}", std::process::id()));

@@ -60,7 +60,8 @@ impl SmoothPath {
     /// the peaks of the tool angle and of the distance from the line or path; a segment that
     /// breaks a constraint gets back the middle waypoint
     /// it skipped, or, between consecutive waypoints, their chord midpoint (moved onto the line
-    /// or path where it lies more than half the tolerance off, [`onto_task`]) moved likewise as a
+    /// or path where it lies more than half the tolerance off, [`onto_task`], on a path toward
+    /// the point its progress reaches from the segment's first knot's) moved likewise as a
     /// new knot (when that holds the constraints and the two lie [`MIN_KNOT_STEP_M`] apart at
     /// least twice over, up to [`MAX_REFINEMENTS`] midpoints in all),
     /// else the path ends at the segment's first waypoint.
@@ -126,8 +127,11 @@ impl SmoothPath {
         let mut cut = None;
         while values.len() >= 2 {
             let spline = JointSpline::natural(knots.clone(), values.clone());
-            let Some((segment, violation)) =
-                first_failing_segment(robot, task, constraints, &spline, from_s)
+            let Some(Failing {
+                segment,
+                from_s: segment_s,
+                violation,
+            }) = first_failing_segment(robot, task, constraints, &spline, from_s)
             else {
                 return Self {
                     spline: Some(spline),
@@ -150,7 +154,9 @@ impl SmoothPath {
             let splittable = knots[segment + 1] - knots[segment] >= 2.0 * MIN_KNOT_STEP_M;
             let midpoint = (midpoints < MAX_REFINEMENTS && splittable)
                 .then(|| (values[segment] + values[segment + 1]) / 2.0)
-                .map(|chord| onto_task(robot, task, &chord, constraints.line_tolerance_m))
+                .map(|chord| {
+                    onto_task(robot, task, &chord, constraints.line_tolerance_m, segment_s)
+                })
                 .and_then(|chord| inset(robot, task, constraints, &chord))
                 .filter(|q| valid(q));
             if let Some(midpoint) = midpoint {
@@ -214,6 +220,16 @@ pub const PROGRESS_CHECK_MARGIN_M: f64 = 1e-5;
 /// a few millimetres shrinks below a nanometre).
 const PEAK_BISECTIONS: usize = 24;
 
+/// A segment of a spline that breaks a constraint.
+struct Failing {
+    /// Its index.
+    segment: usize,
+    /// The progress its first knot reached along the task (m).
+    from_s: f64,
+    /// The first constraint a checked point breaks.
+    violation: Violation,
+}
+
 /// The first segment of `spline` with a checked inside point that breaks a constraint (the line
 /// tolerance less [`LINE_CHECK_MARGIN_M`]), the spline's start standing `from_s` along the task.
 /// Checked are [`CHECKS_PER_SEGMENT`] evenly spaced points, every joint's turning points (where
@@ -227,7 +243,7 @@ fn first_failing_segment(
     constraints: &ConstraintConfig,
     spline: &JointSpline,
     from_s: f64,
-) -> Option<(usize, Violation)> {
+) -> Option<Failing> {
     let constraints = &ConstraintConfig {
         line_tolerance_m: (constraints.line_tolerance_m - LINE_CHECK_MARGIN_M)
             .max(constraints.line_tolerance_m / 2.0),
@@ -265,7 +281,11 @@ fn first_failing_segment(
                             && distance_m > constraints.line_tolerance_m - PROGRESS_CHECK_MARGIN_M)
                             .then_some(Violation::LineTolerance { distance_m })
                     })
-                    .map(|v| (k, v))
+                    .map(|violation| Failing {
+                        segment: k,
+                        from_s: reached[k],
+                        violation,
+                    })
             })
     })
 }
