@@ -14,6 +14,7 @@ mod ablate_control;
 mod backend_choice;
 mod bench_report;
 mod cartesian_eval;
+mod corpus_eval;
 mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
@@ -95,6 +96,10 @@ enum Command {
     /// Jobs on line-art icons and tilted seams planned as `emg job` plans them, checked, beside
     /// the baseline of strokes planned alone and joined straight (docs/results/jobs.*).
     JobEval(job_eval::Args),
+    /// Drawings nobody here made (every icon of lucide-static and bootstrap-icons from npm,
+    /// Hershey text from PyPI, generated coastlines and maps) planned on the shipped arms at
+    /// `emg job`'s defaults and checked; resumable (docs/results/corpus.*).
+    CorpusEval(corpus_eval::Args),
     /// `emg place` on icons near the edge of the arm's reach and a 20-stroke job, beside the
     /// usual point-by-point IK score; the screening timed (docs/results/placement.*).
     PlaceEval(place_eval::Args),
@@ -131,6 +136,7 @@ fn main() -> anyhow::Result<()> {
         Command::PathEval(args) => path_eval::run(&args),
         Command::PrecisionEval(args) => precision_eval::run(&args),
         Command::JobEval(args) => job_eval::run(&args),
+        Command::CorpusEval(args) => corpus_eval::run(&args),
         Command::PlaceEval(args) => place_eval::run(&args),
         Command::GapEval(args) => gap_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
