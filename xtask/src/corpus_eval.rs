@@ -183,8 +183,10 @@ fn evaluate_arm(
     corner_mm: f64,
     drawings: &[Drawing],
 ) -> anyhow::Result<Vec<CorpusRow>> {
-    let robot_file = shipped.path(&workspace::data_dir());
-    let (planner, timing, checker) = job_eval::setup(&robot_file)?;
+    let data = workspace::data_dir();
+    let robot_file = shipped.path(&data);
+    let tasks = shipped.data_dir(&data).join("tasks/eval-v1.tasks");
+    let (planner, timing, checker) = job_eval::setup_with_tasks(&robot_file, &tasks)?;
     let record = args
         .cache
         .join(format!("{}-corner-{corner_mm}.rows.jsonl", shipped.name));

@@ -349,18 +349,21 @@ pub fn icon_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
 }
 
 /// The planner `emg job` plans with (the cell's plate, the corrected step, 0.5 mm), its timing
-/// and the checker.
+/// and the checker, for the selected robot's `robot_file`.
 pub fn setup(
     robot_file: &Path,
 ) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
+    setup_with_tasks(robot_file, &workspace::data("tasks/eval-v1.tasks"))
+}
+
+/// [`setup`] for `robot_file`, its models checked on the task file `tasks` (its own arm's).
+pub fn setup_with_tasks(
+    robot_file: &Path,
+    tasks: &Path,
+) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
     let workspace::PlannerSetup {
         planner, checker, ..
-    } = workspace::planner_setup(
-        robot_file,
-        &workspace::data("tasks/eval-v1.tasks"),
-        0,
-        "job-eval",
-    )?;
+    } = workspace::planner_setup(robot_file, tasks, 0, "job-eval")?;
     let planner = planner.with_config(emg_job::job_config(emg_job::JOB_TOLERANCE_M))?;
     let timing = emg_job::job_timing(planner.robot(), robot_file, planner.config())?;
     Ok((planner, timing, checker))

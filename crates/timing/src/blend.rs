@@ -204,9 +204,36 @@ impl BlendedPath {
     }
 }
 
+/// An inner vertex closer than this (rad, in its largest joint) to the vertex before it is the
+/// same configuration: an edge that short would be rounded by blends too small for the
+/// samples' velocities to integrate to their positions.
+pub const SAME_VERTEX_RAD: f64 = 1e-4;
+
+/// `vertices` without the inner ones within [`SAME_VERTEX_RAD`] of the vertex kept before them;
+/// the ends stay (the last in place of an inner vertex that close to it).
+fn distinct(vertices: &[JointVector]) -> Vec<JointVector> {
+    let mut kept: Vec<JointVector> = Vec::with_capacity(vertices.len());
+    for (index, q) in vertices.iter().enumerate() {
+        let is_last = index + 1 == vertices.len();
+        let inner_before = kept.len() > 1;
+        match kept.last_mut() {
+            Some(previous) if (q - *previous).amax() < SAME_VERTEX_RAD => {
+                if is_last && inner_before {
+                    *previous = *q;
+                } else if is_last {
+                    kept.push(*q);
+                }
+            }
+            _ => kept.push(*q),
+        }
+    }
+    kept
+}
+
 /// The rest-to-rest motion at `request.rate_hz` along the polyline `vertices` with every corner
 /// rounded (each arc starting `share` ≤ ½ of the shorter of its edges before its vertex), not
-/// stopping at any inner vertex; `None` where a corner turns back (more than
+/// stopping at any inner vertex, inner vertices within [`SAME_VERTEX_RAD`] of the one before
+/// them taken as one; `None` where a corner turns back (more than
 /// [`MAX_BLEND_TURN_DEG`]) or the samples break a limit after [`MAX_SLOWDOWNS`] local
 /// slow-downs.
 pub fn time_blended_move(
@@ -215,7 +242,8 @@ pub fn time_blended_move(
     share: f64,
 ) -> Option<TimedMove> {
     let share = share.clamp(0.0, 0.5);
-    let path = BlendedPath::new(vertices, share)?;
+    let vertices = distinct(vertices);
+    let path = BlendedPath::new(&vertices, share)?;
     let mut grid = Vec::new();
     let limits = &request.limits;
     let (velocity, jerk) = (&limits.velocity, &limits.jerk);
@@ -287,7 +315,7 @@ pub fn time_blended_move(
             return Some(TimedMove {
                 samples,
                 definition: MotionDefinition::Blended {
-                    vertices: vertices.to_vec(),
+                    vertices,
                     share,
                     profile,
                 },
@@ -388,6 +416,67 @@ mod tests {
         // Faster than stopping at every vertex.
         let stopping = time_free_move(&vertices, &request).samples;
         assert!(last.time_ns < stopping[stopping.len() - 1].time_ns);
+    }
+
+    #[test]
+    fn a_lift_and_set_down_at_one_place_are_not_blended_through_a_vanishing_edge() {
+        // A pen lifted off one stroke's end and set down on the next's start at the same
+        // point: the two tops of the move 6e-6 rad apart (a program of Hershey lettering). The
+        // blend of so short an edge once gave samples whose velocities did not integrate to
+        // their positions within what the checker allows.
+        let vertex = |q: [f64; 7]| JointVector::from_column_slice(&q);
+        let vertices = [
+            vertex([
+                0.0747457780446972,
+                -0.19079027368490095,
+                0.04309616331353966,
+                -2.205655957703459,
+                -0.008725147775713671,
+                1.9010106634716988,
+                0.7853981633974483,
+            ]),
+            vertex([
+                0.07477564611980778,
+                -0.19457718605336793,
+                0.04309877508703792,
+                -2.2047649524678126,
+                -0.008726981635044737,
+                1.8988938255101038,
+                0.7853981633974483,
+            ]),
+            vertex([
+                0.0747765175241638,
+                -0.19457775090345727,
+                0.04310009378660151,
+                -2.2047664435106897,
+                -0.008726148038853526,
+                1.8988962168610626,
+                0.7853981633974483,
+            ]),
+            vertex([
+                0.07474664867873766,
+                -0.19079083558584417,
+                0.04309748263309584,
+                -2.205657445865117,
+                -0.008724314157741657,
+                1.9010130563672234,
+                0.7853981633974483,
+            ]),
+        ];
+        let request = TimingRequest {
+            limits: crate::limits::DynamicLimits {
+                velocity: JointVector::from_column_slice(&[
+                    2.62, 2.62, 2.62, 2.62, 5.26, 4.18, 5.26,
+                ]),
+                acceleration: JointVector::repeat(10.0),
+                jerk: JointVector::repeat(5000.0),
+            },
+            tool_speed_m_per_s: 0.2,
+            rate_hz: 1000.0,
+        };
+        // Its two tops taken as one, the move turns back there: it is not blended (the job lifts
+        // and sets down at rest instead).
+        assert!(time_blended_move(&vertices, &request, 0.4).is_none());
     }
 
     #[test]
