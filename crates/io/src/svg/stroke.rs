@@ -570,11 +570,17 @@ mod tests {
                         .count()
             );
         }
-        // The flattened circle and the square are passed without a corner.
-        for points in &cases[..2] {
-            let round = pieces(&polyline(points), 5e-5, 0.0, corner);
-            assert!(turns(&round).iter().all(|t| *t <= emg_control::CORNER_RAD));
-        }
+        // The flattened circle is passed without a corner; the square's corners, whose
+        // rounding would be 0.6 mm in radius, tighter than MIN_CORNER_RADIUS_M, stay corners.
+        let circle = pieces(&polyline(&cases[0]), 5e-5, 0.0, corner);
+        assert!(turns(&circle).iter().all(|t| *t <= emg_control::CORNER_RAD));
+        let square = pieces(&polyline(&cases[1]), 5e-5, 0.0, corner);
+        assert_eq!(square.len(), 4);
+        assert!(turns(&square).iter().all(|t| (t - PI / 2.0).abs() < 1e-9));
+        // Within 1 mm, they are rounded too.
+        let square = pieces(&polyline(&cases[1]), 5e-5, 0.0, 1e-3);
+        assert!(turns(&square).iter().all(|t| *t <= emg_control::CORNER_RAD));
+        assert!(deviation_from(&square, &cases[1]).1 <= 1e-3 + 1e-9);
         // A 173° reversal stays a corner: its rounding would be shorter than a piece.
         let back = 173f64.to_radians();
         let zigzag = [
@@ -606,12 +612,27 @@ mod tests {
         let allowance = JoinAllowance {
             smooth_rad: 0.0,
             smooth_m: 0.0,
-            corner_m: 2.5e-4,
+            corner_m: 2e-3,
         };
         let round = rounded(&chain, &allowance);
         assert!(chained(&round));
-        assert!(turns(&round).iter().all(|t| *t <= 1e-9));
-        assert!(apart(&round, &chain) <= 2.5e-4);
+        assert!(
+            turns(&round).iter().all(|t| *t <= emg_control::CORNER_RAD),
+            "{round:?}"
+        );
+        assert!(apart(&round, &chain) <= 2e-3);
+        assert!(
+            round
+                .iter()
+                .filter_map(Piece::radius)
+                .all(|r| r >= MIN_CORNER_RADIUS_M)
+        );
+        // Within 0.25 mm the rounding would be tighter than a millimetre: the corner stays.
+        let tight = JoinAllowance {
+            corner_m: 2.5e-4,
+            ..allowance
+        };
+        assert_eq!(rounded(&chain, &tight), chain.to_vec());
         assert!(distance_to(&round, line_to) > 1e-5);
         // No allowance, no rounding.
         let none = JoinAllowance {
