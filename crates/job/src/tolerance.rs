@@ -63,13 +63,8 @@ pub(crate) fn following(
     }
     let mut config = planner.config().clone();
     let line_m = config.rollout.constraints.line_tolerance_m;
-    if !(corner_tolerance_m > 0.0 && corner_tolerance_m < line_m) {
-        return Err(JobError::CornerTolerance {
-            corner_m: corner_tolerance_m,
-            line_m,
-        });
-    }
-    config.rollout.constraints.line_tolerance_m = line_m - corner_tolerance_m;
+    let shared = DrawingTolerance::new(line_m, corner_tolerance_m)?;
+    config.rollout.constraints.line_tolerance_m = shared.line_m - shared.corner_m;
     let planner = planner
         .with_config(config)
         .expect("a configuration with a smaller positive line tolerance is valid");
