@@ -7,6 +7,7 @@
 mod fetch;
 mod generated;
 
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -61,15 +62,10 @@ pub struct CorpusRow {
     /// How it ended: `planned`, `refused: …` (the reader's or the planner's error) or
     /// `panic: …`.
     pub outcome: String,
-    /// Strokes of the drawing, and those left short by cause: out of reach, the search
-    /// budget spent, a part left out (timing or other).
+    /// Strokes of the drawing.
     pub strokes: usize,
-    /// See `strokes`.
-    pub short_reach: usize,
-    /// See `strokes`.
-    pub short_budget: usize,
-    /// See `strokes`.
-    pub short_left_out: usize,
+    /// The stretches its program leaves undrawn, by cause ([`emg_job::Shortfall::label`]).
+    pub undrawn_by_cause: BTreeMap<String, usize>,
     /// Length drawn and in all (m).
     pub drawn_m: f64,
     /// See `drawn_m`.
@@ -249,9 +245,7 @@ fn evaluate(
         name: drawing.name.clone(),
         outcome: String::new(),
         strokes: 0,
-        short_reach: 0,
-        short_budget: 0,
-        short_left_out: 0,
+        undrawn_by_cause: BTreeMap::new(),
         drawn_m: 0.0,
         total_m: 0.0,
         duration_s: 0.0,
@@ -311,24 +305,30 @@ fn evaluate(
     row
 }
 
-/// The program's lengths, durations and short strokes by cause, into `row`.
+/// The program's lengths, durations and undrawn stretches by cause, into `row`.
 fn measure(program: &JobFile, row: &mut CorpusRow) {
     let s = &program.summary;
     row.drawn_m = s.drawn_m;
     row.duration_s = s.duration_s;
     row.least_s = s.least_pen_down_s + s.least_pen_up_s;
-    for stroke in &program.strokes {
-        let unsearched = stroke
-            .unsearched_from_s
-            .is_some_and(|from| stroke.unreached.iter().any(|u| u.to_s > from));
-        if !stroke.parts_left_out.is_empty() {
-            row.short_left_out += 1;
-        } else if unsearched {
-            row.short_budget += 1;
-        } else if !stroke.unreached.is_empty() {
-            row.short_reach += 1;
-        }
+    for cause in program.strokes.iter().flat_map(|s| &s.unreached_causes) {
+        *row.undrawn_by_cause
+            .entry(cause.label().into())
+            .or_default() += 1;
     }
+}
+
+/// The undrawn stretches of `rows` by cause, as `reach 3, not_searched 1` (`none` without any).
+fn by_cause(rows: &[&CorpusRow]) -> String {
+    let mut total: BTreeMap<&str, usize> = BTreeMap::new();
+    for (cause, count) in rows.iter().flat_map(|r| &r.undrawn_by_cause) {
+        *total.entry(cause).or_default() += count;
+    }
+    if total.is_empty() {
+        return "none".into();
+    }
+    let causes: Vec<String> = total.iter().map(|(c, n)| format!("{c} {n}")).collect();
+    causes.join(", ")
 }
 
 /// The value at share `q` of the sorted `values` (nearest rank); 0 when empty.
@@ -346,10 +346,10 @@ fn markdown(record: &Record) -> String {
     let mut text = format!(
         "# Corpus: drawings nobody here made\n\nWritten by `{}` ({}); sources: {}. Every \
          drawing 0.2 m wide at the default place, planned as `emg job` plans it, its program \
-         checked by `emg check`'s checker. Short strokes by cause: out of reach, the search \
-         budget spent, a part left out. Duration over the lower bound the program prints.\n\n\
+         checked by `emg check`'s checker. Undrawn stretches by cause (docs/jobs.md, \
+         \"Why a stroke stops short\"). Duration over the lower bound the program prints.\n\n\
          | arm | corners (mm) | set | jobs | panics | refused | check fails | pen-up low | drawn / length | \
-         short: reach, budget, left out | duration / bound (median, p95) | planning (s) |\n\
+         undrawn stretches by cause | duration / bound (median, p95) | planning (s) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|\n",
         record.command,
         record.machine,
@@ -375,7 +375,7 @@ fn markdown(record: &Record) -> String {
             .map(|r| r.duration_s / r.least_s)
             .collect();
         text += &format!(
-            "| {robot} | {corner_mm} | {set} | {} | {} | {} | {} | {} | {:.1} % of {:.2} m | {}, {}, {} | \
+            "| {robot} | {corner_mm} | {set} | {} | {} | {} | {} | {} | {:.1} % of {:.2} m | {} | \
              {:.2}×, {:.2}× | {:.0} |\n",
             rows.len(),
             count(&|r| r.outcome.starts_with("panic")),
@@ -384,9 +384,7 @@ fn markdown(record: &Record) -> String {
             count(&|r| r.pen_up_low),
             100.0 * sum(&|r| r.drawn_m) / sum(&|r| r.total_m).max(f64::MIN_POSITIVE),
             sum(&|r| r.total_m),
-            sum(&|r| r.short_reach as f64),
-            sum(&|r| r.short_budget as f64),
-            sum(&|r| r.short_left_out as f64),
+            by_cause(&rows),
             quantile(&mut ratios.clone(), 0.5),
             quantile(&mut ratios, 0.95),
             sum(&|r| r.planning_s),

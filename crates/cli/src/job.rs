@@ -328,33 +328,22 @@ pub fn print_summary(file: &emg_job::JobFile) {
         s.least_pen_up_s,
         s.duration_s / (s.least_pen_down_s + s.least_pen_up_s).max(f64::MIN_POSITIVE)
     );
-    for stroke in file.strokes.iter().filter(|r| !r.unreached.is_empty()) {
-        for (stretch, at) in stroke.unreached.iter().zip(&stroke.unreached_at) {
-            // Past where the searches were spent, the stroke was not searched.
-            let unsearched = stroke
-                .unsearched_from_s
-                .map_or(stretch.to_s, |s| s.clamp(stretch.from_s, stretch.to_s));
-            if unsearched > stretch.from_s {
-                println!(
-                    "  stroke {}: {:.4} m out of reach from {:.4} m along it, at ({:.3}, {:.3}, {:.3})",
-                    stroke.stroke,
-                    unsearched - stretch.from_s,
-                    stretch.from_s,
-                    at[0],
-                    at[1],
-                    at[2]
-                );
-            }
-            if unsearched < stretch.to_s {
-                println!(
-                    "  stroke {}: {:.4} m from {:.4} m along it not searched: its {} searches \
-                     (settings.max_parts) were spent",
-                    stroke.stroke,
-                    stretch.to_s - unsearched,
-                    unsearched,
-                    file.settings.max_parts
-                );
-            }
+    for stroke in &file.strokes {
+        let undrawn = stroke
+            .unreached
+            .iter()
+            .zip(&stroke.unreached_at)
+            .zip(&stroke.unreached_causes);
+        for ((stretch, at), cause) in undrawn {
+            println!(
+                "  stroke {}: {:.4} m not drawn from {:.4} m along it, at ({:.3}, {:.3}, {:.3}): {cause}",
+                stroke.stroke,
+                stretch.length_m(),
+                stretch.from_s,
+                at[0],
+                at[1],
+                at[2]
+            );
         }
     }
     if file.home.is_none() {

@@ -33,6 +33,7 @@ pub mod page;
 pub mod place;
 pub mod program;
 pub mod reorder;
+pub mod shortfall;
 pub mod spec;
 pub mod stroke;
 pub mod tolerance;
@@ -72,6 +73,7 @@ pub use program::{
     SegmentKind, StrokeReport,
 };
 pub use reorder::{MIN_SAVED_S, in_order, reorder_by_move_time};
+pub use shortfall::{LeftOut, Shortfall, Stop};
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};
 pub use stroke::{StrokePart, StrokePlan, finish_from_the_end, plan_stroke, reachable_start_s};
 pub use tolerance::DrawingTolerance;
@@ -502,6 +504,9 @@ fn connect_strokes(
         let mut queue: VecDeque<StrokePart> = plan.parts.iter().cloned().collect();
         let mut rest_plans = 0;
         let mut unsearched_from_s = plan.unsearched_from_s;
+        // Where the stroke's searches stopped short, and the parts left out.
+        let mut stops = plan.stops.clone();
+        let mut left_out = Vec::new();
         let mut next_index = 0;
         // Where the stroke's first placed part starts and its last ends.
         let mut stroke_ends: Option<[JointVector; 2]> = None;
@@ -572,6 +577,10 @@ fn connect_strokes(
                         rank += 1;
                     } else {
                         parts_left_out.push(format!("part {index}: {why}"));
+                        left_out.push(LeftOut {
+                            planned: planned.planned(),
+                            why: why.to_string(),
+                        });
                     }
                     (again.then_some(planned.from_s), None)
                 }
@@ -590,6 +599,7 @@ fn connect_strokes(
                 )?;
                 searches += rest.searches;
                 unsearched_from_s = rest.unsearched_from_s;
+                stops.extend(rest.stops);
                 let backward: Vec<StrokePart> = queue.drain(..).filter(|p| p.backward).collect();
                 queue = rest.parts.into_iter().chain(backward).collect();
             }
@@ -643,6 +653,10 @@ fn connect_strokes(
         placed_ends.push(stroke_ends.map(|ends| ends.map(|q| branches.held(&q))));
         let length_m = plan.path.length_m();
         let coverage = Coverage::of(length_m, &covered);
+        let (unreached, unreached_causes) =
+            shortfall::undrawn_causes(&coverage.undrawn, &stops, &left_out, unsearched_from_s)
+                .into_iter()
+                .unzip::<_, _, Vec<_>, Vec<_>>();
         reports.push(StrokeReport {
             stroke: oriented.stroke,
             reversed: oriented.reversed,
@@ -650,12 +664,12 @@ fn connect_strokes(
             length_m,
             drawn_m: coverage.drawn_m,
             parts: covered.len(),
-            unreached_at: coverage
-                .undrawn
+            unreached_at: unreached
                 .iter()
-                .map(|u| plan.path.point_at(u.from_s).into())
+                .map(|u: &Stretch| plan.path.point_at(u.from_s).into())
                 .collect(),
-            unreached: coverage.undrawn,
+            unreached,
+            unreached_causes,
             parts_left_out,
             unsearched_from_s,
         });
@@ -878,11 +892,13 @@ impl Branches for JobBranches<'_> {
         let part =
             self.connector
                 .replanned_nearby(self.cascade[rank], self.request, first, from)?;
+        let stops = Stop::of_motion(part.reached_s(), &part.trajectory.termination);
         Some(StrokePlan {
             path: plan.path.clone(),
             parts: vec![part],
             searches: plan.searches,
             unsearched_from_s: None,
+            stops: stops.into_iter().collect(),
         })
     }
 

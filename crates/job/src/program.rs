@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use crate::claims::Stretch;
 use crate::motion::Motion;
 use crate::order::Ordering;
+use crate::shortfall::Shortfall;
 use crate::spec::JobSettings;
 
 /// The format tag of a job file.
@@ -89,6 +90,9 @@ pub struct StrokeReport {
     pub unreached: Vec<Stretch>,
     /// See `unreached`.
     pub unreached_at: Vec<[f64; 3]>,
+    /// Why each of `unreached` is not drawn, found where it starts (docs/jobs.md, "Why a
+    /// stroke stops short").
+    pub unreached_causes: Vec<Shortfall>,
     /// Parts planned but left out, each with why: no safe move reached them or they could not
     /// be timed.
     pub parts_left_out: Vec<String>,

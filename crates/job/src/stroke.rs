@@ -8,6 +8,7 @@ use emg_kinematics::Robot;
 use emg_planner::{PlanRequest, Planner};
 
 use crate::claims::{Coverage, OnStroke, Stretch};
+use crate::shortfall::{Shortfall, Stop};
 use crate::spec::JobSettings;
 use crate::watch::{Stopped, Watch};
 
@@ -58,6 +59,9 @@ pub struct StrokePlan {
     /// spent before its end: past it the stroke was not searched. `None` where they reached
     /// the end.
     pub unsearched_from_s: Option<f64>,
+    /// Where each search that ended short of the stroke's end ended, and why, in the order
+    /// searched.
+    pub stops: Vec<Stop>,
 }
 
 impl StrokePlan {
@@ -98,6 +102,7 @@ pub fn plan_stroke(
         parts: Vec::new(),
         searches: 0,
         unsearched_from_s: None,
+        stops: Vec::new(),
     };
     // How far the stroke is drawn or given up.
     let mut done = start_s;
@@ -122,24 +127,40 @@ pub fn plan_stroke(
         } else {
             (done - settings.overlap_m).max(0.0)
         };
-        let part = path
-            .stretch(from_s, length.min(from_s + searched_m))
-            .and_then(|stretch| Task::on_path(planner.robot(), stretch, None).ok())
-            .and_then(|task| {
-                let planned = planner
-                    .plan_until(&task, request, &|| watch.stop_requested())
-                    .ok()?;
-                Some(StrokePart {
-                    from_s,
-                    backward: false,
-                    task,
-                    trajectory: planned.trajectory,
-                })
-            });
+        let part = match path.stretch(from_s, length.min(from_s + searched_m)) {
+            None => Err("the stretch is too short to follow".to_string()),
+            Some(stretch) => Task::on_path(planner.robot(), stretch, None)
+                .map_err(|error| error.to_string())
+                .and_then(|task| {
+                    let planned = planner
+                        .plan_until(&task, request, &|| watch.stop_requested())
+                        .map_err(|error| error.to_string())?;
+                    Ok(StrokePart {
+                        from_s,
+                        backward: false,
+                        task,
+                        trajectory: planned.trajectory,
+                    })
+                }),
+        };
         // A search ended by the stop request is not the search's plan: nothing of it is kept.
         if watch.stop_requested() {
             return Err(Stopped);
         }
+        let part = match part {
+            Ok(part) => {
+                let stop = Stop::of_motion(part.reached_s(), &part.trajectory.termination);
+                plan.stops.extend(stop);
+                Some(part)
+            }
+            Err(why) => {
+                plan.stops.push(Stop {
+                    at_s: done,
+                    why: Shortfall::NoStart { why },
+                });
+                None
+            }
+        };
         let gained = part
             .as_ref()
             .filter(|part| {
@@ -195,6 +216,11 @@ pub fn finish_from_the_end(
         plan.unsearched_from_s = None;
     }
     // A part `from_s` along the reversed stretch starts `length − from_s` along the stroke.
+    plan.stops
+        .extend(back_plan.stops.into_iter().map(|stop| Stop {
+            at_s: length - stop.at_s,
+            ..stop
+        }));
     plan.parts
         .extend(back_plan.parts.into_iter().map(|part| StrokePart {
             from_s: length - part.from_s,

@@ -471,6 +471,13 @@ fn verify_claims(report: &StrokeReport, covered: &[Stretch]) -> Result<Coverage,
             report.unreached_at.len()
         )));
     }
+    if report.unreached_causes.len() != report.unreached.len() {
+        return Err(claim(format!(
+            "lists {} unreached stretches but {} causes",
+            report.unreached.len(),
+            report.unreached_causes.len()
+        )));
+    }
     Ok(measured)
 }
 

@@ -5,7 +5,7 @@
 mod common;
 
 use emg_io::Placement;
-use emg_job::{JobCheckError, JobFile, SegmentKind, verify_job};
+use emg_job::{JobCheckError, JobFile, SegmentKind, Shortfall, verify_job};
 use emg_planner::Planner;
 use emg_verify::ReferenceModel;
 
@@ -139,10 +139,28 @@ fn a_job_left_short_lists_what_it_misses_and_inflated_claims_are_refused() {
         error.to_string().contains("m drawn; its samples draw"),
         "{error}"
     );
+    // Each undrawn stretch has its cause: the constraint that stopped the arm where it starts,
+    // why no motion starts there, or the searches spent before it, the first of a stroke never
+    // the last; a program without them is refused.
+    for stroke in &program.strokes {
+        assert_eq!(stroke.unreached_causes.len(), stroke.unreached.len());
+        for (place, cause) in stroke.unreached_causes.iter().enumerate() {
+            let searched = matches!(cause, Shortfall::Reach { .. } | Shortfall::NoStart { .. });
+            assert!(
+                searched || (place > 0 && *cause == Shortfall::NotSearched),
+                "stroke {}: {cause}",
+                stroke.stroke
+            );
+        }
+    }
+    let mut causeless = program.clone();
+    causeless.strokes[short].unreached_causes.clear();
+    assert!(refused(&causeless).to_string().contains("causes"));
     // A stroke whose undrawn stretch is not listed.
     let mut hidden = program.clone();
     hidden.strokes[short].unreached.clear();
     hidden.strokes[short].unreached_at.clear();
+    hidden.strokes[short].unreached_causes.clear();
     let error = refused(&hidden);
     assert!(
         error.to_string().contains("not listed as unreached"),
