@@ -14,7 +14,8 @@ use serde::{Deserialize, Serialize};
 use crate::precision_eval::Setting;
 use crate::{progress, workspace};
 
-/// The README's markers around the table of [`report_table`].
+/// The markers around the table of [`report_table`] in `docs/results/summary.md` (written there
+/// by `cargo xtask report`, [`crate::workspace::RESULTS_SUMMARY`]).
 pub const README_START: &str = "<!-- gaps:start -->";
 /// See [`README_START`].
 pub const README_END: &str = "<!-- gaps:end -->";

@@ -58,7 +58,7 @@ enum Command {
     Eval(eval::Args),
     /// Regenerate docs/results.md (every table beside the paper's numbers) and its figures.
     Report(report::Args),
-    /// Run the criterion benchmarks and write their medians to docs/results/benchmarks.md and README.md.
+    /// Run the criterion benchmarks and write their medians to docs/results/benchmarks.md.
     BenchReport(bench_report::Args),
     /// Train the diffusion seeder on the seed labels (resumable); ship its EMA weights in data/models/.
     TrainDiffusion(train_diffusion::Args),

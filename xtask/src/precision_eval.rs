@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::{progress, workspace};
 
-/// The README's markers around the table of [`readme_table`].
+/// The markers around the table of [`readme_table`] in `docs/results/summary.md` (written there
+/// by `cargo xtask report`, [`crate::workspace::RESULTS_SUMMARY`]).
 pub const README_START: &str = "<!-- precision:start -->";
 /// See [`README_START`].
 pub const README_END: &str = "<!-- precision:end -->";

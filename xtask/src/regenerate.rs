@@ -284,6 +284,11 @@ const STAGES: &[Stage] = &[
         writes: &["docs/results/ur5e/jobs.json", "docs/results/ur5e/jobs.md"],
     },
     Stage {
+        name: "corpus-eval",
+        args: &["corpus-eval", "--every", "20"],
+        writes: &["docs/results/corpus.json", "docs/results/corpus.md"],
+    },
+    Stage {
         name: "place-eval",
         args: &["place-eval"],
         writes: &[
@@ -553,6 +558,7 @@ const STAGES: &[Stage] = &[
         args: &["report"],
         writes: &[
             "docs/results.md",
+            "docs/results/summary.md",
             "docs/figures/reference-lengths.svg",
             "docs/figures/path-lengths.svg",
             "docs/figures/hybrid-trace.svg",

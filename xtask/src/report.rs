@@ -210,23 +210,28 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             search_eval::README_END,
             &shares,
         )?;
-        workspace::replace_readme_section(
+        workspace::replace_section(
+            workspace::RESULTS_SUMMARY,
             crate::timing::README_START,
             crate::timing::README_END,
             &plan_times,
         )?;
-        workspace::replace_readme_section(
+        workspace::replace_section(
+            workspace::RESULTS_SUMMARY,
             crate::precision_eval::README_START,
             crate::precision_eval::README_END,
             &precision,
         )?;
-        workspace::replace_readme_section(
+        workspace::replace_section(
+            workspace::RESULTS_SUMMARY,
             crate::gap_eval::README_START,
             crate::gap_eval::README_END,
             &gaps,
         )?;
         println!(
-            "wrote the README's tables of search shares, plan times, precision and loose bounds"
+            "wrote the table of search shares into README.md and those of plan times, precision \
+             and loose bounds into {}",
+            workspace::RESULTS_SUMMARY
         );
     }
     Ok(())

@@ -263,8 +263,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Markers of the README's table of `emg plan`'s time per task ([`plan_times_table`], written
-/// by `cargo xtask report`).
+/// Markers of the table of `emg plan`'s time per task in `docs/results/summary.md`
+/// ([`plan_times_table`], written there by `cargo xtask report`,
+/// [`crate::workspace::RESULTS_SUMMARY`]).
 pub const README_START: &str = "<!-- plan-times:start -->";
 /// The end marker of that table.
 pub const README_END: &str = "<!-- plan-times:end -->";

@@ -234,15 +234,27 @@ pub fn machine() -> String {
     )
 }
 
+/// The page, relative to the workspace root, of the generated tables the README links to rather
+/// than shows (plan times, precision, loose bounds), each between its markers.
+pub const RESULTS_SUMMARY: &str = "docs/results/summary.md";
+
 /// Replaces the text between the `start` and `end` marker lines of the workspace's README.md
 /// with `text` (atomically); an error when a marker is missing.
 pub fn replace_readme_section(start: &str, end: &str, text: &str) -> anyhow::Result<()> {
-    let path = root().join("README.md");
-    let readme = std::fs::read_to_string(&path)?;
-    let (Some(from), Some(to)) = (readme.find(start), readme.find(end)) else {
-        anyhow::bail!("README.md lacks the {start} … {end} markers");
+    replace_section("README.md", start, end, text)
+}
+
+/// Replaces the text between the `start` and `end` marker lines of `page` (a path relative to
+/// the workspace root, such as [`RESULTS_SUMMARY`]) with `text` (atomically); an error when a
+/// marker is missing.
+pub fn replace_section(page: &str, start: &str, end: &str, text: &str) -> anyhow::Result<()> {
+    let path = root().join(page);
+    let content =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let (Some(from), Some(to)) = (content.find(start), content.find(end)) else {
+        anyhow::bail!("{page} lacks the {start} … {end} markers");
     };
-    let updated = format!("{}{start}\n{text}{}", &readme[..from], &readme[to..]);
+    let updated = format!("{}{start}\n{text}{}", &content[..from], &content[to..]);
     emg_io::write_atomically(&path, updated)?;
     Ok(())
 }

@@ -20,7 +20,7 @@ pub struct JobInput {
     #[arg(value_name = "JOB")]
     pub file: PathBuf,
     /// Robot: fr3, iiwa14, ur5e, or a URDF path.
-    #[arg(long, value_parser = robot::parse_robot, default_value_os_t = robot::default_robot())]
+    #[arg(long, value_parser = robot::parse_robot, default_value = "fr3")]
     pub robot: PathBuf,
     /// The strokes' line tolerance (mm).
     #[arg(long, value_name = "MM", default_value_t = emg_job::JOB_TOLERANCE_M * 1e3,
