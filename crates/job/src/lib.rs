@@ -562,12 +562,26 @@ fn connect_strokes(
             // planned again from there by the next planner of the cascade; where a stand-in that
             // draws less than the planned part was placed, the rest of the stroke is planned
             // again from where it ends. The parts from the stroke's other end still follow.
+            // A timed motion cut before the end it was planned to (a timed sample left the
+            // tolerance, `emg_planner::MotionTiming::time`) is resumed from where its samples
+            // stop, as a stand-in that draws less is.
             let (resume_s, placed) = match placed {
                 Ok((part, placed)) => {
+                    let drawn = part_coverage(
+                        robot,
+                        &part.task,
+                        part.on_stroke(),
+                        placed.timed.samples.iter().map(|sample| &sample.q),
+                    );
                     let short = part.trajectory.path_length_m
                         < planned.trajectory.path_length_m - SAME_LENGTH_M;
-                    let resume_s = (part.reached_s() - settings.overlap_m).max(part.from_s);
-                    (short.then_some(resume_s), Some((part, placed)))
+                    let reached_s = part.reached_s().min(drawn.to_s);
+                    let cut = reached_s < part.reached_s() - COVERAGE_SLACK_M;
+                    let resume_s = (reached_s - settings.overlap_m).max(part.from_s);
+                    (
+                        (short || cut).then_some(resume_s),
+                        Some((part, placed, drawn)),
+                    )
                 }
                 Err(why) => {
                     let again = rank + 1 < cascade.len()
@@ -603,7 +617,7 @@ fn connect_strokes(
                 let backward: Vec<StrokePart> = queue.drain(..).filter(|p| p.backward).collect();
                 queue = rest.parts.into_iter().chain(backward).collect();
             }
-            let Some((part, placed)) = placed else {
+            let Some((part, placed, stretch)) = placed else {
                 continue;
             };
             let Placed {
@@ -638,12 +652,6 @@ fn connect_strokes(
                 &timed.samples,
                 Some(&part.task),
                 dof,
-            );
-            let stretch = part_coverage(
-                robot,
-                &part.task,
-                part.on_stroke(),
-                timed.samples.iter().map(|sample| &sample.q),
             );
             least.add_stroke(above_start, start, end, stretch.length_m());
             stroke_ends = Some([stroke_ends.map_or(start, |[first, _]| first), end]);

@@ -476,3 +476,44 @@ fn pen_up_moves_keep_clear_of_the_part_and_a_program_that_does_not_is_refused() 
         other => panic!("a program whose moves skim the part passes: {other:?}"),
     }
 }
+
+#[test]
+fn a_timed_motion_cut_short_of_its_plan_is_resumed_where_its_samples_stop() {
+    // The figure eight of the Hershey simplex font (the `8` of a line of digits 0.2 m wide,
+    // one polyline crossing itself), its corners rounded within 0.125 mm: a timed sample of
+    // its one planned motion left the tolerance at a rounded corner and cut the motion after
+    // 19 mm of 34 mm, and the rest was once listed undrawn ("the timed motion stops before it").
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 450 34">
+        <polyline fill="none" stroke="black" points="166,29 163,28 162,26 162,24 163,22 165,21
+        169,20 172,19 174,17 175,15 175,12 174,10 173,9 170,8 166,8 163,9 162,10 161,12 161,15
+        162,17 164,19 167,20 171,21 173,22 174,24 174,26 173,28 170,29 166,29"/>
+        </svg>"#;
+    let dir = std::env::temp_dir().join(format!("emg-figure-eight-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let file = dir.join("eight.svg");
+    std::fs::write(&file, svg).expect("the drawing is written");
+    let (planner, timing, checker, robot_file) = common::setup("fr3");
+    // Where and how large the line of digits put it.
+    let placement = Placement {
+        origin_m: [0.449_330_357_142_857, 0.025_446_428_571_428, 0.25],
+        width_m: Some(0.006_25),
+        ..Placement::default()
+    };
+    let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 1.25e-4).unwrap();
+    let drawing =
+        emg_io::read_svg_file(&file, &placement, &tolerance.svg_options()).expect("the drawing");
+    std::fs::remove_dir_all(&dir).ok();
+    let job = tolerance
+        .job(drawing, planner.robot())
+        .expect("a valid job");
+    let program = common::plan(&planner, &timing, &robot_file, &job);
+    claims_are_measured(&program, &planner, &checker);
+    let stroke = &program.strokes[0];
+    assert!(
+        stroke.unreached.is_empty() && stroke.unreached_causes.is_empty(),
+        "{:?}",
+        stroke.unreached_causes
+    );
+    // Drawn in more than the one part planned: resumed where the cut part's samples stop.
+    assert!(stroke.parts > 1, "{} parts", stroke.parts);
+}
