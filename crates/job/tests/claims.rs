@@ -488,10 +488,6 @@ fn a_timed_motion_cut_short_of_its_plan_is_resumed_where_its_samples_stop() {
         169,20 172,19 174,17 175,15 175,12 174,10 173,9 170,8 166,8 163,9 162,10 161,12 161,15
         162,17 164,19 167,20 171,21 173,22 174,24 174,26 173,28 170,29 166,29"/>
         </svg>"#;
-    let dir = std::env::temp_dir().join(format!("emg-figure-eight-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a temporary directory");
-    let file = dir.join("eight.svg");
-    std::fs::write(&file, svg).expect("the drawing is written");
     let (planner, timing, checker, robot_file) = common::setup("fr3");
     // Where and how large the line of digits put it.
     let placement = Placement {
@@ -500,9 +496,7 @@ fn a_timed_motion_cut_short_of_its_plan_is_resumed_where_its_samples_stop() {
         ..Placement::default()
     };
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 1.25e-4).unwrap();
-    let drawing =
-        emg_io::read_svg_file(&file, &placement, &tolerance.svg_options()).expect("the drawing");
-    std::fs::remove_dir_all(&dir).ok();
+    let drawing = emg_io::read_svg(svg, &placement, &tolerance.svg_options()).expect("the drawing");
     let job = tolerance
         .job(drawing, planner.robot())
         .expect("a valid job");
