@@ -19,6 +19,7 @@ mod eval;
 mod figure_branches;
 mod figure_dp_seeds;
 mod gap_eval;
+mod import_circles;
 mod job_eval;
 mod label_seeds;
 mod limit;
@@ -112,6 +113,8 @@ enum Command {
     /// Every shipped task set, label file, model and result, each pipeline in dependency order
     /// (resumable: finished stages are journaled in target/regenerate/; --list, --from STAGE).
     Regenerate(regenerate::Args),
+    /// Fail where the modules of a crate import each other in a circle (each circle listed).
+    ImportCircles(import_circles::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -140,5 +143,6 @@ fn main() -> anyhow::Result<()> {
         Command::PlaceEval(args) => place_eval::run(&args),
         Command::GapEval(args) => gap_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
+        Command::ImportCircles(args) => import_circles::run(&args),
     }
 }
