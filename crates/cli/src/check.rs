@@ -5,27 +5,83 @@
 //! the task and the constraints, and runs [`emg_verify::check_replay`]. The layouts and what is
 //! verified are documented in `docs/joint-trajectory-format.md`.
 
-use std::path::Path;
+mod script;
+
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use clap::Args;
 use emg_control::{ConstraintConfig, Task};
 use emg_io::{Carried, TrajectoryContents};
 use emg_kinematics::{Robot, Vec3};
-use emg_verify::{JointDynamics, ReferenceModel, ReplayReport};
-
-use crate::args::CheckArgs;
-use crate::output::count;
 use emg_planner::MotionTiming;
+use emg_verify::{JointDynamics, ReplayReport};
+
+use crate::config::read_config;
+use crate::options::{ChainArgs, ScalingArgs, TaskLineArgs};
+use crate::output::count;
+use crate::program::read_job_file;
+use crate::robot;
+
+/// Options of `emg check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json`, `<stem>.csv`, a job's
+    /// program (emg-job/3) or a URScript program exported from one for the UR5e (`.script`).
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// A URScript program's job program (emg-job/3), which it is read back against. Default: the
+    /// `.json` of the script's name (`drawing.job.script` and `drawing.job-part1.script` →
+    /// `drawing.job.json`).
+    #[arg(long, value_name = "JOB")]
+    pub program: Option<PathBuf>,
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) or a robot file (URDF). Default: the
+    /// file's `robot` field (a JSON file, or the --task-from file for a CSV), else `fr3`.
+    #[arg(long, value_name = "NAME|URDF", value_parser = robot::parse_robot)]
+    pub robot: Option<PathBuf>,
+    /// The kinematic chain's ends.
+    #[command(flatten)]
+    pub chain: ChainArgs,
+    /// Take the task (and, without --config, the constraints) from this emg-trajectory/1 or
+    /// emg-joint-trajectory/2 file instead of FILE (a CSV carries none).
+    #[arg(long, value_name = "JSON", conflicts_with = "p0")]
+    pub task_from: Option<PathBuf>,
+    /// A task given on the command line instead of the file's.
+    #[command(flatten)]
+    pub line: TaskLineArgs,
+    /// As `plan --config` (a JSON file, or inline JSON starting with `{`): its
+    /// `rollout.constraints` replace the file's.
+    #[arg(long, value_name = "FILE|JSON")]
+    pub config: Option<PathBuf>,
+    /// Check a joint-trajectory file against these joint limits (MoveIt joint_limits.yaml,
+    /// scaled by --velocity-scaling and --acceleration-scaling) instead of the file's own.
+    #[arg(long, value_name = "YAML")]
+    pub limits: Option<PathBuf>,
+    /// Scaling of the --limits file.
+    #[command(flatten)]
+    pub scaling: ScalingArgs,
+}
 
 /// Runs `emg check`: prints the report and `OK`, or fails naming the point and the constraint.
-pub fn run_check(args: &CheckArgs) -> Result<()> {
+pub fn run(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
     if file.extension().is_some_and(|e| e == "script") {
-        return crate::check_script::check_script(args, file);
+        return script::check_script(
+            file,
+            args.program.as_deref(),
+            args.robot.as_deref(),
+            &args.chain,
+        );
     }
-    if let Some(job) = read_job_file(file)? {
-        return check_job(args, file, &job);
+    match read_job_file(file)? {
+        Some(job) => check_job(args, file, &job),
+        None => check_trajectory(args, file),
     }
+}
+
+/// `emg check` on a trajectory file (either JSON layout or the CSV): its task and constraints
+/// resolved from the options, the file or the file beside it, and every point verified.
+fn check_trajectory(args: &CheckArgs, file: &Path) -> Result<()> {
     let contents = TrajectoryContents::read(file)?;
     let carried = contents.carried();
     // A CSV carries no task: by default it is taken from the JSON written beside it.
@@ -39,11 +95,11 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
 
     let robot_path = match (&args.robot, &task_from, &carried) {
         (Some(path), _, _) => path.clone(),
-        (None, _, Some(c)) => crate::robot::resolve(&c.robot, file)?,
-        (None, Some((path, c)), None) => crate::robot::resolve(&c.robot, path)?,
-        (None, None, None) => crate::robot::default_robot(),
+        (None, _, Some(c)) => robot::resolve(&c.robot, file)?,
+        (None, Some((path, c)), None) => robot::resolve(&c.robot, path)?,
+        (None, None, None) => robot::default_robot(),
     };
-    let (robot, model) = robot_and_checker(args, &robot_path)?;
+    let (robot, model) = args.chain.robot_and_checker(&robot_path)?;
 
     let (task, task_origin) = match (args.line.p0, args.line.d, args.line.n, &task_from, &carried) {
         (Some(p0), Some(d), Some(n), _, _) => (
@@ -70,7 +126,7 @@ pub fn run_check(args: &CheckArgs) -> Result<()> {
     };
     let (constraints, constraints_origin) = match (&args.config, &carried, &task_from) {
         (Some(path), _, _) => (
-            crate::read_config(path)?.rollout.constraints,
+            read_config(path)?.rollout.constraints,
             format!("--config {}", path.display()),
         ),
         (None, Some(c), _) => (c.constraints.clone(), "the file".to_string()),
@@ -161,26 +217,13 @@ fn read_task_from(path: &Path) -> Result<Carried> {
         .with_context(|| format!("--task-from {}: carries no task", path.display()))
 }
 
-/// The job program in `file`, when it is a job's program (refused where it is one of another
-/// version).
-pub(crate) fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
-    if !emg_job::JobFile::is_job(&text) {
-        return Ok(None);
-    }
-    let job =
-        emg_job::JobFile::parse(&text).map_err(|e| anyhow::anyhow!("{} {e}", file.display()))?;
-    Ok(Some(job))
-}
-
 /// `emg check` on a job's program: every segment replayed by the independent checker.
 fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()> {
     let robot_path = match &args.robot {
         Some(path) => path.clone(),
-        None => crate::robot::resolve(&job.robot, file)?,
+        None => robot::resolve(&job.robot, file)?,
     };
-    let (robot, model) = robot_and_checker(args, &robot_path)?;
+    let (robot, model) = args.chain.robot_and_checker(&robot_path)?;
     let check = emg_job::verify_job(job, &model, robot.joint_names())
         .map_err(|failure| anyhow::anyhow!("{} does not hold up: {failure}", file.display()))?;
     println!(
@@ -213,23 +256,12 @@ fn check_job(args: &CheckArgs, file: &Path, job: &emg_job::JobFile) -> Result<()
     Ok(())
 }
 
-/// The robot of `robot_path` (with the chain's ends the options name) and its independent
-/// checker.
-pub fn robot_and_checker(args: &CheckArgs, robot_path: &Path) -> Result<(Robot, ReferenceModel)> {
-    let robot = crate::robot::load_robot(
-        robot_path,
-        args.base_link.as_deref(),
-        args.tip_link.as_deref(),
-    )?;
-    let model = crate::robot::load_checker(robot_path, &robot)?;
-    Ok((robot, model))
-}
-
 /// `task` validated again for `robot` (a validated task comes back bit for bit).
 fn validated(robot: &Robot, task: &Task) -> Result<Task> {
     Ok(task.revalidated(robot)?)
 }
 
+/// The constraints in words, as the reports print them.
 fn describe(constraints: &ConstraintConfig) -> String {
     let speeds = match constraints.velocity_limit_fraction {
         Some(fraction) => format!("joint speeds ≤ {} × limit", fraction.get()),
@@ -243,6 +275,8 @@ fn describe(constraints: &ConstraintConfig) -> String {
     )
 }
 
+/// Prints what the checker verified of a trajectory file; `limits_origin` names where the
+/// joint limits checked come from, if any were.
 fn print_report(report: &ReplayReport, limits_origin: Option<&str>) {
     println!(
         "  {}, {:.3} s, path length {:.4} m",

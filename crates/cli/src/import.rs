@@ -1,19 +1,60 @@
 //! `emg import-robot`: a vendor robot description (boxes, cylinders, STL/OBJ meshes) written as
 //! a capsule URDF with a pen, and a report of what was fitted.
 
+use std::path::PathBuf;
+
 use anyhow::{Context, Result};
+use clap::Args;
 use emg_io::{
     DisabledBecause, ImportOptions, ImportedRobot, PEN_LINK, PEN_PROTRUSION_M,
     PEN_REACH_TOLERANCE_M, Pen, ToolLinkChoice, import_robot,
 };
 use emg_kinematics::{PairRule, Robot, srdf_beside};
 
-use crate::args::ImportArgs;
 use crate::output::write_text;
+
+/// Options of `emg import-robot`.
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// The vendor description (URDF).
+    #[arg(value_name = "URDF")]
+    pub file: PathBuf,
+    /// The URDF to write (capsules as a cylinder plus two sphere caps; the pen's link is
+    /// `pen_tip`, the TCP).
+    #[arg(long, value_name = "URDF")]
+    pub out: PathBuf,
+    /// Where `package://NAME/...` meshes are: a directory of packages (DIR/NAME, or a directory
+    /// below DIR whose package.xml names NAME), or NAME=DIR for one package. Repeatable.
+    #[arg(long, value_name = "DIR|NAME=DIR")]
+    pub package_path: Vec<emg_io::PackagePath>,
+    /// The link the pen attaches to, along its z axis (default: the file's only leaf link; of
+    /// several, `tool0`, else `flange`, as REP 199 names them).
+    #[arg(long)]
+    pub tool_link: Option<String>,
+    /// The chain's base link, checked to reach the pen (default: the file's only root link).
+    #[arg(long)]
+    pub base_link: Option<String>,
+    /// Pen length from the tool link's origin to the tip (m) (default: 0.1 m beyond the tool's
+    /// collision geometry along its z axis, the links fixed to it included; 0.1 m when none lies
+    /// ahead of its origin).
+    #[arg(long, value_name = "M")]
+    pub pen_length: Option<f64>,
+    /// Pen radius (m).
+    #[arg(long, value_name = "M", default_value_t = emg_io::Pen::default().radius_m)]
+    pub pen_radius: f64,
+    /// An SRDF file (MoveIt's) whose `disable_collisions` pairs are not checked for
+    /// self-collision, besides adjacent links and links whose capsules overlap at mid-range.
+    #[arg(long, value_name = "SRDF")]
+    pub srdf: Option<PathBuf>,
+    /// Most capsules fitted to one link (1 to 3): a loose single capsule is split along its
+    /// axis when that saves a quarter of its volume.
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u8).range(1..=3))]
+    pub max_capsules: u8,
+}
 
 /// Imports, checks that the planners read the result as a chain of six or seven joints ending in
 /// the pen, writes it and prints the fit report.
-pub fn run_import(args: &ImportArgs) -> Result<()> {
+pub fn run(args: &ImportArgs) -> Result<()> {
     let srdf = srdf_beside(&args.out);
     let limits = emg_planner::limits_file_beside(&args.out);
     let mut inputs = vec![("vendor URDF", args.file.as_path())];

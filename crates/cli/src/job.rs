@@ -3,82 +3,16 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
-use emg_io::{Placement, read_svg_file};
-use emg_job::{Job, JobPlanError, Order, Tool, plan_job};
-use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
+use emg_job::{JobPlanError, plan_job};
 
+use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
-use crate::output::{count, progress_bar, write_text};
+use crate::job_input::{JobInput, Ready, print_size};
+use crate::output::{progress_bar, write_text};
+use crate::program::print_summary;
 use crate::robot;
-
-/// What a job is and how it is planned: the options `emg job` and `emg place` share.
-#[derive(Debug, Args)]
-pub struct JobInput {
-    /// The job: a job file (JSON, docs/jobs.md) or an SVG drawing (every subpath a stroke).
-    #[arg(value_name = "JOB")]
-    pub file: PathBuf,
-    /// Robot: fr3, iiwa14, ur5e, or a URDF path.
-    #[arg(long, value_parser = robot::parse_robot, default_value = "fr3")]
-    pub robot: PathBuf,
-    /// The strokes' line tolerance (mm).
-    #[arg(long, value_name = "MM", default_value_t = emg_job::JOB_TOLERANCE_M * 1e3,
-          value_parser = crate::args::tolerance_mm, allow_hyphen_values = true)]
-    pub tolerance: f64,
-    /// The tool cone's half-angle around the surface normal (degrees).
-    #[arg(long, value_name = "DEG", default_value_t = 30.0, value_parser = crate::args::cone_deg,
-          allow_hyphen_values = true)]
-    pub cone: f64,
-    /// The drawing order: `shortest` (default: order and directions that cut the pen-up travel)
-    /// or `given`; overrides the job file's.
-    #[arg(long, value_parser = parse_order)]
-    pub order: Option<Order>,
-    /// The tool, whose lift between strokes is the default: `pen` (2 mm), `dispenser` (1 cm)
-    /// or `torch` (3 cm); overrides the job file's.
-    #[arg(long, value_parser = parse_tool)]
-    pub tool: Option<Tool>,
-    /// How far the tool lifts off the surface between strokes (mm); overrides the tool's and
-    /// the job file's.
-    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
-    pub lift: Option<f64>,
-    /// SVG only: how far the rounding of a corner may leave it (mm), out of --tolerance: the
-    /// strokes are followed within the rest (docs/jobs.md#corner-rounding). 0 keeps every
-    /// corner, passed at rest.
-    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
-    pub corner_tolerance: Option<f64>,
-    /// SVG only: where the drawing's centre goes (m, base frame).
-    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
-    pub origin: Option<[f64; 3]>,
-    /// SVG only: the surface normal the pen points along.
-    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
-    pub normal: Option<[f64; 3]>,
-    /// SVG only: the drawing's x axis on the surface.
-    #[arg(long, value_name = "X,Y,Z", value_parser = crate::args::parse_vec3, allow_hyphen_values = true)]
-    pub x_axis: Option<[f64; 3]>,
-    /// SVG only: the drawing's width (m). Default: 0.2 m, unless --scale sets the size.
-    #[arg(long, value_name = "M")]
-    pub width: Option<f64>,
-    /// SVG only, instead of --width: metres per unit of the drawing (its CSS pixels), or
-    /// `physical` for the drawing at its own physical size (`width="200mm"` draws 0.2 m wide).
-    #[arg(long, value_name = "M_PER_UNIT|physical", value_parser = crate::args::parse_scale,
-          conflicts_with = "width")]
-    pub scale: Option<f64>,
-    /// The cell's obstacles (a scene file, docs/scene.md), which the arm keeps clear of while
-    /// drawing and between strokes.
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
-    /// The arm's home (rad, one value per joint, comma-separated): the program starts and ends
-    /// there, through checked free moves. Default: the job file's `home`, else the shipped
-    /// arm's (docs/jobs.md#home); a robot file with neither starts above its first stroke.
-    #[arg(
-        long,
-        value_name = "Q,Q,…",
-        value_delimiter = ',',
-        allow_hyphen_values = true
-    )]
-    pub home: Option<Vec<f64>>,
-}
 
 /// Options of `emg job`.
 #[derive(Debug, Args)]
@@ -91,11 +25,11 @@ pub struct JobArgs {
     pub out: PathBuf,
     /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
     /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
-    #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
+    #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
     /// How a URScript export is written.
     #[command(flatten)]
-    pub urscript: crate::export::UrScriptArgs,
+    pub urscript: exporting::UrScriptArgs,
     /// Also write the program's viewer page (self-contained HTML): the arm playing the whole
     /// program, every stroke on the part (drawn stretches solid, the rest faint), the pen-up
     /// moves dashed, the segment under way named.
@@ -103,134 +37,18 @@ pub struct JobArgs {
     pub html: Option<PathBuf>,
 }
 
-/// A job ready to plan: the job read, the planner and timing `emg job` plans it with, the
-/// request.
-pub struct Ready {
-    /// The job.
-    pub job: Job,
-    /// The planner at the job's tolerance and cone.
-    pub planner: Planner,
-    /// The program's timing.
-    pub timing: MotionTiming,
-    /// The request (the search with the best shipped controller).
-    pub request: PlanRequest,
-}
-
-impl JobInput {
-    /// The files the job is read from, named as an overwrite refusal names them.
-    pub fn files(&self) -> Vec<(&'static str, &std::path::Path)> {
-        let mut files = vec![
-            ("job", self.file.as_path()),
-            ("robot file", self.robot.as_path()),
-        ];
-        files.extend(self.scene.as_deref().map(|path| ("--scene", path)));
-        files
-    }
-
-    /// The job read and its planner set up.
-    pub fn ready(&self) -> Result<Ready> {
-        let robot = robot::load_robot(&self.robot, None, None)?;
-        let drawing = self.drawing_tolerance()?;
-        let mut job = read_job(self, drawing.as_ref(), &robot)?;
-        let shipped_home = robot::shipped(&self.robot).map(|shipped| shipped.home);
-        match (&self.home, shipped_home) {
-            (Some(values), _) => {
-                job = job.with_home(values, &robot).map_err(|e| match e {
-                    emg_job::JobError::Home(problem) => anyhow::anyhow!("--home {problem}"),
-                    other => other.into(),
-                })?;
-            }
-            (None, Some(values)) if job.home.is_none() => job = job.with_home(values, &robot)?,
-            _ => {}
-        }
-        let mut config = emg_job::job_config(self.tolerance * 1e-3);
-        config.rollout.constraints.theta_max_deg = self.cone;
-        if let Some(path) = &self.scene {
-            config.rollout.constraints.scene = emg_io::read_scene(path)?;
-        }
-        config.validate()?;
-        let diffusion = robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
-        let policy = robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE);
-        let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
-        let timing = emg_job::job_timing(&robot, &self.robot, &config)?;
-        let planner = Planner::new(robot, models, config)?;
-        let request = PlanRequest {
-            controller: planner.models().best_controller(),
-            ..PlanRequest::default()
-        };
-        Ok(Ready {
-            job,
-            planner,
-            timing,
-            request,
-        })
-    }
-
-    /// Whether the job is an SVG drawing (else a job file).
-    fn is_svg(&self) -> bool {
-        self.file
-            .extension()
-            .is_some_and(|ext| ext.eq_ignore_ascii_case("svg"))
-    }
-
-    /// A drawing's tolerance, shared between its corners and its strokes; `None` for a job
-    /// file, whose strokes are followed as they are within --tolerance.
-    fn drawing_tolerance(&self) -> Result<Option<emg_job::DrawingTolerance>> {
-        if !self.is_svg() {
-            if self.corner_tolerance.is_some() {
-                anyhow::bail!(
-                    "--corner-tolerance rounds the corners of an SVG drawing; {} is a job file, \
-                     whose strokes are followed as they are",
-                    self.file.display()
-                );
-            }
-            return Ok(None);
-        }
-        let corner_m = self.corner_tolerance.unwrap_or(0.0) * 1e-3;
-        emg_job::DrawingTolerance::new(self.tolerance * 1e-3, corner_m)
-            .map(Some)
-            .map_err(|e| anyhow::anyhow!("--corner-tolerance: {e}"))
-    }
-}
-
-fn parse_tool(value: &str) -> Result<Tool, String> {
-    match value {
-        "pen" => Ok(Tool::Pen),
-        "dispenser" => Ok(Tool::Dispenser),
-        "torch" => Ok(Tool::Torch),
-        other => Err(format!("'{other}' is not a tool: pen, dispenser or torch")),
-    }
-}
-
-fn parse_order(value: &str) -> Result<Order, String> {
-    match value {
-        "shortest" => Ok(Order::Shortest),
-        "given" => Ok(Order::Given),
-        other => Err(format!("'{other}' is not an order: shortest or given")),
-    }
-}
-
-/// Prints a job's size before it is planned: its strokes and their length.
-pub fn print_size(job: &Job) {
-    println!(
-        "{}, {:.3} m to draw",
-        count(job.strokes.len(), "stroke"),
-        job.strokes.iter().map(|s| s.length_m()).sum::<f64>()
-    );
-}
-
 /// Reads the job, plans it, prints its summary and writes its program; `interrupt` stops the
 /// planning, and then nothing is written.
-pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
+pub fn run(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
     let exported = args
         .export
-        .map(|format| crate::export::beside_program(&args.out, format));
+        .map(|format| exporting::beside_program(&args.out, format));
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    crate::export::refuse_program_export(args.export, &args.urscript, &input.robot)?;
+    exporting::refuse_program_export(args.export, &args.urscript, &input.robot)?;
     let Ready {
         job,
         planner,
@@ -255,7 +73,7 @@ pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
     println!("wrote {}", args.out.display());
     if let Some(format) = args.export {
-        let text = crate::export::export_program(
+        let text = exporting::export_program(
             &file,
             format,
             &args.urscript,
@@ -282,160 +100,4 @@ pub fn run_job(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
         println!("wrote {}", path.display());
     }
     Ok(())
-}
-
-/// Prints a planned program's summary: strokes, length drawn, travel, times, what was left out.
-pub fn print_summary(file: &emg_job::JobFile) {
-    let s = &file.summary;
-    println!(
-        "{}: {} complete, {} resumed after a reconfiguration, {} short",
-        count(file.strokes.len(), "stroke"),
-        s.complete,
-        s.resumed,
-        s.short
-    );
-    let (merged, into) = file.ordering.merged();
-    if merged > 0 {
-        println!(
-            "{} merged into {into}, meeting end to end",
-            count(merged, "stroke")
-        );
-    }
-    println!(
-        "pen down {:.4} m of {:.4} m ({:.1} %); pen-up travel {:.3} m in the order drawn ({:.3} m as given)",
-        s.drawn_m,
-        s.total_m,
-        100.0 * s.drawn_m / s.total_m.max(f64::MIN_POSITIVE),
-        s.travel_m,
-        s.travel_given_m
-    );
-    println!(
-        "program {:.2} s ({:.2} s pen down, {:.2} s pen up; {}, {} found by the sampling \
-         planner); planned in {:.2} s ({})",
-        s.duration_s,
-        s.pen_down_s,
-        s.pen_up_s,
-        count(s.straight_moves, "straight move"),
-        s.sampled_moves,
-        s.planning_s,
-        count(s.searches, "search")
-    );
-    println!(
-        "at the arm's limits no program drawing these parts lasts less than {:.2} s ({:.2} s pen \
-         down, {:.2} s pen up): this one takes {:.2}×",
-        s.least_pen_down_s + s.least_pen_up_s,
-        s.least_pen_down_s,
-        s.least_pen_up_s,
-        s.duration_s / (s.least_pen_down_s + s.least_pen_up_s).max(f64::MIN_POSITIVE)
-    );
-    for stroke in &file.strokes {
-        let undrawn = stroke
-            .unreached
-            .iter()
-            .zip(&stroke.unreached_at)
-            .zip(&stroke.unreached_causes);
-        for ((stretch, at), cause) in undrawn {
-            println!(
-                "  stroke {}: {:.4} m not drawn from {:.4} m along it, at ({:.3}, {:.3}, {:.3}): {cause}",
-                stroke.stroke,
-                stretch.length_m(),
-                stretch.from_s,
-                at[0],
-                at[1],
-                at[2]
-            );
-        }
-    }
-    if file.home.is_none() {
-        println!(
-            "  the robot has no home: the program starts above its first stroke and ends above \
-             its last (give --home)"
-        );
-    } else if !s.ends_at_home {
-        println!(
-            "  no free move back to the job's home was found: the program ends above its last stroke"
-        );
-    }
-    for stroke in &file.strokes {
-        for why in &stroke.parts_left_out {
-            println!("  stroke {}, {why}", stroke.stroke);
-        }
-    }
-}
-
-/// The job of a job file, or of an SVG drawing placed as the options say.
-/// `tolerance` is the drawing's, for an SVG drawing.
-fn read_job(
-    args: &JobInput,
-    tolerance: Option<&emg_job::DrawingTolerance>,
-    robot: &emg_kinematics::Robot,
-) -> Result<Job> {
-    let mut job = if let Some(tolerance) = tolerance {
-        let placement = placement(args)?;
-        let options = tolerance.svg_options();
-        let drawing = read_svg_file(&args.file, &placement, &options)?;
-        if drawing.dropped_tiny > 0 {
-            println!(
-                "{}: {} shorter than {} mm dropped",
-                args.file.display(),
-                count(drawing.dropped_tiny, "stroke"),
-                options.min_stroke_m * 1e3
-            );
-        }
-        tolerance.job(drawing, robot)?
-    } else {
-        if [&args.origin, &args.normal, &args.x_axis]
-            .iter()
-            .any(|o| o.is_some())
-            || args.width.is_some()
-            || args.scale.is_some()
-        {
-            anyhow::bail!(
-                "--origin, --normal, --x-axis, --width and --scale place an SVG drawing; {} is a \
-                 job file, whose strokes are already placed",
-                args.file.display()
-            );
-        }
-        let text = std::fs::read_to_string(&args.file)
-            .with_context(|| format!("cannot read {}", args.file.display()))?;
-        Job::from_json(&args.file.display().to_string(), &text, robot)?
-    };
-    if let Some(order) = args.order {
-        job.settings.order = order;
-    }
-    if let Some(tool) = args.tool {
-        job.settings.tool = tool;
-        job.settings.lift_m = None;
-    }
-    if let Some(lift_mm) = args.lift {
-        let lift_m = lift_mm * 1e-3;
-        if !(lift_m.is_finite() && lift_m > 0.0 && lift_m <= 0.5) {
-            anyhow::bail!("--lift must be in (0, 500] mm, got {lift_mm}");
-        }
-        job.settings.lift_m = Some(lift_m);
-    }
-    Ok(job)
-}
-
-/// The drawing's placement: the default with what the options set.
-fn placement(args: &JobInput) -> Result<Placement> {
-    let mut placement = Placement::default();
-    if let Some(origin) = args.origin {
-        placement.origin_m = origin;
-    }
-    if let Some(normal) = args.normal {
-        placement.normal = normal;
-    }
-    if let Some(x_axis) = args.x_axis {
-        placement.x_axis = x_axis;
-    }
-    if let Some(width) = args.width {
-        placement.width_m = Some(width);
-        placement.scale_m_per_unit = None;
-    }
-    if let Some(scale) = args.scale {
-        placement.width_m = None;
-        placement.scale_m_per_unit = Some(scale);
-    }
-    Ok(placement)
 }

@@ -11,9 +11,12 @@ use emg_job::{
     place_job, placement_map,
 };
 
+use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
-use crate::job::{JobInput, Ready, print_summary};
+use crate::job_input::{JobInput, Ready, print_size};
 use crate::output::{progress_bar, write_text};
+use crate::program::print_summary;
+use crate::robot;
 
 /// Options of `emg place`.
 #[derive(Debug, Args)]
@@ -24,7 +27,13 @@ pub struct PlaceArgs {
     /// What moves: `part` (default: the part on its surface, turned about its normal through
     /// its centre) or `base` (the robot's base on its mount, turned about its z axis; the part
     /// and the cell stay).
-    #[arg(long = "move", value_name = "WHAT", value_parser = parse_moving, default_value = "part")]
+    #[arg(
+        long = "move",
+        value_name = "WHAT",
+        value_enum,
+        hide_possible_values = true,
+        default_value = "part"
+    )]
     pub moving: Moving,
     /// The shifts searched along x (the part's: the base's x laid on the surface; the base's
     /// own): MIN,MAX (m).
@@ -57,7 +66,7 @@ pub struct PlaceArgs {
     /// What screens a place: `bound` (default: each stroke's reachability bound, how far one
     /// motion could go along it) or `point-ik` (the share of stroke points with an IK solution
     /// in the cone, each on its own, as reachability studies score).
-    #[arg(long, value_parser = parse_score, default_value = "bound")]
+    #[arg(long, value_enum, hide_possible_values = true, default_value = "bound")]
     pub score: Score,
     /// The program planned at the chosen place (an emg-job/3 file; missing parent directories
     /// are created, as for every file written).
@@ -74,13 +83,14 @@ pub struct PlaceArgs {
     /// Also export the program for a robot's own stack, as `emg job --export` does:
     /// `ros2-mcap` or `urscript`, written beside `--out` (its extension `.mcap` or `.script`;
     /// see docs/robot-export.md).
-    #[arg(long, value_name = "FORMAT", value_parser = crate::export::parse_format)]
+    #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
     /// How a URScript export is written.
     #[command(flatten)]
-    pub urscript: crate::export::UrScriptArgs,
+    pub urscript: exporting::UrScriptArgs,
 }
 
+/// Parses a range searched, `MIN,MAX`.
 fn parse_range(value: &str) -> Result<[f64; 2], String> {
     let numbers: Vec<f64> = value
         .split(',')
@@ -93,35 +103,19 @@ fn parse_range(value: &str) -> Result<[f64; 2], String> {
     }
 }
 
-fn parse_moving(value: &str) -> Result<Moving, String> {
-    match value {
-        "part" => Ok(Moving::Part),
-        "base" => Ok(Moving::Base),
-        other => Err(format!("'{other}' is not what moves: part or base")),
-    }
-}
-
-fn parse_score(value: &str) -> Result<Score, String> {
-    match value {
-        "bound" => Ok(Score::Bound),
-        "point-ik" => Ok(Score::PointIk),
-        other => Err(format!("'{other}' is not a score: bound or point-ik")),
-    }
-}
-
 /// Searches the region, prints the certified places and writes the outputs; `interrupt` stops
 /// the search, and then nothing is written.
-pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
+pub fn run(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
     let exported = args
         .export
-        .map(|format| crate::export::beside_program(&args.out, format));
+        .map(|format| exporting::beside_program(&args.out, format));
     let mut outputs = vec![("--out", args.out.as_path())];
     outputs.extend(args.map.as_deref().map(|path| ("--map", path)));
     outputs.extend(args.job_out.as_deref().map(|path| ("--job-out", path)));
     outputs.extend(exported.as_deref().map(|path| ("--export", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    crate::export::refuse_program_export(args.export, &args.urscript, &input.robot)?;
+    exporting::refuse_program_export(args.export, &args.urscript, &input.robot)?;
     let region = Region {
         moving: args.moving,
         x_m: args.x,
@@ -144,14 +138,14 @@ pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
         timing,
         request,
     } = input.ready()?;
-    crate::job::print_size(&job);
+    print_size(&job);
     let watch = Watched::new(progress_bar(0, "places"), interrupt);
     let placement = match place_job(
         &planner,
         &request,
         &job,
         &timing,
-        &crate::robot::reference(&input.robot)?.to_string(),
+        &robot::reference(&input.robot)?.to_string(),
         &region,
         &settings,
         args.score,
@@ -171,7 +165,7 @@ pub fn run_place(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     write_text(&args.out, &(serde_json::to_string(program)? + "\n"))?;
     println!("wrote {}", args.out.display());
     if let Some(format) = args.export {
-        let text = crate::export::export_program(
+        let text = exporting::export_program(
             program,
             format,
             &args.urscript,
@@ -215,12 +209,12 @@ fn print_places(placement: &Placement) {
     for (rank, place) in placement.certified.iter().enumerate() {
         let p = &place.scored.place;
         println!(
-            "{:>4}  {:>6.3}  {:>6.3}  {:>6.3}  {:>8.1}  {:>5.3}  {:>9.4}  {:>6.4}  {:>4} / {:<3}  {:>10.2}",
+            "{:>4}  {:>6}  {:>6}  {:>6}  {:>8}  {:>5.3}  {:>9.4}  {:>6.4}  {:>4} / {:<3}  {:>10.2}",
             rank + 1,
-            p.x_m,
-            p.y_m,
-            p.z_m,
-            p.rotation_deg,
+            rounded(p.x_m, 3),
+            rounded(p.y_m, 3),
+            rounded(p.z_m, 3),
+            rounded(p.rotation_deg, 1),
             place.scored.score,
             place.drawn_m,
             place.total_m,
@@ -251,11 +245,14 @@ fn print_places(placement: &Placement) {
         Moving::Part => "the part",
         Moving::Base => "the base",
     };
-    // In full (the shortest text that reads back to the same number): the place is reproduced
-    // from what is printed.
+    // The place to 0.1 mm and 0.1°; the transforms below in full (the shortest text that reads
+    // back to the same number), so that what is printed reproduces the place.
     println!(
         "chosen: {what} shifted ({}, {}, {}) m, turned {}°",
-        place.x_m, place.y_m, place.z_m, place.rotation_deg
+        rounded(place.x_m, 4),
+        rounded(place.y_m, 4),
+        rounded(place.z_m, 4),
+        rounded(place.rotation_deg, 1)
     );
     let written = |t: &emg_job::Transform| {
         format!(
@@ -279,5 +276,28 @@ fn print_places(placement: &Placement) {
         );
     } else {
         println!("  the job's transform: {}", written(&placement.transform()));
+    }
+}
+
+/// `value` to `decimals` decimals, a value that rounds to zero written without a sign.
+fn rounded(value: f64, decimals: usize) -> String {
+    let scale = 10f64.powi(i32::try_from(decimals).unwrap_or(i32::MAX));
+    // Adding +0.0 turns a -0.0 into 0.0.
+    format!("{:.*}", decimals, (value * scale).round() / scale + 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rounded;
+
+    #[test]
+    fn places_are_printed_rounded_without_a_negative_zero() {
+        assert_eq!(
+            rounded(-0.000_000_000_000_000_006_938_893_903_907_228, 4),
+            "0.0000"
+        );
+        assert_eq!(rounded(-0.03, 4), "-0.0300");
+        assert_eq!(rounded(0.123_456, 4), "0.1235");
+        assert_eq!(rounded(-22.54, 1), "-22.5");
     }
 }

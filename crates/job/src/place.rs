@@ -43,6 +43,7 @@ const SCORE_MARGIN: f64 = SAME_SCORE;
 /// What a placement moves.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Moving {
     /// The part, with the strokes on it: shifted on its surface, turned about its normal through
     /// the strokes' centre. The cell stays.
@@ -320,13 +321,17 @@ impl Placement {
 }
 
 /// The places of the region's grid: `count` values spread evenly over `[low, high]` (the middle
-/// where `count` is 1 or the range a point).
+/// where `count` is 1 or the range a point). Each is the weighted mean
+/// `(low (n - 1 - k) + high k) / (n - 1)`, so the ends and a middle between opposite ends come
+/// out exact (`0`, not a rounding residue of `low + (high - low) k / (n - 1)`).
 fn spread(range: [f64; 2], count: usize) -> Vec<f64> {
     if count <= 1 || range[0] == range[1] {
         return vec![0.5 * (range[0] + range[1])];
     }
+    let [low, high] = range;
+    let steps = (count - 1) as f64;
     (0..count)
-        .map(|k| range[0] + (range[1] - range[0]) * k as f64 / (count - 1) as f64)
+        .map(|k| (low * (steps - k as f64) + high * k as f64) / steps)
         .collect()
 }
 
@@ -442,6 +447,7 @@ impl PlaceSettings {
 /// What a place is scored by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Score {
     /// The reachability bound of each stroke: how far along it one motion could go.
     Bound,

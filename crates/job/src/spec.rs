@@ -34,6 +34,7 @@ pub struct JobSpec {
 /// The order the strokes are drawn in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Order {
     /// As listed, each in its own direction.
     Given,
@@ -46,6 +47,7 @@ pub enum Order {
 /// The tool a job draws, seals or welds with: what it needs between strokes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Tool {
     /// A pen: lifts [`Tool::PEN_LIFT_M`] off the paper between strokes.
     #[default]

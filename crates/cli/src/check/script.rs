@@ -9,8 +9,10 @@ use anyhow::{Context, Result, anyhow, bail};
 use emg_io::DriverProfile;
 use emg_planner::ShippedRobot;
 
-use crate::args::CheckArgs;
+use crate::options::ChainArgs;
 use crate::output::count;
+use crate::program::read_job_file;
+use crate::robot;
 
 /// The job's program a script `file` was exported from by default: the `.json` of its name, a
 /// part's suffix `-partN` left out.
@@ -40,13 +42,19 @@ fn stream_parts(file: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// Runs `emg check` on a URScript program: prints what was read and `OK`, or fails naming the
-/// line and what the arm would do wrong there.
-pub fn check_script(args: &CheckArgs, file: &Path) -> Result<()> {
+/// Runs `emg check` on a URScript program `file`: prints what was read and `OK`, or fails naming
+/// the line and what the arm would do wrong there. `program` and `robot` are `--program` and
+/// `--robot`, `chain` the chain's ends.
+pub fn check_script(
+    file: &Path,
+    program: Option<&Path>,
+    robot: Option<&Path>,
+    chain: &ChainArgs,
+) -> Result<()> {
     let text =
         std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
-    let program_path = args.program.clone().unwrap_or_else(|| program_beside(file));
-    let job = crate::check::read_job_file(&program_path)
+    let program_path = program.map_or_else(|| program_beside(file), Path::to_path_buf);
+    let job = read_job_file(&program_path)
         .with_context(|| {
             format!(
                 "a URScript program is read back against the job's program it was exported \
@@ -62,11 +70,11 @@ pub fn check_script(args: &CheckArgs, file: &Path) -> Result<()> {
                 file.display()
             )
         })?;
-    let robot_path = match &args.robot {
-        Some(path) => path.clone(),
-        None => crate::robot::resolve(&job.robot, &program_path)?,
+    let robot_path = match robot {
+        Some(path) => path.to_path_buf(),
+        None => robot::resolve(&job.robot, &program_path)?,
     };
-    let ur5e = ShippedRobot::by_path(&robot_path, &crate::robot::data_dir())
+    let ur5e = ShippedRobot::by_path(&robot_path, &robot::data_dir())
         .and_then(|shipped| DriverProfile::for_shipped(shipped.name))
         .is_some_and(DriverProfile::has_ur_controller_frames);
     if !ur5e {
@@ -77,7 +85,7 @@ pub fn check_script(args: &CheckArgs, file: &Path) -> Result<()> {
             robot_path.display()
         );
     }
-    let (_, model) = crate::check::robot_and_checker(args, &robot_path)?;
+    let (_, model) = chain.robot_and_checker(&robot_path)?;
     let fail = |e: emg_ur_check::ReadError| anyhow!("{} does not hold up: {e}", file.display());
     println!(
         "{}: URScript read back against {}, robot {}",

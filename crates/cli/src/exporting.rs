@@ -1,0 +1,228 @@
+//! Writing a joint trajectory or a job's program for a robot's own stack (a ROS 2
+//! `JointTrajectory` in an MCAP bag, or a URScript program), by [`emg_io::export`]: what
+//! `emg export`, `emg plan --export`, `emg job --export` and `emg place --export` share.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use emg_io::{DriverProfile, ExportFormat, ExportOptions, ExportRobot};
+use emg_kinematics::Robot;
+use emg_planner::ShippedRobot;
+
+use crate::robot;
+
+/// The form of a URScript export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum UrScriptForm {
+    /// One program as UR integrators write it: movej between strokes, movel down and up, each
+    /// stroke a blended movep run through the plan's poses, the tool switched by its output
+    /// (a job's program on the shipped UR5e).
+    Native,
+    /// The plan's joint values streamed by servoj every 2 ms, split where the arm rests.
+    Servoj,
+}
+
+/// How a URScript export is written; every command that exports takes these.
+#[derive(Clone, Copy, Debug, Args)]
+pub struct UrScriptArgs {
+    /// urscript: `native` (one program of movej, movel and blended movep through the plan's
+    /// targets, with the tool's output; a job's program on the shipped ur5e) or `servoj` (the
+    /// joint values every 2 ms). Default: native for a job's program, servoj for a joint
+    /// trajectory.
+    #[arg(long, value_name = "FORM", value_enum)]
+    pub urscript: Option<UrScriptForm>,
+    /// urscript servoj: most servoj lines (2 ms each) per program.
+    #[arg(long, value_name = "N", default_value_t = ExportOptions::default().max_servoj_lines)]
+    pub max_servoj: usize,
+}
+
+/// Parses `--format` and `--export`.
+pub fn parse_format(value: &str) -> Result<ExportFormat, String> {
+    value
+        .parse()
+        .map_err(|e: emg_io::ExportError| e.to_string())
+}
+
+/// The driver profile of `robot_file` when it is a shipped robot's file.
+fn shipped_profile(robot_file: &Path) -> Option<&'static DriverProfile> {
+    ShippedRobot::by_path(robot_file, &robot::data_dir())
+        .and_then(|shipped| DriverProfile::for_shipped(shipped.name))
+}
+
+/// Exports the timed motion `trajectory` (read from `input`, named by what it is: a joint
+/// trajectory or a job's program) for the robot of `robot_file`; returns what to print.
+pub fn export_to(
+    trajectory: emg_io::TimedPoints<'_>,
+    format: ExportFormat,
+    out: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+    options: &ExportOptions,
+    input: (&str, &Path),
+) -> Result<String> {
+    let file = robot_file.display().to_string();
+    let reference = robot::reference(robot_file)?.to_string();
+    let target = ExportRobot {
+        file: &file,
+        reference: &reference,
+        shipped: shipped_profile(robot_file),
+        kinematics: Some(robot),
+    };
+    let export = emg_io::export(trajectory, format, out, &target, options)?;
+    export.write(&[input, ("robot", robot_file)])?;
+    let written: Vec<String> = export
+        .files
+        .iter()
+        .map(|(path, _)| path.display().to_string())
+        .collect();
+    Ok(format!(
+        "{}\n  wrote {}",
+        export.summary,
+        written.join(", ")
+    ))
+}
+
+/// The file `--export FORMAT` of `emg job` and `emg place` writes beside the program `out`:
+/// its extension `.mcap` or `.script`.
+pub fn beside_program(out: &Path, format: ExportFormat) -> PathBuf {
+    out.with_extension(format.extension())
+}
+
+/// Refuses, before anything is planned, `--export FORMAT` of a program for a robot it cannot run
+/// on (URScript for an arm that is not a Universal Robots arm).
+pub fn refuse_program_export(
+    format: Option<ExportFormat>,
+    urscript: &UrScriptArgs,
+    robot_file: &Path,
+) -> Result<()> {
+    let Some(format) = format else {
+        return Ok(());
+    };
+    let robot = robot::load_robot(robot_file, None, None)?;
+    refuse_format(format, robot_file, &robot)
+        .context("--export urscript: nothing was planned or written")?;
+    if format == ExportFormat::UrScript {
+        writes_native(urscript, robot_file)
+            .context("--export urscript: nothing was planned or written")?;
+    }
+    Ok(())
+}
+
+/// Exports a job's program `file`, written to `out`, as `format` beside it
+/// ([`beside_program`]); returns what to print.
+pub fn export_program(
+    file: &emg_job::JobFile,
+    format: ExportFormat,
+    urscript: &UrScriptArgs,
+    out: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    let target = ExportTarget {
+        format,
+        out: &beside_program(out, format),
+        urscript,
+        thinning_tolerance: ExportOptions::default().tolerance_rad,
+    };
+    export_job(file, &target, out, robot_file, robot)
+}
+
+/// What a job's program is exported as, and where.
+pub struct ExportTarget<'a> {
+    /// The format written.
+    pub format: ExportFormat,
+    /// The file written (a split URScript stream: its parts beside it).
+    pub out: &'a Path,
+    /// How a URScript export is written.
+    pub urscript: &'a UrScriptArgs,
+    /// ros2-mcap: the largest joint deviation (rad) of the thinned trajectory.
+    pub thinning_tolerance: f64,
+}
+
+/// Exports the job's program `file` (read from `input`) for the robot of `robot_file`: a native
+/// UR program unless `--urscript servoj` asks for the joint stream; returns what to print.
+pub fn export_job(
+    file: &emg_job::JobFile,
+    target: &ExportTarget<'_>,
+    input: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    if target.format == ExportFormat::UrScript && writes_native(target.urscript, robot_file)? {
+        return native_ur_program(file, target.out, input, robot_file, robot);
+    }
+    let options = ExportOptions {
+        tolerance_rad: target.thinning_tolerance,
+        max_servoj_lines: target.urscript.max_servoj,
+    };
+    let (points, switches) = (file.points(), file.tool_switches());
+    let output = file.settings.tool_output.to_string();
+    let tool = emg_io::ToolSwitching {
+        switches: &switches,
+        output: &output,
+    };
+    export_to(
+        file.timed_points(&points, tool),
+        target.format,
+        target.out,
+        robot_file,
+        robot,
+        &options,
+        ("job program", input),
+    )
+}
+
+/// Whether a URScript export of a job's program is written native: where `--urscript` asks
+/// (refused for a robot other than the shipped UR5e, the one whose base and flange frames are
+/// known to be the controller's Base and tool flange), and by default on the shipped UR5e;
+/// servoj on any other UR arm.
+fn writes_native(urscript: &UrScriptArgs, robot_file: &Path) -> Result<bool> {
+    let known = shipped_profile(robot_file).is_some_and(DriverProfile::has_ur_controller_frames);
+    match urscript.urscript {
+        Some(UrScriptForm::Servoj) => Ok(false),
+        Some(UrScriptForm::Native) if !known => anyhow::bail!(
+            "--urscript native writes poses in the controller's Base frame with the TCP on the \
+             tool flange, frames known for the shipped ur5e only; robot {} is not it: export \
+             --urscript servoj",
+            robot_file.display()
+        ),
+        Some(UrScriptForm::Native) => Ok(true),
+        None => Ok(known),
+    }
+}
+
+/// Writes the job's program `file` (read from `input`) as one native UR program to `out`;
+/// returns what to print.
+fn native_ur_program(
+    file: &emg_job::JobFile,
+    out: &Path,
+    input: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    let reference = robot::reference(robot_file)?.to_string();
+    let export = emg_job::ur_program::ur_program_export(file, robot, &reference, out)?;
+    export.write(&[("job program", input), ("robot", robot_file)])?;
+    Ok(format!("{}\n  wrote {}", export.summary, out.display()))
+}
+
+/// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when
+/// shipped, else by its joint names).
+pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> Result<()> {
+    let names = robot.joint_names();
+    let is_ur = match shipped_profile(robot_file) {
+        Some(profile) => profile.joint_names == emg_io::UR_JOINT_NAMES,
+        None => emg_io::is_universal_robots_arm(names),
+    };
+    if format == ExportFormat::UrScript && !is_ur {
+        return Err(anyhow::Error::new(
+            emg_io::ExportError::NotUniversalRobots {
+                robot: robot_file.display().to_string(),
+                joints: names.len(),
+                names: names.join(", "),
+            },
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,100 @@
+//! A job's program (an `emg-job/3` file): read back from a file, and its summary printed as
+//! `emg job` and `emg place` print it.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+
+use crate::output::count;
+
+/// The job program in `file`, when it is a job's program (refused where it is one of another
+/// version).
+pub fn read_job_file(file: &Path) -> Result<Option<emg_job::JobFile>> {
+    let text =
+        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    if !emg_job::JobFile::is_job(&text) {
+        return Ok(None);
+    }
+    let job =
+        emg_job::JobFile::parse(&text).map_err(|e| anyhow::anyhow!("{} {e}", file.display()))?;
+    Ok(Some(job))
+}
+
+/// Prints a planned program's summary: strokes, length drawn, travel, times, what was left out.
+pub fn print_summary(file: &emg_job::JobFile) {
+    let s = &file.summary;
+    println!(
+        "{}: {} complete, {} resumed after a reconfiguration, {} short",
+        count(file.strokes.len(), "stroke"),
+        s.complete,
+        s.resumed,
+        s.short
+    );
+    let (merged, into) = file.ordering.merged();
+    if merged > 0 {
+        println!(
+            "{} merged into {into}, meeting end to end",
+            count(merged, "stroke")
+        );
+    }
+    println!(
+        "pen down {:.4} m of {:.4} m ({:.1} %); pen-up travel {:.3} m in the order drawn ({:.3} m as given)",
+        s.drawn_m,
+        s.total_m,
+        100.0 * s.drawn_m / s.total_m.max(f64::MIN_POSITIVE),
+        s.travel_m,
+        s.travel_given_m
+    );
+    println!(
+        "program {:.2} s ({:.2} s pen down, {:.2} s pen up; {}, {} found by the sampling \
+         planner); planned in {:.2} s ({})",
+        s.duration_s,
+        s.pen_down_s,
+        s.pen_up_s,
+        count(s.straight_moves, "straight move"),
+        s.sampled_moves,
+        s.planning_s,
+        count(s.searches, "search")
+    );
+    println!(
+        "at the arm's limits no program drawing these parts lasts less than {:.2} s ({:.2} s pen \
+         down, {:.2} s pen up): this one takes {:.2}×",
+        s.least_pen_down_s + s.least_pen_up_s,
+        s.least_pen_down_s,
+        s.least_pen_up_s,
+        s.duration_s / (s.least_pen_down_s + s.least_pen_up_s).max(f64::MIN_POSITIVE)
+    );
+    for stroke in &file.strokes {
+        let undrawn = stroke
+            .unreached
+            .iter()
+            .zip(&stroke.unreached_at)
+            .zip(&stroke.unreached_causes);
+        for ((stretch, at), cause) in undrawn {
+            println!(
+                "  stroke {}: {:.4} m not drawn from {:.4} m along it, at ({:.3}, {:.3}, {:.3}): {cause}",
+                stroke.stroke,
+                stretch.length_m(),
+                stretch.from_s,
+                at[0],
+                at[1],
+                at[2]
+            );
+        }
+    }
+    if file.home.is_none() {
+        println!(
+            "  the robot has no home: the program starts above its first stroke and ends above \
+             its last (give --home)"
+        );
+    } else if !s.ends_at_home {
+        println!(
+            "  no free move back to the job's home was found: the program ends above its last stroke"
+        );
+    }
+    for stroke in &file.strokes {
+        for why in &stroke.parts_left_out {
+            println!("  stroke {}, {why}", stroke.stroke);
+        }
+    }
+}
