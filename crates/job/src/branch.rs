@@ -19,7 +19,8 @@
 use emg_kinematics::JointVector;
 use rayon::prelude::*;
 
-use crate::SAME_LENGTH_M;
+use crate::measures::SAME_LENGTH_M;
+use crate::plan_strokes::PlannedStroke;
 use crate::stroke::StrokePlan;
 
 /// Consecutive strokes placed further apart than this on some joint (rad, from the end of one
@@ -67,22 +68,24 @@ struct Candidate {
     ends: [JointVector; 2],
 }
 
-/// The plans to connect again for the strokes planned as `plans` (one per stroke, in the order
-/// drawn; each by the job's cascade's planner of its rank in `ranks`), connected once with their parts placed as `placed` says (where each stroke's first part
+/// The plans to connect again for the planned `strokes` (in the order drawn; each planned by
+/// the job's cascade's planner of its rank), connected once with their parts placed as
+/// `placed` says (where each stroke's first part
 /// starts and its last ends, as [`Branches::ends`] holds them; `None` where none was placed):
 /// each stroke's branch chosen for the job as a whole (the module's description), the arm
 /// starting and ending at `home` where it has one. `None` where no stroke changes branch.
 /// Deterministic: the candidates are found in parallel but gathered in order, and ties keep the
 /// strokes as placed.
 pub fn choose_branches(
-    plans: &[StrokePlan],
-    ranks: &[usize],
+    strokes: &[PlannedStroke],
     placed: &[Option<[JointVector; 2]>],
     home: Option<&JointVector>,
     job: &impl Branches,
 ) -> Option<Vec<BranchChoice>> {
     // The strokes that have a part, in the order drawn: the others play no part in the choice.
-    let drawn: Vec<usize> = (0..plans.len()).filter(|&i| placed[i].is_some()).collect();
+    let drawn: Vec<usize> = (0..strokes.len())
+        .filter(|&i| placed[i].is_some())
+        .collect();
     let ends = |i: usize| placed[i].expect("a drawn stroke has ends");
     let changes: Vec<usize> = (1..drawn.len())
         .filter(|&k| apart(&ends(drawn[k - 1])[1], &ends(drawn[k])[0]) > BRANCH_CHANGE_RAD)
@@ -93,9 +96,9 @@ pub fn choose_branches(
     // Per change, the branches known about it carried to the strokes about it.
     let carried: Vec<Vec<(usize, Candidate)>> = changes
         .par_iter()
-        .map(|&k| carried_about((plans, ranks), placed, &drawn, k, job))
+        .map(|&k| carried_about(strokes, placed, &drawn, k, job))
         .collect();
-    let mut others: Vec<Vec<Candidate>> = (0..plans.len()).map(|_| Vec::new()).collect();
+    let mut others: Vec<Vec<Candidate>> = (0..strokes.len()).map(|_| Vec::new()).collect();
     for (stroke, candidate) in carried.into_iter().flatten() {
         others[stroke].push(candidate);
     }
@@ -112,12 +115,11 @@ pub fn choose_branches(
     if picks.iter().all(|&pick| pick == 0) {
         return None;
     }
-    let mut chosen: Vec<BranchChoice> = plans
+    let mut chosen: Vec<BranchChoice> = strokes
         .iter()
-        .zip(ranks)
-        .map(|(plan, rank)| BranchChoice {
-            plan: plan.clone(),
-            rank: *rank,
+        .map(|stroke| BranchChoice {
+            plan: stroke.plan.clone(),
+            rank: stroke.rank,
             moved_to: None,
         })
         .collect();
@@ -156,7 +158,7 @@ fn new_branch(known: &[[JointVector; 2]], ends: &[JointVector; 2]) -> bool {
 /// they lie on another branch than placed, then each branch known there carried to the strokes
 /// before and after it (the module's description). With the stroke each is for.
 fn carried_about(
-    (plans, ranks): (&[StrokePlan], &[usize]),
+    strokes: &[PlannedStroke],
     placed: &[Option<[JointVector; 2]>],
     drawn: &[usize],
     k: usize,
@@ -170,13 +172,18 @@ fn carried_about(
     let mut found: Vec<(usize, Candidate)> = Vec::new();
     // Each branch to carry: where it lies in the window, its ends there, the rank of its
     // planner, and whether it is carried back (to earlier strokes) and on (to later ones).
-    let rank = |position: usize| ranks[drawn[position]];
+    let rank = |position: usize| strokes[drawn[position]].rank;
     let mut seeds = vec![
         (k, placed_ends(k), rank(k), true, false),
         (k - 1, placed_ends(k - 1), rank(k - 1), false, true),
     ];
     for position in window.clone() {
-        let (own, own_rank) = (&plans[drawn[position]], ranks[drawn[position]]);
+        let PlannedStroke {
+            plan: own,
+            rank: own_rank,
+            ..
+        } = &strokes[drawn[position]];
+        let own_rank = *own_rank;
         let Some(ends) = job.ends(own) else {
             continue;
         };
@@ -192,7 +199,7 @@ fn carried_about(
     // where it draws as far on a branch not known for it, kept: its ends.
     let mut extend = |position: usize, from: &JointVector, rank: usize| {
         let stroke = drawn[position];
-        let own = &plans[stroke];
+        let own = &strokes[stroke].plan;
         let plan = job
             .carried(own, rank, from)
             .filter(|plan| plan.planned_m() >= own.planned_m() - SAME_LENGTH_M)?;

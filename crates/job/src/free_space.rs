@@ -47,7 +47,7 @@ pub const TIP_CHECKS_PER_STEP: f64 = 10.0;
 const SAME_PLANE: f64 = 1e-6;
 
 /// The part under `job`'s strokes: [`part_surfaces`] of their tasks.
-pub fn job_part(robot: &Robot, job: &crate::Job) -> Vec<Task> {
+pub fn job_part(robot: &Robot, job: &crate::spec::Job) -> Vec<Task> {
     let tasks: Vec<Task> = job
         .strokes
         .iter()

@@ -27,10 +27,13 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::free_space::{job_part, with_part};
+use crate::measures::SAME_LENGTH_M;
+use crate::pipeline::plan_job;
+use crate::plan_error::JobPlanError;
 use crate::program::JobFile;
 use crate::spec::{Job, JobError, Order, Transform};
+use crate::stroke::reachable_start_s;
 use crate::watch::{Stopped, StopsWith, Watch};
-use crate::{JobPlanError, SAME_LENGTH_M, plan_job, reachable_start_s};
 
 /// The step scores are ranked in: within one, the place deeper inside the arm's reach goes
 /// first.
