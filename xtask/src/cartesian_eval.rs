@@ -3,7 +3,6 @@
 //! paper's pipeline's seed, beside the same tasks' reachability bounds, the pipeline and the
 //! default search (read from `search.json`), per bucket of the bound.
 
-use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -11,25 +10,27 @@ use emg_eval::{BoundShare, bound_shares};
 use emg_planner::{CartesianConfig, cartesian_path, prepare_seed};
 use serde::{Deserialize, Serialize};
 
-use crate::progress;
 use crate::search_eval;
-use crate::workspace;
+use crate::task_set_options::TaskSetOptions;
+use crate::{progress, workspace};
+
+/// Where `--threads` stands among the options of `cartesian-eval`: after the other three of
+/// [`TaskSetOptions`].
+const LAST_SLOT: usize = 4;
 
 /// Options of `cargo xtask cartesian-eval`.
-#[derive(Debug, clap::Args)]
+#[derive(clap::Args)]
+#[command(
+    mut_arg("task_file", |arg| arg.help("Task set: the one `search-eval` planned (its bounds are read from search.json)")),
+    mut_arg("out_dir", |arg| arg.help("Directory holding search.json and receiving cartesian.{json,md}")),
+    mut_arg("threads", |arg| arg
+        .help("Worker threads (0 = one per core); the lengths do not depend on it")
+        .display_order(LAST_SLOT)),
+)]
 pub struct Args {
-    /// Task set: the one `search-eval` planned (its bounds are read from search.json).
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file.
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Directory holding search.json and receiving cartesian.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
-    /// Worker threads (0 = one per core); the lengths do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
 }
 
 /// The Cartesian paths of the evaluation tasks.
@@ -65,7 +66,7 @@ pub struct Record {
 
 /// Plans every task's Cartesian path and writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let search_path = args.out_dir.join("search.json");
+    let search_path = args.common.out_dir.join("search.json");
     let search: search_eval::Record =
         serde_json::from_str(&std::fs::read_to_string(&search_path).with_context(|| {
             format!(
@@ -74,8 +75,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             )
         })?)?;
     let workspace::PlannerSetup { planner, tasks, .. } = workspace::planner_setup(
-        &args.robot,
-        &args.task_file,
+        &args.common.robot,
+        &args.common.task_file,
         search.task_count,
         "cartesian-eval",
     )?;
@@ -86,7 +87,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         search.bounds_m.len(),
         tasks.len()
     );
-    let pool = workspace::thread_pool(args.threads)?;
+    let pool = workspace::thread_pool(args.common.threads)?;
     let config = CartesianConfig::default();
     let constraints = &planner.config().rollout.constraints;
     let bar = progress::bar(tasks.len() as u64, "Cartesian paths");
@@ -141,7 +142,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let record = Record {
         robot: planner.robot().name().to_string(),
-        tasks: workspace::relative(&args.task_file),
+        tasks: workspace::relative(&args.common.task_file),
         task_count: tasks.len(),
         machine: workspace::machine(),
         cartesian: config,
@@ -155,7 +156,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         mean_ms: total_ms / tasks.len().max(1) as f64,
         lengths_m: lengths,
     };
-    workspace::write_results(&args.out_dir, "cartesian", &record, &markdown(&record))
+    workspace::write_results(
+        &args.common.out_dir,
+        "cartesian",
+        &record,
+        &markdown(&record),
+    )
 }
 
 /// The record as a page.

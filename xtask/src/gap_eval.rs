@@ -4,7 +4,7 @@
 //! the bound, where each gets back to, and whether the arm can change from the plan's branch to
 //! theirs in place or going back and forth along the line (`docs/results/gaps.{json,md}`).
 
-use std::path::PathBuf;
+use std::path::Path;
 
 use emg_control::{Task, Tracking};
 use emg_planner::{GapProbe, GapProbeOutcome, InPlaceConfig, Planner, gap_probes};
@@ -12,16 +12,40 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::precision_eval::Setting;
+use crate::results::{SummaryTable, shipped_results};
+use crate::task_set_options::TaskSetOptions;
 use crate::{progress, workspace};
 
 /// The markers around the table of [`report_table`] in `docs/results/summary.md` (written there
 /// by `cargo xtask report`, [`crate::workspace::RESULTS_SUMMARY`]).
-pub const README_START: &str = "<!-- gaps:start -->";
+const README_START: &str = "<!-- gaps:start -->";
 /// See [`README_START`].
-pub const README_END: &str = "<!-- gaps:end -->";
+const README_END: &str = "<!-- gaps:end -->";
+
+/// The section of `docs/results.md` before the table.
+const INTRO: &str = "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
+         step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
+         the far side: motions planned back from beyond the plan's end, and motions in place \
+         and along the line between their branches and the plan's (`cargo xtask gap-eval`; \
+         `docs/results/gaps.md` per arm):\n\n";
+
+/// The table of likely-loose bounds ([`report_table`]) in its section and between its
+/// markers in the results summary.
+pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
+    Ok(SummaryTable {
+        page: workspace::RESULTS_SUMMARY,
+        start: README_START,
+        end: README_END,
+        intro: INTRO,
+        table: report_table(results)?,
+    })
+}
 
 /// Options of `gap-eval`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("out_dir", |arg| arg.help("Output directory of gaps.{json,md}")),
+)]
 pub struct Args {
     /// Lines: the first this many tasks of the task set (`precision-eval`'s).
     #[arg(long, default_value_t = 400)]
@@ -33,18 +57,9 @@ pub struct Args {
     /// (its budget).
     #[arg(long, default_value_t = InPlaceConfig::default().samples)]
     samples: usize,
-    /// Worker threads (0 = one per core); the results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
-    /// Task set.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file.
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of gaps.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
 }
 
 /// A line whose bound is likely loose, and its probes.
@@ -130,8 +145,12 @@ pub struct Record {
 
 /// Plans every line, probes those whose bound is likely loose, writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let workspace::PlannerSetup { planner, tasks, .. } =
-        workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "gap-eval")?;
+    let workspace::PlannerSetup { planner, tasks, .. } = workspace::planner_setup(
+        &args.common.robot,
+        &args.common.task_file,
+        args.tasks,
+        "gap-eval",
+    )?;
     let setting = Setting {
         tolerance_mm: args.tolerance_mm,
         tracking: Tracking::Corrected,
@@ -143,7 +162,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         ..InPlaceConfig::default()
     };
     in_place.validate()?;
-    let pool = workspace::thread_pool(args.threads)?;
+    let pool = workspace::thread_pool(args.common.threads)?;
     let bar = progress::bar(tasks.len() as u64, "lines");
     let lines: Vec<(f64, f64, Option<LooseLine>)> = pool.install(|| {
         tasks
@@ -159,8 +178,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     bar.finish();
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: workspace::command_for("gap-eval", &args.robot),
-        tasks: workspace::relative(&args.task_file),
+        command: workspace::command_for("gap-eval", &args.common.robot),
+        tasks: workspace::relative(&args.common.task_file),
         line_count: tasks.len(),
         tolerance_mm: args.tolerance_mm,
         in_place,
@@ -173,7 +192,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         machine: workspace::machine(),
         threads: pool.current_num_threads(),
     };
-    workspace::write_results(&args.out_dir, "gaps", &record, &markdown(&record))
+    workspace::write_results(&args.common.out_dir, "gaps", &record, &markdown(&record))
 }
 
 /// The plan's length and bound of one line, with its probes when its bound is likely loose.
@@ -304,7 +323,7 @@ impl Summary {
 }
 
 /// The report's table: one row per shipped arm with a `gaps.json`.
-pub fn report_table(results: &std::path::Path) -> anyhow::Result<String> {
+fn report_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | lines: Σ plan / Σ bound | likely loose | their Σ plan / Σ bound (m) \
          | longest shown from `p0` (m) | with one stop in place (m) | back and forth along the \
@@ -312,7 +331,7 @@ pub fn report_table(results: &std::path::Path) -> anyhow::Result<String> {
          | joined along the line | Σ plan / Σ bound over the others |\n\
          |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for (shipped, record) in crate::report::shipped_results::<Record>(results, "gaps.json")? {
+    for (shipped, record) in shipped_results::<Record>(results, "gaps.json")? {
         let summary = Summary::of(&record);
         md.push_str(&format!(
             "| {} | {} mm | {:.3} | {} of {} | {:.2} / {:.2} | {:.2} | {:.2} | {:.2} | {} / {} / {} / \

@@ -28,10 +28,19 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::search_eval::far_end_points;
+use crate::task_set_options::TaskSetOptions;
 use crate::{progress, workspace};
+
+/// Where `--out-dir` stands among the options of `limit` (after `--tasks`, `--shard`,
+/// `--merge` and the three options before it in [`TaskSetOptions`]): `--journal` is listed
+/// there, before it.
+const OUT_DIR_SLOT: usize = 6;
 
 /// Options of `limit`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("out_dir", |arg| arg.help("Output directory of limit.{json,md}")),
+)]
 pub struct Args {
     /// Tasks: the first this many of the task set.
     #[arg(long, default_value_t = 1000)]
@@ -42,21 +51,12 @@ pub struct Args {
     /// Merge the journal into docs/results/limit.{json,md} instead of running.
     #[arg(long)]
     merge: bool,
-    /// Worker threads (0 = one per core); the results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
-    /// Task set.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file.
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
     /// Journal directory: one file per finished task.
-    #[arg(long, default_value_os_t = workspace::scratch("limit"))]
+    #[arg(long, default_value_os_t = workspace::scratch("limit"), display_order = OUT_DIR_SLOT)]
     journal: PathBuf,
-    /// Output directory of limit.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
 }
 
 /// The search settings of the limit: far more starts, finalists, repairs, chains and steps
@@ -121,9 +121,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "limit")?;
+    } = workspace::planner_setup(
+        &args.common.robot,
+        &args.common.task_file,
+        args.tasks,
+        "limit",
+    )?;
     let identity = Identity {
-        tasks: workspace::relative(&args.task_file),
+        tasks: workspace::relative(&args.common.task_file),
         task_count: tasks.len(),
         limit: limit_search(),
         search: SearchConfig::default(),
@@ -157,7 +162,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner: PlannerKind::Search,
         ..PlanRequest::pipeline()
     };
-    workspace::thread_pool(args.threads)?.install(|| {
+    workspace::thread_pool(args.common.threads)?.install(|| {
         pending.par_iter().try_for_each(|&index| {
             let task = &tasks[index];
             let plan = |planner: &Planner, request: &PlanRequest| {
@@ -356,14 +361,14 @@ fn merge(args: &Args, identity: &Identity) -> anyhow::Result<()> {
         )
         .collect();
     let record = Record {
-        robot: workspace::relative(&args.robot),
+        robot: workspace::relative(&args.common.robot),
         identity: identity.clone(),
         by_bound,
         continuity: continuity(&records),
         buckets_by_limit: buckets,
         rows,
     };
-    workspace::write_results(&args.out_dir, "limit", &record, &markdown(&record))
+    workspace::write_results(&args.common.out_dir, "limit", &record, &markdown(&record))
 }
 
 /// The continuity of the short tasks per bucket of the bound, then over all tasks.

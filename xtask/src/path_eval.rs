@@ -6,7 +6,7 @@
 //! them; the rectangles also planned one line at a time, as a line-only planner makes a user
 //! plan them (`docs/results/paths.{json,md}`).
 
-use std::path::PathBuf;
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -14,17 +14,25 @@ use emg_control::{CheckRollout, PathShape, Task, Termination, path_tasks};
 use emg_eval::{LinesOutcome, Summary, lines_one_at_a_time};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    ControllerKind, DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind,
-    SeedSource, limits_file_beside,
+    ControllerKind, DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner,
+    PlannerKind, SeedSource,
 };
-use emg_timing::Scaling;
+use emg_verify::ReferenceModel;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::results::shipped_results;
+use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
 use crate::{progress, workspace};
 
 /// Options of `path-eval`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("threads", |arg| arg.help(THREADS_TIMED)),
+    mut_arg("task_file", |arg| arg.help("Task set whose starts the paths leave from")),
+    mut_arg("robot", |arg| arg.help(ROBOT_WITH_JOINT_LIMITS)),
+    mut_arg("out_dir", |arg| arg.help("Output directory of paths.{json,md}")),
+)]
 pub struct Args {
     /// Paths: one from each of the first this many tasks of the task set.
     #[arg(long, default_value_t = 1000)]
@@ -32,18 +40,9 @@ pub struct Args {
     /// Seed of the path population's sizes and sides.
     #[arg(long, default_value_t = 20_261_126)]
     seed: u64,
-    /// Worker threads (0 = one per core); the results other than times do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
-    /// Task set whose starts the paths leave from.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file (its joint limits are the `.joint_limits.yaml` beside it).
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of paths.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
 }
 
 /// One path's outcome.
@@ -165,127 +164,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks: anchors,
-    } = workspace::planner_setup(&args.robot, &args.task_file, args.paths, "path-eval")?;
+    } = workspace::planner_setup(
+        &args.common.robot,
+        &args.common.task_file,
+        args.paths,
+        "path-eval",
+    )?;
     let paths = path_tasks(planner.robot(), &anchors, args.seed)?;
-    let pool = workspace::thread_pool(args.threads)?;
-    let config = planner.config().clone();
-    let constraints = &config.rollout.constraints;
-    let limits_file = limits_file_beside(&args.robot);
-    let timing = MotionTiming::new(
-        planner.robot(),
-        &limits_file,
-        Scaling::default(),
-        config.rollout.speed_m_per_s,
-        DEFAULT_RATE_HZ,
-        constraints,
-    )
-    .with_context(|| format!("the joint limits {}", limits_file.display()))?;
-    let classical = PlanRequest {
-        planner: PlannerKind::Controller,
-        seed: Some(SeedSource::Generating),
-        controller: ControllerKind::Classical,
+    let pool = workspace::thread_pool(args.common.threads)?;
+    let (timing, _) = workspace::motion_timing(&planner, &args.common.robot, DEFAULT_RATE_HZ)?;
+    let robot_name = args.common.robot.display().to_string();
+    let comparison = Comparison {
+        planner: &planner,
+        checker: &checker,
+        timing: &timing,
+        robot_name: &robot_name,
     };
-    let pipeline = PlanRequest::pipeline();
-    let search = PlanRequest::default();
-    let search_classical = PlanRequest {
-        controller: ControllerKind::Classical,
-        ..PlanRequest::default()
-    };
-    let robot_name = args.robot.display().to_string();
     let bar = progress::bar(paths.len() as u64, "paths");
     let outcomes: Vec<(PathRow, Vec<String>)> = pool.install(|| {
         paths
             .par_iter()
             .enumerate()
-            .map(|(index, (shape, task))| -> anyhow::Result<_> {
-                let mut failures = Vec::new();
-                let mut check = |what: &str, result: Result<(), String>| {
-                    if let Err(problem) = result {
-                        failures.push(format!("{} path, {what}: {problem}", shape.name()));
-                    }
-                };
-                let base = planner.plan(task, &classical)?;
-                check(
-                    "classical rollout",
-                    checker
-                        .check(task, &base.trajectory, constraints)
-                        .map_err(|e| e.to_string()),
-                );
-                let learned = planner.plan(task, &pipeline)?;
-                let classical_search = planner.plan(task, &search_classical)?;
-                for (what, plan) in [
-                    ("pipeline", &learned),
-                    ("classical search", &classical_search),
-                ] {
-                    check(
-                        what,
-                        checker
-                            .check(task, &plan.trajectory, constraints)
-                            .map_err(|e| e.to_string()),
-                    );
-                }
-                let started = Instant::now();
-                let plan = planner.plan(task, &search)?;
-                let plan_ms = started.elapsed().as_secs_f64() * 1e3;
-                let bound = planner.bound_note(task, &plan);
-                let record = PlanRecord {
-                    robot: &robot_name,
-                    request: &search,
-                    bound: Some(&bound),
-                    timing: &timing,
-                };
-                let files = PlanFiles::new(&planner, task, &plan, &record).with_context(|| {
-                    format!(
-                        "path {index} ({}): {}",
-                        shape.name(),
-                        serde_json::to_string(task.path.as_ref().expect("a path task"))
-                            .unwrap_or_default()
-                    )
-                })?;
-                for (what, text, own_task) in [
-                    ("search's trajectory file", &files.json, true),
-                    (
-                        "search's joint trajectory file",
-                        &files.joint_trajectory,
-                        true,
-                    ),
-                ] {
-                    let verified = TrajectoryContents::parse(text)
-                        .map_err(|e| e.to_string())
-                        .and_then(|contents| {
-                            contents
-                                .verify(
-                                    &checker,
-                                    planner.robot().joint_names(),
-                                    task,
-                                    constraints,
-                                    own_task,
-                                    None,
-                                )
-                                .map(|_| ())
-                                .map_err(|e| e.to_string())
-                        });
-                    check(what, verified);
-                }
-                let lines = lines_one_at_a_time(&planner, task, &search).transpose()?;
+            .map(|(index, (shape, task))| {
+                let outcome = comparison.plan_path(index, *shape, task);
                 bar.inc(1);
-                let length_m = task.length_m().unwrap_or(0.0);
-                Ok((
-                    PathRow {
-                        shape: *shape,
-                        length_m,
-                        classical_m: base.trajectory.path_length_m,
-                        pipeline_m: learned.trajectory.path_length_m,
-                        search_classical_m: classical_search.trajectory.path_length_m,
-                        search_m: plan.trajectory.path_length_m,
-                        bound_m: bound.reachable_m,
-                        search_completed: plan.trajectory.termination == Termination::Completed,
-                        lines,
-                        duration_s: files.timing.duration_s,
-                        plan_ms,
-                    },
-                    failures,
-                ))
+                outcome
             })
             .collect::<anyhow::Result<Vec<_>>>()
     })?;
@@ -294,8 +197,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let failures: Vec<String> = failures.into_iter().flatten().collect();
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: workspace::command_for("path-eval", &args.robot),
-        tasks: workspace::relative(&args.task_file),
+        command: workspace::command_for("path-eval", &args.common.robot),
+        tasks: workspace::relative(&args.common.task_file),
         seed: args.seed,
         machine: workspace::machine(),
         threads: pool.current_num_threads(),
@@ -309,7 +212,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         failure_examples: failures.iter().take(5).cloned().collect(),
         rows,
     };
-    workspace::write_results(&args.out_dir, "paths", &record, &markdown(&record))?;
+    workspace::write_results(&args.common.out_dir, "paths", &record, &markdown(&record))?;
     anyhow::ensure!(
         record.checker_failures == 0,
         "{} checks fail, e.g. {}",
@@ -317,6 +220,138 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         failures[0]
     );
     Ok(())
+}
+
+/// What every path is planned, checked and timed with.
+struct Comparison<'a> {
+    planner: &'a Planner,
+    checker: &'a ReferenceModel,
+    timing: &'a MotionTiming,
+    /// The robot file as the plan records name it.
+    robot_name: &'a str,
+}
+
+impl Comparison<'_> {
+    /// Path `index` planned by the classical controller, the pipeline and the search (with the
+    /// classical controller too), checked, the search's files written, read back and checked,
+    /// and one line at a time; its row and what the checker rejects.
+    fn plan_path(
+        &self,
+        index: usize,
+        shape: PathShape,
+        task: &Task,
+    ) -> anyhow::Result<(PathRow, Vec<String>)> {
+        let constraints = &self.planner.config().rollout.constraints;
+        let classical = PlanRequest {
+            planner: PlannerKind::Controller,
+            seed: Some(SeedSource::Generating),
+            controller: ControllerKind::Classical,
+        };
+        let pipeline = PlanRequest::pipeline();
+        let search = PlanRequest::default();
+        let search_classical = PlanRequest {
+            controller: ControllerKind::Classical,
+            ..PlanRequest::default()
+        };
+        let mut failures = Vec::new();
+        let mut check = |what: &str, result: Result<(), String>| {
+            if let Err(problem) = result {
+                failures.push(format!("{} path, {what}: {problem}", shape.name()));
+            }
+        };
+        let base = self.planner.plan(task, &classical)?;
+        check(
+            "classical rollout",
+            self.checker
+                .check(task, &base.trajectory, constraints)
+                .map_err(|e| e.to_string()),
+        );
+        let learned = self.planner.plan(task, &pipeline)?;
+        let classical_search = self.planner.plan(task, &search_classical)?;
+        for (what, plan) in [
+            ("pipeline", &learned),
+            ("classical search", &classical_search),
+        ] {
+            check(
+                what,
+                self.checker
+                    .check(task, &plan.trajectory, constraints)
+                    .map_err(|e| e.to_string()),
+            );
+        }
+        let started = Instant::now();
+        let plan = self.planner.plan(task, &search)?;
+        let plan_ms = started.elapsed().as_secs_f64() * 1e3;
+        let bound = self.planner.bound_note(task, &plan);
+        let record = PlanRecord {
+            robot: self.robot_name,
+            request: &search,
+            bound: Some(&bound),
+            timing: self.timing,
+        };
+        let files = PlanFiles::new(self.planner, task, &plan, &record).with_context(|| {
+            format!(
+                "path {index} ({}): {}",
+                shape.name(),
+                serde_json::to_string(task.path.as_ref().expect("a path task")).unwrap_or_default()
+            )
+        })?;
+        for (what, verified) in self.verify_files(task, &files) {
+            check(what, verified);
+        }
+        let lines = lines_one_at_a_time(self.planner, task, &search).transpose()?;
+        let length_m = task.length_m().unwrap_or(0.0);
+        Ok((
+            PathRow {
+                shape,
+                length_m,
+                classical_m: base.trajectory.path_length_m,
+                pipeline_m: learned.trajectory.path_length_m,
+                search_classical_m: classical_search.trajectory.path_length_m,
+                search_m: plan.trajectory.path_length_m,
+                bound_m: bound.reachable_m,
+                search_completed: plan.trajectory.termination == Termination::Completed,
+                lines,
+                duration_s: files.timing.duration_s,
+                plan_ms,
+            },
+            failures,
+        ))
+    }
+
+    /// The search's trajectory files of `task` read back and verified as `emg check` verifies
+    /// them: each file's name and what the checker says.
+    fn verify_files(
+        &self,
+        task: &Task,
+        files: &PlanFiles,
+    ) -> [(&'static str, Result<(), String>); 2] {
+        let constraints = &self.planner.config().rollout.constraints;
+        let verify = |text: &str| {
+            TrajectoryContents::parse(text)
+                .map_err(|e| e.to_string())
+                .and_then(|contents| {
+                    contents
+                        .verify(
+                            self.checker,
+                            self.planner.robot().joint_names(),
+                            task,
+                            constraints,
+                            true,
+                            None,
+                        )
+                        .map(|_| ())
+                        .map_err(|e| e.to_string())
+                })
+        };
+        [
+            ("search's trajectory file", verify(&files.json)),
+            (
+                "search's joint trajectory file",
+                verify(&files.joint_trajectory),
+            ),
+        ]
+    }
 }
 
 /// Whether a reached length counts as the end of a path of `length_m` (the step lands on it
@@ -491,10 +526,10 @@ fn markdown(record: &Record) -> String {
 
 /// The report's section on paths: per shipped arm with a `paths.json` under `results`, the
 /// shares over all paths and per shape, and one line at a time on the rectangles.
-pub fn report_section(results: &std::path::Path) -> anyhow::Result<String> {
+pub fn report_section(results: &Path) -> anyhow::Result<String> {
     let mut rows = String::new();
     let mut lines = String::new();
-    for (shipped, record) in crate::report::shipped_results::<Record>(results, "paths.json")? {
+    for (shipped, record) in shipped_results::<Record>(results, "paths.json")? {
         for row in &record.shapes {
             rows += &format!(
                 "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {} / {} / {} |\n",

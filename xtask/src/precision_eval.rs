@@ -6,7 +6,7 @@
 //! re-checked by the independent checker and every corrected plan timed rest to rest with its
 //! files verified as `emg check` verifies them (`docs/results/precision.{json,md}`).
 
-use std::path::PathBuf;
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
@@ -15,19 +15,37 @@ use emg_eval::{BoundShare, bound_shares};
 use emg_io::TrajectoryContents;
 use emg_planner::{
     ControllerKind, DEFAULT_RATE_HZ, FAR_END_SHARE, MotionTiming, PlanFiles, PlanRecord,
-    PlanRequest, Planner, PlannerConfig, SHORTFALL_SHARE, limits_file_beside,
+    PlanRequest, Planner, PlannerConfig, SHORTFALL_SHARE,
 };
-use emg_timing::Scaling;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::results::{SummaryTable, shipped_results};
+use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
 use crate::{progress, workspace};
 
 /// The markers around the table of [`readme_table`] in `docs/results/summary.md` (written there
 /// by `cargo xtask report`, [`crate::workspace::RESULTS_SUMMARY`]).
-pub const README_START: &str = "<!-- precision:start -->";
+const README_START: &str = "<!-- precision:start -->";
 /// See [`README_START`].
-pub const README_END: &str = "<!-- precision:end -->";
+const README_END: &str = "<!-- precision:end -->";
+
+/// The section of `docs/results.md` before the table.
+const INTRO: &str = "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
+         corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
+         `docs/results/precision.md` per arm):\n\n";
+
+/// The precision table ([`readme_table`]) in its section and between its markers in the
+/// results summary.
+pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
+    Ok(SummaryTable {
+        page: workspace::RESULTS_SUMMARY,
+        start: README_START,
+        end: README_END,
+        intro: INTRO,
+        table: readme_table(results)?,
+    })
+}
 
 /// The tolerances compared (mm): the paper's benchmark, then two a cell uses.
 pub const TOLERANCES_MM: [f64; 3] = [20.0, 0.5, 0.1];
@@ -37,6 +55,11 @@ const UNLEARNED_TOLERANCE_MM: f64 = 0.5;
 
 /// Options of `precision-eval`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("threads", |arg| arg.help(THREADS_TIMED)),
+    mut_arg("robot", |arg| arg.help(ROBOT_WITH_JOINT_LIMITS)),
+    mut_arg("out_dir", |arg| arg.help("Output directory of precision.{json,md}")),
+)]
 pub struct Args {
     /// Lines: the first this many tasks of the task set.
     #[arg(long, default_value_t = 400)]
@@ -47,18 +70,9 @@ pub struct Args {
     /// Seed of the path population's sizes and sides (`path-eval`'s).
     #[arg(long, default_value_t = 20_261_126)]
     seed: u64,
-    /// Worker threads (0 = one per core); the results other than times do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
-    /// Task set.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file (its joint limits are the `.joint_limits.yaml` beside it).
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of precision.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
 }
 
 /// What a row plans with.
@@ -237,17 +251,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         checker,
         tasks,
     } = workspace::planner_setup(
-        &args.robot,
-        &args.task_file,
+        &args.common.robot,
+        &args.common.task_file,
         args.tasks.max(args.paths),
         "precision-eval",
     )?;
     let lines: Vec<Task> = tasks[..args.tasks].to_vec();
     let paths = path_tasks(planner.robot(), &tasks[..args.paths], args.seed)?;
     let path_only: Vec<Task> = paths.iter().map(|(_, task)| task.clone()).collect();
-    let pool = workspace::thread_pool(args.threads)?;
-    let limits_file = limits_file_beside(&args.robot);
-    let robot_name = args.robot.display().to_string();
+    let pool = workspace::thread_pool(args.common.threads)?;
+    let robot_name = args.common.robot.display().to_string();
 
     let grid_m = planner.config().reach.grid_m;
     let mut rows = Vec::new();
@@ -265,15 +278,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let mut outcomes = Vec::new();
         for setting in &settings {
             let planner = planner.with_config(setting.config())?;
-            let timing = MotionTiming::new(
-                planner.robot(),
-                &limits_file,
-                Scaling::default(),
-                planner.config().rollout.speed_m_per_s,
-                DEFAULT_RATE_HZ,
-                &planner.config().rollout.constraints,
-            )
-            .with_context(|| format!("the joint limits {}", limits_file.display()))?;
+            let (timing, _) =
+                workspace::motion_timing(&planner, &args.common.robot, DEFAULT_RATE_HZ)?;
             let planned: Vec<Outcome> = pool.install(|| {
                 set.par_iter()
                     .map(|task| {
@@ -287,60 +293,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             outcomes.push(planned);
         }
         bar.finish();
-        // The bound of a task at a tolerance: the scan's, raised to every plan there.
-        let kind_bounds: Vec<Vec<f64>> = TOLERANCES_MM
-            .iter()
-            .map(|&tolerance_mm| {
-                (0..set.len())
-                    .map(|i| {
-                        let at = settings
-                            .iter()
-                            .zip(&outcomes)
-                            .filter(|(setting, _)| setting.tolerance_mm == tolerance_mm);
-                        let bound = at
-                            .map(|(_, planned)| planned[i].bound_m.max(planned[i].length_m))
-                            .fold(0.0, f64::max);
-                        match kind {
-                            Kind::Lines => bound,
-                            Kind::Paths => bound.min(set[i].length_m().unwrap_or(bound)),
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
+        let kind_bounds = tolerance_bounds(kind, set, &settings, &outcomes);
         for (setting, planned) in settings.iter().zip(outcomes) {
-            let tolerance = TOLERANCES_MM
-                .iter()
-                .position(|&t| t == setting.tolerance_mm)
-                .expect("a compared tolerance");
-            let lengths: Vec<f64> = planned.iter().map(|o| o.length_m).collect();
             failures.extend(planned.iter().flat_map(|o| o.failures.iter().cloned()));
-            rows.push(Row {
-                kind,
-                setting: *setting,
-                bound_shares: bound_shares(
-                    &lengths,
-                    &kind_bounds[tolerance],
-                    &kind_bounds[tolerance],
-                ),
-                ended_by_line_tolerance: planned
-                    .iter()
-                    .filter(|o| o.ended_by_line_tolerance)
-                    .count(),
-                ended_by_line_tolerance_short: planned
-                    .iter()
-                    .zip(&kind_bounds[tolerance])
-                    .filter(|(o, bound)| o.ended_by_line_tolerance && *bound - o.length_m > grid_m)
-                    .count(),
-                bound_likely_loose: (0..planned.len())
-                    .filter(|&i| planned[i].bound_likely_loose)
-                    .collect(),
-                completed: planned.iter().filter(|o| o.completed).count(),
-                checker_failures: planned.iter().map(|o| o.failures.len()).sum(),
-                plan_ms_mean: planned.iter().map(|o| o.plan_ms).sum::<f64>()
-                    / planned.len().max(1) as f64,
-                lengths_m: lengths,
-            });
+            rows.push(Row::of(kind, *setting, &planned, &kind_bounds, grid_m));
         }
         bounds[kind as usize] = kind_bounds;
     }
@@ -348,8 +304,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let unfinished_at_tightest = unfinished(&rows, &paths, &path_bounds_m);
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: workspace::command_for("precision-eval", &args.robot),
-        tasks: workspace::relative(&args.task_file),
+        command: workspace::command_for("precision-eval", &args.common.robot),
+        tasks: workspace::relative(&args.common.task_file),
         line_count: args.tasks,
         path_count: args.paths,
         seed: args.seed,
@@ -362,7 +318,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         grid_m,
         failure_examples: failures.iter().take(5).cloned().collect(),
     };
-    workspace::write_results(&args.out_dir, "precision", &record, &markdown(&record))?;
+    workspace::write_results(
+        &args.common.out_dir,
+        "precision",
+        &record,
+        &markdown(&record),
+    )?;
     anyhow::ensure!(
         failures.is_empty(),
         "{} checks fail, e.g. {}",
@@ -370,6 +331,74 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         failures[0]
     );
     Ok(())
+}
+
+/// The bound of each task of `set` at each compared tolerance: the scan's, raised to every plan
+/// at that tolerance (`outcomes` per setting of `settings`); a path's no longer than the path.
+fn tolerance_bounds(
+    kind: Kind,
+    set: &[Task],
+    settings: &[Setting],
+    outcomes: &[Vec<Outcome>],
+) -> Vec<Vec<f64>> {
+    TOLERANCES_MM
+        .iter()
+        .map(|&tolerance_mm| {
+            (0..set.len())
+                .map(|i| {
+                    let at = settings
+                        .iter()
+                        .zip(outcomes)
+                        .filter(|(setting, _)| setting.tolerance_mm == tolerance_mm);
+                    let bound = at
+                        .map(|(_, planned)| planned[i].bound_m.max(planned[i].length_m))
+                        .fold(0.0, f64::max);
+                    match kind {
+                        Kind::Lines => bound,
+                        Kind::Paths => bound.min(set[i].length_m().unwrap_or(bound)),
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+impl Row {
+    /// The row of `setting` over the tasks `planned`, beside their bounds per tolerance
+    /// (`bounds`, [`tolerance_bounds`]); a line motion the tolerance ended more than `grid_m`
+    /// short of its bound counts as short.
+    fn of(
+        kind: Kind,
+        setting: Setting,
+        planned: &[Outcome],
+        bounds: &[Vec<f64>],
+        grid_m: f64,
+    ) -> Self {
+        let tolerance = TOLERANCES_MM
+            .iter()
+            .position(|&t| t == setting.tolerance_mm)
+            .expect("a compared tolerance");
+        let lengths: Vec<f64> = planned.iter().map(|o| o.length_m).collect();
+        Self {
+            kind,
+            setting,
+            bound_shares: bound_shares(&lengths, &bounds[tolerance], &bounds[tolerance]),
+            ended_by_line_tolerance: planned.iter().filter(|o| o.ended_by_line_tolerance).count(),
+            ended_by_line_tolerance_short: planned
+                .iter()
+                .zip(&bounds[tolerance])
+                .filter(|(o, bound)| o.ended_by_line_tolerance && *bound - o.length_m > grid_m)
+                .count(),
+            bound_likely_loose: (0..planned.len())
+                .filter(|&i| planned[i].bound_likely_loose)
+                .collect(),
+            completed: planned.iter().filter(|o| o.completed).count(),
+            checker_failures: planned.iter().map(|o| o.failures.len()).sum(),
+            plan_ms_mean: planned.iter().map(|o| o.plan_ms).sum::<f64>()
+                / planned.len().max(1) as f64,
+            lengths_m: lengths,
+        }
+    }
 }
 
 /// Plans `task` at `setting`, checks the plan and, under the corrected step, its timed files.
@@ -662,14 +691,14 @@ fn loose_bounds(record: &Record, kind: Kind) -> String {
 /// One row per shipped arm, tolerance and step of every `precision.json` under `results`:
 /// Σ plan / Σ bound over all lines and all paths, the share of line motions the tolerance ended,
 /// the paths completed, checker failures.
-pub fn readme_table(results: &std::path::Path) -> anyhow::Result<String> {
+fn readme_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | step | lines: Σ plan / Σ bound | lines ended by the tolerance | \
          of them short of the bound | paths: Σ plan / Σ bound | paths completed | checker \
          failures |\n\
          |---|---|---|---|---|---|---|---|---|\n",
     );
-    for (shipped, record) in crate::report::shipped_results::<Record>(results, "precision.json")? {
+    for (shipped, record) in shipped_results::<Record>(results, "precision.json")? {
         let rows_of = |kind: Kind| record.rows.iter().filter(move |r| r.kind == kind);
         for line in rows_of(Kind::Lines).filter(|r| r.setting.learned) {
             let path = rows_of(Kind::Paths).find(|r| r.setting == line.setting);

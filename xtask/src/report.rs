@@ -15,11 +15,14 @@ use emg_planner::{
 };
 use plotters::prelude::*;
 use serde::Deserialize;
-use serde::de::DeserializeOwned;
 
 use crate::ablate_control::{SwitchingAblation, WeightsAblation};
+use crate::results::{dp, read};
 use crate::search_eval::{self, BUDGET_FIGURE};
-use crate::{protocol, workspace};
+use crate::{
+    gap_eval, limit, path_eval, precision_eval, protocol, search_shares, surface_report, timing,
+    workspace,
+};
 
 /// Options of `report`.
 #[derive(clap::Args)]
@@ -91,31 +94,6 @@ struct PaperSwitchRow {
     ratio: Four,
 }
 
-/// The typed record in the result file `path`.
-pub(crate) fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
-    let text = std::fs::read_to_string(path).with_context(|| {
-        format!(
-            "reading {} (run the command that writes it first)",
-            path.display()
-        )
-    })?;
-    serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
-}
-
-/// Every shipped arm with a result file `name` under `results` (the FR3's at the top, the
-/// others' in their sub-directories), with the typed record that file holds ([`read`]).
-pub(crate) fn shipped_results<T: DeserializeOwned>(
-    results: &Path,
-    name: &str,
-) -> anyhow::Result<Vec<(ShippedRobot, T)>> {
-    SHIPPED_ROBOTS
-        .into_iter()
-        .map(|shipped| (shipped, results.join(shipped.data_subdir()).join(name)))
-        .filter(|(_, path)| path.exists())
-        .map(|(shipped, path)| Ok((shipped, read(&path)?)))
-        .collect()
-}
-
 /// `mean / std / min / max` of one of the paper's entries.
 fn paper_four(values: &Four, decimals: usize) -> String {
     values
@@ -173,61 +151,23 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         md += &dp_rows(seen, "all");
     }
     md += &velocity_limits(&args.results)?;
-    md += &crate::surface_report::section(&args.results);
+    md += &surface_report::section(&args.results);
     md += &other_arms(&args.results, &args.figures)?;
-    let shares = search_eval::shares_table(&args.results)?;
-    md += &format!(
-        "## Long lines: the share of the bound\n\nΣ path length / Σ reachability bound over the \
-         unseen tasks whose bound lies in each bucket (`cargo xtask search-eval`; \
-         `docs/results/search.md` per budget):\n\n{shares}\n"
-    );
-    let plan_times = crate::timing::plan_times_table(&args.results)?;
-    md += &format!(
-        "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
-         bound's note and the timed files, as `emg plan` computes them (`cargo xtask timing`; \
-         `docs/results/timing.md` per arm):\n\n{plan_times}\n"
-    );
-    md += &crate::path_eval::report_section(&args.results)?;
-    let precision = crate::precision_eval::readme_table(&args.results)?;
-    md += &format!(
-        "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
-         corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
-         `docs/results/precision.md` per arm):\n\n{precision}\n"
-    );
-    let gaps = crate::gap_eval::report_table(&args.results)?;
-    md += &format!(
-        "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
-         step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
-         the far side: motions planned back from beyond the plan's end, and motions in place \
-         and along the line between their branches and the plan's (`cargo xtask gap-eval`; \
-         `docs/results/gaps.md` per arm):\n\n{gaps}\n"
-    );
+    let shares = search_shares::summary_table(&args.results)?;
+    let plan_times = timing::summary_table(&args.results)?;
+    let precision = precision_eval::summary_table(&args.results)?;
+    let gaps = gap_eval::summary_table(&args.results)?;
+    md += &shares.section();
+    md += &plan_times.section();
+    md += &path_eval::report_section(&args.results)?;
+    md += &precision.section();
+    md += &gaps.section();
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     if args.results == workspace::root().join("docs/results") {
-        workspace::replace_readme_section(
-            search_eval::README_START,
-            search_eval::README_END,
-            &shares,
-        )?;
-        workspace::replace_section(
-            workspace::RESULTS_SUMMARY,
-            crate::timing::README_START,
-            crate::timing::README_END,
-            &plan_times,
-        )?;
-        workspace::replace_section(
-            workspace::RESULTS_SUMMARY,
-            crate::precision_eval::README_START,
-            crate::precision_eval::README_END,
-            &precision,
-        )?;
-        workspace::replace_section(
-            workspace::RESULTS_SUMMARY,
-            crate::gap_eval::README_START,
-            crate::gap_eval::README_END,
-            &gaps,
-        )?;
+        for table in [&shares, &plan_times, &precision, &gaps] {
+            table.copy_to_page()?;
+        }
         println!(
             "wrote the table of search shares into README.md and those of plan times, precision \
              and loose bounds into {}",
@@ -235,11 +175,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     Ok(())
-}
-
-/// The name of the DP seed in result files.
-pub(crate) fn dp() -> &'static str {
-    SeedSource::Dp.name()
 }
 
 fn dp_rows(set: &SetResult, group: &str) -> String {
@@ -307,7 +242,7 @@ impl LimitIdentity {
     /// Whether the limit's searches are today's: its own settings and the default search's.
     fn is_current(&self) -> bool {
         let today = |config: SearchConfig| serde_json::to_value(config).ok();
-        Some(&self.limit) == today(crate::limit::limit_search()).as_ref()
+        Some(&self.limit) == today(limit::limit_search()).as_ref()
             && Some(&self.search) == today(SearchConfig::default()).as_ref()
     }
 }

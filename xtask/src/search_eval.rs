@@ -7,20 +7,32 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::CheckRollout;
+use emg_control::{CheckRollout, Task};
 use emg_eval::{BoundShare, Summary, bound_shares, four};
-use emg_planner::{PlanRequest, PlannerConfig, PlannerKind, SHORTFALL_SHARE, SearchConfig};
+use emg_planner::{
+    PlanRequest, Planner, PlannerConfig, PlannerKind, SHORTFALL_SHARE, SearchConfig,
+};
+use emg_verify::ReferenceModel;
 use indicatif::ProgressIterator;
 use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::task_set_options::TaskSetOptions;
 use crate::{progress, workspace};
 
 /// File name of the mean length against budget figure in a robot's figure directory.
 pub const BUDGET_FIGURE: &str = "search-budget.svg";
 
+/// Where `--budgets` stands among the options of `search-eval`: `--threads` is listed beside
+/// it (after it, by name), before `--search-config`.
+const BUDGETS_SLOT: usize = 1;
+
 /// Options of `search-eval`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("threads", |arg| arg.display_order(BUDGETS_SLOT)),
+    mut_arg("out_dir", |arg| arg.help("Output directory of search.{json,md}")),
+)]
 pub struct Args {
     /// Tasks: the first this many of the task set (the report's Search rows need the whole
     /// evaluation set).
@@ -29,22 +41,13 @@ pub struct Args {
     /// Step budgets of the search, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [1_000u64, 5_000, 10_000, 20_000, 50_000])]
     budgets: Vec<u64>,
-    /// Worker threads (0 = one per core); the results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
     /// JSON file of search settings (`emg_planner::SearchConfig`; unset fields keep their
     /// defaults, `budget_steps` is replaced by each of `--budgets`).
     #[arg(long, value_name = "JSON")]
     search_config: Option<PathBuf>,
-    /// Task set.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file.
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of search.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
     /// Output figure.
     #[arg(long, default_value_os_t = workspace::figure(BUDGET_FIGURE))]
     figure: PathBuf,
@@ -119,107 +122,40 @@ impl Record {
 /// Runs the comparison and writes the record, its table and its figure.
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.render_only {
-        let path = args.out_dir.join("search.json");
-        let record: Record = serde_json::from_str(
-            &std::fs::read_to_string(&path)
-                .with_context(|| format!("reading {}", path.display()))?,
-        )?;
-        workspace::write_results(&args.out_dir, "search", &record, &markdown(&record))?;
-        draw(&record, &args.figure)?;
-        println!("wrote {}", args.figure.display());
-        return Ok(());
+        return render(args);
     }
     let workspace::PlannerSetup {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(&args.robot, &args.task_file, args.tasks, "search-eval")?;
-    let pool = workspace::thread_pool(args.threads)?;
-    let threads = pool.current_num_threads();
+    } = workspace::planner_setup(
+        &args.common.robot,
+        &args.common.task_file,
+        args.tasks,
+        "search-eval",
+    )?;
+    let pool = workspace::thread_pool(args.common.threads)?;
     let search: SearchConfig =
         workspace::read_config(args.search_config.as_deref(), "search config")?;
-
-    let mut rows = Vec::new();
+    let budgets = Budgets {
+        planner: &planner,
+        checker: &checker,
+        tasks: &tasks,
+        pool: &pool,
+        search: &search,
+    };
+    let mut rows: Vec<Row> = Vec::new();
     // The scan's bound of every task: the search scans it (from the pipeline's seed, at every
     // budget alike) and hands it back with its plan.
     let mut scanned: Option<Vec<f64>> = None;
-    let mut pipeline_mean: Option<f64> = None;
     let settings = std::iter::once(None).chain(args.budgets.iter().copied().map(Some));
     for budget in settings.progress_with(progress::bar(1 + args.budgets.len() as u64, "budgets")) {
-        let mut config = PlannerConfig {
-            search: search.clone(),
-            ..PlannerConfig::default()
-        };
-        let request = match budget {
-            None => PlanRequest::pipeline(),
-            Some(steps) => {
-                config.search.budget_steps = steps;
-                PlanRequest {
-                    planner: PlannerKind::Search,
-                    ..PlanRequest::pipeline()
-                }
-            }
-        };
-        let planner = planner.with_config(config)?;
-        let started = Instant::now();
-        let plans: Vec<_> = pool.install(|| {
-            use rayon::prelude::*;
-            tasks
-                .par_iter()
-                .map(|task| {
-                    let started = Instant::now();
-                    let plan = planner.plan(task, &request);
-                    (plan, started.elapsed().as_secs_f64() * 1e3)
-                })
-                .collect()
-        });
-        let cpu_ms = started.elapsed().as_secs_f64() * 1e3 * threads as f64;
-        let mut lengths = Vec::with_capacity(tasks.len());
-        let mut plan_ms = Vec::with_capacity(tasks.len());
-        let mut scans = Vec::with_capacity(tasks.len());
-        let mut steps = 0usize;
-        let mut failures = 0;
-        for (task, (plan, ms)) in tasks.iter().zip(plans) {
-            let plan = plan.with_context(|| format!("planning {task:?}"))?;
-            if checker
-                .check(
-                    task,
-                    &plan.trajectory,
-                    &planner.config().rollout.constraints,
-                )
-                .is_err()
-            {
-                failures += 1;
-            }
-            steps += plan.trajectory.steps.len() - 1;
-            lengths.push(plan.trajectory.path_length_m);
-            plan_ms.push(ms);
-            scans.extend(plan.reach.map(|reach| reach.scanned_m));
-        }
+        let pipeline_mean = rows.first().map(|pipeline| pipeline.path_length_m.mean);
+        let (row, scans) = budgets.plan_all(budget, pipeline_mean)?;
         if scans.len() == tasks.len() {
             scanned.get_or_insert(scans);
         }
-        let summary = Summary::of(&lengths).context("no tasks")?;
-        let pipeline_mean = *pipeline_mean.get_or_insert(summary.mean);
-        rows.push(Row {
-            planner: if budget.is_some() {
-                "search"
-            } else {
-                "pipeline"
-            }
-            .to_string(),
-            budget_steps: budget,
-            ratio_to_pipeline: summary.mean / pipeline_mean,
-            path_length_m: summary,
-            share_of_bound: 0.0,
-            bound_shares: Vec::new(),
-            plan_steps: steps as f64 / tasks.len() as f64,
-            cpu_ms_per_task: cpu_ms / tasks.len() as f64,
-            plan_ms: Summary::of(&plan_ms).context("no tasks")?,
-            plan_ms_median_p99: [percentile(&plan_ms, 0.5), percentile(&plan_ms, 0.99)],
-            checker_failures: failures,
-            lengths_m: lengths,
-        });
+        rows.push(row);
     }
     let scanned = match scanned {
         Some(scanned) => scanned,
@@ -242,100 +178,132 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         row.share_of_bound = mean_ratio(&row.lengths_m, &bounds);
         row.bound_shares = bound_shares(&row.lengths_m, &bounds, &bounds);
     }
-
     let record = Record {
         robot: planner.robot().name().to_string(),
-        tasks: workspace::relative(&args.task_file),
+        tasks: workspace::relative(&args.common.task_file),
         task_count: tasks.len(),
         machine: workspace::machine(),
-        threads,
+        threads: pool.current_num_threads(),
         search,
         reachability_bound_m: Summary::of(&bounds).context("no tasks")?,
         scan_missed,
         bounds_m: bounds,
         rows,
     };
-    workspace::write_results(&args.out_dir, "search", &record, &markdown(&record))?;
+    workspace::write_results(&args.common.out_dir, "search", &record, &markdown(&record))?;
     draw(&record, &args.figure)?;
     println!("wrote {}", args.figure.display());
     Ok(())
 }
 
-/// Markers of the README's table of search shares by bucket of the bound
-/// ([`shares_table`], written by `cargo xtask report`).
-pub const README_START: &str = "<!-- search-shares:start -->";
-/// The end marker of that table.
-pub const README_END: &str = "<!-- search-shares:end -->";
-
-/// For every shipped arm with a `search.json` under `results` (the FR3's top-level, the
-/// others' in their sub-directories), the pipeline and the search at the default budget:
-/// `Σ length / Σ bound` per bucket of the bound, the tasks below half their bound and the mean
-/// time per plan.
-pub fn shares_table(results: &Path) -> anyhow::Result<String> {
-    let mut md = String::from(
-        "| arm | planner | < 0.5 m | 0.5 – 1 m | ≥ 1 m | all | below ½ bound | mean ms per plan |\n\
-         |---|---|---|---|---|---|---|---|\n",
-    );
-    for (shipped, record) in crate::report::shipped_results::<Record>(results, "search.json")? {
-        let cartesian = results.join(shipped.data_subdir()).join("cartesian.json");
-        if cartesian.exists() {
-            let baseline: crate::cartesian_eval::Record = crate::report::read(&cartesian)?;
-            md += &share_row(
-                shipped.name,
-                "MoveIt-style Cartesian path",
-                &baseline.bound_shares,
-                baseline.task_count,
-                baseline.mean_ms,
-            );
-        }
-        let pipeline = record.rows.iter().find(|r| r.budget_steps.is_none());
-        for row in pipeline.into_iter().chain(record.default_budget_row()) {
-            md += &share_row(
-                shipped.name,
-                &row_name(row, &record.search),
-                &row.bound_shares,
-                record.task_count,
-                row.plan_ms.mean,
-            );
-        }
-    }
-    Ok(md)
+/// Writes `search.md` and the figure again from the `search.json` in the output directory.
+fn render(args: &Args) -> anyhow::Result<()> {
+    let path = args.common.out_dir.join("search.json");
+    let record: Record = serde_json::from_str(
+        &std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?,
+    )?;
+    workspace::write_results(&args.common.out_dir, "search", &record, &markdown(&record))?;
+    draw(&record, &args.figure)?;
+    println!("wrote {}", args.figure.display());
+    Ok(())
 }
 
-/// One row of [`shares_table`]: the arm, the planner, its shares per bucket, the tasks below
-/// half their bound and the mean time per plan.
-fn share_row(
-    arm: &str,
-    planner: &str,
-    shares: &[BoundShare],
-    tasks: usize,
-    mean_ms: f64,
-) -> String {
-    let mut row = format!("| {arm} | {planner} |");
-    for bucket in shares {
-        row += &format!(" {:.3} |", bucket.share);
-    }
-    let below = shares.last().map_or(0, |all| all.below_half.len());
-    row + &format!(" {below} of {tasks} | {mean_ms:.1} |\n")
+/// The tasks, and what each budget plans and checks them with.
+struct Budgets<'a> {
+    planner: &'a Planner,
+    checker: &'a ReferenceModel,
+    tasks: &'a [Task],
+    pool: &'a rayon::ThreadPool,
+    /// The search's settings but its budget.
+    search: &'a SearchConfig,
 }
 
-/// A row's planner for tables: the pipeline, or the search (`config`) with its budget, the
-/// steps its widened pass adds where a plan ends short of its bound, and its beam stage.
-fn row_name(row: &Row, config: &SearchConfig) -> String {
-    let Some(budget) = row.budget_steps else {
-        return "Hybrid + DP (the paper's pipeline)".into();
-    };
-    let mut name = format!("search ({budget} steps");
-    if config.widened_budget_steps > 0 {
-        name += &format!(", + {} where short", config.widened_budget_steps);
+impl Budgets<'_> {
+    /// Every task planned by the pipeline (`budget` none) or by the search at `budget` steps,
+    /// and checked: the row (its shares of the bound left for the caller, its mean length
+    /// against `pipeline_mean`, its own when none) and the scan's bound of each task the
+    /// plans hand back.
+    fn plan_all(
+        &self,
+        budget: Option<u64>,
+        pipeline_mean: Option<f64>,
+    ) -> anyhow::Result<(Row, Vec<f64>)> {
+        let mut config = PlannerConfig {
+            search: self.search.clone(),
+            ..PlannerConfig::default()
+        };
+        let request = match budget {
+            None => PlanRequest::pipeline(),
+            Some(steps) => {
+                config.search.budget_steps = steps;
+                PlanRequest {
+                    planner: PlannerKind::Search,
+                    ..PlanRequest::pipeline()
+                }
+            }
+        };
+        let planner = self.planner.with_config(config)?;
+        let started = Instant::now();
+        let plans: Vec<_> = self.pool.install(|| {
+            use rayon::prelude::*;
+            self.tasks
+                .par_iter()
+                .map(|task| {
+                    let started = Instant::now();
+                    let plan = planner.plan(task, &request);
+                    (plan, started.elapsed().as_secs_f64() * 1e3)
+                })
+                .collect()
+        });
+        let threads = self.pool.current_num_threads();
+        let cpu_ms = started.elapsed().as_secs_f64() * 1e3 * threads as f64;
+        let count = self.tasks.len();
+        let mut lengths = Vec::with_capacity(count);
+        let mut plan_ms = Vec::with_capacity(count);
+        let mut scans = Vec::with_capacity(count);
+        let mut steps = 0usize;
+        let mut failures = 0;
+        for (task, (plan, ms)) in self.tasks.iter().zip(plans) {
+            let plan = plan.with_context(|| format!("planning {task:?}"))?;
+            if self
+                .checker
+                .check(
+                    task,
+                    &plan.trajectory,
+                    &planner.config().rollout.constraints,
+                )
+                .is_err()
+            {
+                failures += 1;
+            }
+            steps += plan.trajectory.steps.len() - 1;
+            lengths.push(plan.trajectory.path_length_m);
+            plan_ms.push(ms);
+            scans.extend(plan.reach.map(|reach| reach.scanned_m));
+        }
+        let summary = Summary::of(&lengths).context("no tasks")?;
+        let pipeline_mean = pipeline_mean.unwrap_or(summary.mean);
+        let row = Row {
+            planner: if budget.is_some() {
+                "search"
+            } else {
+                "pipeline"
+            }
+            .to_string(),
+            budget_steps: budget,
+            ratio_to_pipeline: summary.mean / pipeline_mean,
+            path_length_m: summary,
+            share_of_bound: 0.0,
+            bound_shares: Vec::new(),
+            plan_steps: steps as f64 / count as f64,
+            cpu_ms_per_task: cpu_ms / count as f64,
+            plan_ms: Summary::of(&plan_ms).context("no tasks")?,
+            plan_ms_median_p99: [percentile(&plan_ms, 0.5), percentile(&plan_ms, 0.99)],
+            checker_failures: failures,
+            lengths_m: lengths,
+        };
+        Ok((row, scans))
     }
-    if !config.far_end_shares.is_empty() {
-        name += ", then from the far end";
-    }
-    if config.beam_width > 0 {
-        name += &format!(", then a beam of {}", config.beam_width);
-    }
-    name + ")"
 }
 
 /// The points the far-end stage of `config` plans back from, as words: "3 and 10 grid steps

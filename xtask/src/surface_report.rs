@@ -6,7 +6,7 @@ use std::path::Path;
 use emg_eval::{EvalRecord, MIN_REFERENCE_M, SetResult, four};
 use emg_planner::ControllerKind;
 
-use crate::report::{dp, read};
+use crate::results::{dp, read};
 
 /// The three evaluations the section reads, by file name and the command that writes each.
 const CELL_OFF: (&str, &str) = (

@@ -9,21 +9,28 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
+use emg_control::Task;
 use emg_eval::{Summary, four};
 use emg_io::TrajectoryContents;
 use emg_planner::{
-    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, PlannerKind,
-    limits_file_beside,
+    DEFAULT_RATE_HZ, MotionTiming, PlanFiles, PlanRecord, PlanRequest, Planner, PlannerKind,
 };
-use emg_timing::Scaling;
+use emg_verify::ReferenceModel;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::results::{SummaryTable, shipped_results};
+use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
 use crate::{progress, workspace};
 
 /// Options of `timing`.
 #[derive(clap::Args)]
+#[command(
+    mut_arg("threads", |arg| arg.help(THREADS_TIMED)),
+    mut_arg("robot", |arg| arg.help(ROBOT_WITH_JOINT_LIMITS)),
+    mut_arg("out_dir", |arg| arg.help("Output directory of timing.{json,md}")),
+)]
 pub struct Args {
     /// Tasks: the first this many of the task set (default: all).
     #[arg(long)]
@@ -31,18 +38,9 @@ pub struct Args {
     /// Samples per second of the joint trajectories.
     #[arg(long, default_value_t = DEFAULT_RATE_HZ)]
     rate_hz: f64,
-    /// Worker threads (0 = one per core); the results other than times do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
-    /// Task set.
-    #[arg(long, default_value_os_t = workspace::data("tasks/eval-v1.tasks"))]
-    task_file: PathBuf,
-    /// Robot file (its joint limits are the `.joint_limits.yaml` beside it).
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of timing.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Worker threads, task set, robot file and output directory.
+    #[command(flatten)]
+    common: TaskSetOptions,
     /// Output figure.
     #[arg(long, default_value_os_t = workspace::figure("timing-durations.svg"))]
     figure: PathBuf,
@@ -118,139 +116,58 @@ struct Record {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let count = match args.tasks {
         Some(count) => count,
-        None => emg_io::read_tasks(&args.task_file, &workspace::load_robot(&args.robot)?)?.len(),
+        None => emg_io::read_tasks(
+            &args.common.task_file,
+            &workspace::load_robot(&args.common.robot)?,
+        )?
+        .len(),
     };
     let workspace::PlannerSetup {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(&args.robot, &args.task_file, count, "timing")?;
-    let pool = workspace::thread_pool(args.threads)?;
-    let threads = pool.current_num_threads();
+    } = workspace::planner_setup(&args.common.robot, &args.common.task_file, count, "timing")?;
+    let pool = workspace::thread_pool(args.common.threads)?;
     let config = planner.config().clone();
-    let limits_file = limits_file_beside(&args.robot);
-    let timing = MotionTiming::new(
-        planner.robot(),
-        &limits_file,
-        Scaling::default(),
-        config.rollout.speed_m_per_s,
-        args.rate_hz,
-        &config.rollout.constraints,
-    )
-    .with_context(|| format!("the joint limits {}", limits_file.display()))?;
-    // `emg plan`'s defaults: the search planner, the hybrid controller, DP seeds.
-    let request = PlanRequest {
-        planner: PlannerKind::Search,
-        ..PlanRequest::pipeline()
+    let (timing, limits_file) =
+        workspace::motion_timing(&planner, &args.common.robot, args.rate_hz)?;
+    let robot_name = args.common.robot.display().to_string();
+    let timer = Timer {
+        planner: &planner,
+        checker: &checker,
+        timing: &timing,
+        // `emg plan`'s defaults: the search planner, the hybrid controller, DP seeds.
+        request: PlanRequest {
+            planner: PlannerKind::Search,
+            ..PlanRequest::pipeline()
+        },
+        robot_name: &robot_name,
     };
-    let robot_name = args.robot.display().to_string();
     let bar = progress::bar(tasks.len() as u64, "timing");
     let outcomes: Vec<Outcome> = pool.install(|| {
         tasks
             .par_iter()
             .enumerate()
             .map(|(index, task)| {
-                let whole = Instant::now();
-                let plan = planner.plan(task, &request)?;
-                let bound = planner.bound_note(task, &plan);
-                let record = PlanRecord {
-                    robot: &robot_name,
-                    request: &request,
-                    bound: Some(&bound),
-                    timing: &timing,
-                };
-                let files = PlanFiles::new(&planner, task, &plan, &record)?;
-                let whole_ms = whole.elapsed().as_secs_f64() * 1e3;
-                let started = Instant::now();
-                let motion = timing.time(
-                    planner.robot(),
-                    task,
-                    &config.rollout.constraints,
-                    &plan.trajectory,
-                )?;
-                let timing_ms = started.elapsed().as_secs_f64() * 1e3;
-                let contents = TrajectoryContents::parse(&files.joint_trajectory)?;
-                let failure = contents
-                    .verify(
-                        &checker,
-                        planner.robot().joint_names(),
-                        task,
-                        &config.rollout.constraints,
-                        true,
-                        None,
-                    )
-                    .err()
-                    .map(|failure| format!("task {index}: {failure}"));
-                let report = &motion.report;
+                let outcome = timer.time_task(index, task);
                 bar.inc(1);
-                Ok(Outcome {
-                    duration_s: report.duration_s,
-                    time_optimal_s: report.time_optimal_s,
-                    tool_speed_share: report.tool_speed_share,
-                    path_travel_m: report.path_travel_m,
-                    points: motion.samples.len(),
-                    file_bytes: files.joint_trajectory.len(),
-                    refined: report.refined_knots > 0,
-                    cut: report.cut.as_ref().map(|(point, violation)| {
-                        format!("task {index}: ends at planned point {point}: {violation}")
-                    }),
-                    slowdowns: report.slowdowns,
-                    timing_ms,
-                    whole_ms,
-                    failure,
-                })
+                outcome
             })
             .collect::<anyhow::Result<Vec<_>>>()
     })?;
     bar.finish();
-
-    let summary = |value: fn(&Outcome) -> f64| {
-        Summary::of(&outcomes.iter().map(value).collect::<Vec<_>>()).context("no tasks")
-    };
-    let moving: Vec<&Outcome> = outcomes.iter().filter(|o| o.time_optimal_s > 0.0).collect();
-    let overhead: Vec<f64> = moving
-        .iter()
-        .map(|o| o.duration_s / o.time_optimal_s - 1.0)
-        .collect();
-    let sorted = |value: fn(&Outcome) -> f64| {
-        let mut values: Vec<f64> = outcomes.iter().map(value).collect();
-        values.sort_by(f64::total_cmp);
-        values
-    };
-    let quantile =
-        |sorted: &[f64], q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
-    let (timing_ms, whole_ms) = (sorted(|o| o.timing_ms), sorted(|o| o.whole_ms));
-    let failures: Vec<String> = outcomes.iter().filter_map(|o| o.failure.clone()).collect();
-    let cuts: Vec<String> = outcomes.iter().filter_map(|o| o.cut.clone()).collect();
     let record = Record {
         robot: planner.robot().name().to_string(),
         joint_limits: workspace::relative(&limits_file),
-        tasks: workspace::relative(&args.task_file),
+        tasks: workspace::relative(&args.common.task_file),
         task_count: tasks.len(),
         rate_hz: args.rate_hz,
         tool_speed_m_per_s: config.rollout.speed_m_per_s,
         machine: workspace::machine(),
-        threads,
-        duration_s: summary(|o| o.duration_s)?,
-        time_optimal_s: summary(|o| o.time_optimal_s)?,
-        jerk_limited_overhead: Summary::of(&overhead).context("no moving task")?,
-        tool_speed_share: summary(|o| o.tool_speed_share)?,
-        path_travel_m: summary(|o| o.path_travel_m)?,
-        points_per_trajectory: summary(|o| o.points as f64)?,
-        file_megabytes: summary(|o| o.file_bytes as f64 / 1e6)?,
-        tasks_refined: outcomes.iter().filter(|o| o.refined).count(),
-        tasks_cut: cuts.len(),
-        cut_examples: cuts.iter().take(5).cloned().collect(),
-        slowdowns: summary(|o| o.slowdowns as f64)?,
-        timing_ms_median: quantile(&timing_ms, 0.5),
-        timing_ms_p95: quantile(&timing_ms, 0.95),
-        whole_plan_ms: summary(|o| o.whole_ms)?,
-        whole_plan_ms_median: quantile(&whole_ms, 0.5),
-        whole_plan_ms_p99: quantile(&whole_ms, 0.99),
-        checker_failures: failures.len(),
-        failure_examples: failures.iter().take(5).cloned().collect(),
+        threads: pool.current_num_threads(),
+        ..Record::of(&outcomes)?
     };
-    workspace::write_results(&args.out_dir, "timing", &record, &markdown(&record))?;
+    workspace::write_results(&args.common.out_dir, "timing", &record, &markdown(&record))?;
     draw(&outcomes, &record, &args.figure)?;
     println!("wrote {}", args.figure.display());
     anyhow::ensure!(
@@ -258,28 +175,160 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "{} of {} timed trajectories fail the check, e.g. {}",
         record.checker_failures,
         record.task_count,
-        failures[0]
+        record.failure_examples[0]
     );
     Ok(())
+}
+
+/// What every task is planned, timed and checked with, as `emg plan` and `emg check` do.
+struct Timer<'a> {
+    planner: &'a Planner,
+    checker: &'a ReferenceModel,
+    timing: &'a MotionTiming,
+    request: PlanRequest,
+    /// The robot file as the plan records name it.
+    robot_name: &'a str,
+}
+
+impl Timer<'_> {
+    /// Plans task `index` as `emg plan` does, times its motion, and reads back and checks the
+    /// joint trajectory it writes.
+    fn time_task(&self, index: usize, task: &Task) -> anyhow::Result<Outcome> {
+        let constraints = &self.planner.config().rollout.constraints;
+        let whole = Instant::now();
+        let plan = self.planner.plan(task, &self.request)?;
+        let bound = self.planner.bound_note(task, &plan);
+        let record = PlanRecord {
+            robot: self.robot_name,
+            request: &self.request,
+            bound: Some(&bound),
+            timing: self.timing,
+        };
+        let files = PlanFiles::new(self.planner, task, &plan, &record)?;
+        let whole_ms = whole.elapsed().as_secs_f64() * 1e3;
+        let started = Instant::now();
+        let motion = self
+            .timing
+            .time(self.planner.robot(), task, constraints, &plan.trajectory)?;
+        let timing_ms = started.elapsed().as_secs_f64() * 1e3;
+        let contents = TrajectoryContents::parse(&files.joint_trajectory)?;
+        let failure = contents
+            .verify(
+                self.checker,
+                self.planner.robot().joint_names(),
+                task,
+                constraints,
+                true,
+                None,
+            )
+            .err()
+            .map(|failure| format!("task {index}: {failure}"));
+        let report = &motion.report;
+        Ok(Outcome {
+            duration_s: report.duration_s,
+            time_optimal_s: report.time_optimal_s,
+            tool_speed_share: report.tool_speed_share,
+            path_travel_m: report.path_travel_m,
+            points: motion.samples.len(),
+            file_bytes: files.joint_trajectory.len(),
+            refined: report.refined_knots > 0,
+            cut: report.cut.as_ref().map(|(point, violation)| {
+                format!("task {index}: ends at planned point {point}: {violation}")
+            }),
+            slowdowns: report.slowdowns,
+            timing_ms,
+            whole_ms,
+            failure,
+        })
+    }
+}
+
+impl Record {
+    /// The statistics of `outcomes`; the fields that name the run are left empty.
+    fn of(outcomes: &[Outcome]) -> anyhow::Result<Self> {
+        let summary = |value: fn(&Outcome) -> f64| {
+            Summary::of(&outcomes.iter().map(value).collect::<Vec<_>>()).context("no tasks")
+        };
+        let overhead: Vec<f64> = outcomes
+            .iter()
+            .filter(|o| o.time_optimal_s > 0.0)
+            .map(|o| o.duration_s / o.time_optimal_s - 1.0)
+            .collect();
+        let sorted = |value: fn(&Outcome) -> f64| {
+            let mut values: Vec<f64> = outcomes.iter().map(value).collect();
+            values.sort_by(f64::total_cmp);
+            values
+        };
+        let quantile =
+            |sorted: &[f64], q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+        let (timing_ms, whole_ms) = (sorted(|o| o.timing_ms), sorted(|o| o.whole_ms));
+        let failures: Vec<String> = outcomes.iter().filter_map(|o| o.failure.clone()).collect();
+        let cuts: Vec<String> = outcomes.iter().filter_map(|o| o.cut.clone()).collect();
+        Ok(Self {
+            robot: String::new(),
+            joint_limits: String::new(),
+            tasks: String::new(),
+            task_count: 0,
+            rate_hz: 0.0,
+            tool_speed_m_per_s: 0.0,
+            machine: String::new(),
+            threads: 0,
+            duration_s: summary(|o| o.duration_s)?,
+            time_optimal_s: summary(|o| o.time_optimal_s)?,
+            jerk_limited_overhead: Summary::of(&overhead).context("no moving task")?,
+            tool_speed_share: summary(|o| o.tool_speed_share)?,
+            path_travel_m: summary(|o| o.path_travel_m)?,
+            points_per_trajectory: summary(|o| o.points as f64)?,
+            file_megabytes: summary(|o| o.file_bytes as f64 / 1e6)?,
+            tasks_refined: outcomes.iter().filter(|o| o.refined).count(),
+            tasks_cut: cuts.len(),
+            cut_examples: cuts.iter().take(5).cloned().collect(),
+            slowdowns: summary(|o| o.slowdowns as f64)?,
+            timing_ms_median: quantile(&timing_ms, 0.5),
+            timing_ms_p95: quantile(&timing_ms, 0.95),
+            whole_plan_ms: summary(|o| o.whole_ms)?,
+            whole_plan_ms_median: quantile(&whole_ms, 0.5),
+            whole_plan_ms_p99: quantile(&whole_ms, 0.99),
+            checker_failures: failures.len(),
+            failure_examples: failures.iter().take(5).cloned().collect(),
+        })
+    }
 }
 
 /// Markers of the table of `emg plan`'s time per task in `docs/results/summary.md`
 /// ([`plan_times_table`], written there by `cargo xtask report`,
 /// [`crate::workspace::RESULTS_SUMMARY`]).
-pub const README_START: &str = "<!-- plan-times:start -->";
+const README_START: &str = "<!-- plan-times:start -->";
 /// The end marker of that table.
-pub const README_END: &str = "<!-- plan-times:end -->";
+const README_END: &str = "<!-- plan-times:end -->";
+
+/// The section of `docs/results.md` before the table.
+const INTRO: &str = "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
+         bound's note and the timed files, as `emg plan` computes them (`cargo xtask timing`; \
+         `docs/results/timing.md` per arm):\n\n";
+
+/// The table of plan times ([`plan_times_table`]) in its section and between its markers in
+/// the results summary.
+pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
+    Ok(SummaryTable {
+        page: workspace::RESULTS_SUMMARY,
+        start: README_START,
+        end: README_END,
+        intro: INTRO,
+        table: plan_times_table(results)?,
+    })
+}
 
 /// For every shipped arm with a `timing.json` under `results` (the FR3's top-level, the others'
 /// in their sub-directories): the time of the whole `emg plan` per task (mean, median, 99th
 /// percentile, slowest), the timing's share of it (median) and the machine and threads it was
 /// measured with.
-pub fn plan_times_table(results: &Path) -> anyhow::Result<String> {
+fn plan_times_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tasks | mean ms | median ms | 99th percentile ms | slowest ms | timing alone, \
          median ms | measured on |\n|---|---|---|---|---|---|---|---|\n",
     );
-    for (shipped, record) in crate::report::shipped_results::<Record>(results, "timing.json")? {
+    for (shipped, record) in shipped_results::<Record>(results, "timing.json")? {
         md += &format!(
             "| {} | {} | {:.1} | {:.1} | {:.1} | {:.1} | {:.2} | {}, {} threads busy |\n",
             shipped.name,

@@ -7,7 +7,10 @@ use anyhow::Context;
 use emg_control::Task;
 use emg_io::read_tasks;
 use emg_kinematics::Robot;
-use emg_planner::{DataDir, Models, Planner, PlannerConfig, ShippedRobot};
+use emg_planner::{
+    DataDir, Models, MotionTiming, Planner, PlannerConfig, ShippedRobot, limits_file_beside,
+};
+use emg_timing::Scaling;
 use emg_verify::ReferenceModel;
 use serde::de::DeserializeOwned;
 
@@ -165,6 +168,27 @@ pub struct PlannerSetup {
     pub tasks: Vec<Task>,
 }
 
+/// The timing `emg plan` gives `planner`'s motions at `rate_hz` samples per second, within the
+/// joint limits file beside the robot file `robot` (returned with it).
+pub fn motion_timing(
+    planner: &Planner,
+    robot: &Path,
+    rate_hz: f64,
+) -> anyhow::Result<(MotionTiming, PathBuf)> {
+    let limits_file = limits_file_beside(robot);
+    let config = planner.config();
+    let timing = MotionTiming::new(
+        planner.robot(),
+        &limits_file,
+        Scaling::default(),
+        config.rollout.speed_m_per_s,
+        rate_hz,
+        &config.rollout.constraints,
+    )
+    .with_context(|| format!("the joint limits {}", limits_file.display()))?;
+    Ok((timing, limits_file))
+}
+
 /// The [`PlannerSetup`] of the shipped robot file `robot` and the first `count` tasks of
 /// `task_file`; `command` names the caller in errors.
 pub fn planner_setup(
@@ -237,12 +261,6 @@ pub fn machine() -> String {
 /// The page, relative to the workspace root, of the generated tables the README links to rather
 /// than shows (plan times, precision, loose bounds), each between its markers.
 pub const RESULTS_SUMMARY: &str = "docs/results/summary.md";
-
-/// Replaces the text between the `start` and `end` marker lines of the workspace's README.md
-/// with `text` (atomically); an error when a marker is missing.
-pub fn replace_readme_section(start: &str, end: &str, text: &str) -> anyhow::Result<()> {
-    replace_section("README.md", start, end, text)
-}
 
 /// Replaces the text between the `start` and `end` marker lines of `page` (a path relative to
 /// the workspace root, such as [`RESULTS_SUMMARY`]) with `text` (atomically); an error when a

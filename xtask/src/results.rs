@@ -1,0 +1,70 @@
+//! The shipped result files under `docs/results/`: read back into their typed records, for
+//! every shipped arm. The evaluations read their own and each other's files through it, and
+//! `cargo xtask report` assembles the sections they write from them.
+
+use std::path::Path;
+
+use anyhow::Context;
+use emg_planner::{SHIPPED_ROBOTS, SeedSource, ShippedRobot};
+use serde::de::DeserializeOwned;
+
+use crate::workspace;
+
+/// The typed record in the result file `path`.
+pub(crate) fn read<T: DeserializeOwned>(path: &Path) -> anyhow::Result<T> {
+    let text = std::fs::read_to_string(path).with_context(|| {
+        format!(
+            "reading {} (run the command that writes it first)",
+            path.display()
+        )
+    })?;
+    serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+}
+
+/// Every shipped arm with a result file `name` under `results` (the FR3's at the top, the
+/// others' in their sub-directories), with the typed record that file holds ([`read`]).
+pub(crate) fn shipped_results<T: DeserializeOwned>(
+    results: &Path,
+    name: &str,
+) -> anyhow::Result<Vec<(ShippedRobot, T)>> {
+    SHIPPED_ROBOTS
+        .into_iter()
+        .map(|shipped| (shipped, results.join(shipped.data_subdir()).join(name)))
+        .filter(|(_, path)| path.exists())
+        .map(|(shipped, path)| Ok((shipped, read(&path)?)))
+        .collect()
+}
+
+/// The name of the DP seed in result files.
+pub(crate) fn dp() -> &'static str {
+    SeedSource::Dp.name()
+}
+
+/// A table an evaluation writes over every shipped arm: shown in its section of
+/// `docs/results.md` and copied between its markers into a summary page.
+pub(crate) struct SummaryTable {
+    /// The page the table is copied into, relative to the workspace root (`README.md` or
+    /// [`workspace::RESULTS_SUMMARY`]).
+    pub page: &'static str,
+    /// The marker line the table follows in `page`.
+    pub start: &'static str,
+    /// The marker line the table precedes in `page`.
+    pub end: &'static str,
+    /// The section of `docs/results.md` before the table: its heading and the words that
+    /// introduce the table.
+    pub intro: &'static str,
+    /// The table (Markdown).
+    pub table: String,
+}
+
+impl SummaryTable {
+    /// The table's section of `docs/results.md`.
+    pub fn section(&self) -> String {
+        format!("{}{}\n", self.intro, self.table)
+    }
+
+    /// Copies the table between its markers in its page.
+    pub fn copy_to_page(&self) -> anyhow::Result<()> {
+        workspace::replace_section(self.page, self.start, self.end, &self.table)
+    }
+}
