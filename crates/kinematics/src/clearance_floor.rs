@@ -13,9 +13,10 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use crate::collision::CollisionPair;
+use crate::broad_phase::ClearanceFloor;
+use crate::capsule::CollisionPair;
 use crate::robot::Robot;
-use crate::{JointVector, Vec3};
+use crate::vectors::{JointVector, Vec3};
 
 /// Most joints between two segments for which a floor is searched (a cell splits into
 /// `2^joints` children).
@@ -26,24 +27,6 @@ pub(crate) const FLOOR_TOLERANCE_M: f64 = 1e-3;
 
 /// Most cells one search measures; a search stopped by it keeps the (lower) floor it has.
 const MAX_CELLS: usize = 4096;
-
-/// The outcome of one floor search.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct ClearanceFloor {
-    /// No configuration brings the pairs closer than this (m); `−∞` when not searched.
-    pub(crate) floor: f64,
-    /// The smallest clearance measured on the way (m): a configuration attains it, so the floor
-    /// is never above it.
-    pub(crate) smallest_measured: f64,
-}
-
-impl ClearanceFloor {
-    /// The floor of segment pairs with too many joints between them to search.
-    pub(crate) const UNSEARCHED: Self = Self {
-        floor: f64::NEG_INFINITY,
-        smallest_measured: f64::INFINITY,
-    };
-}
 
 /// A box of joint angles (half-widths `half` about `centre`) and what it guarantees.
 #[derive(Clone, Copy, Debug)]

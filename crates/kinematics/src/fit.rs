@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, SymmetricEigen};
 
-use crate::Vec3;
+use crate::vectors::Vec3;
 
 /// A ball: mesh vertices are balls of radius 0, sphere elements keep their radius.
 #[derive(Clone, Copy, Debug, PartialEq)]

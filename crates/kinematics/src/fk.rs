@@ -3,7 +3,7 @@
 use nalgebra::{Isometry3, Matrix3, SMatrix, Translation3, UnitQuaternion};
 
 use crate::robot::Robot;
-use crate::{JointVector, MAX_DOF, Vec3};
+use crate::vectors::{JointVector, MAX_DOF, Vec3};
 
 /// The 3×n position Jacobian `J = ∂p/∂q` of the TCP, zero-padded to 3×[`MAX_DOF`] (columns
 /// past the arm's joints are exactly zero).

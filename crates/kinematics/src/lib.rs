@@ -33,8 +33,11 @@
 //! # Ok::<(), emg_kinematics::RobotError>(())
 //! ```
 
+mod broad_phase;
+mod capsule;
 mod clearance_floor;
 mod collision;
+mod error;
 mod fit;
 mod fk;
 mod manipulability;
@@ -45,8 +48,10 @@ mod robot;
 mod rotation;
 mod scene;
 mod srdf;
+mod vectors;
 
-pub use collision::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
+pub use capsule::{Capsule, CollisionHit, CollisionPair, MAX_CAPSULES, segment_distance};
+pub use error::RobotError;
 pub use fit::{Ball, Covered, FittedCapsule, fit_capsules};
 pub use fk::{Kinematics, PositionJacobian};
 pub use manipulability::{directional_manipulability, tool_alignment_gradient};
@@ -56,26 +61,11 @@ pub use projection::{
     pose_residual, project_to_point, project_to_pose,
 };
 pub use pseudo_inverse::{DampedPseudoInverse, DampingConfig, damped_pseudo_inverse};
-pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot, RobotError};
+pub use robot::{CONTINUOUS_JOINT_RANGE_RAD, JointLimits, Robot};
 pub use rotation::{Transform, rotation_about, rotation_from_rpy, rotation_onto, rpy_of};
 pub use scene::{
     ContactHit, Obstacle, ObstacleError, Plate, Scene, Shape, ToolContact, WorkSurface,
     capsule_ray_entry,
 };
 pub use srdf::{MIN_LINK_SEPARATION, PairRule, disabled_pairs, srdf_beside};
-
-/// Most revolute joints a supported arm may have: the length of every [`JointVector`].
-pub const MAX_DOF: usize = 7;
-
-/// Fewest revolute joints a supported arm may have: three fix the TCP's position and at least
-/// three more move it in the null space (the pen's free roll and its tilt inside the cone), as
-/// the null-space step needs.
-pub const MIN_DOF: usize = 6;
-
-/// A joint-space vector (configuration, velocity or gradient), radians. An arm of
-/// [`Robot::dof`] `< MAX_DOF` joints uses the leading entries; the others are zero and stay
-/// zero (its Jacobian's trailing columns are zero, so no step moves them).
-pub type JointVector = nalgebra::SVector<f64, MAX_DOF>;
-
-/// A Cartesian 3-vector, metres or unit direction.
-pub type Vec3 = nalgebra::Vector3<f64>;
+pub use vectors::{JointVector, MAX_DOF, MIN_DOF, Vec3};

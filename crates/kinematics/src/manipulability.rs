@@ -3,7 +3,7 @@
 use nalgebra::Matrix3;
 
 use crate::fk::Kinematics;
-use crate::{JointVector, MAX_DOF, Vec3};
+use crate::vectors::{JointVector, MAX_DOF, Vec3};
 
 /// Directional manipulability `w_d = (dᵀ(JJᵀ + λ_μ²I)⁻¹d)^(−1/2)` (SPEC §4, the `k_μ` term of
 /// Eq. 3) and its analytic gradient.

@@ -4,7 +4,7 @@ use nalgebra::{Matrix3, Matrix4, SMatrix, Vector4};
 use serde::{Deserialize, Serialize};
 
 use crate::fk::{Kinematics, PositionJacobian};
-use crate::{JointVector, MAX_DOF};
+use crate::vectors::{JointVector, MAX_DOF};
 
 /// Dimension of the null space of a full-rank 3×7 position Jacobian: the most columns a basis
 /// holds.

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::pseudo_inverse::{DampingConfig, damped_pseudo_inverse};
 use crate::robot::Robot;
-use crate::{JointVector, MAX_DOF, Vec3};
+use crate::vectors::{JointVector, MAX_DOF, Vec3};
 
 /// The pose a configuration is projected onto.
 #[derive(Clone, Debug, PartialEq)]
@@ -243,7 +243,7 @@ fn check_target(target: &PoseTarget) -> Result<(), ProjectionError> {
 /// vector toward the target. Without a roll target only the two directions ⟂ `z` are
 /// constrained (rows 3–4) and row 5 and `e[5]` are zero, so `M` has rank 5.
 pub fn pose_residual(
-    kin: &crate::Kinematics,
+    kin: &crate::fk::Kinematics,
     target: &PoseTarget,
 ) -> (SMatrix<f64, 6, MAX_DOF>, SVector<f64, 6>) {
     let mut rows = SMatrix::<f64, 6, MAX_DOF>::zeros();

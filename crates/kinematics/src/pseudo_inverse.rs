@@ -3,8 +3,8 @@
 use nalgebra::{Matrix3, SMatrix};
 use serde::{Deserialize, Serialize};
 
-use crate::MAX_DOF;
 use crate::fk::PositionJacobian;
+use crate::vectors::MAX_DOF;
 
 /// Variable-damping schedule: `λ = λ_max·√(1 − (σ_min/σ_0)²)` when `σ_min < σ_0`, else 0.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

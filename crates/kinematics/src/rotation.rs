@@ -10,7 +10,7 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
-use crate::Vec3;
+use crate::vectors::Vec3;
 
 /// The rotation of URDF's `rpy` (fixed axes x, y, z in turn): `R = R_z(yaw) R_y(pitch) R_x(roll)`.
 pub fn rotation_from_rpy(roll: f64, pitch: f64, yaw: f64) -> Rotation3<f64> {

@@ -4,11 +4,11 @@
 use nalgebra::{Isometry3, Rotation3};
 use serde::{Deserialize, Serialize};
 
-use crate::Vec3;
-use crate::collision::segment_distance;
+use crate::capsule::segment_distance;
 use crate::fk::Kinematics;
 use crate::robot::Robot;
 use crate::rotation::{Transform, rotation_from_rpy, rpy_of};
+use crate::vectors::Vec3;
 
 /// A solid the arm keeps clear of, in the base frame.
 #[derive(Clone, Debug, PartialEq)]

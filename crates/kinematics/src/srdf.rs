@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::robot::RobotError;
+use crate::error::RobotError;
 
 /// Smallest chain-index separation of two bodies whose capsules are checked against each other
 /// under [`PairRule::LinkSeparation`] (adjacent links always touch at their joint).
