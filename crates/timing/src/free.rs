@@ -7,8 +7,7 @@
 use emg_kinematics::JointVector;
 
 use crate::dynamics::TimedSample;
-use crate::motion::{MotionDefinition, ProfileGrid, at_rest, moving_edges};
-use crate::profile::SmoothedProfile;
+use crate::motion::{MotionDefinition, ProfileGrid, moving_edges};
 use crate::retime::TimingRequest;
 use crate::topp::{GridPoint, topp_ra};
 
@@ -45,68 +44,6 @@ pub fn time_free_move(vertices: &[JointVector], request: &TimingRequest) -> Time
         samples: definition.samples(request.rate_hz),
         definition,
     }
-}
-
-/// The samples of the motion along the polyline `vertices`, along each edge of at least 1e-9
-/// rad by its profile in `edges` ([`MotionDefinition::Polyline`]).
-pub(crate) fn polyline_samples(
-    vertices: &[JointVector],
-    edges: &[ProfileGrid],
-    rate_hz: f64,
-) -> Vec<TimedSample> {
-    let mut samples = vec![at_rest(vertices[0])];
-    // Every sample lies on the grid `k / rate`; an edge's last sample, on the first grid time at
-    // or after its end, holds its end vertex at rest.
-    let mut elapsed = 0u64;
-    for ((from, to, direction, _), profile) in moving_edges(vertices).zip(edges) {
-        elapsed = push_samples(
-            &profile.smoothed(),
-            rate_hz,
-            elapsed,
-            &to,
-            &mut samples,
-            |s| (from + direction * s, direction, JointVector::zeros()),
-        );
-    }
-    samples
-}
-
-/// Appends the samples of `profile` along a joint path, `path(s)` its point, first and second
-/// derivatives by the path parameter, every `1 / rate_hz` from `elapsed` periods on (the last
-/// at `end`, at rest); returns the periods elapsed after them.
-pub(crate) fn push_samples(
-    profile: &SmoothedProfile,
-    rate_hz: f64,
-    elapsed: u64,
-    end: &JointVector,
-    samples: &mut Vec<TimedSample>,
-    path: impl Fn(f64) -> (JointVector, JointVector, JointVector),
-) -> u64 {
-    let period_ns = 1e9 / rate_hz;
-    let duration = profile.duration();
-    let last = ((duration * rate_hz).ceil() as u64).max(1);
-    let mut hints = [0, 0];
-    for k in 1..=last {
-        let time_ns = ((elapsed + k) as f64 * period_ns).round() as u64;
-        if k == last {
-            samples.push(TimedSample {
-                time_ns,
-                q: *end,
-                qd: JointVector::zeros(),
-                qdd: JointVector::zeros(),
-            });
-            break;
-        }
-        let state = profile.state_from(k as f64 / rate_hz, &mut hints);
-        let (q, dq, ddq) = path(state.s);
-        samples.push(TimedSample {
-            time_ns,
-            q,
-            qd: dq * state.sd,
-            qdd: dq * state.sdd + ddq * (state.sd * state.sd),
-        });
-    }
-    elapsed + last
 }
 
 /// The jerk-limited rest-to-rest profile along a straight edge of `length` rad in the unit

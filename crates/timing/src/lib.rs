@@ -23,6 +23,7 @@
 //! Limits a URDF cannot hold come from a MoveIt `joint_limits.yaml` ([`DynamicLimits`]).
 
 mod blend;
+mod blended_path;
 mod bound;
 mod dynamics;
 mod free;
@@ -32,10 +33,12 @@ mod motion;
 mod path;
 mod profile;
 mod retime;
+mod sampling;
 mod spline;
 mod topp;
 
-pub use blend::{MAX_BLEND_TURN_DEG, time_blended_move};
+pub use blend::time_blended_move;
+pub use blended_path::MAX_BLEND_TURN_DEG;
 pub use bound::{least_move_s, rest_to_rest_s};
 pub use dynamics::{LimitBreach, TimedSample, breaches, first_breach};
 pub use free::{FREE_GRID_PER_RAD, TimedMove, time_free_move};
@@ -43,14 +46,14 @@ pub use inset::{CLEARANCE_INSET_M, CONE_INSET_DEG, JOINT_INSET_RAD};
 pub use limits::{
     ASSUMED_ACCELERATION_RAD_S2, ASSUMED_JERK_RAD_S3, DynamicLimits, LimitsError, Scaling,
 };
-pub use motion::{MotionDefinition, ProfileGrid, SplineStretch};
+pub use motion::{MAX_SAMPLES, MotionDefinition, ProfileGrid, SplineStretch};
 pub use path::{
     CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, LINE_CHECK_MARGIN_M, MAX_REFINEMENTS,
     MIN_KNOT_STEP_M, SmoothPath,
 };
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{
-    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_FORCED_RESTS, MAX_SAMPLES, MAX_SLOWDOWNS,
+    ACCELERATION_MARGIN, AT_TOOL_SPEED, GRID_STEP_M, MAX_FORCED_RESTS, MAX_SLOWDOWNS,
     MIN_GRID_INTERVALS, PASSING_WINDOW_RAD, REST_SNAP_M, SLOWDOWN, TimedMotion, TimingError,
     TimingReport, TimingRequest, rest_waypoints, time_motion, waypoint_progress,
 };

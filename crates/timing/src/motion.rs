@@ -6,12 +6,15 @@
 
 use emg_kinematics::JointVector;
 
-use crate::blend::BlendedPath;
+use crate::blended_path::BlendedPath;
 use crate::dynamics::TimedSample;
-use crate::free::polyline_samples;
 use crate::profile::{SmoothedProfile, SpeedProfile};
-use crate::retime::{MAX_SAMPLES, spline_samples};
+use crate::sampling::{at_rest, push_samples, sample};
 use crate::spline::JointSpline;
+
+/// Most samples one motion may have: a rate or tool speed that would give more is refused
+/// (ten million samples are almost three hours at 1 kHz).
+pub const MAX_SAMPLES: f64 = 1e7;
 
 /// A rest-to-rest speed profile along a path as the timing chose it: the path speeds
 /// `x_i = ṡ²` at the grid points `s_i` (TOPP-RA's, `s̈` constant between them:
@@ -220,12 +223,51 @@ pub(crate) fn moving_edges(
     })
 }
 
-/// A sample at rest at `q` at time 0.
-pub(crate) fn at_rest(q: JointVector) -> TimedSample {
-    TimedSample {
-        time_ns: 0,
-        q,
-        qd: JointVector::zeros(),
-        qdd: JointVector::zeros(),
+/// The samples of the motion along the polyline `vertices`, along each edge of at least 1e-9
+/// rad by its profile in `edges` ([`MotionDefinition::Polyline`]).
+pub(crate) fn polyline_samples(
+    vertices: &[JointVector],
+    edges: &[ProfileGrid],
+    rate_hz: f64,
+) -> Vec<TimedSample> {
+    let mut samples = vec![at_rest(vertices[0])];
+    // Every sample lies on the grid `k / rate`; an edge's last sample, on the first grid time at
+    // or after its end, holds its end vertex at rest.
+    let mut elapsed = 0u64;
+    for ((from, to, direction, _), profile) in moving_edges(vertices).zip(edges) {
+        elapsed = push_samples(
+            &profile.smoothed(),
+            rate_hz,
+            elapsed,
+            &to,
+            &mut samples,
+            |s| (from + direction * s, direction, JointVector::zeros()),
+        );
     }
+    samples
+}
+
+/// The samples of a path task's motion at `rate_hz` ([`MotionDefinition::Splines`]): at rest at
+/// `start`, then each stretch's samples after its first, on one grid of `k / rate_hz` (rounded
+/// to whole nanoseconds), as [`crate::time_motion`] joins its stretches.
+pub(crate) fn spline_samples(
+    start: &JointVector,
+    stretches: &[SplineStretch],
+    rate_hz: f64,
+) -> Vec<TimedSample> {
+    let mut samples = vec![at_rest(*start)];
+    for stretch in stretches {
+        let offset = samples.len() as u64 - 1;
+        let (part, _) = sample(&stretch.spline, &stretch.profile.smoothed(), rate_hz);
+        samples.extend(
+            part.iter()
+                .enumerate()
+                .skip(1)
+                .map(|(k, sample)| TimedSample {
+                    time_ns: ((offset + k as u64) as f64 * 1e9 / rate_hz).round() as u64,
+                    ..*sample
+                }),
+        );
+    }
+    samples
 }

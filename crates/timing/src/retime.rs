@@ -8,10 +8,10 @@ use emg_kinematics::{JointVector, Robot};
 
 use crate::dynamics::{LimitBreach, TimedSample, breaches};
 use crate::limits::DynamicLimits;
-use crate::motion::{MotionDefinition, ProfileGrid, SplineStretch, at_rest};
+use crate::motion::{MAX_SAMPLES, MotionDefinition, ProfileGrid, SplineStretch};
 use crate::path::SmoothPath;
 use crate::profile::{PathState, SmoothedProfile};
-use crate::spline::JointSpline;
+use crate::sampling::{at_rest, sample};
 use crate::topp::{GridPoint, profile_duration, topp_ra};
 
 /// Longest grid step of TOPP-RA along the path (m of TCP travel).
@@ -30,10 +30,6 @@ pub const ACCELERATION_MARGIN: f64 = 0.97;
 
 /// Slow-down rounds at most before giving up.
 pub const MAX_SLOWDOWNS: usize = 60;
-
-/// Most samples one motion may have: a rate or tool speed that would give more is refused
-/// (ten million samples are almost three hours at 1 kHz).
-pub const MAX_SAMPLES: f64 = 1e7;
 
 /// Largest distance (m of arc length) between an unblended corner of a path and the waypoint
 /// the motion rests at for it.
@@ -627,57 +623,6 @@ pub(crate) fn slow_down(
             *f *= SLOWDOWN;
         }
     }
-}
-
-/// The samples of a path task's motion at `rate_hz` ([`MotionDefinition::Splines`]): at rest at
-/// `start`, then each stretch's samples after its first, on one grid of `k / rate_hz` (rounded
-/// to whole nanoseconds), as [`time_motion`] joins its stretches.
-pub(crate) fn spline_samples(
-    start: &JointVector,
-    stretches: &[SplineStretch],
-    rate_hz: f64,
-) -> Vec<TimedSample> {
-    let mut samples = vec![at_rest(*start)];
-    for stretch in stretches {
-        let offset = samples.len() as u64 - 1;
-        let (part, _) = sample(&stretch.spline, &stretch.profile.smoothed(), rate_hz);
-        samples.extend(
-            part.iter()
-                .enumerate()
-                .skip(1)
-                .map(|(k, sample)| TimedSample {
-                    time_ns: ((offset + k as u64) as f64 * 1e9 / rate_hz).round() as u64,
-                    ..*sample
-                }),
-        );
-    }
-    samples
-}
-
-/// The motion sampled at `k / rate_hz` (rounded to whole nanoseconds) for `k = 0, 1, …` up to
-/// the first sample at or after the end, with the path state of each sample.
-fn sample(
-    spline: &JointSpline,
-    profile: &SmoothedProfile,
-    rate_hz: f64,
-) -> (Vec<TimedSample>, Vec<PathState>) {
-    let duration = profile.duration();
-    let count = (duration * rate_hz - 1e-9).ceil().max(1.0) as u64;
-    let (mut profile_hints, mut segment) = ([0, 0], 0);
-    (0..=count)
-        .map(|k| {
-            let time_ns = (k as f64 * 1e9 / rate_hz).round() as u64;
-            let state = profile.state_from(time_ns as f64 * 1e-9, &mut profile_hints);
-            let point = spline.eval_from(state.s, &mut segment);
-            let sample = TimedSample {
-                time_ns,
-                q: point.q,
-                qd: point.dq * state.sd,
-                qdd: point.dq * state.sdd + point.ddq * (state.sd * state.sd),
-            };
-            (sample, state)
-        })
-        .unzip()
 }
 
 /// Share of the sampling intervals in which the tool speed `|p'(s)| ṡ` (with `|p'|`
