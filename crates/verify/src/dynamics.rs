@@ -4,7 +4,7 @@
 //! velocities and accelerations, and their agreement with the positions.
 
 use crate::record::Joints;
-use crate::replay::JointSamples;
+use crate::samples::JointSamples;
 
 /// Joint velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits, one per joint of the
 /// arm, base to tip.

@@ -33,6 +33,7 @@ mod dynamics;
 mod model;
 mod record;
 mod replay;
+mod samples;
 
 pub use check::{CheckFailure, FailedCheck};
 pub use dynamics::{
@@ -46,6 +47,7 @@ pub use record::{
     PATH_WINDOW_M, PathPiece, RecordedStep, Recording, Solid, Surface,
 };
 pub use replay::{
-    DECLARED_VELOCITY_TOLERANCE, JointSamples, ReplayCheck, ReplayError, ReplayReport,
-    VELOCITY_LIMIT_SLACK, check_joint_names, check_replay, point_velocities,
+    DECLARED_VELOCITY_TOLERANCE, ReplayCheck, ReplayError, ReplayReport, VELOCITY_LIMIT_SLACK,
+    check_joint_names, check_replay, point_velocities,
 };
+pub use samples::JointSamples;

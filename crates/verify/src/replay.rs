@@ -3,8 +3,9 @@
 
 use crate::check::{FailedCheck, Points};
 use crate::dynamics::{DynamicsCheck, DynamicsReport, JointDynamics, check_dynamics};
-use crate::model::{ReferenceModel, angle_deg, within};
-use crate::record::{Bounds, Ending, Joints, Line, RecordedStep, Recording};
+use crate::model::{ReferenceModel, within};
+use crate::record::{Bounds, Joints, Line, Recording};
+use crate::samples::JointSamples;
 
 /// Relative slack when comparing a declared velocity with its limit (float rounding).
 pub const VELOCITY_LIMIT_SLACK: f64 = 1e-9;
@@ -14,62 +15,6 @@ pub const VELOCITY_LIMIT_SLACK: f64 = 1e-9;
 /// `1e-9 · (1 + |q̇_i|)` rad/s (the writers use that very rule, so their files agree to the
 /// last bit; the tolerance admits a reader that computes it in another order).
 pub const DECLARED_VELOCITY_TOLERANCE: f64 = 1e-9;
-
-/// Timed joint positions read from a trajectory file, with the velocities it declares.
-#[derive(Clone, Debug, PartialEq)]
-pub struct JointSamples {
-    /// Time of each point since the start (s).
-    pub time_s: Vec<f64>,
-    /// Joint positions of each point (rad).
-    pub q: Vec<Joints>,
-    /// Velocities the file declares at each point (rad/s), if it declares any.
-    pub qd: Option<Vec<Joints>>,
-    /// Accelerations the file declares at each point (rad/s²), if it declares any.
-    pub qdd: Option<Vec<Joints>>,
-}
-
-impl JointSamples {
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.q.len()
-    }
-
-    /// Whether there is no point at all.
-    pub fn is_empty(&self) -> bool {
-        self.q.is_empty()
-    }
-
-    /// The points as a [`Recording`] of `line`: TCP and tool angle from the checker's own
-    /// forward kinematics, the path length from the last point's TCP (along a path, followed
-    /// point by point), and [`Ending::Stopped`].
-    ///
-    /// A file of points says nothing about why the motion ended, so the check of such a
-    /// recording verifies every point but no reason for the end. Since the TCP and tool angles
-    /// are recomputed here, the check compares them with themselves; what it verifies are the
-    /// constraints at each point.
-    pub fn to_recording(&self, model: &ReferenceModel, line: &Line) -> Recording {
-        let steps: Vec<RecordedStep> = self
-            .time_s
-            .iter()
-            .zip(&self.q)
-            .map(|(time_s, q)| {
-                let (tcp, axis) = model.tcp_pose(q);
-                RecordedStep {
-                    time_s: *time_s,
-                    q: *q,
-                    tcp,
-                    tool_angle_deg: angle_deg(&axis, &line.n),
-                }
-            })
-            .collect();
-        let path_length_m = line.reached(steps.iter().map(|step| step.tcp));
-        Recording {
-            steps,
-            ending: Ending::Stopped,
-            path_length_m,
-        }
-    }
-}
 
 /// Joint velocities at timed points: interior points take the central difference
 /// `(q_{k+1} − q_{k−1}) / (t_{k+1} − t_{k−1})` (a convex combination of the two segment
