@@ -7,8 +7,8 @@ use emg_verify::ReferenceModel;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 
+use crate::errors::{CheckFailed, InputError, input_error, message};
 use crate::robot::Robot;
-use crate::{CheckFailed, InputError, input_error, message};
 
 /// What the independent checker measured on a trajectory file that holds up.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]

@@ -7,8 +7,9 @@ use emg_planner::ShippedRobot;
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 
+use crate::data::data_dir;
+use crate::errors::{InputError, message};
 use crate::robot::Robot;
-use crate::{InputError, data_dir, message};
 
 /// What an export wrote.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]

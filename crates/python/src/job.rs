@@ -12,7 +12,7 @@ use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::{InputError, PlanningError, input_error, message};
+use crate::errors::{InputError, PlanningError, input_error, message};
 
 /// A job's program: every stroke to the limit, the safe moves between them, one timed joint
 /// trajectory (docs/jobs.md). Arrays have one row per sample at 1 kHz.

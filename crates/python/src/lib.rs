@@ -18,85 +18,17 @@
 //! planned, [`CheckFailed`] when a file does not hold up; failed file writes raise `OSError`.
 
 mod check;
+mod data;
+mod errors;
 mod export;
 mod job;
 mod planner;
 mod robot;
 mod timing;
 
-use std::path::{Path, PathBuf};
-
-use emg_planner::DataDir;
-use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyOSError};
 use pyo3::prelude::*;
 
-create_exception!(
-    extreme_line_motion,
-    Error,
-    PyException,
-    "Base class of every error the package raises."
-);
-create_exception!(
-    extreme_line_motion,
-    InputError,
-    Error,
-    "Bad input: a robot file, model, configuration, task or option that cannot be used; the message names it and what is wrong."
-);
-create_exception!(
-    extreme_line_motion,
-    PlanningError,
-    Error,
-    "A valid task that cannot be planned (no seed could be prepared)."
-);
-create_exception!(
-    extreme_line_motion,
-    CheckFailed,
-    Error,
-    "A trajectory file that does not hold up under the independent checker; the message names the point and the constraint."
-);
-
-/// The shipped data: `$EMG_DATA` when set, else the copy compiled into the module
-/// ([`emg_planner::embedded::extracted`]), so an installed wheel needs no checkout.
-fn data_dir() -> PyResult<DataDir> {
-    match std::env::var_os(DataDir::ENV) {
-        Some(dir) if !dir.is_empty() => Ok(DataDir::new(dir)),
-        _ => emg_planner::embedded::extracted().map_err(|e| {
-            PyOSError::new_err(format!(
-                "cannot write the shipped robots and models to the cache directory: {e} (set \
-                 XDG_CACHE_HOME to a writable directory, or EMG_DATA to a copy of data/)"
-            ))
-        }),
-    }
-}
-
-/// The robot file a `robot` argument selects: a shipped robot's name or a path.
-fn robot_file(robot: &Path) -> PyResult<PathBuf> {
-    Ok(data_dir()?.robot_file(&robot.to_string_lossy()))
-}
-
-/// `error` and its causes, each once, joined by `": "`.
-fn message(error: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = error.to_string();
-    let mut source = error.source();
-    while let Some(cause) = source {
-        let cause_text = cause.to_string();
-        if !text.contains(&cause_text) {
-            text.push_str(": ");
-            text.push_str(&cause_text);
-        }
-        source = cause.source();
-    }
-    text
-}
-
-/// An [`InputError`] saying what `context` names and why it cannot be used.
-fn input_error(
-    context: impl std::fmt::Display,
-    error: &(dyn std::error::Error + 'static),
-) -> PyErr {
-    InputError::new_err(format!("{context}: {}", message(error)))
-}
+use errors::{CheckFailed, Error, InputError, PlanningError};
 
 /// Plan, check and inspect extreme straight-line motions of redundant robot arms.
 #[pymodule]

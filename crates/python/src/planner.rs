@@ -17,9 +17,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 
-use crate::robot::{Robot, joint_array, joint_rows, joint_vector};
+use crate::data::data_dir;
+use crate::errors::{InputError, PlanningError, input_error, message};
+use crate::robot::{Robot, array1, joint_array, joint_rows, joint_vector};
 use crate::timing::{Motion, motion_timing};
-use crate::{InputError, PlanningError, data_dir, input_error, message};
 use emg_timing::Scaling;
 
 /// Plans extreme straight-line motions for one robot with its models and configuration.
@@ -239,13 +240,6 @@ pub(crate) fn array2<'py, const N: usize>(
     Array2::from_shape_vec((count, N), flat)
         .expect("rows of N values")
         .into_pyarray(py)
-}
-
-pub(crate) fn array1<'py>(
-    py: Python<'py>,
-    values: impl Iterator<Item = f64>,
-) -> Bound<'py, PyArray1<f64>> {
-    values.collect::<Vec<_>>().into_pyarray(py)
 }
 
 #[pymethods]

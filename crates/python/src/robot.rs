@@ -11,7 +11,8 @@ use pyo3::prelude::*;
 use emg_io::RobotRef;
 use emg_planner::ShippedRobot;
 
-use crate::{InputError, data_dir, input_error, message, robot_file};
+use crate::data::{data_dir, robot_file};
+use crate::errors::{InputError, input_error, message};
 
 /// A serial arm of six or seven revolute joints from a robot file: `Robot("fr3")`,
 /// `Robot("iiwa14")`, `Robot("ur5e")` or `Robot(path)` (the chain from the file's root link to
@@ -71,7 +72,7 @@ pub(crate) fn joint_vector(
     field: &str,
 ) -> PyResult<JointVector> {
     if q.len() != robot.dof() {
-        return Err(crate::InputError::new_err(format!(
+        return Err(InputError::new_err(format!(
             "{field}: give {} joint angles (rad), one per joint of the arm; got {}",
             robot.dof(),
             q.len()
@@ -86,7 +87,7 @@ pub(crate) fn joint_array<'py>(
     robot: &emg_kinematics::Robot,
     q: &JointVector,
 ) -> Bound<'py, PyArray1<f64>> {
-    vector(py, robot.joints_of(q).iter().copied())
+    array1(py, robot.joints_of(q).iter().copied())
 }
 
 /// Rows of the arm's `joints` entries of each vector, shape (len, joints).
@@ -102,7 +103,8 @@ pub(crate) fn joint_rows<'py, 'q>(
         .into_pyarray(py)
 }
 
-fn vector<'py>(
+/// `values` as an array, shape (len,).
+pub(crate) fn array1<'py>(
     py: Python<'py>,
     values: impl IntoIterator<Item = f64>,
 ) -> Bound<'py, PyArray1<f64>> {
@@ -164,7 +166,7 @@ impl Robot {
     /// robot file.
     #[getter]
     fn home<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        self.home.map(|home| vector(py, home.iter().copied()))
+        self.home.map(|home| array1(py, home.iter().copied()))
     }
 
     /// The tool-centre-point pose at `q` (n joint angles, rad) as a 4×4 homogeneous transform in

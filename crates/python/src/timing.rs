@@ -8,9 +8,8 @@ use emg_timing::{Scaling, TimedMotion};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
-use crate::input_error;
-use crate::planner::array1;
-use crate::robot::joint_rows;
+use crate::errors::input_error;
+use crate::robot::{array1, joint_rows};
 
 /// The timing the keyword arguments of `Plan.timed` and `Plan.save` ask for, for `planner`'s
 /// robot read from `robot_file`: `limits` a MoveIt joint_limits.yaml (default: the one beside
