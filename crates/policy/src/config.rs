@@ -122,9 +122,9 @@ impl PpoConfig {
     }
 
     /// A clear error naming the first unusable field.
-    pub fn validate(&self) -> Result<(), crate::PolicyError> {
+    pub fn validate(&self) -> Result<(), crate::error::PolicyError> {
         let bad = |field: &'static str, problem: &str| {
-            Err(crate::PolicyError::BadConfig {
+            Err(crate::error::PolicyError::BadConfig {
                 field,
                 problem: problem.to_string(),
             })

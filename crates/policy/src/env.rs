@@ -8,8 +8,8 @@ use emg_seeding::LabelSet;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;
 
-use crate::PolicyError;
 use crate::config::EnvConfig;
+use crate::error::PolicyError;
 use crate::observation::{ACTION_DIM, OBSERVATION_DIM, observe};
 use crate::vec_env::{Environment, EpisodeEnd, Transition};
 

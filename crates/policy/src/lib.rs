@@ -34,6 +34,8 @@ mod advantage;
 mod config;
 mod controller;
 mod env;
+mod error;
+mod format;
 mod inference;
 #[cfg(feature = "train")]
 mod network;
@@ -50,6 +52,8 @@ pub use controller::RlController;
 pub use emg_learning::checkpoint::CheckpointError;
 pub use emg_learning::container::ContainerError;
 pub use env::{ArmEnvironment, TrainingPool};
+pub use error::PolicyError;
+pub use format::{WEIGHTS_FORMAT_VERSION, WeightsError};
 pub use inference::{ActorOutput, PlainPolicy, PolicyScratch};
 #[cfg(feature = "train")]
 pub use network::{ActorCritic, PolicyOutput, Trunk};
@@ -57,32 +61,4 @@ pub use observation::{ACTION_DIM, OBSERVATION_DIM, PolicyDims, observe};
 #[cfg(feature = "train")]
 pub use ppo::{IterationLog, IterationTiming, Trainer};
 pub use vec_env::{Environment, EpisodeEnd, MAX_ENVS, Rollout, Transition, VecEnv, VecEnvSnapshot};
-pub use weights::{
-    PolicyWeights, WEIGHTS_FORMAT_VERSION, WeightsError, WeightsHeader, layer_shapes,
-};
-
-/// Why a configuration, a training pool or a checkpoint is unusable.
-#[derive(Debug, thiserror::Error)]
-pub enum PolicyError {
-    /// A configuration field with an unusable value.
-    #[error("field '{field}' {problem}")]
-    BadConfig {
-        /// Field.
-        field: &'static str,
-        /// What is wrong.
-        problem: String,
-    },
-    /// A checkpoint file could not be read or written.
-    #[cfg(feature = "train")]
-    #[error(transparent)]
-    Checkpoint(#[from] CheckpointError),
-    /// A checkpoint made with other settings.
-    #[error("checkpoint was made with a different {what}; start a new run or restore the settings")]
-    ConfigMismatch {
-        /// `network config` or `PPO config`.
-        what: &'static str,
-    },
-    /// Unusable weights.
-    #[error(transparent)]
-    Weights(#[from] WeightsError),
-}
+pub use weights::{PolicyWeights, WeightsHeader, layer_shapes};

@@ -19,9 +19,9 @@ use rand::seq::SliceRandom;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::PolicyError;
 use crate::advantage::{ReturnScaler, generalised_advantages};
 use crate::config::{Backend, NetworkConfig, PpoConfig};
+use crate::error::PolicyError;
 use crate::inference::PlainPolicy;
 use crate::network::ActorCritic;
 

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::PolicyError;
+use crate::error::PolicyError;
 use crate::inference::PlainPolicy;
 use crate::observation::{ACTION_DIM, OBSERVATION_DIM, PolicyDims};
 

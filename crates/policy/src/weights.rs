@@ -17,15 +17,13 @@ use emg_learning::container::{self, ContainerError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::NetworkConfig;
+use crate::format::{WEIGHTS_FORMAT_VERSION, WeightsError};
 #[cfg(feature = "train")]
 use crate::network::ActorCritic;
 use crate::observation::PolicyDims;
 use emg_kinematics::{MAX_DOF, MIN_DOF};
 
 const MAGIC: &[u8; 8] = b"EMGPPOWT";
-
-/// Version of the weights file layout this build reads and writes.
-pub const WEIGHTS_FORMAT_VERSION: u32 = 1;
 
 /// What a weights file says about itself.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,36 +43,6 @@ pub struct WeightsHeader {
     /// recorded; the planner refuses such a file until it is stamped).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub robot: Option<emg_learning::RobotStamp>,
-}
-
-/// Why a weights file is unusable; every variant says what is wrong.
-#[derive(Debug, thiserror::Error)]
-pub enum WeightsError {
-    /// The file could not be read or written.
-    #[error("cannot access weights file {path}")]
-    Io {
-        /// File.
-        path: String,
-        /// Cause.
-        source: std::io::Error,
-    },
-    /// The bytes are not a well-formed policy weights file of this layout version (the cause
-    /// says what is wrong: magic, version, truncation, header, value count, trailing bytes).
-    #[error("not a valid policy weights file (EMGPPOWT, format version {WEIGHTS_FORMAT_VERSION})")]
-    Format(#[from] ContainerError),
-    /// A header field disagrees with what this build uses.
-    #[error("weights field '{field}' is {found}, but {expected} is required")]
-    ShapeMismatch {
-        /// Header field.
-        field: &'static str,
-        /// Required value.
-        expected: usize,
-        /// Value in the file.
-        found: usize,
-    },
-    /// A NaN or infinite value.
-    #[error("weights value {0} is not finite")]
-    NotFinite(usize),
 }
 
 /// `(inputs, outputs)` of every linear layer in file order: actor hidden layers, mean head,

@@ -17,12 +17,14 @@
 //! URScript writer of `emg_io::export`): the plan's data types and the checker are all it reads
 //! besides the script, so an exporter's mistake cannot cancel out in its reading.
 
+mod error;
 mod geometry;
 mod native;
 mod script;
 mod servoj;
 mod ur5e;
 
+pub use error::ReadError;
 pub use geometry::{Pose, Rotation, angle_deg, wrap};
 pub use native::{
     COVERAGE_ALLOWANCE_M, JOINT_MATCH_RAD, JOINT_STEP_RAD, JointPiece, MAX_JOINT_JUMP_RAD,
@@ -38,39 +40,3 @@ pub use ur5e::{
     Branch, IkSolution, UR5E_A, UR5E_ALPHA, UR5E_D, checker_joints, checker_tcp,
     nearest_equivalent, ur5e_flange, ur5e_follow, ur5e_inverse,
 };
-
-/// Why the reader refuses a program: the program (where several are read together), the line
-/// (1-based; 0 for the program as a whole) and what failed there.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ReadError {
-    /// The program's place (1-based) among those read together; `None` where one is read.
-    pub program: Option<usize>,
-    /// The line.
-    pub line: usize,
-    /// What failed.
-    pub problem: String,
-}
-
-impl std::fmt::Display for ReadError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let program = self
-            .program
-            .map_or(String::new(), |p| format!("program {p}, "));
-        if self.line == 0 {
-            write!(f, "{program}the program: {}", self.problem)
-        } else {
-            write!(f, "{program}line {}: {}", self.line, self.problem)
-        }
-    }
-}
-
-impl std::error::Error for ReadError {}
-
-/// A [`ReadError`] at `line`.
-fn fail<T>(line: usize, problem: impl Into<String>) -> Result<T, ReadError> {
-    Err(ReadError {
-        program: None,
-        line,
-        problem: problem.into(),
-    })
-}

@@ -11,10 +11,10 @@ use emg_job::{Coverage, JobFile, SegmentKind, Stretch, with_part};
 use emg_kinematics::Vec3;
 use emg_verify::{Bounds, Line, ReferenceModel};
 
+use crate::error::{ReadError, fail};
 use crate::geometry::{Pose, Rotation, angle_deg};
 use crate::script::{Form, Output, Statement, parse_program};
 use crate::ur5e::{checker_joints, checker_tcp, largest_change, ur5e_flange, ur5e_follow};
-use crate::{ReadError, fail};
 
 /// Largest spacing (m) of the TCP samples along an interpolated Cartesian path.
 pub const PATH_STEP_M: f64 = 1e-4;

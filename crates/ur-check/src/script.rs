@@ -3,8 +3,8 @@
 //! in a native program; the home check or `movej`, `servoj` and `stopj` in a joint stream), its
 //! `end`, and comments. Anything else is refused at its line.
 
+use crate::error::{ReadError, fail};
 use crate::geometry::Pose;
-use crate::{ReadError, fail};
 
 /// A digital output the program writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

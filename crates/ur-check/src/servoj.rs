@@ -9,8 +9,8 @@ use emg_io::{JointTrajectoryPoint, TimingLimits};
 use emg_job::JobFile;
 use emg_verify::ReferenceModel;
 
+use crate::error::{ReadError, fail};
 use crate::script::{Form, Statement, parse_program};
-use crate::{ReadError, fail};
 
 /// The e-Series controller's cycle (s): the time each streamed target is tracked for, and the
 /// time between the motion's samples two targets stand for.

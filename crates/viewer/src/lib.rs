@@ -55,33 +55,16 @@
 //! pages run on one core script (projection, painter's order, the arm, the cell, the controls)
 //! and one template.
 
+mod input;
 mod job;
 mod page;
 mod placement_map;
 mod scene;
 
+pub use input::ViewerInput;
 pub use job::{
     JOB_PAGE_RATE_HZ, JobSample, JobSegment, JobSegmentKind, JobViewerInput, MIN_UNREACHED_M,
     MOVE_POINT_SPACING_M, drawn_stretches,
 };
 pub use page::{render_html, render_job_html};
 pub use placement_map::{MapCell, MapMark, placement_map_svg};
-
-use emg_control::{ConstraintConfig, Task, Trajectory};
-use emg_kinematics::Robot;
-
-/// Everything one viewer page shows: the arm, its task, the planned motion and its limits.
-#[derive(Clone, Copy, Debug)]
-pub struct ViewerInput<'a> {
-    /// The arm that moves (its capsules are drawn).
-    pub robot: &'a Robot,
-    /// The straight-line task `(p0, d, n)`.
-    pub task: &'a Task,
-    /// The planned rollout; its timestamps drive the playback.
-    pub trajectory: &'a Trajectory,
-    /// The constraints it was planned under (line tolerance, tool-cone half-angle, work surface
-    /// and obstacles are drawn).
-    pub constraints: &'a ConstraintConfig,
-    /// Page title and heading (plain text; escaped as needed).
-    pub title: &'a str,
-}

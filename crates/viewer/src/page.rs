@@ -3,9 +3,9 @@
 //! projection, painter's order, the arm, the cell and the controls); each adds its own script
 //! (`motion.js`, `job.js`) and read-out.
 
-use crate::job::JobScene;
+use crate::input::ViewerInput;
+use crate::job::{JobScene, JobViewerInput};
 use crate::scene::Scene;
-use crate::{JobViewerInput, ViewerInput};
 
 const TEMPLATE: &str = include_str!("viewer.html");
 const STYLE: &str = include_str!("viewer.css");

@@ -6,7 +6,7 @@ use emg_control::{ActingController, Path, StepRecord};
 use emg_kinematics::{JointVector, MAX_DOF, Robot, Shape, Vec3, WorkSurface};
 use serde::Serialize;
 
-use crate::ViewerInput;
+use crate::input::ViewerInput;
 
 /// Metres (and unit-vector components) are written to 10 µm: far below a pixel, and it keeps the
 /// page small.

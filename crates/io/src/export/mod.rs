@@ -11,6 +11,7 @@
 mod drivers;
 mod ros2_mcap;
 mod thinning;
+mod tool;
 mod urscript;
 
 use std::collections::BTreeMap;
@@ -22,6 +23,7 @@ use emg_kinematics::Robot;
 pub use drivers::{DRIVER_PROFILES, DriverProfile, UR_JOINT_NAMES, is_universal_robots_arm};
 pub use ros2_mcap::{JOINT_TRAJECTORY_TYPE, TOOL_OUTPUT_TOPIC, TOOL_OUTPUT_TYPE};
 pub use thinning::ThinningReport;
+pub use tool::{ToolSwitch, ToolSwitching};
 pub use urscript::{home_check, joint_list};
 
 use thinning::{DEFAULT_TOLERANCE_RAD, SplineLimits, measure, thin};
@@ -103,7 +105,7 @@ pub enum ExportError {
         /// The file.
         path: PathBuf,
         /// What the reader found wrong, naming the field.
-        source: crate::FormatError,
+        source: crate::error::FormatError,
     },
     /// The file's joint names are not the robot's.
     #[error("field 'joint_names' is {file:?}, but robot {robot} has the joints {expected:?}")]
@@ -230,9 +232,9 @@ impl Export {
             .iter()
             .map(|(path, _)| ("--out", path.as_path()))
             .collect();
-        crate::refuse_overwriting(inputs, &outputs)?;
+        crate::paths::refuse_overwriting(inputs, &outputs)?;
         for (path, bytes) in &self.files {
-            crate::write_atomically(path, bytes).map_err(|source| ExportError::Write {
+            crate::atomic::write_atomically(path, bytes).map_err(|source| ExportError::Write {
                 path: path.clone(),
                 source,
             })?;
@@ -258,24 +260,6 @@ pub struct TimedPoints<'a> {
     /// The tool switched on and off along the motion (a job's program), which a ROS 2 export
     /// writes beside the trajectory.
     pub tool: Option<ToolSwitching<'a>>,
-}
-
-/// The tool switched on and off along a motion.
-#[derive(Clone, Copy, Debug)]
-pub struct ToolSwitching<'a> {
-    /// Each switch in time order.
-    pub switches: &'a [ToolSwitch],
-    /// The output that switches the tool, in words.
-    pub output: &'a str,
-}
-
-/// The tool switched on or off at a time of the motion.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ToolSwitch {
-    /// Time since the motion's start (s).
-    pub time_s: f64,
-    /// Whether the tool is switched on (else off).
-    pub on: bool,
 }
 
 impl<'a> From<&'a JointTrajectory> for TimedPoints<'a> {

@@ -97,7 +97,7 @@ pub struct Ros2Message<'a> {
     /// frames, the thinning).
     pub notes: BTreeMap<String, String>,
     /// The tool's switches, written on [`TOOL_OUTPUT_TOPIC`] at their times.
-    pub tool: Option<&'a [super::ToolSwitch]>,
+    pub tool: Option<&'a [super::tool::ToolSwitch]>,
 }
 
 /// The CDR bytes of the message with `points` (the header's stamp zero: "start now" to

@@ -3,7 +3,8 @@
 //! with its transforms applied, in the drawing's units, and their bounding box.
 
 use super::bezier::{Cubic, V2};
-use super::{DrawingBounds, SvgError};
+use super::bounds::DrawingBounds;
+use super::error::SvgError;
 
 /// One drawn segment, from where the one before it ends.
 #[derive(Clone, Copy, Debug, PartialEq)]

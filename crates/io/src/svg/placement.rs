@@ -4,7 +4,8 @@ use emg_kinematics::Vec3;
 use serde::{Deserialize, Serialize};
 
 use super::bezier::V2;
-use super::{DrawingBounds, SvgError};
+use super::bounds::DrawingBounds;
+use super::error::SvgError;
 
 /// Metres per SVG unit for a drawing at its own physical size: the drawing's units are CSS
 /// pixels, 96 to the inch (`scale_m_per_unit: SVG_PX_M` draws a `width="100mm"` drawing
