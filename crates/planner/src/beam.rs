@@ -18,11 +18,9 @@ use std::collections::HashMap;
 
 use emg_control::{
     ActingController, ClassicalController, Episode, NullAction, NullSpaceController, RolloutConfig,
-    StepContext, StepOutcome, Task, Trajectory, continue_rollout, tool_angle_deg,
+    StepContext, StepOutcome, Task, Termination, Trajectory, continue_rollout, tool_angle_deg,
 };
 use emg_kinematics::{JointVector, Robot};
-
-use crate::search::steps_evaluated;
 
 /// Side of a diversity cell in the normalised joint space `q̄ ∈ [−1, 1]ⁿ` (16 cells per
 /// joint). Measured on the 38 tasks of the first 1,000 FR3 evaluation tasks whose bound is
@@ -342,6 +340,16 @@ fn score_of(state: &StepContext<'_>, progress_m: f64, rho: f64, angle_deg: f64) 
     let joints = 1.0 - rho;
     let tilt = (theta_max - angle_deg) / theta_max;
     10.0 * progress_m + joints.min(tilt) + MANIPULABILITY_WEIGHT * state.manipulability
+}
+
+/// Steps a rollout evaluated: every accepted step, and the rejected one that ended it.
+pub(crate) fn steps_evaluated(trajectory: &Trajectory) -> u64 {
+    let accepted = trajectory.steps.len().saturating_sub(1) as u64;
+    accepted
+        + u64::from(matches!(
+            trajectory.termination,
+            Termination::Violation { .. }
+        ))
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use crate::DataDir;
+use crate::shipped::DataDir;
 
 /// `(path, contents)` of the file at `path` in the workspace's `data/` directory.
 macro_rules! shipped {

@@ -6,8 +6,8 @@
 //! `s_far` along the line back to `p0` and beyond, read backwards, shows a motion from `p0`
 //! out to `s_far`. Planned from the far end, the search starts where the arm has the fewest
 //! configurations left, and the branch it keeps is one that reaches that far; planned from
-//! `p0`, it must guess that branch at the start. The search's far-end stage
-//! (`crate::search`) plans such motions ([`motion_back`]) from the points gap-eval asks from
+//! `p0`, it must guess that branch at the start. The search's far-end stage (`crate::search`)
+//! plans such motions (`Planner::motion_back`) from the points gap-eval asks from
 //! ([`probe_starts`]) and takes each that passes `p0` read forwards ([`read_forwards`]) and
 //! followed from `p0` ([`forward_reference`]); `crate::gap` asks the same motions what lies
 //! beyond a plan's end.
@@ -19,7 +19,6 @@ use emg_kinematics::{
     JointVector, Plate, PoseTarget, ProjectionConfig, Robot, WorkSurface, project_to_pose,
 };
 
-use crate::planner::{PlanRequest, Planner};
 use crate::reach::Reach;
 use crate::track::Reference;
 
@@ -41,21 +40,6 @@ pub(crate) fn probe_starts(end_m: f64, reach: &Reach) -> Vec<f64> {
         ])
         .filter(|&from_m| from_m > end_m && from_m < reach.reachable_m)
         .collect()
-}
-
-/// The motion `planner` plans back from `from_m` along `task`'s line: the whole planner (its
-/// seed, its scan, its search) on the reversed task, its work surface seen from there, its own
-/// far-end stage left out (a motion back does not ask for motions back in turn). `None` on a
-/// path task, where the point lies out of reach, or where no motion starts there.
-pub(crate) fn motion_back(planner: &Planner, task: &Task, from_m: f64) -> Option<Trajectory> {
-    let reversed = reversed_task(planner.robot(), task, from_m)?;
-    let mut config = planner.config().clone();
-    config.rollout.constraints.work_surface =
-        reversed_surface(&config.rollout.constraints.work_surface, from_m);
-    config.search.far_end_shares.clear();
-    let backward = planner.with_config(config).ok()?;
-    let plan = backward.plan(&reversed, &PlanRequest::default()).ok()?;
-    (plan.trajectory.steps.len() >= 2).then_some(plan.trajectory)
 }
 
 /// `back`, a motion of the reversed task from `s_far_m` along `task`'s line that got back past

@@ -6,7 +6,7 @@
 //! beyond lie on branches no motion from `p0` reaches. [`gap_probes`] asks the line from the
 //! far side: from a few points between the plan's end and the bound it plans the reversed task
 //! (the whole planner, as [`Planner::plan`] plans, its far-end stage left out:
-//! `crate::far_end::motion_back`, the motions the search's own far-end stage asks for from the
+//! `Planner::motion_back`, the motions the search's own far-end stage asks for from the
 //! same points) and sees where each motion back gets to:
 //! - past `p0`: read forwards, a motion from `p0` to that point exists, longer than the plan;
 //! - past the plan's end but not to `p0`: both motions cover the points between, and
@@ -24,7 +24,7 @@ use emg_control::{Task, Trajectory};
 use emg_kinematics::{JointVector, Robot, Vec3, project_to_point};
 use serde::{Deserialize, Serialize};
 
-use crate::far_end::{motion_back, probe_starts};
+use crate::far_end::probe_starts;
 use crate::in_place::{InPlaceConfig, in_place_motion, motion_along_line};
 use crate::planner::{Plan, Planner};
 
@@ -111,7 +111,7 @@ fn probe_from(
         outcome: GapProbeOutcome::NoStart,
     };
     let robot = planner.robot();
-    let Some(back) = motion_back(planner, task, from_m) else {
+    let Some(back) = planner.motion_back(task, from_m) else {
         return no_start;
     };
     let back_to_m = from_m - back.path_length_m;

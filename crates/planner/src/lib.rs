@@ -70,10 +70,12 @@ pub use reach::{
     start_blockers, witness_chains,
 };
 pub use search::{
-    CHAIN_SOURCE, FAR_END_SOURCE, MAX_FAR_END_SHARES, MAX_SEARCH_BUDGET_STEPS, SearchConfig,
-    search_classical_gains,
+    MAX_FAR_END_SHARES, MAX_SEARCH_BUDGET_STEPS, SearchConfig, search_classical_gains,
 };
-pub use seed::{SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed, seed_source_meaning};
+pub use seed::{
+    CHAIN_SOURCE, FAR_END_SOURCE, SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed,
+    seed_source_meaning,
+};
 pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
 pub use timing::{
     ASSUMED_LIMITS, DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside,

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{ConfigError, PlannerConfig};
 use crate::controller::{ControllerKind, Executor, ExecutorError};
+use crate::far_end::{reversed_surface, reversed_task};
 use crate::models::Models;
 use crate::parse::ParseError;
 use crate::reach::{
@@ -211,8 +212,9 @@ impl Planner {
                 }
                 Err(error) => return Err(error.into()),
             };
+            let motion_back = |task: &Task, from_m: f64| self.motion_back(task, from_m);
             let context = SearchContext {
-                planner: self,
+                motion_back: &motion_back,
                 robot: &self.robot,
                 rollout: &self.config.rollout,
                 reach: &self.config.reach,
@@ -241,6 +243,21 @@ impl Planner {
             trajectory,
             reach: None,
         })
+    }
+
+    /// The motion this planner plans back from `from_m` along `task`'s line: the whole planner
+    /// (its seed, its scan, its search) on the reversed task, its work surface seen from there,
+    /// its own far-end stage left out (a motion back does not ask for motions back in turn).
+    /// `None` on a path task, where the point lies out of reach, or where no motion starts there.
+    pub(crate) fn motion_back(&self, task: &Task, from_m: f64) -> Option<Trajectory> {
+        let reversed = reversed_task(self.robot(), task, from_m)?;
+        let mut config = self.config().clone();
+        config.rollout.constraints.work_surface =
+            reversed_surface(&config.rollout.constraints.work_surface, from_m);
+        config.search.far_end_shares.clear();
+        let backward = self.with_config(config).ok()?;
+        let plan = backward.plan(&reversed, &PlanRequest::default()).ok()?;
+        (plan.trajectory.steps.len() >= 2).then_some(plan.trajectory)
     }
 
     /// The reachability bound of `task` witnessed by `plan`: the plan's own when it holds one,

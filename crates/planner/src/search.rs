@@ -46,8 +46,8 @@
 
 use emg_control::{
     ARRIVAL_M, ActingController, ClassicalController, ClassicalGains, Episode, NullAction,
-    NullSpaceController, OutOfRange, RolloutConfig, StepContext, StepRecord, Task, Termination,
-    Trajectory, continue_rollout, first_violation,
+    NullSpaceController, OutOfRange, RolloutConfig, StepContext, StepRecord, Task, Trajectory,
+    continue_rollout, first_violation,
 };
 use emg_diffusion::{DpSeeder, SeedWorkspace};
 use emg_kinematics::{JointVector, PoseTarget, ProjectionConfig, Robot, project_to_pose};
@@ -58,15 +58,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::beam::{BeamLimits, beam_search, null_actions};
+use crate::beam::{BeamLimits, beam_search, null_actions, steps_evaluated};
 use crate::controller::Executor;
 use crate::far_end::{
-    forward_reference, motion_back, probe_starts, read_forwards, reversed_reach, reversed_surface,
-    reversed_task,
+    forward_reference, probe_starts, read_forwards, reversed_reach, reversed_surface, reversed_task,
 };
-use crate::planner::Planner;
 use crate::reach::{Reach, ReachConfig, SHORTFALL_SHARE, witness_chains};
-use crate::seed::Seed;
+use crate::seed::{CHAIN_SOURCE, FAR_END_SOURCE, Seed};
 use crate::track::{Reference, progress_per_step, tracking_action};
 
 /// Settings of the search planner.
@@ -147,7 +145,7 @@ pub struct SearchConfig {
     /// share beyond the longest rollout, the search's first pass plans the motion back to `p0`
     /// on the scan read backwards, and from the points gap-eval asks from beyond it (3 and 10
     /// grid steps past its end, halfway to the bound, half a grid step before it) the whole
-    /// planner does (`crate::far_end::motion_back`, its own far-end stage left out); each
+    /// planner does (`Planner::motion_back`, its own far-end stage left out); each
     /// motion that gets back past `p0` is taken read forwards and followed from `p0`, each tail
     /// going on where it ends; while the probes take the plan further, the points beyond its
     /// new end are asked in turn. Measured, when the stage
@@ -346,8 +344,9 @@ struct Candidate {
 
 /// Everything the search needs besides the task and the controller.
 pub(crate) struct SearchContext<'a> {
-    /// The planner the search plans for; the far-end stage plans motions back with it.
-    pub planner: &'a Planner,
+    /// The motion the planner the search plans for plans back from a point along the task's
+    /// line (`Planner::motion_back`): the far-end stage asks it from the points beyond the plan.
+    pub motion_back: &'a dyn Fn(&Task, f64) -> Option<Trajectory>,
     pub robot: &'a Robot,
     pub rollout: &'a RolloutConfig,
     pub reach: &'a ReachConfig,
@@ -770,7 +769,7 @@ impl Search<'_> {
     /// scan's grid points ([`SearchConfig::far_end_shares`]) beyond the longest rollout, the
     /// search's first pass plans the motion back to `p0` ([`Search::searched_back`]); then,
     /// from the points beyond the longest rollout that gap-eval asks from
-    /// (`crate::far_end::probe_starts`), the whole planner does (`crate::far_end::motion_back`).
+    /// (`crate::far_end::probe_starts`), the whole planner does (`Planner::motion_back`).
     /// Each motion back that gets past `p0`, read forwards, is a motion from `p0` to where it
     /// started ([`Search::take_motion_back`]). While the probes take the longest rollout
     /// further, the line beyond its new end is asked in turn: the stage ends where no motion
@@ -808,7 +807,7 @@ impl Search<'_> {
                     return;
                 }
                 asked.push(from_m);
-                if let Some(back) = motion_back(context.planner, self.task, from_m) {
+                if let Some(back) = (context.motion_back)(self.task, from_m) {
                     self.take_motion_back(&back, from_m, tails);
                 }
             }
@@ -962,14 +961,6 @@ impl Search<'_> {
     }
 }
 
-/// The source name of a start the long-horizon stage found: the first configuration of a chain
-/// of the reachability scan.
-pub const CHAIN_SOURCE: &str = "scan-chain";
-
-/// The source name of a start the far-end stage found: where a motion planned back from far
-/// along the line reaches `p0`.
-pub const FAR_END_SOURCE: &str = "far-end";
-
 /// The task's start pose: the TCP on `p0`, the tool axis along `n`.
 fn start_pose(task: &Task) -> PoseTarget {
     PoseTarget {
@@ -987,16 +978,6 @@ impl Candidate {
             projection_iterations: None,
         }
     }
-}
-
-/// Steps a rollout evaluated: every accepted step, and the rejected one that ended it.
-pub(crate) fn steps_evaluated(trajectory: &Trajectory) -> u64 {
-    let accepted = trajectory.steps.len().saturating_sub(1) as u64;
-    accepted
-        + u64::from(matches!(
-            trajectory.termination,
-            Termination::Violation { .. }
-        ))
 }
 
 /// The distinct valid starts on the start pose other than `tried` (the seeds already rolled

@@ -81,9 +81,17 @@ impl FromStr for SeedSource {
 /// when the requested seed cannot be put on the start pose.
 pub const SCAN_SOURCE: &str = "scan";
 
+/// The source name of a start the long-horizon stage found: the first configuration of a chain
+/// of the reachability scan.
+pub const CHAIN_SOURCE: &str = "scan-chain";
+
+/// The source name of a start the far-end stage found: where a motion planned back from far
+/// along the line reaches `p0`.
+pub const FAR_END_SOURCE: &str = "far-end";
+
 /// What a seed's source (its name in output and files) means: the sources of
-/// [`SeedSource::name`] and the search's own starts (`ik`, [`crate::CHAIN_SOURCE`],
-/// [`crate::FAR_END_SOURCE`], [`SCAN_SOURCE`]).
+/// [`SeedSource::name`] and the search's own starts (`ik`, [`CHAIN_SOURCE`],
+/// [`FAR_END_SOURCE`], [`SCAN_SOURCE`]).
 pub fn seed_source_meaning(name: &str) -> &'static str {
     match name {
         "dp" => "the diffusion seeder's start",
@@ -93,10 +101,10 @@ pub fn seed_source_meaning(name: &str) -> &'static str {
         "q_mu" => "a manipulability ascent from the generating configuration",
         "q_jl" => "a joint-centring ascent from the generating configuration",
         "ik" => "a start the search found by inverse kinematics at p0 within the cone",
-        crate::search::CHAIN_SOURCE => {
+        CHAIN_SOURCE => {
             "the reachability scan's chain of configurations from p0, followed by the search"
         }
-        crate::search::FAR_END_SOURCE => {
+        FAR_END_SOURCE => {
             "where a motion the search planned back from far along the line reaches p0, \
              followed forwards"
         }
