@@ -1,6 +1,6 @@
 //! Every constant of the rollout and the classical controller, with SPEC defaults (serde).
 
-use emg_kinematics::{BasisConfig, DampingConfig, Scene, WorkSurface};
+use emg_kinematics::{BasisConfig, DampingConfig, JointVector, Scene, WorkSurface};
 use serde::{Deserialize, Serialize};
 
 /// The constraints a rollout must hold at every step (SPEC §2).
@@ -198,6 +198,21 @@ impl ConstraintConfig {
 }
 
 impl RolloutConfig {
+    /// How long a step at the mean joint velocity `velocity` (rad/s) lasts on an arm with the
+    /// joint velocity limits `velocity_limits`: `dt_s`, stretched so that no joint exceeds its
+    /// share ([`ConstraintConfig::velocity_limit_fraction`]) of its limit; `dt_s` where joint
+    /// speeds are unbounded (`None`). Every rollout step is timed by it, and so is the first step
+    /// of a motion planned backwards and read forwards.
+    pub fn step_duration_s(&self, velocity: &JointVector, velocity_limits: &JointVector) -> f64 {
+        let Some(fraction) = self.constraints.velocity_limit_fraction else {
+            return self.dt_s;
+        };
+        let stretch = (0..velocity.len())
+            .map(|i| velocity[i].abs() / (fraction.get() * velocity_limits[i]))
+            .fold(1.0, f64::max);
+        self.dt_s * stretch
+    }
+
     /// Checks every setting: `dt_s`, `speed_m_per_s` and `null_speed_max_rad_per_s` positive,
     /// `1 ≤ max_steps ≤` [`MAX_STEPS_CAP`], gains, dampings and thresholds finite and
     /// non-negative (the damping threshold and `λ_max` positive), and the constraints.

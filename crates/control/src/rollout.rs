@@ -246,7 +246,7 @@ impl<'a> Episode<'a> {
             None => (self.current.kinematics.tcp() - previous_tcp).dot(&task.d),
             Some(_) => derived.along.s_m - self.current.along.s_m,
         };
-        self.time_s += self.step_duration(&velocity) * fraction;
+        self.time_s += config.step_duration_s(&velocity, &robot.limits().velocity) * fraction;
         self.current
             .advance(self.steps.len(), tool_angle_deg, applied, derived);
         if task.completed(self.current.along.s_m) {
@@ -335,20 +335,6 @@ impl<'a> Episode<'a> {
             termination,
             path_length_m,
         }
-    }
-
-    /// How long a step at joint velocity `velocity` lasts: `Δt`, stretched so that no joint
-    /// exceeds its share of the velocity limit.
-    fn step_duration(&self, velocity: &JointVector) -> f64 {
-        let config = self.current.config;
-        let Some(fraction) = config.constraints.velocity_limit_fraction else {
-            return config.dt_s;
-        };
-        let limits = &self.current.robot.limits().velocity;
-        let stretch = (0..velocity.len())
-            .map(|i| velocity[i].abs() / (fraction.get() * limits[i]))
-            .fold(1.0, f64::max);
-        config.dt_s * stretch
     }
 
     /// Records the current configuration, measuring its tool angle and `ρ`.

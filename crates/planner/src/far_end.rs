@@ -46,8 +46,8 @@ pub(crate) fn probe_starts(end_m: f64, reach: &Reach) -> Vec<f64> {
 /// `p0`, read forwards as far as its start: its last configuration not yet past `p0`, put on
 /// `p0` with its own tool axis (the seed), then its steps in reverse order up to the one before
 /// its first, each recorded as the forward task sees it. Each reversed step lasts what the step
-/// it reverses lasted, so every joint speed is one the motion back had; the seed's lasts a
-/// control period, stretched where a joint would otherwise move faster than its limit. `None`
+/// it reverses lasted, so every joint speed is one the motion back had; the seed's lasts what a
+/// rollout's step does ([`RolloutConfig::step_duration_s`]). `None`
 /// where `back` does not pass `p0` or its seed is not a valid configuration on `p0`. The
 /// configuration `back` started from (`back.steps[0]`) is where the forward motion goes on.
 pub(crate) fn read_forwards(
@@ -87,17 +87,9 @@ pub(crate) fn read_forwards(
             controller: Some(ActingController::Search),
         }
     };
-    // The step from the seed lasts a control period, longer where a joint would move faster
-    // than its speed limit allows (as a rollout's step does).
-    let moved = back.steps[last].q - seed;
-    let limits = &robot.limits().velocity;
-    let fraction = config
-        .constraints
-        .velocity_limit_fraction
-        .map_or(1.0, |fraction| fraction.get());
-    let first_s = (0..robot.dof())
-        .map(|i| moved[i].abs() / (fraction * limits[i]))
-        .fold(config.dt_s, f64::max);
+    // The step from the seed lasts what a rollout's step at its mean joint velocity lasts.
+    let velocity = (back.steps[last].q - seed) / config.dt_s;
+    let first_s = config.step_duration_s(&velocity, &robot.limits().velocity);
     let mut time_s = 0.0;
     let mut steps = vec![record(time_s, seed)];
     for k in (1..=last).rev() {
