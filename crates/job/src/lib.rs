@@ -32,6 +32,7 @@ pub mod plan_error;
 pub mod plan_strokes;
 pub mod program;
 pub mod reorder;
+pub mod setting;
 pub mod setup;
 pub mod shortfall;
 pub mod spec;
@@ -71,6 +72,7 @@ pub use program::{
     SegmentKind, StrokeReport,
 };
 pub use reorder::{MIN_SAVED_S, in_order, reorder_by_move_time};
+pub use setting::InvalidSetting;
 pub use setup::{JobPlanner, job_config, job_timing};
 pub use shortfall::{LeftOut, Shortfall, Stop};
 pub use spec::{JOB_FORMAT_VERSION, Job, JobError, JobSettings, JobSpec, Order, Tool, Transform};

@@ -15,48 +15,15 @@ use crate::spec::Order;
 
 pub mod merge;
 pub mod near;
+pub mod oriented;
 pub mod tour;
 
 pub use merge::{Chain, merge_strokes};
 use near::Grid;
+pub use near::NEIGHBOURS;
+pub use oriented::Oriented;
 use tour::{Legs, Tour};
-
-/// The ends of another stroke each stroke end keeps as candidates for a move.
-pub const NEIGHBOURS: usize = 10;
-
-/// Strokes a move shifts or reverses at most.
-pub const MAX_SPAN: usize = 1000;
-
-/// Strokes an Or-opt move takes at most.
-pub const MAX_RUN: usize = 3;
-
-/// Times each stroke is looked at for a move, on average, at most.
-pub const MAX_ROUNDS: usize = 50;
-
-/// A stroke drawn in a direction.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct Oriented {
-    /// The stroke's index: among the drawn strokes ([`Ordering::drawn`]) in an ordering's
-    /// sequence, among the job's in a [`Chain`].
-    pub stroke: usize,
-    /// Whether it is drawn from its end to its start.
-    pub reversed: bool,
-}
-
-impl Oriented {
-    /// The stroke as drawn, from `strokes` (the list it indexes): reversed where it is drawn
-    /// from its end (only reversible strokes are, [`order_strokes`]).
-    pub fn path(&self, strokes: &[Path]) -> Path {
-        let stroke = &strokes[self.stroke];
-        if self.reversed {
-            stroke
-                .reversed()
-                .expect("only reversible strokes are reversed")
-        } else {
-            stroke.clone()
-        }
-    }
-}
+pub use tour::{MAX_ROUNDS, MAX_RUN, MAX_SPAN};
 
 /// The strokes drawn, the order chosen and the pen-up travel it saves.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -18,9 +18,9 @@
 use emg_kinematics::{JointVector, Vec3};
 
 use crate::branch::Branches;
-use crate::order::near::Grid;
+use crate::order::near::{Grid, NEIGHBOURS};
+use crate::order::oriented::Oriented;
 use crate::order::tour::{Legs, Tour};
-use crate::order::{NEIGHBOURS, Oriented};
 
 /// The least estimated pen-up time (s) a new order must save to be connected: below it, the
 /// time a connect takes is not worth what the estimate promises.

@@ -1,6 +1,7 @@
 //! The read stage: a job file (`emg-job` input, version 1), a path file (a job of one stroke) or
 //! a drawing's strokes, validated into a [`Job`].
 
+use crate::setting::InvalidSetting;
 use crate::tool_output::ToolOutput;
 use emg_control::{Path, PathError, PathSpec};
 pub use emg_kinematics::Transform;
@@ -166,15 +167,8 @@ pub enum JobError {
         source: PathError,
     },
     /// A setting is out of range.
-    #[error("job field 'settings.{field}' must be {allowed}, got {value}")]
-    Setting {
-        /// The field.
-        field: &'static str,
-        /// The value given.
-        value: f64,
-        /// The allowed range.
-        allowed: &'static str,
-    },
+    #[error(transparent)]
+    Setting(#[from] InvalidSetting),
     /// The home configuration does not fit the arm.
     #[error("job field 'home': {0}")]
     Home(String),
@@ -213,11 +207,11 @@ impl JobSettings {
             if value.is_finite() && ok {
                 Ok(())
             } else {
-                Err(JobError::Setting {
+                Err(JobError::Setting(InvalidSetting {
                     field,
                     value,
                     allowed,
-                })
+                }))
             }
         };
         let lift = self.lift();
@@ -252,7 +246,7 @@ impl JobSettings {
             "in [1, 1000000]",
             (1..=1_000_000).contains(&self.rrt_max_samples),
         )?;
-        self.tool_output.validate()
+        Ok(self.tool_output.validate()?)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::spec::JobError;
+use crate::setting::InvalidSetting;
 
 /// A controller's bank of digital outputs.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -70,10 +70,10 @@ impl ToolOutput {
     pub const MAX_DWELL_S: f64 = 10.0;
 
     /// Checks the number against its bank and the dwells, naming the field.
-    pub fn validate(&self) -> Result<(), JobError> {
+    pub fn validate(&self) -> Result<(), InvalidSetting> {
         let last = self.bank.last_output();
         if self.number > last {
-            return Err(JobError::Setting {
+            return Err(InvalidSetting {
                 field: "tool_output.number",
                 value: f64::from(self.number),
                 allowed: match self.bank {
@@ -87,7 +87,7 @@ impl ToolOutput {
             ("tool_output.lag_s", self.lag_s),
         ] {
             if !(value.is_finite() && (0.0..=Self::MAX_DWELL_S).contains(&value)) {
-                return Err(JobError::Setting {
+                return Err(InvalidSetting {
                     field,
                     value,
                     allowed: "in [0, 10] s",

@@ -8,8 +8,8 @@
 use emg_control::Path;
 use serde::{Deserialize, Serialize};
 
-use super::Oriented;
 use super::near::Grid;
+use super::oriented::Oriented;
 use crate::spec::Order;
 
 /// The sharpest turn (degrees) where two merged strokes join.

@@ -7,6 +7,9 @@ use std::collections::HashMap;
 
 use emg_kinematics::Vec3;
 
+/// The ends of another stroke each stroke end keeps as candidates for a move.
+pub const NEIGHBOURS: usize = 10;
+
 /// The points an occupied cell holds on average, about.
 const POINTS_PER_CELL: f64 = 2.0;
 

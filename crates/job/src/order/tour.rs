@@ -7,7 +7,16 @@
 
 use std::collections::VecDeque;
 
-use super::{MAX_ROUNDS, MAX_RUN, MAX_SPAN, Oriented};
+use super::oriented::Oriented;
+
+/// Strokes a move shifts or reverses at most.
+pub const MAX_SPAN: usize = 1000;
+
+/// Strokes an Or-opt move takes at most.
+pub const MAX_RUN: usize = 3;
+
+/// Times each stroke is looked at for a move, on average, at most.
+pub const MAX_ROUNDS: usize = 50;
 
 /// The pen-up moves between strokes, each with a cost a [`Tour`] shortens the sum of. A stroke
 /// end is a point: 2i is stroke i's start, 2i + 1 its end.
