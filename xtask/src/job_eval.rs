@@ -206,12 +206,67 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             profile,
             checker: &checker,
         });
+    let jobs = jobs(&args.icons, &planner, home)?;
+    let bar = progress::bar(jobs.len() as u64, "jobs");
+    let mut rows = Vec::new();
+    let mut ur_rows = Vec::new();
+    for (name, job) in &jobs {
+        let (row, ur_row) = evaluate(
+            &planner,
+            &timing,
+            &checker,
+            &robot_name,
+            (name, job),
+            ur_arm.as_ref(),
+        )?;
+        rows.push(row);
+        ur_rows.extend(ur_row);
+        bar.inc(1);
+    }
+    bar.finish();
+    let one_thread_s = one_thread_times(&jobs, &planner, &timing, &robot_name)?;
+    let mut large_rows = Vec::new();
+    let sizes = progress::bar(2 * args.large.len() as u64, "large jobs");
+    for &strokes in &args.large {
+        for threads in [None, Some(1)] {
+            large_rows.push(large::evaluate(
+                &planner,
+                &timing,
+                &checker,
+                &robot_name,
+                home,
+                strokes,
+                threads,
+            )?);
+            sizes.inc(1);
+        }
+    }
+    sizes.finish();
+    let record = Record {
+        robot: planner.robot().name().to_string(),
+        command: workspace::command_for("job-eval", &args.robot),
+        icons: workspace::relative(&args.icons),
+        machine: workspace::machine(),
+        threads: rayon::current_num_threads(),
+        one_thread_s,
+        rows,
+        large: large_rows,
+        ur_programs: ur_rows,
+    };
+    workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
+    ensure_checked(&record)
+}
+
+/// The jobs of the evaluation, each by its name: every icon of `icons` at every place, the
+/// seams on tilted surfaces, the valley seams as given and in the order of least travel, and
+/// the jobs of hundreds of strokes; each starting and ending at the arm's `home`.
+fn jobs(icons: &Path, planner: &Planner, home: &[f64]) -> anyhow::Result<Vec<(String, Job)>> {
     let with_home = |strokes: Vec<PathSpec>| {
         Job::from_strokes(strokes, planner.robot())
             .and_then(|job| job.with_home(home, planner.robot()))
     };
     let mut jobs: Vec<(String, Job)> = Vec::new();
-    let icons = icon_files(&args.icons)?;
+    let icons = icon_files(icons)?;
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     for icon in &icons {
         for (origin, width) in PLACES {
@@ -252,23 +307,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (name, strokes) in &hundreds {
         jobs.push((name.to_string(), with_home(strokes.clone())?));
     }
-    let bar = progress::bar(jobs.len() as u64, "jobs");
-    let mut rows = Vec::new();
-    let mut ur_rows = Vec::new();
-    for (name, job) in &jobs {
-        let (row, ur_row) = evaluate(
-            &planner,
-            &timing,
-            &checker,
-            &robot_name,
-            (name, job),
-            ur_arm.as_ref(),
-        )?;
-        rows.push(row);
-        ur_rows.extend(ur_row);
-        bar.inc(1);
-    }
-    bar.finish();
+    Ok(jobs)
+}
+
+/// The time (s) of planning each job of hundreds of strokes (`GRID`, `HATCH`) on one thread.
+fn one_thread_times(
+    jobs: &[(String, Job)],
+    planner: &Planner,
+    timing: &MotionTiming,
+    robot_name: &str,
+) -> anyhow::Result<Vec<(String, f64)>> {
     let request = PlanRequest::default();
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut one_thread_s = Vec::new();
@@ -277,39 +325,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .filter(|(name, _)| [GRID, HATCH].contains(&name.as_str()))
     {
         let started = Instant::now();
-        one_thread
-            .install(|| plan_job(&planner, &request, job, &timing, &robot_name, &Unwatched))?;
+        one_thread.install(|| plan_job(planner, &request, job, timing, robot_name, &Unwatched))?;
         one_thread_s.push((name.clone(), started.elapsed().as_secs_f64()));
     }
-    let mut large_rows = Vec::new();
-    let sizes = progress::bar(2 * args.large.len() as u64, "large jobs");
-    for &strokes in &args.large {
-        for threads in [None, Some(1)] {
-            large_rows.push(large::evaluate(
-                &planner,
-                &timing,
-                &checker,
-                &robot_name,
-                home,
-                strokes,
-                threads,
-            )?);
-            sizes.inc(1);
-        }
-    }
-    sizes.finish();
-    let record = Record {
-        robot: planner.robot().name().to_string(),
-        command: workspace::command_for("job-eval", &args.robot),
-        icons: workspace::relative(&args.icons),
-        machine: workspace::machine(),
-        threads: rayon::current_num_threads(),
-        one_thread_s,
-        rows,
-        large: large_rows,
-        ur_programs: ur_rows,
-    };
-    workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
+    Ok(one_thread_s)
+}
+
+/// An error where a program fails the checker or a UR program does not read back.
+fn ensure_checked(record: &Record) -> anyhow::Result<()> {
     let failures = record
         .rows
         .iter()

@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use emg_control::CheckRollout;
+use emg_control::{CheckRollout, Task};
 use emg_eval::{
     BOUND_BUCKET_EDGES_M, BoundShare, BucketConfig, Difficulty, Summary, bound_bucket,
     bound_shares, four,
@@ -24,6 +24,7 @@ use emg_planner::{
     far_end_chains,
 };
 use emg_seeding::Shard;
+use emg_verify::ReferenceModel;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -158,72 +159,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         args.journal.display()
     );
     let bar = progress::bar(pending.len() as u64, "limit");
-    let search = PlanRequest {
-        planner: PlannerKind::Search,
-        ..PlanRequest::pipeline()
-    };
     workspace::thread_pool(args.common.threads)?.install(|| {
         pending.par_iter().try_for_each(|&index| {
-            let task = &tasks[index];
-            let plan = |planner: &Planner, request: &PlanRequest| {
-                planner
-                    .plan(task, request)
-                    .with_context(|| format!("task {index}"))
-            };
-            let pipeline = plan(&planner, &PlanRequest::pipeline())?;
-            let searched = plan(&planner, &search)?;
-            let large = plan(&limit_planner, &search)?;
-            let (pipeline_m, search_m) = (
-                pipeline.trajectory.path_length_m,
-                searched.trajectory.path_length_m,
-            );
-            // ℓ*: the longest of all three plans (the large search usually).
-            let limit = [large, searched, pipeline]
-                .into_iter()
-                .reduce(|best, other| {
-                    if other.trajectory.path_length_m > best.trajectory.path_length_m {
-                        other
-                    } else {
-                        best
-                    }
-                })
-                .context("three plans")?;
-            checker
-                .check(
-                    task,
-                    &limit.trajectory,
-                    &planner.config().rollout.constraints,
-                )
-                .map_err(|failure| {
-                    anyhow::anyhow!("task {index}: the limit fails the checker: {failure:?}")
-                })?;
-            let reach = planner.reach_of(task, &limit);
-            let config = planner.config();
-            let joined = !far_end_chains(
-                planner.robot(),
-                task,
-                &config.rollout.constraints,
-                &config.reach,
-                &reach,
-                config.search.chain_jump_rad,
-                FAR_END_RESTARTS,
-            )
-            .is_empty();
-            let record = TaskLimit {
-                index,
-                limit_m: limit.trajectory.path_length_m,
-                limit_seed: limit.seed.source.to_string(),
-                limit_q: limit
-                    .trajectory
-                    .steps
-                    .iter()
-                    .map(|s| planner.robot().joints_of(&s.q).to_vec())
-                    .collect(),
-                bound_m: reach.reachable_m,
-                pipeline_m,
-                search_m,
-                joined,
-            };
+            let record = task_limit(&planner, &limit_planner, &checker, index, &tasks[index])?;
             let text = serde_json::to_string(&record)? + "\n";
             emg_io::write_atomically(task_path(&args.journal, index), text.as_bytes())?;
             bar.inc(1);
@@ -232,6 +170,81 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     })?;
     bar.finish();
     Ok(())
+}
+
+/// Task `index` planned by the pipeline, by the default search and by the limit's
+/// (`limit_planner`): the longest plan, checked, with its reachability bound and whether its
+/// far end joins back to `p0`.
+fn task_limit(
+    planner: &Planner,
+    limit_planner: &Planner,
+    checker: &ReferenceModel,
+    index: usize,
+    task: &Task,
+) -> anyhow::Result<TaskLimit> {
+    let search = PlanRequest {
+        planner: PlannerKind::Search,
+        ..PlanRequest::pipeline()
+    };
+    let plan = |planner: &Planner, request: &PlanRequest| {
+        planner
+            .plan(task, request)
+            .with_context(|| format!("task {index}"))
+    };
+    let pipeline = plan(planner, &PlanRequest::pipeline())?;
+    let searched = plan(planner, &search)?;
+    let large = plan(limit_planner, &search)?;
+    let (pipeline_m, search_m) = (
+        pipeline.trajectory.path_length_m,
+        searched.trajectory.path_length_m,
+    );
+    // ℓ*: the longest of all three plans (the large search usually).
+    let limit = [large, searched, pipeline]
+        .into_iter()
+        .reduce(|best, other| {
+            if other.trajectory.path_length_m > best.trajectory.path_length_m {
+                other
+            } else {
+                best
+            }
+        })
+        .context("three plans")?;
+    checker
+        .check(
+            task,
+            &limit.trajectory,
+            &planner.config().rollout.constraints,
+        )
+        .map_err(|failure| {
+            anyhow::anyhow!("task {index}: the limit fails the checker: {failure:?}")
+        })?;
+    let reach = planner.reach_of(task, &limit);
+    let config = planner.config();
+    let joined = !far_end_chains(
+        planner.robot(),
+        task,
+        &config.rollout.constraints,
+        &config.reach,
+        &reach,
+        config.search.chain_jump_rad,
+        FAR_END_RESTARTS,
+    )
+    .is_empty();
+    Ok(TaskLimit {
+        index,
+        limit_m: limit.trajectory.path_length_m,
+        limit_seed: limit.seed.source.to_string(),
+        limit_q: limit
+            .trajectory
+            .steps
+            .iter()
+            .map(|s| planner.robot().joints_of(&s.q).to_vec())
+            .collect(),
+        bound_m: reach.reachable_m,
+        pipeline_m,
+        search_m,
+        joined,
+    })
 }
 
 fn task_path(journal: &Path, index: usize) -> PathBuf {

@@ -179,7 +179,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let twenty = Job::from_strokes(grid_of_circles(4, 5, [0.75, 0.0, 0.25]), planner.robot())?;
     jobs.push((TWENTY.to_string(), twenty.clone()));
     let settings = PlaceSettings::default();
-    let request = PlanRequest::default();
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
     let mut twenty_placement = None;
@@ -201,44 +200,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     bar.finish();
     let placement = twenty_placement.expect("the 20-stroke job was placed");
-    // Every one of the 20 best refined places planned.
-    let frame = PlaceFrame::of(&twenty, REGION.moving);
-    let best_of_top_m = placement
-        .refined
-        .iter()
-        .take(20)
-        .map(|scored| {
-            let moved = twenty.moved(&frame.job_motion(&scored.place))?;
-            Ok(
-                plan_job(&planner, &request, &moved, &timing, &robot_name, &Unwatched)
-                    .map_or(0.0, |program| program.summary.drawn_m),
-            )
-        })
-        .collect::<anyhow::Result<Vec<f64>>>()?
-        .into_iter()
-        .fold(0.0, f64::max);
-    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let again = one_thread.install(|| {
-        place_job(
-            &planner,
-            &request,
-            &twenty,
-            &timing,
-            &robot_name,
-            &REGION,
-            &settings,
-            Score::Bound,
-            &Unwatched,
-        )
-    })?;
-    let same_on_one_thread = again.screened == placement.screened
-        && again.refined == placement.refined
-        && again.best().scored == placement.best().scored;
-    let top_twenty = TopTwenty {
-        best_of_top_m,
-        chosen_m: placement.best().drawn_m,
-        same_on_one_thread,
-    };
+    let top_twenty = top_twenty(
+        &planner,
+        &timing,
+        &robot_name,
+        &twenty,
+        &placement,
+        &settings,
+    )?;
     write_map(&args.map, &placement)?;
     let record = Record {
         robot: planner.robot().name().to_string(),
@@ -255,7 +224,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         record.rows.iter().all(|r| r.chosen_checked),
         "a chosen place's program fails the checker"
     );
-    anyhow::ensure!(same_on_one_thread, "the places differ on one thread");
+    anyhow::ensure!(
+        record.top_twenty.same_on_one_thread,
+        "the places differ on one thread"
+    );
     anyhow::ensure!(
         record
             .rows
@@ -264,6 +236,56 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "a random place draws more than the chosen one"
     );
     Ok(())
+}
+
+/// Every one of the 20 best refined places of the 20-stroke job `twenty` (placed as
+/// `placement`) planned, and the placement again on one thread.
+fn top_twenty(
+    planner: &Planner,
+    timing: &MotionTiming,
+    robot_name: &str,
+    twenty: &Job,
+    placement: &Placement,
+    settings: &PlaceSettings,
+) -> anyhow::Result<TopTwenty> {
+    let request = PlanRequest::default();
+    let frame = PlaceFrame::of(twenty, REGION.moving);
+    let best_of_top_m = placement
+        .refined
+        .iter()
+        .take(20)
+        .map(|scored| {
+            let moved = twenty.moved(&frame.job_motion(&scored.place))?;
+            Ok(
+                plan_job(planner, &request, &moved, timing, robot_name, &Unwatched)
+                    .map_or(0.0, |program| program.summary.drawn_m),
+            )
+        })
+        .collect::<anyhow::Result<Vec<f64>>>()?
+        .into_iter()
+        .fold(0.0, f64::max);
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let again = one_thread.install(|| {
+        place_job(
+            planner,
+            &request,
+            twenty,
+            timing,
+            robot_name,
+            &REGION,
+            settings,
+            Score::Bound,
+            &Unwatched,
+        )
+    })?;
+    let same_on_one_thread = again.screened == placement.screened
+        && again.refined == placement.refined
+        && again.best().scored == placement.best().scored;
+    Ok(TopTwenty {
+        best_of_top_m,
+        chosen_m: placement.best().drawn_m,
+        same_on_one_thread,
+    })
 }
 
 /// `job` as it stands, placed by `emg place` and by the point-by-point score.
