@@ -74,12 +74,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 search_path.display()
             )
         })?)?;
-    let workspace::PlannerSetup { planner, tasks, .. } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        search.task_count,
-        "cartesian-eval",
-    )?;
+    let workspace::PlannerSetup { planner, tasks, .. } = args
+        .common
+        .planner_setup(search.task_count, "cartesian-eval")?;
     anyhow::ensure!(
         search.bounds_m.len() == tasks.len(),
         "{} holds {} bounds for {} tasks",

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::precision_eval::Setting;
-use crate::results::{SummaryTable, shipped_results};
+use crate::results::{SummaryPlace, shipped_results};
 use crate::task_set_options::TaskSetOptions;
 use crate::{progress, workspace};
 
@@ -22,24 +22,17 @@ const README_START: &str = "<!-- gaps:start -->";
 /// See [`README_START`].
 const README_END: &str = "<!-- gaps:end -->";
 
-/// The section of `docs/results.md` before the table.
-const INTRO: &str = "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
+/// Where the table of likely-loose bounds ([`report_table`]) is shown: the results summary.
+pub const SUMMARY: SummaryPlace = SummaryPlace {
+    page: workspace::RESULTS_SUMMARY,
+    start: README_START,
+    end: README_END,
+    intro: "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
          step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
          the far side: motions planned back from beyond the plan's end, and motions in place \
          and along the line between their branches and the plan's (`cargo xtask gap-eval`; \
-         `docs/results/gaps.md` per arm):\n\n";
-
-/// The table of likely-loose bounds ([`report_table`]) in its section and between its
-/// markers in the results summary.
-pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
-    Ok(SummaryTable {
-        page: workspace::RESULTS_SUMMARY,
-        start: README_START,
-        end: README_END,
-        intro: INTRO,
-        table: report_table(results)?,
-    })
-}
+         `docs/results/gaps.md` per arm):\n\n",
+};
 
 /// Options of `gap-eval`.
 #[derive(clap::Args)]
@@ -145,12 +138,8 @@ pub struct Record {
 
 /// Plans every line, probes those whose bound is likely loose, writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let workspace::PlannerSetup { planner, tasks, .. } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        args.tasks,
-        "gap-eval",
-    )?;
+    let workspace::PlannerSetup { planner, tasks, .. } =
+        args.common.planner_setup(args.tasks, "gap-eval")?;
     let setting = Setting {
         tolerance_mm: args.tolerance_mm,
         tracking: Tracking::Corrected,
@@ -323,7 +312,7 @@ impl Summary {
 }
 
 /// The report's table: one row per shipped arm with a `gaps.json`.
-fn report_table(results: &Path) -> anyhow::Result<String> {
+pub fn report_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | lines: Σ plan / Σ bound | likely loose | their Σ plan / Σ bound (m) \
          | longest shown from `p0` (m) | with one stop in place (m) | back and forth along the \

@@ -122,12 +122,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        args.tasks,
-        "limit",
-    )?;
+    } = args.common.planner_setup(args.tasks, "limit")?;
     let identity = Identity {
         tasks: workspace::relative(&args.common.task_file),
         task_count: tasks.len(),

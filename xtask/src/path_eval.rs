@@ -164,12 +164,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks: anchors,
-    } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        args.paths,
-        "path-eval",
-    )?;
+    } = args.common.planner_setup(args.paths, "path-eval")?;
     let paths = path_tasks(planner.robot(), &anchors, args.seed)?;
     let pool = workspace::thread_pool(args.common.threads)?;
     let (timing, _) = workspace::motion_timing(&planner, &args.common.robot, DEFAULT_RATE_HZ)?;

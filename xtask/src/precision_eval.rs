@@ -20,7 +20,7 @@ use emg_planner::{
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::results::{SummaryTable, shipped_results};
+use crate::results::{SummaryPlace, shipped_results};
 use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
 use crate::{progress, workspace};
 
@@ -30,22 +30,15 @@ const README_START: &str = "<!-- precision:start -->";
 /// See [`README_START`].
 const README_END: &str = "<!-- precision:end -->";
 
-/// The section of `docs/results.md` before the table.
-const INTRO: &str = "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
+/// Where the precision table ([`readme_table`]) is shown: the results summary.
+pub const SUMMARY: SummaryPlace = SummaryPlace {
+    page: workspace::RESULTS_SUMMARY,
+    start: README_START,
+    end: README_END,
+    intro: "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
          corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
-         `docs/results/precision.md` per arm):\n\n";
-
-/// The precision table ([`readme_table`]) in its section and between its markers in the
-/// results summary.
-pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
-    Ok(SummaryTable {
-        page: workspace::RESULTS_SUMMARY,
-        start: README_START,
-        end: README_END,
-        intro: INTRO,
-        table: readme_table(results)?,
-    })
-}
+         `docs/results/precision.md` per arm):\n\n",
+};
 
 /// The tolerances compared (mm): the paper's benchmark, then two a cell uses.
 pub const TOLERANCES_MM: [f64; 3] = [20.0, 0.5, 0.1];
@@ -250,12 +243,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        args.tasks.max(args.paths),
-        "precision-eval",
-    )?;
+    } = args
+        .common
+        .planner_setup(args.tasks.max(args.paths), "precision-eval")?;
     let lines: Vec<Task> = tasks[..args.tasks].to_vec();
     let paths = path_tasks(planner.robot(), &tasks[..args.paths], args.seed)?;
     let path_only: Vec<Task> = paths.iter().map(|(_, task)| task.clone()).collect();
@@ -691,7 +681,7 @@ fn loose_bounds(record: &Record, kind: Kind) -> String {
 /// One row per shipped arm, tolerance and step of every `precision.json` under `results`:
 /// Σ plan / Σ bound over all lines and all paths, the share of line motions the tolerance ended,
 /// the paths completed, checker failures.
-fn readme_table(results: &Path) -> anyhow::Result<String> {
+pub fn readme_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tolerance | step | lines: Σ plan / Σ bound | lines ended by the tolerance | \
          of them short of the bound | paths: Σ plan / Σ bound | paths completed | checker \

@@ -153,20 +153,29 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     md += &velocity_limits(&args.results)?;
     md += &surface_report::section(&args.results);
     md += &other_arms(&args.results, &args.figures)?;
-    let shares = search_shares::summary_table(&args.results)?;
-    let plan_times = timing::summary_table(&args.results)?;
-    let precision = precision_eval::summary_table(&args.results)?;
-    let gaps = gap_eval::summary_table(&args.results)?;
-    md += &shares.section();
-    md += &plan_times.section();
+    let summaries = [
+        (
+            &search_shares::SUMMARY,
+            search_shares::shares_table(&args.results)?,
+        ),
+        (&timing::SUMMARY, timing::plan_times_table(&args.results)?),
+        (
+            &precision_eval::SUMMARY,
+            precision_eval::readme_table(&args.results)?,
+        ),
+        (&gap_eval::SUMMARY, gap_eval::report_table(&args.results)?),
+    ];
+    let [shares, plan_times, precision, gaps] = &summaries;
+    md += &shares.0.section(&shares.1);
+    md += &plan_times.0.section(&plan_times.1);
     md += &path_eval::report_section(&args.results)?;
-    md += &precision.section();
-    md += &gaps.section();
+    md += &precision.0.section(&precision.1);
+    md += &gaps.0.section(&gaps.1);
     emg_io::write_atomically(&args.out, md)?;
     println!("wrote {}", args.out.display());
     if args.results == workspace::root().join("docs/results") {
-        for table in [&shares, &plan_times, &precision, &gaps] {
-            table.copy_to_page()?;
+        for (place, table) in &summaries {
+            place.copy_to_page(table)?;
         }
         println!(
             "wrote the table of search shares into README.md and those of plan times, precision \

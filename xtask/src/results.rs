@@ -40,9 +40,9 @@ pub(crate) fn dp() -> &'static str {
     SeedSource::Dp.name()
 }
 
-/// A table an evaluation writes over every shipped arm: shown in its section of
-/// `docs/results.md` and copied between its markers into a summary page.
-pub(crate) struct SummaryTable {
+/// Where a table an evaluation writes over every shipped arm is shown: in its section of
+/// `docs/results.md` and between its markers in a summary page.
+pub(crate) struct SummaryPlace {
     /// The page the table is copied into, relative to the workspace root (`README.md` or
     /// [`workspace::RESULTS_SUMMARY`]).
     pub page: &'static str,
@@ -53,18 +53,16 @@ pub(crate) struct SummaryTable {
     /// The section of `docs/results.md` before the table: its heading and the words that
     /// introduce the table.
     pub intro: &'static str,
-    /// The table (Markdown).
-    pub table: String,
 }
 
-impl SummaryTable {
-    /// The table's section of `docs/results.md`.
-    pub fn section(&self) -> String {
-        format!("{}{}\n", self.intro, self.table)
+impl SummaryPlace {
+    /// The section of `docs/results.md` that shows `table`.
+    pub fn section(&self, table: &str) -> String {
+        format!("{}{table}\n", self.intro)
     }
 
-    /// Copies the table between its markers in its page.
-    pub fn copy_to_page(&self) -> anyhow::Result<()> {
-        workspace::replace_section(self.page, self.start, self.end, &self.table)
+    /// Copies `table` between the markers in the page.
+    pub fn copy_to_page(&self, table: &str) -> anyhow::Result<()> {
+        workspace::replace_section(self.page, self.start, self.end, table)
     }
 }

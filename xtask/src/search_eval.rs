@@ -128,12 +128,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(
-        &args.common.robot,
-        &args.common.task_file,
-        args.tasks,
-        "search-eval",
-    )?;
+    } = args.common.planner_setup(args.tasks, "search-eval")?;
     let pool = workspace::thread_pool(args.common.threads)?;
     let search: SearchConfig =
         workspace::read_config(args.search_config.as_deref(), "search config")?;

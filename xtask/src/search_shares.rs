@@ -8,7 +8,7 @@ use emg_eval::BoundShare;
 use emg_planner::SearchConfig;
 
 use crate::cartesian_eval;
-use crate::results::{SummaryTable, read, shipped_results};
+use crate::results::{SummaryPlace, read, shipped_results};
 use crate::search_eval::{Record, Row};
 
 /// Markers of the README's table of search shares by bucket of the bound ([`shares_table`]).
@@ -16,28 +16,21 @@ const README_START: &str = "<!-- search-shares:start -->";
 /// The end marker of that table.
 const README_END: &str = "<!-- search-shares:end -->";
 
-/// The section of `docs/results.md` before the table.
-const INTRO: &str = "## Long lines: the share of the bound\n\nΣ path length / Σ reachability bound over the \
+/// Where the table of search shares ([`shares_table`]) is shown: the README.
+pub const SUMMARY: SummaryPlace = SummaryPlace {
+    page: "README.md",
+    start: README_START,
+    end: README_END,
+    intro: "## Long lines: the share of the bound\n\nΣ path length / Σ reachability bound over the \
          unseen tasks whose bound lies in each bucket (`cargo xtask search-eval`; \
-         `docs/results/search.md` per budget):\n\n";
-
-/// The table of search shares ([`shares_table`]) in its section and between its README
-/// markers.
-pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
-    Ok(SummaryTable {
-        page: "README.md",
-        start: README_START,
-        end: README_END,
-        intro: INTRO,
-        table: shares_table(results)?,
-    })
-}
+         `docs/results/search.md` per budget):\n\n",
+};
 
 /// For every shipped arm with a `search.json` under `results` (the FR3's top-level, the
 /// others' in their sub-directories), the pipeline and the search at the default budget:
 /// `Σ length / Σ bound` per bucket of the bound, the tasks below half their bound and the mean
 /// time per plan.
-fn shares_table(results: &Path) -> anyhow::Result<String> {
+pub fn shares_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | planner | < 0.5 m | 0.5 – 1 m | ≥ 1 m | all | below ½ bound | mean ms per plan |\n\
          |---|---|---|---|---|---|---|---|\n",

@@ -23,6 +23,18 @@ pub struct TaskSetOptions {
     pub out_dir: PathBuf,
 }
 
+impl TaskSetOptions {
+    /// The [`workspace::PlannerSetup`] of the robot file and the first `count` tasks of the task
+    /// set; `command` names the caller in errors.
+    pub fn planner_setup(
+        &self,
+        count: usize,
+        command: &str,
+    ) -> anyhow::Result<workspace::PlannerSetup> {
+        workspace::planner_setup(&self.robot, &self.task_file, count, command)
+    }
+}
+
 /// The help of `--threads` for an evaluation whose times depend on the worker threads.
 pub const THREADS_TIMED: &str =
     "Worker threads (0 = one per core); the results other than times do not depend on it";

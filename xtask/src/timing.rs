@@ -20,7 +20,7 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::results::{SummaryTable, shipped_results};
+use crate::results::{SummaryPlace, shipped_results};
 use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
 use crate::{progress, workspace};
 
@@ -126,7 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         planner,
         checker,
         tasks,
-    } = workspace::planner_setup(&args.common.robot, &args.common.task_file, count, "timing")?;
+    } = args.common.planner_setup(count, "timing")?;
     let pool = workspace::thread_pool(args.common.threads)?;
     let config = planner.config().clone();
     let (timing, limits_file) =
@@ -302,28 +302,21 @@ const README_START: &str = "<!-- plan-times:start -->";
 /// The end marker of that table.
 const README_END: &str = "<!-- plan-times:end -->";
 
-/// The section of `docs/results.md` before the table.
-const INTRO: &str = "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
+/// Where the table of plan times ([`plan_times_table`]) is shown: the results summary.
+pub const SUMMARY: SummaryPlace = SummaryPlace {
+    page: workspace::RESULTS_SUMMARY,
+    start: README_START,
+    end: README_END,
+    intro: "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
          bound's note and the timed files, as `emg plan` computes them (`cargo xtask timing`; \
-         `docs/results/timing.md` per arm):\n\n";
-
-/// The table of plan times ([`plan_times_table`]) in its section and between its markers in
-/// the results summary.
-pub fn summary_table(results: &Path) -> anyhow::Result<SummaryTable> {
-    Ok(SummaryTable {
-        page: workspace::RESULTS_SUMMARY,
-        start: README_START,
-        end: README_END,
-        intro: INTRO,
-        table: plan_times_table(results)?,
-    })
-}
+         `docs/results/timing.md` per arm):\n\n",
+};
 
 /// For every shipped arm with a `timing.json` under `results` (the FR3's top-level, the others'
 /// in their sub-directories): the time of the whole `emg plan` per task (mean, median, 99th
 /// percentile, slowest), the timing's share of it (median) and the machine and threads it was
 /// measured with.
-fn plan_times_table(results: &Path) -> anyhow::Result<String> {
+pub fn plan_times_table(results: &Path) -> anyhow::Result<String> {
     let mut md = String::from(
         "| arm | tasks | mean ms | median ms | 99th percentile ms | slowest ms | timing alone, \
          median ms | measured on |\n|---|---|---|---|---|---|---|---|\n",
