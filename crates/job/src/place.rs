@@ -287,6 +287,22 @@ pub struct Certified {
     pub program: Option<Box<JobFile>>,
 }
 
+impl Certified {
+    /// The certificate of `scored`'s place, where the job moved there (`moved`) was planned as
+    /// `program` (`None` where it could not be).
+    fn of(scored: Scored, moved: &Job, program: Option<JobFile>) -> Self {
+        Self {
+            scored,
+            drawn_m: program.as_ref().map_or(0.0, |p| p.summary.drawn_m),
+            total_m: moved.strokes.iter().map(|s| s.length_m()).sum(),
+            complete: program.as_ref().map_or(0, |p| p.summary.complete),
+            strokes: moved.strokes.len(),
+            duration_s: program.as_ref().map_or(0.0, |p| p.summary.duration_s),
+            program: program.map(Box::new),
+        }
+    }
+}
+
 /// What the place stage found.
 #[derive(Clone, Debug, Serialize)]
 pub struct Placement {
@@ -551,163 +567,239 @@ pub fn place_job(
 ) -> Result<Placement, PlaceError> {
     region.validate()?;
     settings.validate()?;
-    let frame = PlaceFrame::of(job, region.moving);
-    let xs = spread(region.x_m, settings.positions);
-    let ys = spread(region.y_m, settings.positions);
-    let zs = spread(region.z_m, settings.heights);
-    let turns = spread(region.rotation_deg, settings.rotations);
-    let mut grid: Vec<Place> = Vec::with_capacity(xs.len() * ys.len() * zs.len() * turns.len());
-    for &x_m in &xs {
-        for &y_m in &ys {
-            for &z_m in &zs {
-                for &rotation_deg in &turns {
-                    grid.push(Place {
-                        x_m,
-                        y_m,
-                        z_m,
-                        rotation_deg,
-                    });
-                }
-            }
-        }
-    }
+    let search = PlaceSearch {
+        planner,
+        request,
+        job,
+        timing,
+        robot_file,
+        frame: PlaceFrame::of(job, region.moving),
+        score,
+        watch,
+    };
+    let axes = PlaceAxes::of(region, settings);
     let full = planner.config().reach.clone();
     let coarse = ReachConfig {
         grid_m: settings.coarse_grid_m.max(full.grid_m),
         restarts: settings.coarse_restarts.min(full.restarts),
         ..full.clone()
     };
-    let scored = |stage: &str, places: &[Place], config: &ReachConfig| {
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        places
-            .par_iter()
-            .map(|place| {
-                if watch.stop_requested() {
-                    return Err(PlaceError::Stopped(Stopped));
-                }
-                let scored = place_score(planner, job, &frame, place, config, score)?;
-                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                watch.progress(stage, finished, places.len());
-                Ok(scored)
-            })
-            .collect::<Result<Vec<Scored>, PlaceError>>()
-    };
     let started = std::time::Instant::now();
-    let screened = scored("screen", &grid, &coarse)?;
+    let screened = search.scored("screen", &axes.places(), &coarse)?;
     let screening_s = started.elapsed().as_secs_f64();
     let ranked = best_first(&screened);
     if ranked[0].score <= 0.0 {
         return Err(PlaceError::Unreachable);
     }
     // The best screened places, and the places half a step round the best one.
-    let step = |values: &[f64]| match values {
-        [a, b, ..] => 0.5 * (b - a),
-        _ => 0.0,
-    };
-    let top = ranked[0].place;
     let mut refine: Vec<Place> = ranked
         .iter()
         .take(settings.refine)
         .map(|s| s.place)
         .collect();
-    let near_top = |delta: f64, values: &[f64], value: f64, range: [f64; 2]| {
-        (value + delta * step(values)).clamp(range[0], range[1])
-    };
-    for dx in [-1.0, 0.0, 1.0] {
-        for dy in [-1.0, 0.0, 1.0] {
-            for dz in [-1.0, 0.0, 1.0] {
-                for dr in [-1.0, 0.0, 1.0] {
-                    let near = Place {
-                        x_m: near_top(dx, &xs, top.x_m, region.x_m),
-                        y_m: near_top(dy, &ys, top.y_m, region.y_m),
-                        z_m: near_top(dz, &zs, top.z_m, region.z_m),
-                        rotation_deg: near_top(dr, &turns, top.rotation_deg, region.rotation_deg),
-                    };
-                    if !refine.contains(&near) {
-                        refine.push(near);
-                    }
-                }
-            }
+    for near in axes.round(&ranked[0].place, region) {
+        if !refine.contains(&near) {
+            refine.push(near);
         }
     }
-    let refined = best_first(&scored("refine", &refine, &full)?);
-    let mut certified: Vec<Certified> = Vec::new();
-    let mut first_failure = None;
-    for (index, candidate) in refined.iter().enumerate() {
-        // Past the first `settings.certify`, a place is planned while its score (at least the
-        // share the job draws there, `crates/job/tests/place.rs`) could beat the most drawn.
-        let most_drawn = certified
-            .iter()
-            .map(|c| c.drawn_m / c.total_m.max(f64::MIN_POSITIVE))
-            .fold(0.0, f64::max);
-        if index >= settings.certify && candidate.score <= most_drawn + SCORE_MARGIN {
-            break;
-        }
-        let motion = frame.job_motion(&candidate.place);
-        let moved = job.moved(&motion)?;
-        let total_m = moved.strokes.iter().map(|s| s.length_m()).sum();
-        let mut config = planner.config().clone();
-        config.rollout.constraints = cell_at(&config.rollout.constraints, &frame, &motion);
-        let at_place = planner
-            .with_config(config)
-            .expect("the planner's configuration with its cell moved is valid");
-        let planned = plan_job(
-            &at_place,
-            request,
-            &moved,
-            timing,
-            robot_file,
-            &StopsWith(watch),
-        );
-        if let Err(JobPlanError::Stopped(stopped)) = planned {
-            return Err(stopped.into());
-        }
-        watch.progress("certify", index + 1, settings.certify.max(index + 1));
-        certified.push(match planned {
-            Ok(program) => Certified {
-                scored: *candidate,
-                drawn_m: program.summary.drawn_m,
-                total_m,
-                complete: program.summary.complete,
-                strokes: moved.strokes.len(),
-                duration_s: program.summary.duration_s,
-                program: Some(Box::new(program)),
-            },
-            Err(why) => {
-                first_failure.get_or_insert(why);
-                Certified {
-                    scored: *candidate,
-                    drawn_m: 0.0,
-                    total_m,
-                    complete: 0,
-                    strokes: moved.strokes.len(),
-                    duration_s: 0.0,
-                    program: None,
-                }
-            }
-        });
-    }
-    // Most drawn first (counted in steps of [`SAME_LENGTH_M`]), then the shortest program;
-    // ties keep the refined order (stable sort).
-    let steps = |c: &Certified| (c.drawn_m / SAME_LENGTH_M).round();
-    certified.sort_by(|a, b| {
-        steps(b)
-            .total_cmp(&steps(a))
-            .then(a.duration_s.total_cmp(&b.duration_s))
-    });
-    if certified[0].program.is_none() {
-        return Err(PlaceError::NothingDrawn(
-            first_failure.expect("a place without a program failed to plan"),
-        ));
-    }
+    let refined = best_first(&search.scored("refine", &refine, &full)?);
+    let certified = search.certified(&refined, settings.certify)?;
     Ok(Placement {
-        frame,
+        frame: search.frame,
         region: *region,
         screened,
         refined,
         certified,
         screening_s,
     })
+}
+
+/// The values a placement tries along each of its region's ranges.
+struct PlaceAxes {
+    x_m: Vec<f64>,
+    y_m: Vec<f64>,
+    z_m: Vec<f64>,
+    rotation_deg: Vec<f64>,
+}
+
+impl PlaceAxes {
+    /// `settings`' counts of values spread evenly over each of `region`'s ranges.
+    fn of(region: &Region, settings: &PlaceSettings) -> Self {
+        Self {
+            x_m: spread(region.x_m, settings.positions),
+            y_m: spread(region.y_m, settings.positions),
+            z_m: spread(region.z_m, settings.heights),
+            rotation_deg: spread(region.rotation_deg, settings.rotations),
+        }
+    }
+
+    /// Every combination of the values, x outermost, the turn innermost.
+    fn places(&self) -> Vec<Place> {
+        let mut grid = Vec::with_capacity(
+            self.x_m.len() * self.y_m.len() * self.z_m.len() * self.rotation_deg.len(),
+        );
+        for &x_m in &self.x_m {
+            for &y_m in &self.y_m {
+                for &z_m in &self.z_m {
+                    for &rotation_deg in &self.rotation_deg {
+                        grid.push(Place {
+                            x_m,
+                            y_m,
+                            z_m,
+                            rotation_deg,
+                        });
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    /// The places half a step of each range round `top` (itself among them), within `region`.
+    fn round(&self, top: &Place, region: &Region) -> Vec<Place> {
+        let step = |values: &[f64]| match values {
+            [a, b, ..] => 0.5 * (b - a),
+            _ => 0.0,
+        };
+        let near = |delta: f64, values: &[f64], value: f64, range: [f64; 2]| {
+            (value + delta * step(values)).clamp(range[0], range[1])
+        };
+        let deltas = [-1.0, 0.0, 1.0];
+        let mut places = Vec::with_capacity(81);
+        for dx in deltas {
+            for dy in deltas {
+                for dz in deltas {
+                    for dr in deltas {
+                        places.push(Place {
+                            x_m: near(dx, &self.x_m, top.x_m, region.x_m),
+                            y_m: near(dy, &self.y_m, top.y_m, region.y_m),
+                            z_m: near(dz, &self.z_m, top.z_m, region.z_m),
+                            rotation_deg: near(
+                                dr,
+                                &self.rotation_deg,
+                                top.rotation_deg,
+                                region.rotation_deg,
+                            ),
+                        });
+                    }
+                }
+            }
+        }
+        places
+    }
+}
+
+/// A placement's search: the job, how it is planned at a place, and how places are scored.
+struct PlaceSearch<'a> {
+    planner: &'a Planner,
+    request: &'a PlanRequest,
+    job: &'a Job,
+    timing: &'a MotionTiming,
+    robot_file: &'a str,
+    frame: PlaceFrame,
+    score: Score,
+    watch: &'a dyn Watch,
+}
+
+impl PlaceSearch<'_> {
+    /// `places` scored ([`place_score`]) with `config`, in parallel; `watch` told the
+    /// progress as `stage` and asked whether to stop.
+    fn scored(
+        &self,
+        stage: &str,
+        places: &[Place],
+        config: &ReachConfig,
+    ) -> Result<Vec<Scored>, PlaceError> {
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        places
+            .par_iter()
+            .map(|place| {
+                if self.watch.stop_requested() {
+                    return Err(PlaceError::Stopped(Stopped));
+                }
+                let scored = place_score(
+                    self.planner,
+                    self.job,
+                    &self.frame,
+                    place,
+                    config,
+                    self.score,
+                )?;
+                let finished = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                self.watch.progress(stage, finished, places.len());
+                Ok(scored)
+            })
+            .collect()
+    }
+
+    /// The `refined` places, best first, planned as jobs: the first `certify`, then more while
+    /// a place's score (at least the share the job draws there, `crates/job/tests/place.rs`)
+    /// could beat the most drawn; ranked most drawn first (counted in steps of
+    /// [`SAME_LENGTH_M`]), then the shortest program, ties in the refined order.
+    fn certified(&self, refined: &[Scored], certify: usize) -> Result<Vec<Certified>, PlaceError> {
+        let mut certified: Vec<Certified> = Vec::new();
+        let mut first_failure = None;
+        for (index, candidate) in refined.iter().enumerate() {
+            let most_drawn = certified
+                .iter()
+                .map(|c| c.drawn_m / c.total_m.max(f64::MIN_POSITIVE))
+                .fold(0.0, f64::max);
+            if index >= certify && candidate.score <= most_drawn + SCORE_MARGIN {
+                break;
+            }
+            let (planned, moved) = self.planned_at(candidate)?;
+            self.watch
+                .progress("certify", index + 1, certify.max(index + 1));
+            let program = match planned {
+                Ok(program) => Some(program),
+                Err(why) => {
+                    first_failure.get_or_insert(why);
+                    None
+                }
+            };
+            certified.push(Certified::of(*candidate, &moved, program));
+        }
+        let steps = |c: &Certified| (c.drawn_m / SAME_LENGTH_M).round();
+        certified.sort_by(|a, b| {
+            steps(b)
+                .total_cmp(&steps(a))
+                .then(a.duration_s.total_cmp(&b.duration_s))
+        });
+        if certified[0].program.is_none() {
+            return Err(PlaceError::NothingDrawn(
+                first_failure.expect("a place without a program failed to plan"),
+            ));
+        }
+        Ok(certified)
+    }
+
+    /// The job moved to `candidate`'s place, and planned there ([`plan_job`], with the cell
+    /// moved along); [`PlaceError::Stopped`] where the watcher stopped it.
+    fn planned_at(
+        &self,
+        candidate: &Scored,
+    ) -> Result<(Result<JobFile, JobPlanError>, Job), PlaceError> {
+        let motion = self.frame.job_motion(&candidate.place);
+        let moved = self.job.moved(&motion)?;
+        let mut config = self.planner.config().clone();
+        config.rollout.constraints = cell_at(&config.rollout.constraints, &self.frame, &motion);
+        let at_place = self
+            .planner
+            .with_config(config)
+            .expect("the planner's configuration with its cell moved is valid");
+        let planned = plan_job(
+            &at_place,
+            self.request,
+            &moved,
+            self.timing,
+            self.robot_file,
+            &StopsWith(self.watch),
+        );
+        if let Err(JobPlanError::Stopped(stopped)) = planned {
+            return Err(stopped.into());
+        }
+        Ok((planned, moved))
+    }
 }
 
 /// `constraints` with the cell where the place puts it relative to the base: moved by `motion`
