@@ -23,16 +23,15 @@ const README_START: &str = "<!-- gaps:start -->";
 const README_END: &str = "<!-- gaps:end -->";
 
 /// Where the table of likely-loose bounds ([`report_table`]) is shown: the results summary.
-pub const SUMMARY: SummaryPlace = SummaryPlace {
-    page: workspace::RESULTS_SUMMARY,
-    start: README_START,
-    end: README_END,
-    intro: "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
+pub const SUMMARY: SummaryPlace = SummaryPlace::in_results_summary(
+    README_START,
+    README_END,
+    "## Lines whose bound is likely loose\n\nThe lines of the precision table's corrected \
          step at 0.5 mm whose bound no chain of valid configurations joins to `p0`, asked from \
          the far side: motions planned back from beyond the plan's end, and motions in place \
          and along the line between their branches and the plan's (`cargo xtask gap-eval`; \
          `docs/results/gaps.md` per arm):\n\n",
-};
+);
 
 /// Options of `gap-eval`.
 #[derive(clap::Args)]

@@ -31,14 +31,13 @@ const README_START: &str = "<!-- precision:start -->";
 const README_END: &str = "<!-- precision:end -->";
 
 /// Where the precision table ([`readme_table`]) is shown: the results summary.
-pub const SUMMARY: SummaryPlace = SummaryPlace {
-    page: workspace::RESULTS_SUMMARY,
-    start: README_START,
-    end: README_END,
-    intro: "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
+pub const SUMMARY: SummaryPlace = SummaryPlace::in_results_summary(
+    README_START,
+    README_END,
+    "## Precision: 20 mm, 0.5 mm and 0.1 mm\n\nThe search with the paper's step and the \
          corrected one at each tolerance, on lines and paths (`cargo xtask precision-eval`; \
          `docs/results/precision.md` per arm):\n\n",
-};
+);
 
 /// The tolerances compared (mm): the paper's benchmark, then two a cell uses.
 pub const TOLERANCES_MM: [f64; 3] = [20.0, 0.5, 0.1];

@@ -56,6 +56,21 @@ pub(crate) struct SummaryPlace {
 }
 
 impl SummaryPlace {
+    /// A table's place in the results summary ([`workspace::RESULTS_SUMMARY`]) between the
+    /// markers `start` and `end`, shown in `docs/results.md` after `intro`.
+    pub const fn in_results_summary(
+        start: &'static str,
+        end: &'static str,
+        intro: &'static str,
+    ) -> Self {
+        Self {
+            page: workspace::RESULTS_SUMMARY,
+            start,
+            end,
+            intro,
+        }
+    }
+
     /// The section of `docs/results.md` that shows `table`.
     pub fn section(&self, table: &str) -> String {
         format!("{}{table}\n", self.intro)

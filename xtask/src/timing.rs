@@ -303,14 +303,13 @@ const README_START: &str = "<!-- plan-times:start -->";
 const README_END: &str = "<!-- plan-times:end -->";
 
 /// Where the table of plan times ([`plan_times_table`]) is shown: the results summary.
-pub const SUMMARY: SummaryPlace = SummaryPlace {
-    page: workspace::RESULTS_SUMMARY,
-    start: README_START,
-    end: README_END,
-    intro: "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
+pub const SUMMARY: SummaryPlace = SummaryPlace::in_results_summary(
+    README_START,
+    README_END,
+    "## Time of the whole `emg plan`\n\nPer unseen task: the plan (search and bound), the \
          bound's note and the timed files, as `emg plan` computes them (`cargo xtask timing`; \
          `docs/results/timing.md` per arm):\n\n",
-};
+);
 
 /// For every shipped arm with a `timing.json` under `results` (the FR3's top-level, the others'
 /// in their sub-directories): the time of the whole `emg plan` per task (mean, median, 99th
