@@ -24,23 +24,36 @@ use emg_planner::{MotionTiming, PlanRequest, Planner, ShippedRobot};
 use emg_timing::time_free_move;
 use serde::{Deserialize, Serialize};
 
+use crate::task_set_options::ROBOT_WITH_JOINT_LIMITS;
 use crate::{progress, workspace};
 
 mod large;
 mod ur_programs;
 
-/// Options of `job-eval`.
+/// The icons, robot file and output directory of an evaluation of jobs on icons.
 #[derive(clap::Args)]
-pub struct Args {
+pub struct IconJobOptions {
     /// Directory of SVG icons (every `*.svg` in it, in name order).
     #[arg(long, default_value_os_t = workspace::root().join("crates/io/tests/data/icons"))]
-    icons: PathBuf,
-    /// Robot file (its joint limits are the `.joint_limits.yaml` beside it).
+    pub icons: PathBuf,
+    /// Robot file.
     #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of jobs.{json,md}.
+    pub robot: PathBuf,
+    /// Output directory of the result files.
     #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    pub out_dir: PathBuf,
+}
+
+/// Options of `job-eval`.
+#[derive(clap::Args)]
+#[command(
+    mut_arg("robot", |arg| arg.help(ROBOT_WITH_JOINT_LIMITS)),
+    mut_arg("out_dir", |arg| arg.help("Output directory of jobs.{json,md}")),
+)]
+pub struct Args {
+    /// Icons, robot file and output directory.
+    #[command(flatten)]
+    common: IconJobOptions,
     /// Sizes of the large jobs (strokes of generated drawings, comma-separated), each planned
     /// on all threads and on one; none with `--large` alone.
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "500,2000,10000")]
@@ -192,9 +205,9 @@ pub struct Record {
 
 /// Plans, checks and compares every job; writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (planner, timing, checker) = setup(&args.robot)?;
-    let robot_name = args.robot.display().to_string();
-    let shipped = ShippedRobot::by_path(&args.robot, &workspace::data_dir())
+    let (planner, timing, checker) = setup(&args.common.robot)?;
+    let robot_name = args.common.robot.display().to_string();
+    let shipped = ShippedRobot::by_path(&args.common.robot, &workspace::data_dir())
         .context("job-eval plans the shipped arms, whose homes it starts from")?;
     let home = shipped.home;
     // The arm whose controller's frames a native UR program is written in: the UR5e.
@@ -202,11 +215,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .filter(|profile| profile.has_ur_controller_frames())
         .map(|profile| ur_programs::UrArm {
             robot: planner.robot(),
-            robot_file: &args.robot,
+            robot_file: &args.common.robot,
             profile,
             checker: &checker,
         });
-    let jobs = jobs(&args.icons, &planner, home)?;
+    let jobs = jobs(&args.common.icons, &planner, home)?;
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
     let mut ur_rows = Vec::new();
@@ -244,8 +257,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     sizes.finish();
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: workspace::command_for("job-eval", &args.robot),
-        icons: workspace::relative(&args.icons),
+        command: workspace::command_for("job-eval", &args.common.robot),
+        icons: workspace::relative(&args.common.icons),
         machine: workspace::machine(),
         threads: rayon::current_num_threads(),
         one_thread_s,
@@ -253,7 +266,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         large: large_rows,
         ur_programs: ur_rows,
     };
-    workspace::write_results(&args.out_dir, "jobs", &record, &markdown(&record))?;
+    workspace::write_results(&args.common.out_dir, "jobs", &record, &markdown(&record))?;
     ensure_checked(&record)
 }
 

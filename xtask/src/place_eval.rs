@@ -19,21 +19,16 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::job_eval::{grid_of_circles, icon_files, setup};
+use crate::job_eval::{IconJobOptions, grid_of_circles, icon_files, setup};
 use crate::{progress, workspace};
 
 /// Options of `place-eval`.
 #[derive(clap::Args)]
+#[command(mut_arg("out_dir", |arg| arg.help("Output directory of placement.{json,md}")))]
 pub struct Args {
-    /// Directory of SVG icons (every `*.svg` in it, in name order).
-    #[arg(long, default_value_os_t = workspace::root().join("crates/io/tests/data/icons"))]
-    icons: PathBuf,
-    /// Robot file.
-    #[arg(long, value_parser = workspace::robot_file, default_value_os_t = workspace::default_robot())]
-    robot: PathBuf,
-    /// Output directory of placement.{json,md}.
-    #[arg(long, default_value_os_t = workspace::results_dir())]
-    out_dir: PathBuf,
+    /// Icons, robot file and output directory.
+    #[command(flatten)]
+    common: IconJobOptions,
     /// The heat map of the 20-stroke job.
     #[arg(long, default_value_os_t = workspace::root().join("docs/figures/placement-map.svg"))]
     map: PathBuf,
@@ -152,9 +147,9 @@ const TWENTY: &str = "20 circles 2 cm across in a 4 × 5 grid round (0.75, 0, 0.
 
 /// Places every job, compares, checks, writes the record, its table and the heat map.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (planner, timing, checker) = setup(&args.robot)?;
-    let robot_name = args.robot.display().to_string();
-    let icons = icon_files(&args.icons)?;
+    let (planner, timing, checker) = setup(&args.common.robot)?;
+    let robot_name = args.common.robot.display().to_string();
+    let icons = icon_files(&args.common.icons)?;
     let mut jobs: Vec<(String, Job)> = Vec::new();
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     for icon in &icons {
@@ -211,7 +206,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     write_map(&args.map, &placement)?;
     let record = Record {
         robot: planner.robot().name().to_string(),
-        command: workspace::command_for("place-eval", &args.robot),
+        command: workspace::command_for("place-eval", &args.common.robot),
         machine: workspace::machine(),
         threads: rayon::current_num_threads(),
         region: REGION,
@@ -219,7 +214,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         rows,
         top_twenty,
     };
-    workspace::write_results(&args.out_dir, "placement", &record, &markdown(&record))?;
+    workspace::write_results(
+        &args.common.out_dir,
+        "placement",
+        &record,
+        &markdown(&record),
+    )?;
     anyhow::ensure!(
         record.rows.iter().all(|r| r.chosen_checked),
         "a chosen place's program fails the checker"
