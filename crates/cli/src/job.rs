@@ -5,14 +5,13 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use emg_job::{JobPlanError, plan_job};
+use emg_job::JobPlanError;
 
 use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
 use crate::job_input::{JobInput, Ready, print_size};
 use crate::output::{progress_bar, write_text};
 use crate::program::print_summary;
-use crate::robot;
 
 /// Options of `emg job`.
 #[derive(Debug, Args)]
@@ -49,22 +48,10 @@ pub fn run(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
     emg_io::refuse_overwriting(&input.files(), &outputs)?;
     exporting::refuse_program_export(args.export, &args.urscript, &input.robot)?;
-    let Ready {
-        job,
-        planner,
-        timing,
-        request,
-    } = input.ready()?;
+    let Ready { job, planner } = input.ready()?;
     print_size(&job);
     let watch = Watched::new(progress_bar(job.strokes.len() as u64, "strokes"), interrupt);
-    let file = match plan_job(
-        &planner,
-        &request,
-        &job,
-        &timing,
-        &robot::reference(&input.robot)?.to_string(),
-        &watch,
-    ) {
+    let file = match planner.plan(&job, &watch) {
         Err(JobPlanError::Stopped(_)) => return Err(watch.stopped()),
         planned => planned?,
     };

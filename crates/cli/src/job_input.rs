@@ -6,8 +6,8 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 use emg_io::{Placement, read_svg_file};
-use emg_job::{Job, Order, Tool};
-use emg_planner::{Models, MotionTiming, PlanRequest, Planner};
+use emg_job::{Job, JobPlanner, Order, Tool};
+use emg_planner::{Models, Planner};
 
 use crate::options;
 use crate::output::count;
@@ -80,17 +80,12 @@ pub struct JobInput {
     pub home: Option<Vec<f64>>,
 }
 
-/// A job ready to plan: the job read, the planner and timing `emg job` plans it with, the
-/// request.
+/// A job ready to plan: the job read, and what `emg job` and `emg place` plan it with.
 pub struct Ready {
     /// The job.
     pub job: Job,
-    /// The planner at the job's tolerance and cone.
-    pub planner: Planner,
-    /// The program's timing.
-    pub timing: MotionTiming,
-    /// The request (the search with the best shipped controller).
-    pub request: PlanRequest,
+    /// The planner at the job's tolerance, cone and scene, its timing and request.
+    pub planner: JobPlanner,
 }
 
 impl JobInput {
@@ -108,18 +103,16 @@ impl JobInput {
     pub fn ready(&self) -> Result<Ready> {
         let robot = robot::load_robot(&self.robot, None, None)?;
         let drawing = self.drawing_tolerance()?;
-        let mut job = read_job(self, drawing.as_ref(), &robot)?;
+        let job = read_job(self, drawing.as_ref(), &robot)?;
         let shipped_home = robot::shipped(&self.robot).map(|shipped| shipped.home);
-        match (&self.home, shipped_home) {
-            (Some(values), _) => {
-                job = job.with_home(values, &robot).map_err(|e| match e {
-                    emg_job::JobError::Home(problem) => anyhow::anyhow!("--home {problem}"),
-                    other => other.into(),
-                })?;
-            }
-            (None, Some(values)) if job.home.is_none() => job = job.with_home(values, &robot)?,
-            _ => {}
-        }
+        let job = job
+            .homed(self.home.as_deref(), shipped_home, &robot)
+            .map_err(|e| match e {
+                emg_job::JobError::Home(problem) if self.home.is_some() => {
+                    anyhow::anyhow!("--home {problem}")
+                }
+                other => other.into(),
+            })?;
         let mut config = emg_job::job_config(self.tolerance * 1e-3);
         config.rollout.constraints.theta_max_deg = self.cone;
         if let Some(path) = &self.scene {
@@ -129,18 +122,10 @@ impl JobInput {
         let diffusion = robot::shipped_model(&self.robot, emg_planner::DIFFUSION_WEIGHTS_FILE);
         let policy = robot::shipped_model(&self.robot, emg_planner::POLICY_WEIGHTS_FILE);
         let models = Models::load(&robot, diffusion.as_deref(), policy.as_deref())?;
-        let timing = emg_job::job_timing(&robot, &self.robot, &config)?;
         let planner = Planner::new(robot, models, config)?;
-        let request = PlanRequest {
-            controller: planner.models().best_controller(),
-            ..PlanRequest::default()
-        };
-        Ok(Ready {
-            job,
-            planner,
-            timing,
-            request,
-        })
+        let recorded_as = robot::reference(&self.robot)?.to_string();
+        let planner = JobPlanner::new(planner, &self.robot, recorded_as)?;
+        Ok(Ready { job, planner })
     }
 
     /// Whether the job is an SVG drawing (else a job file).

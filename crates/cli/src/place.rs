@@ -8,7 +8,7 @@ use anyhow::Result;
 use clap::Args;
 use emg_job::{
     JOB_FORMAT_VERSION, JobSpec, Moving, PlaceError, PlaceSettings, Placement, Region, Score,
-    place_job, placement_map,
+    placement_map,
 };
 
 use crate::exporting;
@@ -16,7 +16,6 @@ use crate::interrupt::{Interrupt, Watched};
 use crate::job_input::{JobInput, Ready, print_size};
 use crate::output::{progress_bar, write_text};
 use crate::program::print_summary;
-use crate::robot;
 
 /// Options of `emg place`.
 #[derive(Debug, Args)]
@@ -132,25 +131,10 @@ pub fn run(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     };
     region.validate()?;
     settings.validate()?;
-    let Ready {
-        job,
-        planner,
-        timing,
-        request,
-    } = input.ready()?;
+    let Ready { job, planner } = input.ready()?;
     print_size(&job);
     let watch = Watched::new(progress_bar(0, "places"), interrupt);
-    let placement = match place_job(
-        &planner,
-        &request,
-        &job,
-        &timing,
-        &robot::reference(&input.robot)?.to_string(),
-        &region,
-        &settings,
-        args.score,
-        &watch,
-    ) {
+    let placement = match planner.place(&job, &region, &settings, args.score, &watch) {
         Err(PlaceError::Stopped(_)) => return Err(watch.stopped()),
         placed => placed?,
     };

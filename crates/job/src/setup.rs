@@ -78,6 +78,11 @@ impl JobPlanner {
         &self.planner
     }
 
+    /// The arm.
+    pub fn robot(&self) -> &Robot {
+        self.planner.robot()
+    }
+
     /// How programs are timed.
     pub fn timing(&self) -> &MotionTiming {
         &self.timing

@@ -306,6 +306,22 @@ impl Job {
         })
     }
 
+    /// The job with the home its program starts and ends at, as every front end sets it:
+    /// `given` where given, else the job's own, else `default` (a shipped arm's); the job as it
+    /// is where none is.
+    pub fn homed(
+        self,
+        given: Option<&[f64]>,
+        default: Option<&[f64]>,
+        robot: &Robot,
+    ) -> Result<Self, JobError> {
+        match (given, default) {
+            (Some(values), _) => self.with_home(values, robot),
+            (None, Some(values)) if self.home.is_none() => self.with_home(values, robot),
+            _ => Ok(self),
+        }
+    }
+
     /// The job with every stroke moved rigidly by `motion`.
     pub fn moved(&self, motion: &Isometry3<f64>) -> Result<Self, JobError> {
         let strokes = self

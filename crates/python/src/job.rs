@@ -4,8 +4,6 @@
 use std::path::PathBuf;
 
 use emg_job::{Job, JobError, JobFile};
-use emg_planner::{DEFAULT_RATE_HZ, PlanRequest};
-use emg_timing::Scaling;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyOSError;
@@ -109,43 +107,27 @@ pub(crate) fn with_home(
             })
         })
         .transpose()?;
-    let values = match (&given, robot.home) {
-        (Some(values), _) => values.as_slice(),
-        (None, Some(values)) if job.home.is_none() => values,
-        _ => return Ok(job),
-    };
-    job.with_home(values, &robot.inner).map_err(|e| match e {
-        JobError::Home(problem) => InputError::new_err(format!("home: {problem}")),
-        other => input_error("home", &other),
-    })
+    job.homed(given.as_deref(), robot.home, &robot.inner)
+        .map_err(|e| match e {
+            JobError::Home(problem) => InputError::new_err(format!("home: {problem}")),
+            other => input_error("home", &other),
+        })
 }
 
-/// What a job plans with at `tolerance_mm` (positive, as [`read_job`] checks it): `planner` at
-/// that tolerance, its timing and the
-/// request (the search, the best shipped controller), as `emg job` plans.
+/// What a job plans with at `tolerance_mm` (positive, as [`read_job`] checks it): `planner`
+/// at that tolerance, timed and asked as `emg job` plans ([`emg_job::JobPlanner`]).
 fn job_planner(
     planner: &emg_planner::Planner,
-    robot_file: &std::path::Path,
+    robot: &crate::robot::Robot,
     tolerance_mm: f64,
-) -> PyResult<(emg_planner::Planner, emg_planner::MotionTiming, PlanRequest)> {
+) -> PyResult<emg_job::JobPlanner> {
     let mut config = planner.config().clone();
     config.rollout.constraints.line_tolerance_m = tolerance_mm * 1e-3;
     let planner = planner
         .with_config(config)
         .map_err(|e| input_error("tolerance_mm", &e))?;
-    let timing = crate::timing::motion_timing(
-        &planner,
-        robot_file,
-        None,
-        Scaling::default(),
-        None,
-        DEFAULT_RATE_HZ,
-    )?;
-    let request = PlanRequest {
-        controller: planner.models().best_controller(),
-        ..PlanRequest::default()
-    };
-    Ok((planner, timing, request))
+    emg_job::JobPlanner::new(planner, &robot.file, robot.reference.clone())
+        .map_err(|e| input_error("timing", &e))
 }
 
 /// The placement a dict's JSON `text` gives: the default's fields with the dict's over them (a
@@ -174,18 +156,9 @@ pub(crate) fn plan(
     job: &Job,
     tolerance_mm: f64,
 ) -> PyResult<JobPlan> {
-    let (planner, timing, request) = job_planner(planner, &robot.file, tolerance_mm)?;
+    let planner = job_planner(planner, robot, tolerance_mm)?;
     let file = py
-        .detach(|| {
-            emg_job::plan_job(
-                &planner,
-                &request,
-                job,
-                &timing,
-                &robot.reference,
-                &emg_job::Unwatched,
-            )
-        })
+        .detach(|| planner.plan(job, &emg_job::Unwatched))
         .map_err(|e| PlanningError::new_err(message(&e)))?;
     Ok(JobPlan::new(file))
 }
@@ -377,21 +350,9 @@ pub(crate) fn place(
     settings
         .validate()
         .map_err(|e| InputError::new_err(message(&e)))?;
-    let (planner, timing, request) = job_planner(planner, &robot.file, tolerance_mm)?;
+    let planner = job_planner(planner, robot, tolerance_mm)?;
     let placement = py
-        .detach(|| {
-            emg_job::place_job(
-                &planner,
-                &request,
-                job,
-                &timing,
-                &robot.reference,
-                &region,
-                &settings,
-                score,
-                &emg_job::Unwatched,
-            )
-        })
+        .detach(|| planner.place(job, &region, &settings, score, &emg_job::Unwatched))
         .map_err(|e| PlanningError::new_err(message(&e)))?;
     Ok(JobPlacement { placement, score })
 }
