@@ -321,21 +321,11 @@ impl Comparison<'_> {
         task: &Task,
         files: &PlanFiles,
     ) -> [(&'static str, Result<(), String>); 2] {
-        let constraints = &self.planner.config().rollout.constraints;
         let verify = |text: &str| {
             TrajectoryContents::parse(text)
                 .map_err(|e| e.to_string())
                 .and_then(|contents| {
-                    contents
-                        .verify(
-                            self.checker,
-                            self.planner.robot().joint_names(),
-                            task,
-                            constraints,
-                            true,
-                            None,
-                        )
-                        .map(|_| ())
+                    workspace::verify_file(&contents, self.planner, self.checker, task)
                         .map_err(|e| e.to_string())
                 })
         };

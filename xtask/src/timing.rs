@@ -212,15 +212,7 @@ impl Timer<'_> {
             .time(self.planner.robot(), task, constraints, &plan.trajectory)?;
         let timing_ms = started.elapsed().as_secs_f64() * 1e3;
         let contents = TrajectoryContents::parse(&files.joint_trajectory)?;
-        let failure = contents
-            .verify(
-                self.checker,
-                self.planner.robot().joint_names(),
-                task,
-                constraints,
-                true,
-                None,
-            )
+        let failure = workspace::verify_file(&contents, self.planner, self.checker, task)
             .err()
             .map(|failure| format!("task {index}: {failure}"));
         let report = &motion.report;

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use anyhow::Context;
 use emg_control::Task;
-use emg_io::read_tasks;
+use emg_io::{TrajectoryContents, VerifyFailure, read_tasks};
 use emg_kinematics::Robot;
 use emg_planner::{
     DataDir, Models, MotionTiming, Planner, PlannerConfig, ShippedRobot, limits_file_beside,
@@ -187,6 +187,26 @@ pub fn motion_timing(
     )
     .with_context(|| format!("the joint limits {}", limits_file.display()))?;
     Ok((timing, limits_file))
+}
+
+/// Verifies the trajectory file `contents` of `task` as `emg check` verifies a file planned for
+/// its own task: by `checker`, with the joints and constraints of `planner`.
+pub fn verify_file(
+    contents: &TrajectoryContents,
+    planner: &Planner,
+    checker: &ReferenceModel,
+    task: &Task,
+) -> Result<(), VerifyFailure> {
+    contents
+        .verify(
+            checker,
+            planner.robot().joint_names(),
+            task,
+            &planner.config().rollout.constraints,
+            true,
+            None,
+        )
+        .map(|_| ())
 }
 
 /// The [`PlannerSetup`] of the shipped robot file `robot` and the first `count` tasks of
