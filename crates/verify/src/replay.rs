@@ -1,7 +1,7 @@
 //! Verifying timed joint positions read from a file: every point against the task and the
 //! bounds, joint speeds from positions and times, and the velocities the file declares.
 
-use crate::check::{FailedCheck, Points};
+use crate::check::{FailedCheck, Measured, Points};
 use crate::dynamics::{DynamicsCheck, DynamicsReport, JointDynamics, check_dynamics};
 use crate::model::{ReferenceModel, within};
 use crate::record::{Bounds, Joints, Line, Recording};
@@ -174,32 +174,68 @@ pub fn check_replay(
     recorded: Option<&Recording>,
     dynamics: Option<&JointDynamics>,
 ) -> Result<ReplayReport, ReplayError> {
-    let fail = |point: usize, check: ReplayCheck, problem: String| {
-        Err(ReplayError::Point {
-            point,
-            check,
-            problem,
-        })
-    };
     if samples.is_empty() {
         return Err(ReplayError::Empty);
     }
-    for (k, t) in samples.time_s.iter().enumerate() {
-        if !t.is_finite() {
-            return fail(k, ReplayCheck::Times, format!("time {t} s is not finite"));
+    check_times(&samples.time_s)?;
+    let measured = model
+        .check_points(line, replayed_points(samples, recorded), bounds)
+        .map_err(|failure| ReplayError::Point {
+            point: failure.step,
+            check: ReplayCheck::Recording(failure.check),
+            problem: failure.problem,
+        })?;
+    let v_max = model.velocity_limits();
+    let max_declared_velocity_error = check_declared_velocities(samples, bounds, &v_max)?;
+    let dynamics = match dynamics {
+        Some(limits) => {
+            Some(
+                check_dynamics(samples, limits).map_err(|failure| ReplayError::Point {
+                    point: failure.sample,
+                    check: ReplayCheck::Dynamics(failure.check),
+                    problem: failure.problem,
+                })?,
+            )
         }
-        if k > 0 && *t <= samples.time_s[k - 1] {
-            return fail(
-                k,
-                ReplayCheck::Times,
-                format!(
+        None => None,
+    };
+    Ok(replay_report(
+        samples,
+        &v_max,
+        measured,
+        max_declared_velocity_error,
+        dynamics,
+    ))
+}
+
+/// Fails at the first time that is not finite or does not come strictly after the previous.
+fn check_times(time_s: &[f64]) -> Result<(), ReplayError> {
+    for (k, t) in time_s.iter().enumerate() {
+        if !t.is_finite() {
+            return Err(ReplayError::Point {
+                point: k,
+                check: ReplayCheck::Times,
+                problem: format!("time {t} s is not finite"),
+            });
+        }
+        if k > 0 && *t <= time_s[k - 1] {
+            return Err(ReplayError::Point {
+                point: k,
+                check: ReplayCheck::Times,
+                problem: format!(
                     "timestamps must increase strictly: {t} s after {} s",
-                    samples.time_s[k - 1]
+                    time_s[k - 1]
                 ),
-            );
+            });
         }
     }
-    let points = match recorded {
+    Ok(())
+}
+
+/// The points to check: `recorded` (which must hold exactly the samples' times and
+/// positions), or else the samples as [`JointSamples::to_recording`] makes them.
+fn replayed_points<'a>(samples: &'a JointSamples, recorded: Option<&'a Recording>) -> Points<'a> {
+    match recorded {
         Some(recording) => {
             assert!(
                 recording.steps.len() == samples.len()
@@ -217,79 +253,76 @@ pub fn check_replay(
             time_s: &samples.time_s,
             q: &samples.q,
         },
-    };
-    let measured = model
-        .check_points(line, points, bounds)
-        .map_err(|failure| ReplayError::Point {
-            point: failure.step,
-            check: ReplayCheck::Recording(failure.check),
-            problem: failure.problem,
-        })?;
+    }
+}
 
-    let v_max = model.velocity_limits();
-    let mut max_declared_velocity_error = None;
-    if let Some(declared) = &samples.qd {
-        let rule = point_velocities(&samples.time_s, &samples.q);
-        let mut worst = 0.0_f64;
-        for (k, (qd, expected)) in declared.iter().zip(&rule).enumerate() {
-            for i in 0..v_max.len() {
-                if let Some(f) = bounds.velocity_limit_fraction
-                    && !within(qd[i].abs(), f * v_max[i] * (1.0 + VELOCITY_LIMIT_SLACK))
-                {
-                    return fail(
-                        k,
-                        ReplayCheck::DeclaredVelocityLimit { joint: i + 1 },
-                        format!(
-                            "declared velocity of joint {} is {} rad/s, {:.4} × its limit {} \
-                             rad/s (allowed: {f} ×)",
-                            i + 1,
-                            qd[i],
-                            qd[i].abs() / v_max[i],
-                            v_max[i],
-                        ),
-                    );
-                }
-                if samples.qdd.is_some() {
-                    continue;
-                }
-                let error = (qd[i] - expected[i]).abs();
-                if !within(
-                    error,
-                    DECLARED_VELOCITY_TOLERANCE * (1.0 + expected[i].abs()),
-                ) {
-                    return fail(
-                        k,
-                        ReplayCheck::DeclaredVelocityRule { joint: i + 1 },
-                        format!(
-                            "declared velocity of joint {} is {} rad/s but the positions and \
-                             times give {} rad/s (tolerance {DECLARED_VELOCITY_TOLERANCE:e} × \
-                             (1 + |q̇|))",
-                            i + 1,
-                            qd[i],
-                            expected[i]
-                        ),
-                    );
-                }
-                worst = worst.max(error);
+/// Verifies the velocities the samples declare, if any, against their share of the limits
+/// `v_max` and, without declared accelerations, against [`point_velocities`]; returns the
+/// largest difference from that rule where it was compared.
+fn check_declared_velocities(
+    samples: &JointSamples,
+    bounds: &Bounds,
+    v_max: &[f64],
+) -> Result<Option<f64>, ReplayError> {
+    let Some(declared) = &samples.qd else {
+        return Ok(None);
+    };
+    let fail = |point: usize, check: ReplayCheck, problem: String| {
+        Err(ReplayError::Point {
+            point,
+            check,
+            problem,
+        })
+    };
+    let rule = point_velocities(&samples.time_s, &samples.q);
+    let mut worst = 0.0_f64;
+    for (k, (qd, expected)) in declared.iter().zip(&rule).enumerate() {
+        for i in 0..v_max.len() {
+            if let Some(f) = bounds.velocity_limit_fraction
+                && !within(qd[i].abs(), f * v_max[i] * (1.0 + VELOCITY_LIMIT_SLACK))
+            {
+                return fail(
+                    k,
+                    ReplayCheck::DeclaredVelocityLimit { joint: i + 1 },
+                    format!(
+                        "declared velocity of joint {} is {} rad/s, {:.4} × its limit {} \
+                         rad/s (allowed: {f} ×)",
+                        i + 1,
+                        qd[i],
+                        qd[i].abs() / v_max[i],
+                        v_max[i],
+                    ),
+                );
             }
-        }
-        if samples.qdd.is_none() {
-            max_declared_velocity_error = Some(worst);
+            if samples.qdd.is_some() {
+                continue;
+            }
+            let error = (qd[i] - expected[i]).abs();
+            if !within(
+                error,
+                DECLARED_VELOCITY_TOLERANCE * (1.0 + expected[i].abs()),
+            ) {
+                return fail(
+                    k,
+                    ReplayCheck::DeclaredVelocityRule { joint: i + 1 },
+                    format!(
+                        "declared velocity of joint {} is {} rad/s but the positions and \
+                         times give {} rad/s (tolerance {DECLARED_VELOCITY_TOLERANCE:e} × \
+                         (1 + |q̇|))",
+                        i + 1,
+                        qd[i],
+                        expected[i]
+                    ),
+                );
+            }
+            worst = worst.max(error);
         }
     }
-    let dynamics = match dynamics {
-        Some(limits) => {
-            Some(
-                check_dynamics(samples, limits).map_err(|failure| ReplayError::Point {
-                    point: failure.sample,
-                    check: ReplayCheck::Dynamics(failure.check),
-                    problem: failure.problem,
-                })?,
-            )
-        }
-        None => None,
-    };
+    Ok(samples.qdd.is_none().then_some(worst))
+}
 
+/// Per joint, the fastest segment speed of the samples as a fraction of its limit in `v_max`.
+fn peak_speed_fractions(samples: &JointSamples, v_max: &[f64]) -> Vec<f64> {
     let mut peak_speed_fraction = vec![0.0_f64; v_max.len()];
     for k in 1..samples.len() {
         let gap = samples.time_s[k] - samples.time_s[k - 1];
@@ -298,6 +331,19 @@ pub fn check_replay(
             *peak = peak.max(speed / v_max[i]);
         }
     }
+    peak_speed_fraction
+}
+
+/// The report of verified samples: their timing and speeds against `v_max`, what the point
+/// check `measured`, and the results of the declared-velocity and dynamic checks.
+fn replay_report(
+    samples: &JointSamples,
+    v_max: &[f64],
+    measured: Measured,
+    max_declared_velocity_error: Option<f64>,
+    dynamics: Option<DynamicsReport>,
+) -> ReplayReport {
+    let peak_speed_fraction = peak_speed_fractions(samples, v_max);
     let velocities = match &samples.qd {
         Some(declared) => declared.clone(),
         None => point_velocities(&samples.time_s, &samples.q),
@@ -314,7 +360,7 @@ pub fn check_replay(
     ];
     let last = samples.len() - 1;
     let progress = &measured.progress;
-    Ok(ReplayReport {
+    ReplayReport {
         points: samples.len(),
         duration_s: samples.time_s[last],
         path_length_m: progress[last],
@@ -331,7 +377,7 @@ pub fn check_replay(
         min_clearance: measured.min_clearance,
         max_declared_velocity_error,
         dynamics,
-    })
+    }
 }
 
 #[cfg(test)]
