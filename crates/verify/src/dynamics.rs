@@ -88,13 +88,8 @@ pub fn check_dynamics(
     samples: &JointSamples,
     limits: &JointDynamics,
 ) -> Result<DynamicsReport, DynamicsFailure> {
-    let fail = |sample: usize, check: DynamicsCheck, problem: String| DynamicsFailure {
-        sample,
-        check,
-        problem,
-    };
     let (Some(qd), Some(qdd)) = (&samples.qd, &samples.qdd) else {
-        return Err(fail(
+        return Err(DynamicsFailure::at(
             0,
             DynamicsCheck::Rest,
             "the file declares no velocities and accelerations, so rest and limits cannot be \
@@ -102,12 +97,37 @@ pub fn check_dynamics(
                 .to_string(),
         ));
     };
-    let n = samples.len();
-    let joints = limits.velocity.len();
+    check_rest(samples.len(), qd, qdd, limits.velocity.len())?;
+    let mut peaks = PeakLimits::new(limits);
+    peaks.check_declared(samples, qd, qdd)?;
+    peaks.check_positions(samples)?;
+    check_agreement(samples, qd, qdd, limits)?;
+    Ok(peaks.report())
+}
+
+impl DynamicsFailure {
+    /// The failure of check `check` at sample `sample`, `problem` saying what is wrong.
+    fn at(sample: usize, check: DynamicsCheck, problem: String) -> Self {
+        DynamicsFailure {
+            sample,
+            check,
+            problem,
+        }
+    }
+}
+
+/// Fails unless the first and last of `n` samples declare velocities `qd` and accelerations
+/// `qdd` of zero (within [`REST_TOLERANCE`]) for each of the `joints`.
+fn check_rest(
+    n: usize,
+    qd: &[Joints],
+    qdd: &[Joints],
+    joints: usize,
+) -> Result<(), DynamicsFailure> {
     for (k, name) in [(0, "first"), (n - 1, "last")] {
         for i in 0..joints {
             if qd[k][i].abs() > REST_TOLERANCE || qdd[k][i].abs() > REST_TOLERANCE {
-                return Err(fail(
+                return Err(DynamicsFailure::at(
                     k,
                     DynamicsCheck::Rest,
                     format!(
@@ -121,15 +141,48 @@ pub fn check_dynamics(
             }
         }
     }
-    let mut peaks = [vec![0.0_f64; joints], vec![0.0; joints], vec![0.0; joints]];
-    let names = ["velocity", "acceleration", "jerk"];
-    let bounds = [&limits.velocity, &limits.acceleration, &limits.jerk];
-    let mut limit = |k: usize, order: usize, what: &str, value: &Joints, rounding: f64| {
-        for i in 0..joints {
-            let fraction = value[i].abs() / bounds[order][i];
-            peaks[order][i] = peaks[order][i].max(fraction);
-            if value[i].abs() > bounds[order][i] * (1.0 + DYNAMICS_LIMIT_SLACK) + rounding {
-                return Err(fail(
+    Ok(())
+}
+
+/// The velocity, acceleration and jerk limits (orders 0, 1 and 2) and, per order and joint,
+/// the largest value met so far as a fraction of its limit.
+struct PeakLimits<'l> {
+    /// Number of joints checked: as many as velocity limits.
+    joints: usize,
+    /// Limits of each order, per joint.
+    bounds: [&'l [f64]; 3],
+    /// Largest fraction of the limit met, per order and joint.
+    peaks: [Vec<f64>; 3],
+}
+
+impl<'l> PeakLimits<'l> {
+    /// Nothing met yet of `limits`.
+    fn new(limits: &'l JointDynamics) -> Self {
+        let joints = limits.velocity.len();
+        PeakLimits {
+            joints,
+            bounds: [&limits.velocity, &limits.acceleration, &limits.jerk],
+            peaks: [vec![0.0_f64; joints], vec![0.0; joints], vec![0.0; joints]],
+        }
+    }
+
+    /// Records `value` of order `order` at sample `k` and fails when a joint passes its limit
+    /// (with the relative slack and `rounding`); `what` says where the value comes from.
+    fn limit(
+        &mut self,
+        k: usize,
+        order: usize,
+        what: &str,
+        value: &Joints,
+        rounding: f64,
+    ) -> Result<(), DynamicsFailure> {
+        let names = ["velocity", "acceleration", "jerk"];
+        let bounds = self.bounds[order];
+        for i in 0..self.joints {
+            let fraction = value[i].abs() / bounds[i];
+            self.peaks[order][i] = self.peaks[order][i].max(fraction);
+            if value[i].abs() > bounds[i] * (1.0 + DYNAMICS_LIMIT_SLACK) + rounding {
+                return Err(DynamicsFailure::at(
                     k,
                     DynamicsCheck::Limit { joint: i + 1 },
                     format!(
@@ -137,42 +190,84 @@ pub fn check_dynamics(
                         i + 1,
                         names[order],
                         value[i],
-                        bounds[order][i]
+                        bounds[i]
                     ),
                 ));
             }
         }
         Ok(())
-    };
-    for k in 0..n {
-        limit(k, 0, "(declared, rad/s)", &qd[k], 0.0)?;
-        limit(k, 1, "(declared, rad/s²)", &qdd[k], 0.0)?;
-        if k > 0 {
-            let gap = samples.time_s[k] - samples.time_s[k - 1];
-            let jerk = (qdd[k] - qdd[k - 1]) / gap;
-            limit(k, 2, "(from declared accelerations, rad/s³)", &jerk, 0.0)?;
+    }
+
+    /// Holds the declared velocities `qd`, accelerations `qdd` and the jerk between
+    /// consecutive declared accelerations to their limits.
+    fn check_declared(
+        &mut self,
+        samples: &JointSamples,
+        qd: &[Joints],
+        qdd: &[Joints],
+    ) -> Result<(), DynamicsFailure> {
+        for k in 0..samples.len() {
+            self.limit(k, 0, "(declared, rad/s)", &qd[k], 0.0)?;
+            self.limit(k, 1, "(declared, rad/s²)", &qdd[k], 0.0)?;
+            if k > 0 {
+                let gap = samples.time_s[k] - samples.time_s[k - 1];
+                let jerk = (qdd[k] - qdd[k - 1]) / gap;
+                self.limit(k, 2, "(from declared accelerations, rad/s³)", &jerk, 0.0)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Holds the divided differences of order 1 to 3 of the rest-padded positions to the
+    /// velocity, acceleration and jerk limits, with the rounding of the positions.
+    fn check_positions(&mut self, samples: &JointSamples) -> Result<(), DynamicsFailure> {
+        let n = samples.len();
+        let padded = rest_padded(samples);
+        let scale = 1.0 + samples.q.iter().map(|q| q.amax()).fold(0.0, f64::max);
+        let units = ["rad/s", "rad/s²", "rad/s³"];
+        for order in 1..=3 {
+            let factorial = [1.0, 1.0, 2.0, 6.0][order];
+            for start in 0..padded.len() - order {
+                let points = &padded[start..=start + order];
+                let span = points[order].0 - points[0].0;
+                let gap = span / order as f64;
+                let rounding =
+                    factorial * 2f64.powi(order as i32) * 1e-15 * scale / gap.powi(order as i32);
+                let value = divided_difference(points) * factorial;
+                let sample = (start + order).saturating_sub(REST_PADDING).min(n - 1);
+                let what = format!("(from positions, {})", units[order - 1]);
+                self.limit(sample, order - 1, &what, &value, rounding)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The largest fractions met, as the report of the check.
+    fn report(self) -> DynamicsReport {
+        let [
+            peak_velocity_fraction,
+            peak_acceleration_fraction,
+            peak_jerk_fraction,
+        ] = self.peaks;
+        DynamicsReport {
+            peak_velocity_fraction,
+            peak_acceleration_fraction,
+            peak_jerk_fraction,
         }
     }
-    let padded = rest_padded(samples);
-    let scale = 1.0 + samples.q.iter().map(|q| q.amax()).fold(0.0, f64::max);
-    let units = ["rad/s", "rad/s²", "rad/s³"];
-    for order in 1..=3 {
-        let factorial = [1.0, 1.0, 2.0, 6.0][order];
-        for start in 0..padded.len() - order {
-            let points = &padded[start..=start + order];
-            let span = points[order].0 - points[0].0;
-            let gap = span / order as f64;
-            let rounding =
-                factorial * 2f64.powi(order as i32) * 1e-15 * scale / gap.powi(order as i32);
-            let value = divided_difference(points) * factorial;
-            let sample = (start + order).saturating_sub(REST_PADDING).min(n - 1);
-            let what = format!("(from positions, {})", units[order - 1]);
-            limit(sample, order - 1, &what, &value, rounding)?;
-        }
-    }
-    for k in 1..n {
+}
+
+/// Fails where the declared velocities `qd` and accelerations `qdd` do not integrate, by the
+/// trapezoid rule, to the changes of position and of velocity between consecutive samples.
+fn check_agreement(
+    samples: &JointSamples,
+    qd: &[Joints],
+    qdd: &[Joints],
+    limits: &JointDynamics,
+) -> Result<(), DynamicsFailure> {
+    for k in 1..samples.len() {
         let h = samples.time_s[k] - samples.time_s[k - 1];
-        for i in 0..joints {
+        for i in 0..limits.velocity.len() {
             let checks = [
                 (
                     samples.q[k][i] - samples.q[k - 1][i],
@@ -192,7 +287,7 @@ pub fn check_dynamics(
             for (change, integral, bound, what, declared) in checks {
                 let tolerance = bound + 1e-12 * (1.0 + change.abs());
                 if (change - integral).abs() > tolerance {
-                    return Err(fail(
+                    return Err(DynamicsFailure::at(
                         k,
                         DynamicsCheck::Agreement { joint: i + 1 },
                         format!(
@@ -205,16 +300,7 @@ pub fn check_dynamics(
             }
         }
     }
-    let [
-        peak_velocity_fraction,
-        peak_acceleration_fraction,
-        peak_jerk_fraction,
-    ] = peaks;
-    Ok(DynamicsReport {
-        peak_velocity_fraction,
-        peak_acceleration_fraction,
-        peak_jerk_fraction,
-    })
+    Ok(())
 }
 
 /// `(t, q)` of every sample with [`REST_PADDING`] samples of rest before and after.
