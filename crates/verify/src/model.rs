@@ -109,126 +109,22 @@ impl ReferenceModel {
     /// Reads the chain from `base` to `tip` of URDF text.
     pub fn from_urdf_str(text: &str, base: &str, tip: &str) -> Result<Self, ModelError> {
         let urdf = urdf_rs::read_from_string(text).map_err(|e| ModelError::Urdf(e.to_string()))?;
-        let mut path = Vec::new();
-        let mut link = tip.to_string();
-        while link != base {
-            let joint = urdf
-                .joints
-                .iter()
-                .find(|j| j.child.link == link)
-                .ok_or_else(|| ModelError::Unreachable(link.clone()))?;
-            if path.len() == urdf.joints.len() {
-                return Err(ModelError::Loop(link));
-            }
-            path.push(joint);
-            link = joint.parent.link.clone();
-        }
-        path.reverse();
-        let mut joints = Vec::new();
-        let mut capsules = Vec::new();
+        let path = chain_path(&urdf, base, tip)?;
         let mut link_names = vec![base.to_string()];
         link_names.extend(path.iter().map(|j| j.child.link.clone()));
-        for joint in &path {
-            let element = |field: &str| format!("joint '{}' {field}", joint.name);
-            finite(
-                &element("origin"),
-                &[&joint.origin.xyz.0, &joint.origin.rpy.0],
-            )?;
-            let [x, y, z] = joint.origin.xyz.0;
-            let [r, p, yaw] = joint.origin.rpy.0;
-            let mut origin = rpy_rotation(r, p, yaw).to_homogeneous();
-            origin[(0, 3)] = x;
-            origin[(1, 3)] = y;
-            origin[(2, 3)] = z;
-            let (revolute, lower, upper) = match joint.joint_type {
-                urdf_rs::JointType::Revolute => (true, joint.limit.lower, joint.limit.upper),
-                urdf_rs::JointType::Continuous => (true, -CONTINUOUS_RANGE, CONTINUOUS_RANGE),
-                _ => (false, 0.0, 0.0),
-            };
-            let axis = Vector3::from(joint.axis.xyz.0);
-            if revolute && !(axis.norm().is_finite() && axis.norm() > 1e-9) {
-                return Err(ModelError::Value {
-                    element: element("axis"),
-                    problem: format!("{:?} is not a direction", joint.axis.xyz.0),
-                });
-            }
-            if revolute && !(lower.is_finite() && upper.is_finite() && lower < upper) {
-                return Err(ModelError::Value {
-                    element: element("limit"),
-                    problem: format!("[{lower}, {upper}] is not a range of finite numbers"),
-                });
-            }
-            let velocity = joint.limit.velocity;
-            if revolute && !(velocity.is_finite() && velocity > 0.0) {
-                return Err(ModelError::Value {
-                    element: element("velocity limit"),
-                    problem: format!("{velocity} is not a positive number"),
-                });
-            }
-            joints.push(ReferenceJoint {
-                origin,
-                axis: revolute.then(|| Unit::new_normalize(axis)),
-                lower,
-                upper,
-                velocity,
-            });
-        }
+        let joints = path
+            .iter()
+            .map(|joint| reference_joint(joint))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut capsules = Vec::new();
         for (chain_index, name) in link_names.iter().enumerate() {
-            let link = urdf
-                .links
-                .iter()
-                .find(|l| &l.name == name)
-                .ok_or_else(|| ModelError::MissingLink(name.clone()))?;
-            let mut elements = Vec::new();
-            for collision in &link.collision {
-                let (radius, half, cylinder) = match collision.geometry {
-                    urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0, false),
-                    urdf_rs::Geometry::Cylinder { radius, length } => (radius, length / 2.0, true),
-                    urdf_rs::Geometry::Sphere { radius } => (radius, 0.0, false),
-                    _ => return Err(ModelError::Geometry(name.clone())),
-                };
-                let element = format!("link '{name}' collision");
-                finite(
-                    &element,
-                    &[&collision.origin.xyz.0, &collision.origin.rpy.0],
-                )?;
-                if !([radius, half].iter().all(|v| v.is_finite() && *v >= 0.0)) {
-                    return Err(ModelError::Value {
-                        element,
-                        problem: format!("radius {radius} and length {} must be ≥ 0", 2.0 * half),
-                    });
-                }
-                let [x, y, z] = collision.origin.xyz.0;
-                let [r, p, yaw] = collision.origin.rpy.0;
-                let rotation = rpy_rotation(r, p, yaw);
-                let centre = Vector3::new(x, y, z);
-                let axis = rotation * Vector3::z() * half;
-                let capsule = ReferenceCapsule {
-                    link: name.clone(),
-                    chain_index,
-                    start: centre - axis,
-                    end: centre + axis,
-                    radius,
-                };
-                elements.push((capsule, cylinder));
-            }
-            capsules.extend(merge_sphere_caps(name, elements)?);
+            capsules.extend(link_capsules(&urdf, chain_index, name)?);
         }
         let revolute = joints.iter().filter(|j| j.axis.is_some()).count();
         if !(MIN_JOINTS..=MAX_JOINTS).contains(&revolute) {
             return Err(ModelError::JointCount(revolute));
         }
-        // Link i + 1 is the child of joint i: the links from the last revolute joint's child on
-        // move rigidly with the last joint.
-        let last_moving_link = joints
-            .iter()
-            .rposition(|j| j.axis.is_some())
-            .map_or(0, |i| i + 1);
-        let tool_link = capsules
-            .iter()
-            .map(|c| c.chain_index)
-            .max()
-            .filter(|&link| link >= last_moving_link);
+        let tool_link = tool_link(&joints, &capsules);
         let mut model = Self {
             joints,
             capsules,
@@ -796,6 +692,153 @@ fn segments_gap(a0: &Vector3<f64>, a1: &Vector3<f64>, b0: &Vector3<f64>, b1: &Ve
     best
 }
 
+/// The joints of `urdf` from `base` to `tip`, base first: followed from `tip` up through each
+/// link's parent joint.
+fn chain_path<'u>(
+    urdf: &'u urdf_rs::Robot,
+    base: &str,
+    tip: &str,
+) -> Result<Vec<&'u urdf_rs::Joint>, ModelError> {
+    let mut path = Vec::new();
+    let mut link = tip.to_string();
+    while link != base {
+        let joint = urdf
+            .joints
+            .iter()
+            .find(|j| j.child.link == link)
+            .ok_or_else(|| ModelError::Unreachable(link.clone()))?;
+        if path.len() == urdf.joints.len() {
+            return Err(ModelError::Loop(link));
+        }
+        path.push(joint);
+        link = joint.parent.link.clone();
+    }
+    path.reverse();
+    Ok(path)
+}
+
+/// The checker's joint of a URDF joint: its origin transform and, for a revolute or
+/// continuous joint, its axis, position range and velocity limit, each verified.
+fn reference_joint(joint: &urdf_rs::Joint) -> Result<ReferenceJoint, ModelError> {
+    let element = |field: &str| format!("joint '{}' {field}", joint.name);
+    finite(
+        &element("origin"),
+        &[&joint.origin.xyz.0, &joint.origin.rpy.0],
+    )?;
+    let [x, y, z] = joint.origin.xyz.0;
+    let [r, p, yaw] = joint.origin.rpy.0;
+    let mut origin = rpy_rotation(r, p, yaw).to_homogeneous();
+    origin[(0, 3)] = x;
+    origin[(1, 3)] = y;
+    origin[(2, 3)] = z;
+    let (revolute, lower, upper) = match joint.joint_type {
+        urdf_rs::JointType::Revolute => (true, joint.limit.lower, joint.limit.upper),
+        urdf_rs::JointType::Continuous => (true, -CONTINUOUS_RANGE, CONTINUOUS_RANGE),
+        _ => (false, 0.0, 0.0),
+    };
+    let axis = Vector3::from(joint.axis.xyz.0);
+    if revolute && !(axis.norm().is_finite() && axis.norm() > 1e-9) {
+        return Err(ModelError::Value {
+            element: element("axis"),
+            problem: format!("{:?} is not a direction", joint.axis.xyz.0),
+        });
+    }
+    if revolute && !(lower.is_finite() && upper.is_finite() && lower < upper) {
+        return Err(ModelError::Value {
+            element: element("limit"),
+            problem: format!("[{lower}, {upper}] is not a range of finite numbers"),
+        });
+    }
+    let velocity = joint.limit.velocity;
+    if revolute && !(velocity.is_finite() && velocity > 0.0) {
+        return Err(ModelError::Value {
+            element: element("velocity limit"),
+            problem: format!("{velocity} is not a positive number"),
+        });
+    }
+    Ok(ReferenceJoint {
+        origin,
+        axis: revolute.then(|| Unit::new_normalize(axis)),
+        lower,
+        upper,
+        velocity,
+    })
+}
+
+/// The capsules of link `name` (number `chain_index` along the chain) in `urdf`, sphere caps
+/// merged into their cylinders.
+fn link_capsules(
+    urdf: &urdf_rs::Robot,
+    chain_index: usize,
+    name: &str,
+) -> Result<Vec<ReferenceCapsule>, ModelError> {
+    let link = urdf
+        .links
+        .iter()
+        .find(|l| l.name == name)
+        .ok_or_else(|| ModelError::MissingLink(name.to_string()))?;
+    let elements = link
+        .collision
+        .iter()
+        .map(|collision| collision_capsule(name, chain_index, collision))
+        .collect::<Result<Vec<_>, _>>()?;
+    merge_sphere_caps(name, elements)
+}
+
+/// The capsule of one collision element of link `name`, and whether it is a cylinder (whose
+/// caps may stand as spheres of their own).
+fn collision_capsule(
+    name: &str,
+    chain_index: usize,
+    collision: &urdf_rs::Collision,
+) -> Result<(ReferenceCapsule, bool), ModelError> {
+    let (radius, half, cylinder) = match collision.geometry {
+        urdf_rs::Geometry::Capsule { radius, length } => (radius, length / 2.0, false),
+        urdf_rs::Geometry::Cylinder { radius, length } => (radius, length / 2.0, true),
+        urdf_rs::Geometry::Sphere { radius } => (radius, 0.0, false),
+        _ => return Err(ModelError::Geometry(name.to_string())),
+    };
+    let element = format!("link '{name}' collision");
+    finite(
+        &element,
+        &[&collision.origin.xyz.0, &collision.origin.rpy.0],
+    )?;
+    if !([radius, half].iter().all(|v| v.is_finite() && *v >= 0.0)) {
+        return Err(ModelError::Value {
+            element,
+            problem: format!("radius {radius} and length {} must be ≥ 0", 2.0 * half),
+        });
+    }
+    let [x, y, z] = collision.origin.xyz.0;
+    let [r, p, yaw] = collision.origin.rpy.0;
+    let rotation = rpy_rotation(r, p, yaw);
+    let centre = Vector3::new(x, y, z);
+    let axis = rotation * Vector3::z() * half;
+    let capsule = ReferenceCapsule {
+        link: name.to_string(),
+        chain_index,
+        start: centre - axis,
+        end: centre + axis,
+        radius,
+    };
+    Ok((capsule, cylinder))
+}
+
+/// The link that carries the tool: the last link with a capsule, if it moves rigidly with the
+/// last revolute joint.
+fn tool_link(joints: &[ReferenceJoint], capsules: &[ReferenceCapsule]) -> Option<usize> {
+    // Link i + 1 is the child of joint i: the links from the last revolute joint's child on
+    // move rigidly with the last joint.
+    let last_moving_link = joints
+        .iter()
+        .rposition(|j| j.axis.is_some())
+        .map_or(0, |i| i + 1);
+    capsules
+        .iter()
+        .map(|c| c.chain_index)
+        .max()
+        .filter(|&link| link >= last_moving_link)
+}
 /// Fails, naming `element`, unless every number of `groups` is finite.
 fn finite(element: &str, groups: &[&[f64; 3]]) -> Result<(), ModelError> {
     if groups.iter().all(|g| g.iter().all(|v| v.is_finite())) {
