@@ -12,7 +12,7 @@ use burn::module::Param;
 use burn::nn::{LayerNorm, Linear};
 #[cfg(feature = "train")]
 use burn::tensor::{Device, Tensor, TensorData};
-use emg_learning::container::{self, ContainerError};
+use emg_learning::container::{self, ContainerError, FileAccessError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::DiffusionConfig;
@@ -44,13 +44,8 @@ pub struct WeightsHeader {
 #[derive(Debug, thiserror::Error)]
 pub enum WeightsError {
     /// The file could not be read or written.
-    #[error("cannot access weights file {path}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The I/O error.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] FileAccessError),
     /// The bytes are not a well-formed denoiser weights file of this layout version (the cause
     /// says what is wrong: magic, version, truncation, header, value count, trailing bytes).
     #[error(
@@ -310,19 +305,13 @@ impl DenoiserWeights {
 
     /// Writes the file (to a temporary sibling first, so an interrupted write loses nothing).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        emg_io::write_atomically(path, self.to_bytes()).map_err(|source| WeightsError::Io {
-            path: path.display().to_string(),
-            source,
-        })
+        emg_io::write_atomically(path, self.to_bytes())
+            .map_err(|source| FileAccessError::new(path, source).into())
     }
 
     /// Reads a weights file.
     pub fn read(path: &Path) -> Result<Self, WeightsError> {
-        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        Self::from_bytes(&bytes)
+        Self::from_bytes(&container::read_file(path)?)
     }
 }
 

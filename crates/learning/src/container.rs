@@ -4,8 +4,35 @@
 //! `u64` value count, then that many little-endian `f32` values and nothing after them. Every
 //! integer is little-endian.
 
+use std::path::Path;
+
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+
+/// A weights file that could not be read or written: which file, and the I/O error.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot access weights file {path}")]
+pub struct FileAccessError {
+    /// The file.
+    pub path: String,
+    /// The I/O error.
+    pub source: std::io::Error,
+}
+
+impl FileAccessError {
+    /// The I/O error `source` met reading or writing `path`.
+    pub fn new(path: &Path, source: std::io::Error) -> Self {
+        FileAccessError {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+}
+
+/// The bytes of the weights file at `path`.
+pub fn read_file(path: &Path) -> Result<Vec<u8>, FileAccessError> {
+    std::fs::read(path).map_err(|source| FileAccessError::new(path, source))
+}
 
 /// Why bytes are not a valid container; each crate maps these onto its own error type.
 #[derive(Debug, thiserror::Error)]

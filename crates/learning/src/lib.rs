@@ -4,7 +4,8 @@
 //! - [`container`]: the versioned binary container their weights files use — 8 magic bytes, a
 //!   `u32` format version, a `u32` header length, a JSON header, a `u64` value count, then the
 //!   values as little-endian `f32` — with strict truncation and trailing-byte checks (the
-//!   weights files are written with `emg_io::write_atomically`);
+//!   weights files are written with `emg_io::write_atomically`), and [`container::read_file`]
+//!   with its [`container::FileAccessError`], the one way both read their files;
 //! - [`RobotStamp`]: the robot a weights file was trained for (name and chain fingerprint), and
 //!   [`check_stamp`], which refuses a file trained for another arm;
 //! - [`StandardNormal`]: normal samples with the same bits on every machine (the noise of both

@@ -1,6 +1,6 @@
 //! The weights file's layout version, and why a file is not a usable weights file of it.
 
-use emg_learning::container::ContainerError;
+use emg_learning::container::{ContainerError, FileAccessError};
 
 /// Version of the weights file layout this build reads and writes.
 pub const WEIGHTS_FORMAT_VERSION: u32 = 1;
@@ -9,13 +9,8 @@ pub const WEIGHTS_FORMAT_VERSION: u32 = 1;
 #[derive(Debug, thiserror::Error)]
 pub enum WeightsError {
     /// The file could not be read or written.
-    #[error("cannot access weights file {path}")]
-    Io {
-        /// File.
-        path: String,
-        /// Cause.
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] FileAccessError),
     /// The bytes are not a well-formed policy weights file of this layout version (the cause
     /// says what is wrong: magic, version, truncation, header, value count, trailing bytes).
     #[error("not a valid policy weights file (EMGPPOWT, format version {WEIGHTS_FORMAT_VERSION})")]

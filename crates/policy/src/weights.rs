@@ -13,7 +13,7 @@ use burn::module::Param;
 use burn::nn::Linear;
 #[cfg(feature = "train")]
 use burn::tensor::{Device, Tensor, TensorData};
-use emg_learning::container::{self, ContainerError};
+use emg_learning::container::{self, ContainerError, FileAccessError};
 use serde::{Deserialize, Serialize};
 
 use crate::config::NetworkConfig;
@@ -219,19 +219,13 @@ impl PolicyWeights {
 
     /// Writes the file (via a `.partial` sibling renamed into place).
     pub fn write(&self, path: &Path) -> Result<(), WeightsError> {
-        emg_io::write_atomically(path, self.to_bytes()).map_err(|source| WeightsError::Io {
-            path: path.display().to_string(),
-            source,
-        })
+        emg_io::write_atomically(path, self.to_bytes())
+            .map_err(|source| FileAccessError::new(path, source).into())
     }
 
     /// Reads a file written by [`PolicyWeights::write`].
     pub fn read(path: &Path) -> Result<Self, WeightsError> {
-        let bytes = std::fs::read(path).map_err(|source| WeightsError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
-        Self::from_bytes(&bytes)
+        Self::from_bytes(&container::read_file(path)?)
     }
 }
 
