@@ -14,8 +14,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 use emg_io::{Placement, read_svg};
-use emg_job::{DrawingTolerance, JobCheckError, JobFile, Unwatched, plan_job, verify_job};
-use emg_planner::{PlanRequest, ShippedRobot};
+use emg_job::{DrawingTolerance, JobCheckError, JobFile, JobPlanner, Unwatched, verify_job};
+use emg_planner::ShippedRobot;
 use serde::{Deserialize, Serialize};
 
 use crate::{job_eval, progress, workspace};
@@ -182,7 +182,7 @@ fn evaluate_arm(
     let data = workspace::data_dir();
     let robot_file = shipped.path(&data);
     let tasks = shipped.data_dir(&data).join("tasks/eval-v1.tasks");
-    let (planner, timing, checker) = job_eval::setup_with_tasks(&robot_file, &tasks)?;
+    let (job_planner, checker) = job_eval::setup_with_tasks(&robot_file, &tasks)?;
     let record = args
         .cache
         .join(format!("{}-corner-{corner_mm}.rows.jsonl", shipped.name));
@@ -209,14 +209,7 @@ fn evaluate_arm(
         let row = match known {
             Some(index) => done.swap_remove(index),
             None => {
-                let row = evaluate(
-                    &planner,
-                    &timing,
-                    &checker,
-                    (shipped, &robot_file),
-                    &tolerance,
-                    drawing,
-                );
+                let row = evaluate(&job_planner, &checker, shipped, &tolerance, drawing);
                 writeln!(out, "{}", serde_json::to_string(&row)?)?;
                 out.flush()?;
                 row
@@ -231,13 +224,13 @@ fn evaluate_arm(
 
 /// One drawing planned on the arm as `emg job` plans it at the defaults, and checked.
 fn evaluate(
-    planner: &emg_planner::Planner,
-    timing: &emg_planner::MotionTiming,
+    job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
-    (shipped, robot_file): (&ShippedRobot, &Path),
+    shipped: &ShippedRobot,
     tolerance: &DrawingTolerance,
     drawing: &Drawing,
 ) -> CorpusRow {
+    let planner = job_planner.planner();
     let mut row = CorpusRow {
         robot: shipped.name.to_string(),
         corner_mm: tolerance.corner_m * 1e3,
@@ -272,16 +265,8 @@ fn evaluate(
     row.strokes = job.strokes.len();
     row.total_m = job.strokes.iter().map(|s| s.length_m()).sum();
     let started = Instant::now();
-    let reference = robot_file.display().to_string();
     let planned = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        plan_job(
-            planner,
-            &PlanRequest::default(),
-            &job,
-            timing,
-            &reference,
-            &Unwatched,
-        )
+        job_planner.plan(&job, &Unwatched)
     }));
     row.planning_s = started.elapsed().as_secs_f64();
     match planned {

@@ -16,8 +16,8 @@ use anyhow::Context;
 use emg_control::{PathSpec, SegmentSpec};
 use emg_io::{Placement, read_svg_file};
 use emg_job::{
-    FreeSpace, Job, JobCheckError, JobFile, JobSettings, Order, SegmentKind, Unwatched, job_part,
-    order_strokes, part_coverage, plan_job, plan_stroke, valley_seams, verify_job,
+    FreeSpace, Job, JobCheckError, JobFile, JobPlanner, JobSettings, Order, SegmentKind, Unwatched,
+    job_part, order_strokes, part_coverage, plan_stroke, valley_seams, verify_job,
 };
 use emg_kinematics::{JointVector, Vec3};
 use emg_planner::{MotionTiming, PlanRequest, Planner, ShippedRobot};
@@ -205,8 +205,8 @@ pub struct Record {
 
 /// Plans, checks and compares every job; writes the record and its table.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (planner, timing, checker) = setup(&args.common.robot)?;
-    let robot_name = args.common.robot.display().to_string();
+    let (job_planner, checker) = setup(&args.common.robot)?;
+    let planner = job_planner.planner();
     let shipped = ShippedRobot::by_path(&args.common.robot, &workspace::data_dir())
         .context("job-eval plans the shipped arms, whose homes it starts from")?;
     let home = shipped.home;
@@ -219,34 +219,25 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             profile,
             checker: &checker,
         });
-    let jobs = jobs(&args.common.icons, &planner, home)?;
+    let jobs = jobs(&args.common.icons, planner, home)?;
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
     let mut ur_rows = Vec::new();
     for (name, job) in &jobs {
-        let (row, ur_row) = evaluate(
-            &planner,
-            &timing,
-            &checker,
-            &robot_name,
-            (name, job),
-            ur_arm.as_ref(),
-        )?;
+        let (row, ur_row) = evaluate(&job_planner, &checker, (name, job), ur_arm.as_ref())?;
         rows.push(row);
         ur_rows.extend(ur_row);
         bar.inc(1);
     }
     bar.finish();
-    let one_thread_s = one_thread_times(&jobs, &planner, &timing, &robot_name)?;
+    let one_thread_s = one_thread_times(&jobs, &job_planner)?;
     let mut large_rows = Vec::new();
     let sizes = progress::bar(2 * args.large.len() as u64, "large jobs");
     for &strokes in &args.large {
         for threads in [None, Some(1)] {
             large_rows.push(large::evaluate(
-                &planner,
-                &timing,
+                &job_planner,
                 &checker,
-                &robot_name,
                 home,
                 strokes,
                 threads,
@@ -326,11 +317,8 @@ fn jobs(icons: &Path, planner: &Planner, home: &[f64]) -> anyhow::Result<Vec<(St
 /// The time (s) of planning each job of hundreds of strokes (`GRID`, `HATCH`) on one thread.
 fn one_thread_times(
     jobs: &[(String, Job)],
-    planner: &Planner,
-    timing: &MotionTiming,
-    robot_name: &str,
+    job_planner: &JobPlanner,
 ) -> anyhow::Result<Vec<(String, f64)>> {
-    let request = PlanRequest::default();
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
     let mut one_thread_s = Vec::new();
     for (name, job) in jobs
@@ -338,7 +326,7 @@ fn one_thread_times(
         .filter(|(name, _)| [GRID, HATCH].contains(&name.as_str()))
     {
         let started = Instant::now();
-        one_thread.install(|| plan_job(planner, &request, job, timing, robot_name, &Unwatched))?;
+        one_thread.install(|| job_planner.plan(job, &Unwatched))?;
         one_thread_s.push((name.clone(), started.elapsed().as_secs_f64()));
     }
     Ok(one_thread_s)
@@ -384,11 +372,9 @@ pub fn icon_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     Ok(icons)
 }
 
-/// The planner `emg job` plans with (the cell's plate, the corrected step, 0.5 mm), its timing
-/// and the checker, for the selected robot's `robot_file`.
-pub fn setup(
-    robot_file: &Path,
-) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
+/// What `emg job` plans with (the cell's plate, the corrected step, 0.5 mm; its timing and
+/// request) and the checker, for the selected robot's `robot_file`, which programs name.
+pub fn setup(robot_file: &Path) -> anyhow::Result<(JobPlanner, emg_verify::ReferenceModel)> {
     setup_with_tasks(robot_file, &workspace::data("tasks/eval-v1.tasks"))
 }
 
@@ -396,13 +382,13 @@ pub fn setup(
 pub fn setup_with_tasks(
     robot_file: &Path,
     tasks: &Path,
-) -> anyhow::Result<(Planner, MotionTiming, emg_verify::ReferenceModel)> {
+) -> anyhow::Result<(JobPlanner, emg_verify::ReferenceModel)> {
     let workspace::PlannerSetup {
         planner, checker, ..
     } = workspace::planner_setup(robot_file, tasks, 0, "job-eval")?;
     let planner = planner.with_config(emg_job::job_config(emg_job::JOB_TOLERANCE_M))?;
-    let timing = emg_job::job_timing(planner.robot(), robot_file, planner.config())?;
-    Ok((planner, timing, checker))
+    let recorded_as = robot_file.display().to_string();
+    Ok((JobPlanner::new(planner, robot_file, recorded_as)?, checker))
 }
 
 /// Five parallel seams 0.2 m long, 3 cm apart, on a surface through (0.45, 0, 0.25) whose
@@ -450,18 +436,16 @@ fn in_travel_order(job: &Job) -> Job {
 /// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e (`ur_arm`)
 /// its program exported both ways and read back.
 fn evaluate(
-    planner: &Planner,
-    timing: &MotionTiming,
+    job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
-    robot_name: &str,
     (name, job): (&str, &Job),
     ur_arm: Option<&ur_programs::UrArm<'_>>,
 ) -> anyhow::Result<(JobRow, Option<ur_programs::UrRow>)> {
-    let request = PlanRequest::default();
+    let planner = job_planner.planner();
     let started = Instant::now();
-    let planned = plan_job(planner, &request, job, timing, robot_name, &Unwatched);
+    let planned = job_planner.plan(job, &Unwatched);
     let planning_s = started.elapsed().as_secs_f64();
-    let baseline = baseline(planner, timing, job);
+    let baseline = baseline(planner, job_planner.timing(), job);
     let total_m: f64 = job.strokes.iter().map(|s| s.length_m()).sum();
     let ur_row = match (&planned, ur_arm) {
         (Ok(program), Some(arm)) => Some(ur_programs::read_back(arm, name, program)),

@@ -11,10 +11,9 @@ use std::path::{Path, PathBuf};
 
 use emg_io::{Placement as SvgPlacement, read_svg_file};
 use emg_job::{
-    Job, Moving, Place, PlaceFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M, SAME_SCORE,
-    Score, Unwatched, place_job, plan_job, verify_job,
+    Job, JobPlanner, Moving, Place, PlaceFrame, PlaceSettings, Placement, Region, SAME_LENGTH_M,
+    SAME_SCORE, Score, Unwatched, verify_job,
 };
-use emg_planner::{MotionTiming, PlanRequest, Planner};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -147,8 +146,8 @@ const TWENTY: &str = "20 circles 2 cm across in a 4 × 5 grid round (0.75, 0, 0.
 
 /// Places every job, compares, checks, writes the record, its table and the heat map.
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (planner, timing, checker) = setup(&args.common.robot)?;
-    let robot_name = args.common.robot.display().to_string();
+    let (job_planner, checker) = setup(&args.common.robot)?;
+    let planner = job_planner.planner();
     let icons = icon_files(&args.common.icons)?;
     let mut jobs: Vec<(String, Job)> = Vec::new();
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
@@ -178,15 +177,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut twenty_placement = None;
     for (name, job) in &jobs {
-        let (row, placement) = evaluate(
-            &planner,
-            &timing,
-            &checker,
-            &robot_name,
-            name,
-            job,
-            &settings,
-        )?;
+        let (row, placement) = evaluate(&job_planner, &checker, name, job, &settings)?;
         rows.push(row);
         if name == TWENTY {
             twenty_placement = Some(placement);
@@ -195,14 +186,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     bar.finish();
     let placement = twenty_placement.expect("the 20-stroke job was placed");
-    let top_twenty = top_twenty(
-        &planner,
-        &timing,
-        &robot_name,
-        &twenty,
-        &placement,
-        &settings,
-    )?;
+    let top_twenty = top_twenty(&job_planner, &twenty, &placement, &settings)?;
     write_map(&args.map, &placement)?;
     let record = Record {
         robot: planner.robot().name().to_string(),
@@ -241,14 +225,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// Every one of the 20 best refined places of the 20-stroke job `twenty` (placed as
 /// `placement`) planned, and the placement again on one thread.
 fn top_twenty(
-    planner: &Planner,
-    timing: &MotionTiming,
-    robot_name: &str,
+    job_planner: &JobPlanner,
     twenty: &Job,
     placement: &Placement,
     settings: &PlaceSettings,
 ) -> anyhow::Result<TopTwenty> {
-    let request = PlanRequest::default();
     let frame = PlaceFrame::of(twenty, REGION.moving);
     let best_of_top_m = placement
         .refined
@@ -256,28 +237,16 @@ fn top_twenty(
         .take(20)
         .map(|scored| {
             let moved = twenty.moved(&frame.job_motion(&scored.place))?;
-            Ok(
-                plan_job(planner, &request, &moved, timing, robot_name, &Unwatched)
-                    .map_or(0.0, |program| program.summary.drawn_m),
-            )
+            Ok(job_planner
+                .plan(&moved, &Unwatched)
+                .map_or(0.0, |program| program.summary.drawn_m))
         })
         .collect::<anyhow::Result<Vec<f64>>>()?
         .into_iter()
         .fold(0.0, f64::max);
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
-    let again = one_thread.install(|| {
-        place_job(
-            planner,
-            &request,
-            twenty,
-            timing,
-            robot_name,
-            &REGION,
-            settings,
-            Score::Bound,
-            &Unwatched,
-        )
-    })?;
+    let again = one_thread
+        .install(|| job_planner.place(twenty, &REGION, settings, Score::Bound, &Unwatched))?;
     let same_on_one_thread = again.screened == placement.screened
         && again.refined == placement.refined
         && again.best().scored == placement.best().scored;
@@ -290,22 +259,16 @@ fn top_twenty(
 
 /// `job` as it stands, placed by `emg place` and by the point-by-point score.
 fn evaluate(
-    planner: &Planner,
-    timing: &MotionTiming,
+    job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
-    robot_name: &str,
     name: &str,
     job: &Job,
     settings: &PlaceSettings,
 ) -> anyhow::Result<(PlaceRow, Placement)> {
-    let request = PlanRequest::default();
-    let plan = |job: &Job| plan_job(planner, &request, job, timing, robot_name, &Unwatched).ok();
+    let planner = job_planner.planner();
+    let plan = |job: &Job| job_planner.plan(job, &Unwatched).ok();
     let as_given_m = plan(job).map_or(0.0, |program| program.summary.drawn_m);
-    let placed = |score| {
-        place_job(
-            planner, &request, job, timing, robot_name, &REGION, settings, score, &Unwatched,
-        )
-    };
+    let placed = |score| job_planner.place(job, &REGION, settings, score, &Unwatched);
     let ours = placed(Score::Bound)?;
     let chosen = ours.best();
     let program = chosen

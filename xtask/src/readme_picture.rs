@@ -98,8 +98,10 @@ fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&robot_path)?;
     let models = Models::shipped(&robot, workspace::data_dir().path())?;
     let config = emg_job::job_config(emg_job::JOB_TOLERANCE_M);
-    let timing = emg_job::job_timing(&robot, &robot_path, &config)?;
     let planner = Planner::new(robot, models, config)?;
+    let job_planner =
+        emg_job::JobPlanner::new(planner, &robot_path, robot_path.display().to_string())?;
+    let planner = job_planner.planner();
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = emg_io::read_svg_file(
         &workspace::root().join(file),
@@ -107,14 +109,7 @@ fn job_picture(args: &Args, readme: &str, out: &Path) -> anyhow::Result<()> {
         &tolerance.svg_options(),
     )?;
     let job = tolerance.job(drawing, planner.robot())?;
-    let program = emg_job::plan_job(
-        &planner,
-        &PlanRequest::default(),
-        &job,
-        &timing,
-        &robot_path.display().to_string(),
-        &emg_job::Unwatched,
-    )?;
+    let program = job_planner.plan(&job, &emg_job::Unwatched)?;
     let name = Path::new(file).file_stem().map_or_else(
         || file.to_string(),
         |stem| stem.to_string_lossy().into_owned(),

@@ -7,8 +7,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use emg_io::{Placement, read_svg, scattered_strokes_svg};
-use emg_job::{Watch, plan_job, verify_job};
-use emg_planner::{MotionTiming, PlanRequest, Planner};
+use emg_job::{JobPlanner, Watch, verify_job};
 use serde::{Deserialize, Serialize};
 
 /// One large job planned on some number of threads.
@@ -75,14 +74,13 @@ impl Watch for StageClock {
 /// The drawing of `strokes` scattered strokes planned with `threads` threads (all where `None`),
 /// written and checked.
 pub fn evaluate(
-    planner: &Planner,
-    timing: &MotionTiming,
+    job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
-    robot_name: &str,
     home: &[f64],
     strokes: usize,
     threads: Option<usize>,
 ) -> anyhow::Result<LargeRow> {
+    let planner = job_planner.planner();
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = read_svg(
         &scattered_strokes_svg(strokes),
@@ -102,9 +100,8 @@ pub fn evaluate(
         started: Instant::now(),
         stages: Mutex::new(Vec::new()),
     };
-    let request = PlanRequest::default();
     let (program, text) = pool.install(|| -> anyhow::Result<_> {
-        let program = plan_job(planner, &request, &job, timing, robot_name, &clock)?;
+        let program = job_planner.plan(&job, &clock)?;
         clock.progress("writing", 0, 1);
         let text = serde_json::to_vec(&program)?;
         Ok((program, text))
