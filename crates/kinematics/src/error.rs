@@ -135,3 +135,12 @@ pub enum RobotError {
         kind: &'static str,
     },
 }
+
+/// The text of the file at `path` (a robot file or the SRDF file beside it); a failure to
+/// read it is a [`RobotError::Io`] naming the file.
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, RobotError> {
+    std::fs::read_to_string(path).map_err(|source| RobotError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use crate::broad_phase::BroadPhase;
 use crate::capsule::{Capsule, CollisionPair, MAX_CAPSULES};
-use crate::error::RobotError;
+use crate::error::{RobotError, read_text};
 use crate::rotation::{rotation_from_rpy, rotation_onto};
 use crate::srdf::PairRule;
 use crate::vectors::{JointVector, MAX_DOF, MIN_DOF, Vec3};
@@ -168,10 +168,7 @@ impl Robot {
         tip_link: &str,
     ) -> Result<Self, RobotError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = read_text(path)?;
         Self::from_urdf_str_with_rule(&text, base_link, tip_link, PairRule::for_robot_file(path)?)
     }
 
@@ -189,10 +186,7 @@ impl Robot {
         tip_link: Option<&str>,
     ) -> Result<Self, RobotError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| RobotError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = read_text(path)?;
         let urdf =
             urdf_rs::read_from_string(&text).map_err(|e| RobotError::Malformed(e.to_string()))?;
         let (base, tip) = chain_ends(&urdf, base_link, tip_link)?;

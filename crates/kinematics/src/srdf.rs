@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::error::RobotError;
+use crate::error::{RobotError, read_text};
 
 /// Smallest chain-index separation of two bodies whose capsules are checked against each other
 /// under [`PairRule::LinkSeparation`] (adjacent links always touch at their joint).
@@ -27,10 +27,7 @@ impl PairRule {
         if !srdf.is_file() {
             return Ok(Self::LinkSeparation);
         }
-        let text = std::fs::read_to_string(&srdf).map_err(|source| RobotError::Io {
-            path: srdf.display().to_string(),
-            source,
-        })?;
+        let text = read_text(&srdf)?;
         disabled_pairs(&text)
             .map(Self::AllExcept)
             .map_err(|problem| RobotError::Srdf {
