@@ -478,6 +478,46 @@ struct StrokePart {
     end: Vec3,
 }
 
+/// Which way the tool switches.
+#[derive(Clone, Copy)]
+enum Switch {
+    /// On, at the start of a stroke part.
+    On,
+    /// Off, at the end of a stroke part.
+    Off,
+}
+
+impl StrokePart {
+    /// Fails unless the TCP at `pose`, where the tool switches at line `line`, lies within the
+    /// line tolerance of this part's start (switching on) or end (switching off); `index` is
+    /// the part's number in the plan.
+    fn check_switch(
+        &self,
+        line: usize,
+        pose: &Pose,
+        index: usize,
+        switch: Switch,
+    ) -> Result<(), ReadError> {
+        let (way, place, point) = match switch {
+            Switch::On => ("on", "start", self.start),
+            Switch::Off => ("off", "end", self.end),
+        };
+        let off = (pose.position - point).norm();
+        if off > self.bounds.line_tolerance_m + SLACK_M {
+            return fail(
+                line,
+                format!(
+                    "the tool switches {way} {:.4} mm from the {place} of stroke part {index} \
+                     (segment {})",
+                    off * 1e3,
+                    self.segment
+                ),
+            );
+        }
+        Ok(())
+    }
+}
+
 /// What the reader found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NativeReport {
@@ -1088,18 +1128,7 @@ impl<'a> Reading<'a> {
         let Some(pose) = state.pose else {
             return fail(line, "the tool switches on before the first move");
         };
-        let off = (pose.position - part.start).norm();
-        if off > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the tool switches on {:.4} mm from the start of stroke part {} (segment {})",
-                    off * 1e3,
-                    state.parts_on,
-                    part.segment
-                ),
-            );
-        }
+        part.check_switch(line, &pose, state.parts_on, Switch::On)?;
         state.tool_on = true;
         state.parts_on += 1;
         state.report.stroke_parts += 1;
@@ -1113,18 +1142,7 @@ impl<'a> Reading<'a> {
     fn switch_off(&self, state: &mut State, line: usize) -> Result<(), ReadError> {
         let part = &self.parts[state.parts_on - 1];
         let pose = self.current_pose(state, line)?;
-        let off = (pose.position - part.end).norm();
-        if off > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the tool switches off {:.4} mm from the end of stroke part {} (segment {})",
-                    off * 1e3,
-                    state.parts_on - 1,
-                    part.segment
-                ),
-            );
-        }
+        part.check_switch(line, &pose, state.parts_on - 1, Switch::Off)?;
         state.tool_on = false;
         if let Some((least, greatest)) = part.line.covered(state.drawn.drain(..)) {
             // Along the stroke, the task runs on from `from_s`, or back toward its start.
