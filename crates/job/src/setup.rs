@@ -44,6 +44,24 @@ pub fn job_timing(
 /// the Python module, the evaluations): the planner at the job's tolerance, cone and scene,
 /// the program's timing ([`job_timing`]), the search with the planner's strongest controller,
 /// and the robot file as programs name it.
+///
+/// ```no_run
+/// use emg_job::{JOB_TOLERANCE_M, Job, JobPlanner, Unwatched, job_config};
+/// use emg_kinematics::Robot;
+/// use emg_planner::{Models, Planner};
+///
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let robot_file = std::path::Path::new("data/robots/fr3_pen.urdf");
+/// let robot = Robot::from_chain_file(robot_file)?;
+/// let text = std::fs::read_to_string("examples/seams.json")?;
+/// let job = Job::from_json("examples/seams.json", &text, &robot)?;
+/// let models = Models::shipped(&robot, "data".as_ref())?;
+/// let planner = Planner::new(robot, models, job_config(JOB_TOLERANCE_M))?;
+/// let program = JobPlanner::new(planner, robot_file, "fr3")?.plan(&job, &Unwatched)?;
+/// println!("{:.3} m of {:.3} m drawn", program.summary.drawn_m, program.summary.total_m);
+/// # Ok(())
+/// # }
+/// ```
 pub struct JobPlanner {
     planner: Planner,
     timing: MotionTiming,
