@@ -11,7 +11,7 @@ use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
 use crate::job_input::{JobInput, Ready, print_size};
 use crate::output::{progress_bar, write_text};
-use crate::program::print_summary;
+use crate::program::write_program;
 
 /// Options of `emg job`.
 #[derive(Debug, Args)]
@@ -56,20 +56,14 @@ pub fn run(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
         planned => planned?,
     };
     watch.finish();
-    print_summary(&file);
-    write_text(&args.out, &(serde_json::to_string(&file)? + "\n"))?;
-    println!("wrote {}", args.out.display());
-    if let Some(format) = args.export {
-        let text = exporting::export_program(
-            &file,
-            format,
-            &args.urscript,
-            &args.out,
-            &input.robot,
-            planner.robot(),
-        )?;
-        println!("{text}");
-    }
+    write_program(
+        &file,
+        &args.out,
+        args.export,
+        &args.urscript,
+        &input.robot,
+        planner.robot(),
+    )?;
     if let Some(path) = &args.html {
         write_text(
             path,

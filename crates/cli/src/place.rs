@@ -15,7 +15,7 @@ use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
 use crate::job_input::{JobInput, Ready, print_size};
 use crate::output::{progress_bar, write_text};
-use crate::program::print_summary;
+use crate::program::write_program;
 
 /// Options of `emg place`.
 #[derive(Debug, Args)]
@@ -145,20 +145,14 @@ pub fn run(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
         .program
         .as_deref()
         .expect("the chosen place was planned");
-    print_summary(program);
-    write_text(&args.out, &(serde_json::to_string(program)? + "\n"))?;
-    println!("wrote {}", args.out.display());
-    if let Some(format) = args.export {
-        let text = exporting::export_program(
-            program,
-            format,
-            &args.urscript,
-            &args.out,
-            &input.robot,
-            planner.robot(),
-        )?;
-        println!("{text}");
-    }
+    write_program(
+        program,
+        &args.out,
+        args.export,
+        &args.urscript,
+        &input.robot,
+        planner.robot(),
+    )?;
     if let Some(path) = &args.map {
         write_text(path, &placement_map(&placement, args.score))?;
         println!("wrote {}", path.display());

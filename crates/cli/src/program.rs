@@ -1,11 +1,35 @@
-//! A job's program (an `emg-job/3` file): read back from a file, and its summary printed as
-//! `emg job` and `emg place` print it.
+//! A job's program (an `emg-job/3` file): read back from a file, and its summary printed and
+//! the program written and exported as `emg job` and `emg place` write it.
 
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use emg_io::ExportFormat;
+use emg_kinematics::Robot;
 
-use crate::output::count;
+use crate::exporting::{self, UrScriptArgs};
+use crate::output::{count, write_text};
+
+/// Prints `file`'s summary, writes it to `out` and, where `export` asks, writes it for the
+/// robot's own stack beside `out` (`urscript`'s options; the arm `robot` read from
+/// `robot_file`).
+pub fn write_program(
+    file: &emg_job::JobFile,
+    out: &Path,
+    export: Option<ExportFormat>,
+    urscript: &UrScriptArgs,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<()> {
+    print_summary(file);
+    write_text(out, &(serde_json::to_string(file)? + "\n"))?;
+    println!("wrote {}", out.display());
+    if let Some(format) = export {
+        let text = exporting::export_program(file, format, urscript, out, robot_file, robot)?;
+        println!("{text}");
+    }
+    Ok(())
+}
 
 /// The job program in `file`, when it is a job's program (refused where it is one of another
 /// version).
