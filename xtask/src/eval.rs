@@ -152,103 +152,129 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 fn run_protocol(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let name = args.name.clone().unwrap_or_else(|| "eval".into());
-    let shard_dir = args.out_dir.join("eval-shards");
-    let shard_path = |i: usize, n: usize| shard_dir.join(format!("{name}-shard-{i}-of-{n}.json"));
     let raw_sets = match args.merge {
-        Some(n) => {
-            anyhow::ensure!(n > 0, "--merge needs the number of shards (at least 1)");
-            let mut shards = Vec::new();
-            for i in 0..n {
-                let path = shard_path(i, n);
-                let shard = ShardFile::read(&path)?.with_context(|| {
-                    format!(
-                        "{} is missing (run `cargo xtask eval --shard {i}/{n}`)",
-                        path.display()
-                    )
-                })?;
-                if let Some(first) = shards.first().map(|first: &ShardFile| &first.inputs) {
-                    anyhow::ensure!(
-                        shard.inputs == *first,
-                        "{} was computed from other inputs than shard 0/{n} ({:?} against {:?}); \
-                         rerun the shards with the same options",
-                        path.display(),
-                        shard.inputs,
-                        first
-                    );
-                }
-                shards.push(shard);
-            }
-            let mut shard_sets: Vec<Vec<RawSet>> = shards.into_iter().map(|s| s.sets).collect();
-            let mut merged = Vec::new();
-            while !shard_sets[0].is_empty() {
-                let parts = shard_sets.iter_mut().map(|sets| sets.remove(0)).collect();
-                merged.push(merge_sets(parts)?);
-            }
-            merged
+        Some(n) => merged_shards(args, &name, n)?,
+        None => match computed_sets(args, &name)? {
+            Some(sets) => sets,
+            None => return Ok(()),
+        },
+    };
+    write_protocol(args, &name, &raw_sets, started)
+}
+
+/// Where shard `index` of `count` of the run `name` is kept.
+fn shard_path(shard_dir: &Path, name: &str, index: usize, count: usize) -> PathBuf {
+    shard_dir.join(format!("{name}-shard-{index}-of-{count}.json"))
+}
+
+/// The sets of the run `name` merged from its `n` shards, each computed from the same inputs.
+fn merged_shards(args: &Args, name: &str, n: usize) -> anyhow::Result<Vec<RawSet>> {
+    let shard_dir = args.out_dir.join("eval-shards");
+    anyhow::ensure!(n > 0, "--merge needs the number of shards (at least 1)");
+    let mut shards = Vec::new();
+    for i in 0..n {
+        let path = shard_path(&shard_dir, name, i, n);
+        let shard = ShardFile::read(&path)?.with_context(|| {
+            format!(
+                "{} is missing (run `cargo xtask eval --shard {i}/{n}`)",
+                path.display()
+            )
+        })?;
+        if let Some(first) = shards.first().map(|first: &ShardFile| &first.inputs) {
+            anyhow::ensure!(
+                shard.inputs == *first,
+                "{} was computed from other inputs than shard 0/{n} ({:?} against {:?}); \
+                 rerun the shards with the same options",
+                path.display(),
+                shard.inputs,
+                first
+            );
         }
-        None => {
-            let inputs = args.shard.map(|_| ShardInputs::of(args)).transpose()?;
-            if let (Some(s), Some(inputs)) = (args.shard, &inputs) {
-                let path = shard_path(s.index, s.count);
-                match ShardFile::read(&path)? {
-                    Some(done) if done.inputs == *inputs => {
-                        println!(
-                            "shard {}/{} is already done ({}); skipped (remove the file to redo it)",
-                            s.index,
-                            s.count,
-                            path.display()
-                        );
-                        return Ok(());
-                    }
-                    Some(_) => println!(
-                        "{} was computed from other inputs; computing shard {}/{} again",
-                        path.display(),
-                        s.index,
-                        s.count
-                    ),
-                    None => {}
-                }
-            }
-            let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
-            args.velocity_limits.apply(&mut setup.rollout.constraints);
-            args.surface.apply(&mut setup.rollout.constraints);
-            let selection = Selection {
-                shard: args.shard.map(|s| (s.index, s.count)),
-                surface_clearance_m: args.surface_clearance,
-            };
-            let mut sets = vec![protocol_set(
-                &setup,
-                "unseen",
-                &args.tasks,
-                &args.labels,
-                args.limit,
-                &selection,
-            )?];
-            if args.seen_count > 0 {
-                sets.push(protocol_set(
-                    &setup,
-                    "seen",
-                    &args.seen_tasks,
-                    &args.seen_labels,
-                    Some(args.seen_count),
-                    &selection,
-                )?);
-            }
-            if let (Some(s), Some(inputs)) = (args.shard, inputs) {
-                let path = shard_path(s.index, s.count);
-                let file = ShardFile { inputs, sets };
-                emg_io::write_atomically(&path, serde_json::to_string(&file)?)?;
+        shards.push(shard);
+    }
+    let mut shard_sets: Vec<Vec<RawSet>> = shards.into_iter().map(|s| s.sets).collect();
+    let mut merged = Vec::new();
+    while !shard_sets[0].is_empty() {
+        let parts = shard_sets.iter_mut().map(|sets| sets.remove(0)).collect();
+        merged.push(merge_sets(parts)?);
+    }
+    Ok(merged)
+}
+
+/// The run's sets computed here: all of them, or the shard `--shard` names; `None` where that
+/// shard is written to its file (or was already done) and nothing is left to summarise.
+fn computed_sets(args: &Args, name: &str) -> anyhow::Result<Option<Vec<RawSet>>> {
+    let shard_dir = args.out_dir.join("eval-shards");
+    let inputs = args.shard.map(|_| ShardInputs::of(args)).transpose()?;
+    if let (Some(s), Some(inputs)) = (args.shard, &inputs) {
+        let path = shard_path(&shard_dir, name, s.index, s.count);
+        match ShardFile::read(&path)? {
+            Some(done) if done.inputs == *inputs => {
                 println!(
-                    "shard {}/{} done; wrote {}",
+                    "shard {}/{} is already done ({}); skipped (remove the file to redo it)",
                     s.index,
                     s.count,
                     path.display()
                 );
-                return Ok(());
+                return Ok(None);
             }
-            sets
+            Some(_) => println!(
+                "{} was computed from other inputs; computing shard {}/{} again",
+                path.display(),
+                s.index,
+                s.count
+            ),
+            None => {}
         }
+    }
+    let mut setup = protocol::load_setup(&args.robot, &args.weights, &args.diffusion)?;
+    args.velocity_limits.apply(&mut setup.rollout.constraints);
+    args.surface.apply(&mut setup.rollout.constraints);
+    let selection = Selection {
+        shard: args.shard.map(|s| (s.index, s.count)),
+        surface_clearance_m: args.surface_clearance,
     };
+    let mut sets = vec![protocol_set(
+        &setup,
+        "unseen",
+        &args.tasks,
+        &args.labels,
+        args.limit,
+        &selection,
+    )?];
+    if args.seen_count > 0 {
+        sets.push(protocol_set(
+            &setup,
+            "seen",
+            &args.seen_tasks,
+            &args.seen_labels,
+            Some(args.seen_count),
+            &selection,
+        )?);
+    }
+    if let (Some(s), Some(inputs)) = (args.shard, inputs) {
+        let path = shard_path(&shard_dir, name, s.index, s.count);
+        let file = ShardFile { inputs, sets };
+        emg_io::write_atomically(&path, serde_json::to_string(&file)?)?;
+        println!(
+            "shard {}/{} done; wrote {}",
+            s.index,
+            s.count,
+            path.display()
+        );
+        return Ok(None);
+    }
+    Ok(Some(sets))
+}
+
+/// Summarises `raw_sets` and writes the run `name`'s record and its tables, with the wall time
+/// of the whole run `started` then.
+fn write_protocol(
+    args: &Args,
+    name: &str,
+    raw_sets: &[RawSet],
+    started: Instant,
+) -> anyhow::Result<()> {
     let buckets = BucketConfig::default();
     let sets = raw_sets
         .iter()
