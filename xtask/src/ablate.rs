@@ -130,6 +130,8 @@ struct Report<'a> {
     rows: Vec<Row>,
 }
 
+/// Sweeps the DP seeder's `parameter` over `values` (`apply` sets it on a configuration) on
+/// the ablation's tasks, beside the three baseline seeds, and writes `ablate-{name}`.
 fn dp_sweep(
     args: &DpArgs,
     name: &str,
@@ -138,18 +140,7 @@ fn dp_sweep(
     apply: impl Fn(&mut DpSeedConfig, f64),
 ) -> anyhow::Result<()> {
     let setup = crate::protocol::load_setup(&args.robot, &args.policy, &args.weights)?;
-    let robot = &setup.robot;
-    let mut tasks = read_tasks(&args.tasks, robot)
-        .with_context(|| format!("reading {}", args.tasks.display()))?;
-    if let Some(limit) = args.limit {
-        tasks.truncate(limit);
-    }
-    if tasks.is_empty() || tasks.iter().any(|t| t.q0_seed.is_none()) {
-        bail!(
-            "{}: the ablation needs at least one task, each with its q0_seed",
-            args.tasks.display()
-        );
-    }
+    let tasks = ablation_tasks(args, &setup.robot)?;
     let weights = DenoiserWeights::read(&args.weights).with_context(|| {
         format!(
             "reading {} (train it with `cargo xtask train-diffusion`)",
@@ -166,84 +157,167 @@ fn dp_sweep(
         }
         false => None,
     };
-    let rollout = setup.rollout.clone();
-    let kind = args.controller;
-    let prototype = Executor::new(kind, Some(&setup.policy), &setup.executor)?;
-    let lengths_from = |tasks: &[Task], what: &str| -> anyhow::Result<Vec<f64>> {
+    let sweep = Sweep {
+        prototype: Executor::new(args.controller, Some(&setup.policy), &setup.executor)?,
+        setup: &setup,
+        tasks: &tasks,
+        pool: &pool,
+        reference,
+    };
+    let baselines = sweep.baselines()?;
+    let rows = values
+        .iter()
+        .map(|&value| {
+            let mut dp = DpSeedConfig::default();
+            apply(&mut dp, value);
+            sweep.row(value, dp, &weights)
+        })
+        .collect::<anyhow::Result<Vec<Row>>>()?;
+    let report = Report {
+        ablation: name,
+        parameter,
+        tasks: workspace::relative(&args.tasks),
+        task_count: tasks.len(),
+        weights: workspace::relative(&args.weights),
+        weights_dataset: weights.header().dataset.clone(),
+        reference: sweep
+            .reference
+            .as_ref()
+            .map(|_| workspace::relative(&args.reference)),
+        controller: args.controller.name(),
+        rollout: setup.rollout.clone(),
+        baselines,
+        rows,
+    };
+    std::fs::create_dir_all(&args.out_dir)?;
+    let stem = args.out_dir.join(format!("ablate-{name}"));
+    emg_io::write_atomically(
+        stem.with_extension("json"),
+        serde_json::to_string_pretty(&report)? + "\n",
+    )?;
+    emg_io::write_atomically(stem.with_extension("md"), markdown(&report))?;
+    println!("{}", markdown(&report));
+    Ok(())
+}
+
+/// The ablation's tasks (the first `--limit`), each with its `q0_seed`.
+fn ablation_tasks(args: &DpArgs, robot: &emg_kinematics::Robot) -> anyhow::Result<Vec<Task>> {
+    let mut tasks = read_tasks(&args.tasks, robot)
+        .with_context(|| format!("reading {}", args.tasks.display()))?;
+    if let Some(limit) = args.limit {
+        tasks.truncate(limit);
+    }
+    if tasks.is_empty() || tasks.iter().any(|t| t.q0_seed.is_none()) {
+        bail!(
+            "{}: the ablation needs at least one task, each with its q0_seed",
+            args.tasks.display()
+        );
+    }
+    Ok(tasks)
+}
+
+/// One DP-seed sweep: the tasks, the controller they are rolled out with and the reference
+/// lengths they are measured against.
+struct Sweep<'a> {
+    setup: &'a emg_eval::Setup,
+    tasks: &'a [Task],
+    pool: &'a rayon::ThreadPool,
+    prototype: Executor,
+    /// Per-task reference lengths, where the reference labels exist.
+    reference: Option<Vec<f64>>,
+}
+
+impl Sweep<'_> {
+    /// The path lengths `tasks` (seeded) roll out to, each trajectory checked; `what` names
+    /// the progress bar.
+    fn lengths(&self, tasks: &[Task], what: &str) -> anyhow::Result<Vec<f64>> {
         let bar = progress::bar(tasks.len() as u64, what);
-        let trajectories = pool.install(|| {
+        let trajectories = self.pool.install(|| {
             rollout_all(
-                robot,
+                &self.setup.robot,
                 tasks,
                 |t| t.q0_seed.expect("seeded"),
-                || prototype.clone(),
-                &rollout,
+                || self.prototype.clone(),
+                &self.setup.rollout,
                 &|| bar.inc(1),
             )
         });
         bar.finish();
-        pool.install(|| setup.check(tasks, &trajectories))?;
+        self.pool
+            .install(|| self.setup.check(tasks, &trajectories))?;
         Ok(trajectories.iter().map(|t| t.path_length_m).collect())
-    };
-    let mut baselines = Vec::new();
-    for (seed, objective) in [
-        ("q0_seed", None),
-        ("q_mu", Some(HeuristicObjective::Manipulability)),
-        ("q_jl", Some(HeuristicObjective::JointCentring)),
-    ] {
-        let seeded: Vec<Task> = match objective {
-            None => tasks.clone(),
-            Some(objective) => {
-                let bar = progress::bar(tasks.len() as u64, seed);
-                let seeded = pool.install(|| {
-                    tasks
-                        .par_iter()
-                        .map(|task| {
-                            bar.inc(1);
-                            let q = heuristic_seed(
-                                robot,
-                                task,
-                                objective,
-                                &HeuristicConfig::default(),
-                                &ProjectionConfig::default(),
-                            )
-                            .map_or(task.q0_seed, |h| Some(h.q));
-                            Task {
-                                q0_seed: q,
-                                ..task.clone()
-                            }
-                        })
-                        .collect()
-                });
-                bar.finish();
-                seeded
-            }
-        };
-        let lengths = lengths_from(&seeded, seed)?;
-        baselines.push(Baseline {
-            seed,
-            path_length_m: summary(&lengths),
-            ratio_to_reference_pct: reference.as_ref().map(|r| ratio(&lengths, r)),
-        });
     }
 
-    let mut rows = Vec::new();
-    for &value in values {
-        let mut dp = DpSeedConfig::default();
-        apply(&mut dp, value);
-        let seeder = DpSeeder::new(robot, &weights, dp.clone())?;
-        let bar = progress::bar(tasks.len() as u64, "dp seeds");
-        let seeds = pool.install(|| {
-            tasks
+    /// The tasks' own seeds and the two heuristic seeds, measured.
+    fn baselines(&self) -> anyhow::Result<Vec<Baseline>> {
+        let mut baselines = Vec::new();
+        for (seed, objective) in [
+            ("q0_seed", None),
+            ("q_mu", Some(HeuristicObjective::Manipulability)),
+            ("q_jl", Some(HeuristicObjective::JointCentring)),
+        ] {
+            let seeded = match objective {
+                None => self.tasks.to_vec(),
+                Some(objective) => self.heuristic_seeded(objective, seed),
+            };
+            let lengths = self.lengths(&seeded, seed)?;
+            baselines.push(Baseline {
+                seed,
+                path_length_m: summary(&lengths),
+                ratio_to_reference_pct: self.reference.as_ref().map(|r| ratio(&lengths, r)),
+            });
+        }
+        Ok(baselines)
+    }
+
+    /// The tasks seeded by the heuristic `objective` (each keeping its own seed where the
+    /// heuristic finds none); `what` names the progress bar.
+    fn heuristic_seeded(&self, objective: HeuristicObjective, what: &str) -> Vec<Task> {
+        let robot = &self.setup.robot;
+        let bar = progress::bar(self.tasks.len() as u64, what);
+        let seeded = self.pool.install(|| {
+            self.tasks
+                .par_iter()
+                .map(|task| {
+                    bar.inc(1);
+                    let q = heuristic_seed(
+                        robot,
+                        task,
+                        objective,
+                        &HeuristicConfig::default(),
+                        &ProjectionConfig::default(),
+                    )
+                    .map_or(task.q0_seed, |h| Some(h.q));
+                    Task {
+                        q0_seed: q,
+                        ..task.clone()
+                    }
+                })
+                .collect()
+        });
+        bar.finish();
+        seeded
+    }
+
+    /// The row of the parameter's `value`: the tasks seeded by the DP seeder configured as
+    /// `dp` (with `weights`), its seed times, tries and fallbacks, and the lengths rolled out.
+    fn row(&self, value: f64, dp: DpSeedConfig, weights: &DenoiserWeights) -> anyhow::Result<Row> {
+        let robot = &self.setup.robot;
+        let seeder = DpSeeder::new(robot, weights, dp.clone())?;
+        let bar = progress::bar(self.tasks.len() as u64, "dp seeds");
+        let constraints = &self.setup.rollout.constraints;
+        let seeds = self.pool.install(|| {
+            self.tasks
                 .par_iter()
                 .map_init(SeedWorkspace::default, |workspace, task| {
                     bar.inc(1);
-                    seeder.seed(robot, task, &rollout.constraints, workspace)
+                    seeder.seed(robot, task, constraints, workspace)
                 })
                 .collect::<Result<Vec<_>, _>>()
         })?;
         bar.finish();
-        let seeded: Vec<Task> = tasks
+        let seeded: Vec<Task> = self
+            .tasks
             .iter()
             .zip(&seeds)
             .map(|(task, seed)| Task {
@@ -251,14 +325,14 @@ fn dp_sweep(
                 ..task.clone()
             })
             .collect();
-        let lengths = lengths_from(&seeded, "dp rollouts")?;
+        let lengths = self.lengths(&seeded, "dp rollouts")?;
         let mut times: Vec<f64> = seeds
             .iter()
             .map(|s| s.elapsed.as_secs_f64() * 1e3)
             .collect();
         times.sort_by(f64::total_cmp);
         let quantile = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
-        rows.push(Row {
+        Ok(Row {
             value,
             dp,
             seed_time: TimeStats {
@@ -272,33 +346,9 @@ fn dp_sweep(
                 .filter(|s| s.origin == SeedOrigin::Fallback)
                 .count(),
             path_length_m: summary(&lengths),
-            ratio_to_reference_pct: reference.as_ref().map(|r| ratio(&lengths, r)),
-        });
+            ratio_to_reference_pct: self.reference.as_ref().map(|r| ratio(&lengths, r)),
+        })
     }
-    let report = Report {
-        ablation: name,
-        parameter,
-        tasks: workspace::relative(&args.tasks),
-        task_count: tasks.len(),
-        weights: workspace::relative(&args.weights),
-        weights_dataset: weights.header().dataset.clone(),
-        reference: reference
-            .as_ref()
-            .map(|_| workspace::relative(&args.reference)),
-        controller: kind.name(),
-        rollout,
-        baselines,
-        rows,
-    };
-    std::fs::create_dir_all(&args.out_dir)?;
-    let stem = args.out_dir.join(format!("ablate-{name}"));
-    emg_io::write_atomically(
-        stem.with_extension("json"),
-        serde_json::to_string_pretty(&report)? + "\n",
-    )?;
-    emg_io::write_atomically(stem.with_extension("md"), markdown(&report))?;
-    println!("{}", markdown(&report));
-    Ok(())
 }
 
 /// Per-task ratio `L / ℓ_ref` in percent, over the tasks with a positive reference.
