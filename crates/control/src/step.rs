@@ -66,35 +66,24 @@ impl<'a> StepContext<'a> {
         previous_action: NullAction,
     ) -> Self {
         let tool_angle_deg = tool_angle_deg(&kinematics.tool_axis(), &task.n);
-        let Derived {
-            q,
-            along,
-            q_normalised,
-            rho,
-            manipulability,
-            manipulability_gradient,
-            alignment_gradient,
-            centring_gradient,
-            pseudo_inverse,
-            basis,
-        } = Derived::of(robot, task, config, &kinematics, 0.0);
+        let derived = Derived::of(robot, task, config, &kinematics, 0.0);
         Self {
             robot,
             task,
             config,
             step,
-            q,
+            q: derived.q,
             kinematics,
-            q_normalised,
-            rho,
+            q_normalised: derived.q_normalised,
+            rho: derived.rho,
             tool_angle_deg,
-            along,
-            manipulability,
-            manipulability_gradient,
-            alignment_gradient,
-            centring_gradient,
-            pseudo_inverse,
-            basis,
+            along: derived.along,
+            manipulability: derived.manipulability,
+            manipulability_gradient: derived.manipulability_gradient,
+            alignment_gradient: derived.alignment_gradient,
+            centring_gradient: derived.centring_gradient,
+            pseudo_inverse: derived.pseudo_inverse,
+            basis: derived.basis,
             previous_action,
         }
     }

@@ -61,9 +61,16 @@ impl LayoutCursor {
         self.parts.next().expect("views follow parameter_layout")
     }
 
+    /// The next two parameters of a layer (its scale or weight, then its shift or bias): their
+    /// offsets and the first one's shape.
+    fn layer(&mut self) -> (usize, usize, Vec<usize>) {
+        let (first, shape) = self.next();
+        let (second, _) = self.next();
+        (first, second, shape)
+    }
+
     fn norm(&mut self) -> NormView {
-        let (gamma, shape) = self.next();
-        let (beta, _) = self.next();
+        let (gamma, beta, shape) = self.layer();
         NormView {
             gamma,
             beta,
@@ -72,8 +79,7 @@ impl LayoutCursor {
     }
 
     fn linear(&mut self) -> LinearView {
-        let (weight, shape) = self.next();
-        let (bias, _) = self.next();
+        let (weight, bias, shape) = self.layer();
         LinearView {
             weight,
             bias,
@@ -205,39 +211,40 @@ impl PlainDenoiser {
         scratch: &mut ForwardScratch,
         out: &mut [f32],
     ) {
+        let batch = VelocityBatch {
+            t,
+            samples,
+            condition_embeddings,
+            rows,
+        };
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only when the running CPU reports AVX2 (see `new`).
-            unsafe { self.velocity_avx2(t, samples, condition_embeddings, rows, scratch, out) };
+            unsafe { self.velocity_avx2(&batch, scratch, out) };
             return;
         }
-        self.velocity_portable(t, samples, condition_embeddings, rows, scratch, out);
+        self.velocity_portable(&batch, scratch, out);
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn velocity_avx2(
-        &self,
-        t: usize,
-        samples: &[f32],
-        condition_embeddings: &[f32],
-        rows: usize,
-        scratch: &mut ForwardScratch,
-        out: &mut [f32],
-    ) {
-        self.velocity_portable(t, samples, condition_embeddings, rows, scratch, out);
+    fn velocity_avx2(&self, batch: &VelocityBatch, scratch: &mut ForwardScratch, out: &mut [f32]) {
+        self.velocity_portable(batch, scratch, out);
     }
 
     #[inline(always)]
     fn velocity_portable(
         &self,
-        t: usize,
-        samples: &[f32],
-        condition_embeddings: &[f32],
-        rows: usize,
+        batch: &VelocityBatch,
         scratch: &mut ForwardScratch,
         out: &mut [f32],
     ) {
+        let VelocityBatch {
+            t,
+            samples,
+            condition_embeddings,
+            rows,
+        } = *batch;
         let (w, h) = (self.config.width, self.config.hidden);
         grow(&mut scratch.residual, rows * w);
         grow(&mut scratch.normed, rows * w);
@@ -264,6 +271,16 @@ impl PlainDenoiser {
         layer_norm(&self.values, self.output_norm, residual, rows, normed);
         linear(&self.values, self.head, normed, rows, out);
     }
+}
+
+/// The inputs of one [`PlainDenoiser::velocity`] call, as its vector and portable bodies take
+/// them.
+#[derive(Clone, Copy)]
+struct VelocityBatch<'a> {
+    t: usize,
+    samples: &'a [f32],
+    condition_embeddings: &'a [f32],
+    rows: usize,
 }
 
 #[inline(always)]

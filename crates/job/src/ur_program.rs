@@ -184,6 +184,11 @@ pub fn ur_program_export(
     })
 }
 
+/// The smallest of `values` (the slowest joint's limit); infinite where there are none.
+fn smallest(values: &[f64]) -> f64 {
+    values.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
 /// `job`'s program as one native URScript program for `robot` (the shipped UR5e: its base
 /// frame the controller's Base frame, its last joint's segment the tool flange), with `header`
 /// as comment lines.
@@ -196,18 +201,8 @@ pub fn ur_program(
         return Err(UrProgramError::Joints(robot.dof()));
     }
     let free = FreeSpace::new(robot, file.surfaces.clone(), &file.constraints);
-    let joint_speed = file
-        .limits
-        .max_velocity
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
-    let joint_acceleration = file
-        .limits
-        .max_acceleration
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let joint_speed = smallest(&file.limits.max_velocity);
+    let joint_acceleration = smallest(&file.limits.max_acceleration);
     let mut writer = Writer {
         robot,
         free: &free,

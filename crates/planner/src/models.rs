@@ -104,6 +104,20 @@ pub fn robot_stamp(robot: &Robot) -> RobotStamp {
     }
 }
 
+/// Fails unless the weights file at `path`, whose header records `trained_for`, was trained for
+/// `robot`.
+fn check_trained_for(
+    robot: &Robot,
+    trained_for: Option<&RobotStamp>,
+    path: &Path,
+) -> Result<(), StampError> {
+    check_stamp(
+        trained_for,
+        &robot_stamp(robot),
+        &path.display().to_string(),
+    )
+}
+
 /// The diffusion seeder of a weights file trained for `robot`, with the default DP seed
 /// settings.
 pub fn load_seeder(robot: &Robot, path: &Path) -> Result<DpSeeder, ModelsError> {
@@ -111,8 +125,7 @@ pub fn load_seeder(robot: &Robot, path: &Path) -> Result<DpSeeder, ModelsError> 
         path: path.to_path_buf(),
         source,
     })?;
-    let file = path.display().to_string();
-    check_stamp(weights.header().robot.as_ref(), &robot_stamp(robot), &file)?;
+    check_trained_for(robot, weights.header().robot.as_ref(), path)?;
     DpSeeder::new(robot, &weights, DpSeedConfig::default()).map_err(|source| ModelsError::Seeder {
         path: path.to_path_buf(),
         source,
@@ -125,7 +138,6 @@ pub fn load_policy(robot: &Robot, path: &Path) -> Result<RlController, ModelsErr
         path: path.to_path_buf(),
         source,
     })?;
-    let file = path.display().to_string();
-    check_stamp(weights.header().robot.as_ref(), &robot_stamp(robot), &file)?;
+    check_trained_for(robot, weights.header().robot.as_ref(), path)?;
     Ok(RlController::new(&weights))
 }

@@ -108,15 +108,22 @@ pub(crate) mod tests {
         }
     }
 
-    #[test]
-    fn a_free_move_keeps_its_edges_rests_at_its_vertices_and_holds_the_limits() {
-        let request = request();
+    /// The vertices `a`, `b`, `c` of the free move the tests time: from zero, joints 1 and 4
+    /// turn, then joint 2.
+    fn two_edges() -> [JointVector; 3] {
         let a = JointVector::zeros();
         let mut b = a;
         b[0] = 1.0;
         b[3] = -0.5;
         let mut c = b;
         c[1] = 0.4;
+        [a, b, c]
+    }
+
+    #[test]
+    fn a_free_move_keeps_its_edges_rests_at_its_vertices_and_holds_the_limits() {
+        let request = request();
+        let [a, b, c] = two_edges();
         let samples = time_free_move(&[a, b, c], &request).samples;
         assert_eq!(samples.first().unwrap().q, a);
         assert_eq!(samples.last().unwrap().q, c);
@@ -164,13 +171,7 @@ pub(crate) mod tests {
 
     #[test]
     fn a_free_move_gives_the_samples_it_always_gave() {
-        let a = JointVector::zeros();
-        let mut b = a;
-        b[0] = 1.0;
-        b[3] = -0.5;
-        let mut c = b;
-        c[1] = 0.4;
-        let timed = time_free_move(&[a, b, c], &request());
+        let timed = time_free_move(&two_edges(), &request());
         assert_samples(
             &timed.samples,
             2466,
