@@ -20,7 +20,7 @@ use plotters::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-use crate::workspace;
+use crate::{figure, workspace};
 
 /// Options of `figure-branches`.
 #[derive(clap::Args)]
@@ -220,12 +220,7 @@ fn draw(args: &Args, robot: &emg_kinematics::Robot, branches: &[Branch]) -> anyh
                 )))?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
+        figure::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     root.present()?;
     Ok(())

@@ -4,13 +4,13 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use emg_control::{ClassicalController, RolloutConfig, first_violation, rollout};
+use emg_control::{ClassicalController, RolloutConfig, Task, first_violation, rollout};
 use emg_diffusion::{DenoiserWeights, DpSeedConfig, DpSeeder, SeedWorkspace};
 use emg_io::read_tasks;
-use emg_kinematics::{MAX_DOF, PoseTarget, Vec3, project_to_pose};
+use emg_kinematics::{MAX_DOF, PoseTarget, Robot, Vec3, project_to_pose};
 use plotters::prelude::*;
 
-use crate::workspace;
+use crate::{figure, workspace};
 
 /// Options of `figure-dp-seeds`.
 #[derive(clap::Args)]
@@ -54,12 +54,33 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             args.tasks.display()
         );
     };
+    let drawn = ik_valid_seeds(args, &robot, task)?;
+    if drawn.is_empty() {
+        bail!(
+            "none of the {} candidates of task {} is IK-valid; try another --task",
+            args.candidates,
+            args.task
+        );
+    }
+    draw(args, task, &drawn)?;
+    println!(
+        "wrote {} ({} IK-valid seeds of {} candidates)",
+        workspace::relative(&args.out),
+        drawn.len(),
+        args.candidates
+    );
+    Ok(())
+}
+
+/// The DP seed candidates of `task` that project onto its start pose within the constraints,
+/// each with the length the classical controller reaches from it.
+fn ik_valid_seeds(args: &Args, robot: &Robot, task: &Task) -> anyhow::Result<Vec<Drawn>> {
     let weights = DenoiserWeights::read(&args.weights)
         .with_context(|| format!("reading {}", args.weights.display()))?;
     let config = DpSeedConfig::default();
-    let seeder = DpSeeder::new(&robot, &weights, config.clone())?;
+    let seeder = DpSeeder::new(robot, &weights, config.clone())?;
     let candidates =
-        seeder.candidates(&robot, task, args.candidates, &mut SeedWorkspace::default())?;
+        seeder.candidates(robot, task, args.candidates, &mut SeedWorkspace::default())?;
     let rollout_config = RolloutConfig::default();
     let target = PoseTarget {
         position: task.p0,
@@ -68,18 +89,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let mut drawn = Vec::new();
     for start in &candidates {
-        let Ok((q, _)) = project_to_pose(&robot, start, &target, &config.projection) else {
+        let Ok((q, _)) = project_to_pose(robot, start, &target, &config.projection) else {
             continue;
         };
         let kinematics = robot.forward(&q);
-        if first_violation(&robot, task, &kinematics, &rollout_config.constraints).is_some() {
+        if first_violation(robot, task, &kinematics, &rollout_config.constraints).is_some() {
             continue;
         }
         let mut points = vec![Vec3::zeros()];
         points.extend((0..MAX_DOF).map(|i| kinematics.joint_origin(i)));
         points.push(kinematics.tcp());
         let trajectory = rollout(
-            &robot,
+            robot,
             task,
             &q,
             &mut ClassicalController::default(),
@@ -90,13 +111,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             length_m: trajectory.path_length_m,
         });
     }
-    if drawn.is_empty() {
-        bail!(
-            "none of the {} candidates of task {} is IK-valid; try another --task",
-            args.candidates,
-            args.task
-        );
-    }
+    Ok(drawn)
+}
+
+/// The stick figures of `drawn` beside `task`'s line, in a side and a top view.
+fn draw(args: &Args, task: &Task, drawn: &[Drawn]) -> anyhow::Result<()> {
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir)?;
     }
@@ -144,19 +163,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             )?;
         }
         if b == 2 {
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK)
-                .draw()?;
+            figure::draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         }
     }
     root.present()?;
-    println!(
-        "wrote {} ({} IK-valid seeds of {} candidates)",
-        workspace::relative(&args.out),
-        drawn.len(),
-        args.candidates
-    );
     Ok(())
 }

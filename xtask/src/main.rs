@@ -16,6 +16,7 @@ mod bench_report;
 mod cartesian_eval;
 mod corpus_eval;
 mod eval;
+mod figure;
 mod figure_branches;
 mod figure_dp_seeds;
 mod gap_eval;

@@ -6,13 +6,16 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use emg_control::{Task, rollout};
-use emg_eval::{BucketConfig, CellStats, EvalRecord, SetResult, bucket_members, cell_stats, four};
+use emg_control::{Task, Trajectory, rollout};
+use emg_eval::{
+    BucketConfig, CellStats, EvalRecord, SetResult, Setup, bucket_members, cell_stats, four,
+};
 use emg_hybrid::count_switches;
 use emg_io::read_tasks;
 use emg_planner::{
     ControllerKind, Executor, SHIPPED_ROBOTS, SearchConfig, SeedSource, ShippedRobot,
 };
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use serde::Deserialize;
 
@@ -20,8 +23,8 @@ use crate::ablate_control::{SwitchingAblation, WeightsAblation};
 use crate::results::{dp, read};
 use crate::search_eval::{self, BUDGET_FIGURE};
 use crate::{
-    gap_eval, limit, path_eval, precision_eval, protocol, search_shares, surface_report, timing,
-    workspace,
+    figure, gap_eval, limit, path_eval, precision_eval, protocol, search_shares, surface_report,
+    timing, workspace,
 };
 
 /// Options of `report`.
@@ -746,11 +749,7 @@ fn histogram(
             ShapeStyle::from(&BLACK.mix(0.6)),
         ))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    figure::draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     root.present()?;
     Ok(())
 }
@@ -763,11 +762,22 @@ fn trace(args: &Args) -> anyhow::Result<()> {
         &protocol::default_policy(),
         &protocol::default_diffusion(),
     )?;
+    let (task, trajectory) = switching_rollout(&setup)?;
+    draw_trace(
+        &setup,
+        &task,
+        &trajectory,
+        &args.figures.join("hybrid-trace.svg"),
+    )
+}
+
+/// The first task of the first 300 evaluation tasks whose DP + hybrid rollout hands over at
+/// least twice over more than 0.3 m, with that rollout.
+fn switching_rollout(setup: &Setup) -> anyhow::Result<(Task, Trajectory)> {
     let mut tasks: Vec<Task> = read_tasks(&workspace::data("tasks/eval-v1.tasks"), &setup.robot)?;
     tasks.truncate(300);
     let (seeds, _) = setup.seeds(&tasks, &SeedSource::Dp)?;
     let prototype = Executor::new(ControllerKind::Hybrid, Some(&setup.policy), &setup.executor)?;
-    let mut chosen = None;
     for (task, seed) in tasks.iter().zip(&seeds) {
         let trajectory = rollout(
             &setup.robot,
@@ -777,16 +787,23 @@ fn trace(args: &Args) -> anyhow::Result<()> {
             &setup.rollout,
         );
         if count_switches(&trajectory) >= 2 && trajectory.path_length_m > 0.3 {
-            chosen = Some((task.clone(), trajectory));
-            break;
+            return Ok((task.clone(), trajectory));
         }
     }
-    let (task, trajectory) =
-        chosen.context("no representative task with switches among the first 300")?;
+    anyhow::bail!("no representative task with switches among the first 300")
+}
+
+/// `trajectory` of `task` over time at `path`: the progress along the line above, q6 with the
+/// switch thresholds below, each step coloured by the controller acting.
+fn draw_trace(
+    setup: &Setup,
+    task: &Task,
+    trajectory: &Trajectory,
+    path: &Path,
+) -> anyhow::Result<()> {
     let limits = setup.robot.limits();
     let (mid, half) = (limits.mid()[5], limits.half_range()[5]);
-    let path = args.figures.join("hybrid-trace.svg");
-    let root = SVGBackend::new(&path, (800, 560)).into_drawing_area();
+    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let (upper, lower) = root.split_vertically(260);
     let end = trajectory.steps.last().map_or(1.0, |s| s.time_s).max(0.1);
@@ -815,12 +832,7 @@ fn trace(args: &Args) -> anyhow::Result<()> {
         .x_desc("time (s)")
         .y_desc("progress along d (m)")
         .draw()?;
-    top.draw_series(progress.windows(2).map(|w| {
-        PathElement::new(
-            vec![(w[0].0, w[0].1), (w[1].0, w[1].1)],
-            ShapeStyle::from(&w[0].2).stroke_width(3),
-        )
-    }))?;
+    draw_coloured_steps(&mut top, &progress)?;
     let q6: Vec<(f64, f64, RGBColor)> = trajectory
         .steps
         .iter()
@@ -836,12 +848,7 @@ fn trace(args: &Args) -> anyhow::Result<()> {
         .x_desc("time (s)")
         .y_desc("q6 (rad)")
         .draw()?;
-    bottom.draw_series(q6.windows(2).map(|w| {
-        PathElement::new(
-            vec![(w[0].0, w[0].1), (w[1].0, w[1].1)],
-            ShapeStyle::from(&w[0].2).stroke_width(3),
-        )
-    }))?;
+    draw_coloured_steps(&mut bottom, &q6)?;
     for tau in [
         setup.executor.switch.tau_enter,
         setup.executor.switch.tau_exit,
@@ -857,5 +864,19 @@ fn trace(args: &Args) -> anyhow::Result<()> {
         }
     }
     root.present()?;
+    Ok(())
+}
+
+/// The line through `points` (x, y, colour), each piece in the colour of its first point.
+fn draw_coloured_steps<'a>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    points: &[(f64, f64, RGBColor)],
+) -> anyhow::Result<()> {
+    chart.draw_series(points.windows(2).map(|w| {
+        PathElement::new(
+            vec![(w[0].0, w[0].1), (w[1].0, w[1].1)],
+            ShapeStyle::from(&w[0].2).stroke_width(3),
+        )
+    }))?;
     Ok(())
 }

@@ -18,7 +18,7 @@ use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::task_set_options::TaskSetOptions;
-use crate::{progress, workspace};
+use crate::{figure, progress, workspace};
 
 /// File name of the mean length against budget figure in a robot's figure directory.
 pub const BUDGET_FIGURE: &str = "search-budget.svg";
@@ -547,12 +547,7 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 16, y)], colour));
         chart.draw_series(points.iter().map(|p| Circle::new(*p, 4, colour.filled())))?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()?;
+    figure::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     root.present()?;
     Ok(())
 }

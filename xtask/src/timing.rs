@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::results::{SummaryPlace, shipped_results};
 use crate::task_set_options::{ROBOT_WITH_JOINT_LIMITS, THREADS_TIMED, TaskSetOptions};
-use crate::{progress, workspace};
+use crate::{figure, progress, workspace};
 
 /// Options of `timing`.
 #[derive(clap::Args)]
@@ -451,12 +451,7 @@ fn draw(outcomes: &[Outcome], record: &Record, path: &Path) -> anyhow::Result<()
         ))?
         .label(format!("the tool at {speed} m/s throughout"))
         .legend(|(x, y)| PathElement::new([(x, y), (x + 16, y)], BLACK));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()?;
+    figure::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     root.present()?;
     Ok(())
 }
