@@ -5,7 +5,7 @@ Type stubs of the compiled module (PyO3). Arrays are numpy float64 arrays.
 
 import os
 from pathlib import Path
-from typing import Iterable, Literal, Optional, Sequence, Tuple, Union
+from typing import Iterable, Literal, Optional, Sequence, Tuple, Union, type_check_only
 
 import numpy as np
 import numpy.typing as npt
@@ -149,12 +149,11 @@ class Plan:
         """Writes STEM.json, STEM.csv and STEM.joint_trajectory.json (timed as ``timed`` says)
         as ``emg plan`` does."""
 
-class Motion:
-    """A plan timed rest to rest; arrays have one row per sample."""
+@type_check_only
+class _JointSamples:
+    """The joint samples of a timed motion (no class of the module: what ``Motion`` and
+    ``JobPlan`` share); arrays have one row per sample."""
 
-    @property
-    def t(self) -> FloatArray:
-        """Sample times (s), shape (N,)."""
     @property
     def q(self) -> FloatArray:
         """Joint positions (rad), shape (N, n)."""
@@ -164,6 +163,13 @@ class Motion:
     @property
     def qdd(self) -> FloatArray:
         """Joint accelerations (rad/s²), shape (N, n)."""
+
+class Motion(_JointSamples):
+    """A plan timed rest to rest; arrays have one row per sample."""
+
+    @property
+    def t(self) -> FloatArray:
+        """Sample times (s), shape (N,)."""
     @property
     def duration_s(self) -> float:
         """Time from rest to rest (s)."""
@@ -192,7 +198,7 @@ class Motion:
     def tool_speed(self) -> float:
         """The largest tool speed asked for (m/s)."""
 
-class JobPlan:
+class JobPlan(_JointSamples):
     """A job's program (docs/jobs.md); arrays have one row per sample at 1 kHz."""
 
     @property
@@ -209,15 +215,6 @@ class JobPlan:
     @property
     def time_s(self) -> FloatArray:
         """Time of every sample (s), shape (N,)."""
-    @property
-    def q(self) -> FloatArray:
-        """Joint positions (rad), shape (N, n)."""
-    @property
-    def qd(self) -> FloatArray:
-        """Joint velocities (rad/s), shape (N, n)."""
-    @property
-    def qdd(self) -> FloatArray:
-        """Joint accelerations (rad/s²), shape (N, n)."""
     def write(self, path: PathLike) -> None:
         """Writes the program file ``emg check`` verifies."""
 

@@ -7,8 +7,8 @@ use emg_control::Trajectory;
 use emg_io::PlanPaths;
 use emg_kinematics::{Vec3, WorkSurface};
 use emg_planner::{
-    BoundNote, ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, POLICY_WEIGHTS_FILE, PlanError,
-    PlanFiles, PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
+    BoundNote, ControllerKind, DIFFUSION_WEIGHTS_FILE, Models, MotionTiming, POLICY_WEIGHTS_FILE,
+    PlanError, PlanFiles, PlanRecord, PlanRequest, PlannerConfig, PlannerKind, SeedSource,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use crate::data::data_dir;
 use crate::errors::{InputError, PlanningError, input_error, message};
 use crate::robot::{Robot, array1, joint_array, joint_rows, joint_vector};
-use crate::timing::{Motion, motion_timing};
+use crate::timing::Motion;
 use emg_timing::Scaling;
 
 /// Plans extreme straight-line motions for one robot with its models and configuration.
@@ -136,6 +136,20 @@ impl Planner {
             .transpose()?;
         emg_control::Task::new(robot, Vec3::from(p0), Vec3::from(d), Vec3::from(n), q0_seed)
             .map_err(|e| input_error("task", &e))
+    }
+
+    /// The job `plan_job` and `place_job` plan: `job` read as [`crate::job::read_job`] reads
+    /// it, starting and ending at `home` as [`crate::job::with_home`] sets it.
+    fn homed_job(
+        &self,
+        py: Python<'_>,
+        job: &Bound<'_, PyAny>,
+        placement: Option<&Bound<'_, PyDict>>,
+        tolerances: (f64, Option<f64>),
+        home: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<emg_job::Job> {
+        let job = crate::job::read_job(py, self.inner.robot(), job, placement, tolerances)?;
+        crate::job::with_home(job, self.robot.get(), home)
     }
 
     /// One plan (and its reachability bound when asked), made without the GIL.
@@ -391,10 +405,9 @@ impl Planner {
         home: Option<&Bound<'_, PyAny>>,
         corner_tolerance_mm: Option<f64>,
     ) -> PyResult<crate::job::JobPlan> {
-        let robot = self.robot.get();
         let tolerances = (tolerance_mm, corner_tolerance_mm);
-        let job = crate::job::read_job(py, self.inner.robot(), job, placement, tolerances)?;
-        let job = crate::job::with_home(job, robot, home)?;
+        let job = self.homed_job(py, job, placement, tolerances, home)?;
+        let robot = self.robot.get();
         crate::job::plan(py, &self.inner, robot, &job, tolerance_mm)
     }
 
@@ -424,10 +437,9 @@ impl Planner {
         home: Option<&Bound<'_, PyAny>>,
         corner_tolerance_mm: Option<f64>,
     ) -> PyResult<crate::job::JobPlacement> {
-        let robot = self.robot.get();
         let tolerances = (tolerance_mm, corner_tolerance_mm);
-        let job = crate::job::read_job(py, self.inner.robot(), job, placement, tolerances)?;
-        let job = crate::job::with_home(job, robot, home)?;
+        let job = self.homed_job(py, job, placement, tolerances, home)?;
+        let robot = self.robot.get();
         crate::job::place(
             py,
             &self.inner,
@@ -507,6 +519,35 @@ impl Planner {
             "Planner(robot={:?})",
             self.robot.get().file.display().to_string()
         )
+    }
+}
+
+impl Plan {
+    /// The timing the keyword arguments of `timed` and `save` ask for, for the plan's robot
+    /// read from its robot file: `limits` a MoveIt joint_limits.yaml (default: the one beside
+    /// the robot file, else the robot file's velocities with assumed acceleration and jerk
+    /// limits), `tool_speed` in m/s (default: the rollout's line speed).
+    fn timing(
+        &self,
+        limits: Option<PathBuf>,
+        velocity_scaling: f64,
+        acceleration_scaling: f64,
+        tool_speed: Option<f64>,
+        rate_hz: f64,
+    ) -> PyResult<MotionTiming> {
+        let scaling = Scaling::new(velocity_scaling, acceleration_scaling)
+            .map_err(|e| input_error("scaling", &e))?;
+        let config = self.planner.config();
+        MotionTiming::for_robot_file(
+            self.planner.robot(),
+            Path::new(&self.robot),
+            limits.as_deref(),
+            scaling,
+            tool_speed.unwrap_or(config.rollout.speed_m_per_s),
+            rate_hz,
+            &config.rollout.constraints,
+        )
+        .map_err(|e| input_error("timing", &e))
     }
 }
 
@@ -620,12 +661,10 @@ impl Plan {
         tool_speed: Option<f64>,
         rate_hz: f64,
     ) -> PyResult<Motion> {
-        let timing = motion_timing(
-            &self.planner,
-            Path::new(&self.robot),
+        let timing = self.timing(
             limits,
-            Scaling::new(velocity_scaling, acceleration_scaling)
-                .map_err(|e| input_error("scaling", &e))?,
+            velocity_scaling,
+            acceleration_scaling,
             tool_speed,
             rate_hz,
         )?;
@@ -666,12 +705,10 @@ impl Plan {
                  {violation}"
             )));
         }
-        let timing = motion_timing(
-            &self.planner,
-            Path::new(&self.robot),
+        let timing = self.timing(
             limits,
-            Scaling::new(velocity_scaling, acceleration_scaling)
-                .map_err(|e| input_error("scaling", &e))?,
+            velocity_scaling,
+            acceleration_scaling,
             tool_speed,
             rate_hz,
         )?;

@@ -1,40 +1,12 @@
 //! `Motion`: a plan timed rest to rest within joint limits, as numpy arrays.
 
-use std::path::{Path, PathBuf};
-
 use emg_kinematics::JointVector;
 use emg_planner::MotionTiming;
-use emg_timing::{Scaling, TimedMotion};
+use emg_timing::{TimedMotion, TimedSample};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 
-use crate::errors::input_error;
 use crate::robot::{array1, joint_rows};
-
-/// The timing the keyword arguments of `Plan.timed` and `Plan.save` ask for, for `planner`'s
-/// robot read from `robot_file`: `limits` a MoveIt joint_limits.yaml (default: the one beside
-/// the robot file, else the robot file's velocities with assumed acceleration and jerk limits),
-/// `tool_speed` in m/s (default: the rollout's line speed).
-pub fn motion_timing(
-    planner: &emg_planner::Planner,
-    robot_file: &Path,
-    limits: Option<PathBuf>,
-    scaling: Scaling,
-    tool_speed: Option<f64>,
-    rate_hz: f64,
-) -> PyResult<MotionTiming> {
-    let config = planner.config();
-    MotionTiming::for_robot_file(
-        planner.robot(),
-        robot_file,
-        limits.as_deref(),
-        scaling,
-        tool_speed.unwrap_or(config.rollout.speed_m_per_s),
-        rate_hz,
-        &config.rollout.constraints,
-    )
-    .map_err(|e| input_error("timing", &e))
-}
 
 /// A plan timed rest to rest: a C² path through the planned steps, time-optimal within the
 /// joint velocity and acceleration limits and the tool-speed cap, jerk-limited, sampled at a
@@ -74,6 +46,19 @@ impl Motion {
         }
         (knots, rests)
     }
+
+    /// One joint vector of every sample, picked by `value`, shape (N, n).
+    fn sample_rows<'py>(
+        &self,
+        py: Python<'py>,
+        value: impl Fn(&TimedSample) -> &JointVector,
+    ) -> Bound<'py, PyArray2<f64>> {
+        joint_rows(
+            py,
+            self.timing.joints(),
+            self.motion.samples.iter().map(value),
+        )
+    }
 }
 
 #[pymethods]
@@ -87,31 +72,19 @@ impl Motion {
     /// Joint positions (rad), shape (N, n).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        joint_rows(
-            py,
-            self.timing.joints(),
-            self.motion.samples.iter().map(|s| &s.q),
-        )
+        self.sample_rows(py, |s| &s.q)
     }
 
     /// Joint velocities (rad/s), shape (N, n).
     #[getter]
     fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        joint_rows(
-            py,
-            self.timing.joints(),
-            self.motion.samples.iter().map(|s| &s.qd),
-        )
+        self.sample_rows(py, |s| &s.qd)
     }
 
     /// Joint accelerations (rad/s²), shape (N, n).
     #[getter]
     fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        joint_rows(
-            py,
-            self.timing.joints(),
-            self.motion.samples.iter().map(|s| &s.qdd),
-        )
+        self.sample_rows(py, |s| &s.qdd)
     }
 
     /// Time from rest to rest (s).
