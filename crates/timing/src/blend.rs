@@ -10,9 +10,9 @@ use emg_kinematics::JointVector;
 use crate::blended_path::{BlendedPath, Piece};
 use crate::dynamics::breaches;
 use crate::free::{FREE_GRID_PER_RAD, TimedMove};
-use crate::motion::{MotionDefinition, ProfileGrid};
-use crate::retime::{ACCELERATION_MARGIN, MAX_SLOWDOWNS, TimingRequest, slow_down};
-use crate::topp::{GridPoint, topp_ra};
+use crate::motion::MotionDefinition;
+use crate::retime::{MAX_SLOWDOWNS, TimingRequest, planned_profile, slow_down};
+use crate::topp::GridPoint;
 
 /// Grid intervals along a blend at least.
 const GRID_PER_BLEND: f64 = 40.0;
@@ -113,14 +113,9 @@ pub fn time_blended_move(
             .filter(|(_, j)| **j > 0.0)
             .map(|(a, j)| a / j)
             .fold(0.0, f64::max);
-    let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
     let mut factor = vec![1.0; grid.len()];
     for _ in 0..=MAX_SLOWDOWNS {
-        let profile = ProfileGrid {
-            s: s.clone(),
-            x: topp_ra(&grid, &planned_acceleration, &factor),
-            window_s: window,
-        };
+        let profile = planned_profile(&grid, &s, limits, &factor, window);
         let smoothed = profile.smoothed();
         let samples = path.samples(&smoothed, request.rate_hz);
         let found = breaches(&samples, limits);

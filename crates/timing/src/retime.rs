@@ -530,16 +530,11 @@ fn time_stretch(
             .zip(limits.jerk.iter())
             .map(|(a, j)| a / j)
             .fold(0.0, f64::max);
-    let planned_acceleration = limits.acceleration * ACCELERATION_MARGIN;
     let mut factor = vec![1.0; grid.len()];
     let time_optimal_s = profile_duration(&grid, &topp_ra(&grid, &limits.acceleration, &factor));
     let grid_s: Vec<f64> = grid.iter().map(|g| g.s).collect();
     for slowdowns in 0..=MAX_SLOWDOWNS {
-        let definition = ProfileGrid {
-            s: grid_s.clone(),
-            x: topp_ra(&grid, &planned_acceleration, &factor),
-            window_s: window,
-        };
+        let definition = planned_profile(&grid, &grid_s, limits, &factor, window);
         let profile = definition.smoothed();
         let samples = profile.duration() * request.rate_hz;
         if samples > MAX_SAMPLES {
@@ -595,6 +590,23 @@ fn time_stretch(
         );
     }
     unreachable!("the loop returns by its last round")
+}
+
+/// The speed profile planned over `grid` (its parameters `grid_s`) in a round of local
+/// slow-downs: TOPP-RA within [`ACCELERATION_MARGIN`] of the acceleration limits, each grid
+/// point's bound lowered by its `factor`, averaged over `window_s`.
+pub(crate) fn planned_profile(
+    grid: &[GridPoint],
+    grid_s: &[f64],
+    limits: &DynamicLimits,
+    factor: &[f64],
+    window_s: f64,
+) -> ProfileGrid {
+    ProfileGrid {
+        s: grid_s.to_vec(),
+        x: topp_ra(grid, &(limits.acceleration * ACCELERATION_MARGIN), factor),
+        window_s,
+    }
 }
 
 /// Lowers `factor` by [`SLOWDOWN`] on the stretches of path that the windows of the samples
