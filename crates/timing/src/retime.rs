@@ -187,11 +187,17 @@ pub fn time_motion(
     waypoints: &[JointVector],
     request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
+    let problem = TimingProblem {
+        robot,
+        task,
+        constraints,
+        request,
+    };
     let mut end = waypoints.len();
     let mut cut = None;
     loop {
-        let mut motion = time_rested(robot, task, constraints, &waypoints[..end], request)?;
-        let Some((time_s, distance_m)) = first_sample_off(robot, task, constraints, &motion) else {
+        let mut motion = time_rested(&problem, &waypoints[..end])?;
+        let Some((time_s, distance_m)) = first_sample_off(&problem, &motion) else {
             if motion.report.cut.is_none() {
                 motion.report.cut = cut;
             }
@@ -215,15 +221,26 @@ pub fn time_motion(
     }
 }
 
+/// What every stretch of a [`time_motion`] call is timed for: the arm, its task and the
+/// constraints its waypoints hold, and the request.
+#[derive(Clone, Copy)]
+struct TimingProblem<'a> {
+    robot: &'a Robot,
+    task: &'a Task,
+    constraints: &'a ConstraintConfig,
+    request: &'a TimingRequest,
+}
+
 /// The time (s) of the first sample of `motion` whose TCP, followed along a path task sample by
 /// sample, lies farther than the line tolerance from the path point it reached, and that
 /// distance (m); `None` on a line, or where every sample lies within it.
-fn first_sample_off(
-    robot: &Robot,
-    task: &Task,
-    constraints: &ConstraintConfig,
-    motion: &TimedMotion,
-) -> Option<(f64, f64)> {
+fn first_sample_off(problem: &TimingProblem, motion: &TimedMotion) -> Option<(f64, f64)> {
+    let TimingProblem {
+        robot,
+        task,
+        constraints,
+        ..
+    } = *problem;
     task.path.as_ref()?;
     let mut s = 0.0;
     motion.samples.iter().find_map(|sample| {
@@ -237,25 +254,20 @@ fn first_sample_off(
 /// [`time_motion`] before its samples are measured: the stretches between rests timed, with
 /// the rests a limit forces.
 fn time_rested(
-    robot: &Robot,
-    task: &Task,
-    constraints: &ConstraintConfig,
+    problem: &TimingProblem,
     waypoints: &[JointVector],
-    request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
+    let TimingProblem {
+        robot,
+        task,
+        request,
+        ..
+    } = *problem;
     request.validate()?;
     let progress = waypoint_progress(robot, task, waypoints);
     let mut rests = rest_waypoints(task, &progress);
     for forced in 0..=MAX_FORCED_RESTS {
-        let unmet = match time_through(
-            robot,
-            task,
-            constraints,
-            waypoints,
-            &progress,
-            &rests,
-            request,
-        ) {
+        let unmet = match time_through(problem, waypoints, &progress, &rests) {
             Ok(motion) => return Ok(motion),
             Err(StretchError::Timing(error)) => return Err(error),
             Err(StretchError::Unmet(unmet)) => unmet,
@@ -298,13 +310,10 @@ struct Unmet {
 /// `rests` (increasing inner waypoints): each stretch between rests timed on its own, the
 /// stretches one after another on the sample grid, up to the first one the smooth path cuts.
 fn time_through(
-    robot: &Robot,
-    task: &Task,
-    constraints: &ConstraintConfig,
+    problem: &TimingProblem,
     waypoints: &[JointVector],
     progress: &[f64],
     rests: &[usize],
-    request: &TimingRequest,
 ) -> Result<TimedMotion, StretchError> {
     let bounds: Vec<usize> = std::iter::once(0)
         .chain(rests.iter().copied())
@@ -312,25 +321,18 @@ fn time_through(
         .collect();
     let mut joined: Option<TimedMotion> = None;
     for pair in bounds.windows(2) {
-        let stretch = time_stretch(
-            robot,
-            task,
-            constraints,
-            &waypoints[pair[0]..=pair[1]],
-            progress[pair[0]],
-            request,
-        )
-        .map_err(|error| match error {
-            StretchError::Unmet(unmet) => StretchError::Unmet(Unmet {
-                between: (pair[0], pair[1]),
-                ..unmet
-            }),
-            timing => timing,
-        })?;
+        let stretch = time_stretch(problem, &waypoints[pair[0]..=pair[1]], progress[pair[0]])
+            .map_err(|error| match error {
+                StretchError::Unmet(unmet) => StretchError::Unmet(Unmet {
+                    between: (pair[0], pair[1]),
+                    ..unmet
+                }),
+                timing => timing,
+            })?;
         let cut = stretch.report.cut.is_some();
         joined = Some(match joined {
             None => stretch,
-            Some(before) => before.followed_by(stretch, pair[0], request.rate_hz),
+            Some(before) => before.followed_by(stretch, pair[0], problem.request.rate_hz),
         });
         if cut {
             break;
@@ -462,13 +464,16 @@ impl TimedMotion {
 /// requested rate, and, while a sample breaks a limit, the speed and acceleration bounds around
 /// it lowered by [`SLOWDOWN`].
 fn time_stretch(
-    robot: &Robot,
-    task: &Task,
-    constraints: &ConstraintConfig,
+    problem: &TimingProblem,
     waypoints: &[JointVector],
     from_s: f64,
-    request: &TimingRequest,
 ) -> Result<TimedMotion, StretchError> {
+    let TimingProblem {
+        robot,
+        task,
+        constraints,
+        request,
+    } = *problem;
     let path = SmoothPath::fit(robot, task, constraints, waypoints, from_s);
     let cut = path
         .cut
