@@ -5,10 +5,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use emg_control::ClassicalGains;
+use emg_control::{ClassicalGains, Task, Trajectory};
 use emg_eval::{CellStats, Setup, Summary, cell_stats, four};
 use emg_hybrid::{BoundaryMeasure, SwitchConfig, count_switches};
 use emg_io::read_tasks;
+use emg_kinematics::JointVector;
 use emg_planner::{ControllerKind, ExecutorConfig, SeedSource};
 use emg_seeding::LabelSet;
 use serde::{Deserialize, Serialize};
@@ -163,80 +164,157 @@ pub type WeightsAblation = ControlAblation<GainGrid, ClassicalGains>;
 /// `docs/results/ablate-switching.json` (Table 6).
 pub type SwitchingAblation = ControlAblation<SwitchGrid, SwitchSetting>;
 
-/// Loads the setup, the tasks and their reference lengths.
-fn prepare(args: &ControlArgs) -> anyhow::Result<(Setup, Vec<emg_control::Task>, Vec<f64>)> {
-    let setup = protocol::load_setup(&args.robot, &args.policy, &args.diffusion)?;
-    let mut tasks = read_tasks(&args.tasks, &setup.robot)?;
-    if let Some(limit) = args.limit {
-        tasks.truncate(limit);
+/// The tasks of a controller ablation, each with its seed and its reference length.
+struct Sweep {
+    setup: Setup,
+    tasks: Vec<Task>,
+    seeds: Vec<JointVector>,
+    /// The protocol's reference length ℓ_ref of each task.
+    references: Vec<f64>,
+}
+
+impl Sweep {
+    /// Loads the setup, the tasks, their seeds from `source` and their reference lengths.
+    fn prepare(args: &ControlArgs, source: &SeedSource) -> anyhow::Result<Self> {
+        let setup = protocol::load_setup(&args.robot, &args.policy, &args.diffusion)?;
+        let mut tasks = read_tasks(&args.tasks, &setup.robot)?;
+        if let Some(limit) = args.limit {
+            tasks.truncate(limit);
+        }
+        let labels = LabelSet::read(&args.labels)
+            .with_context(|| format!("reading {}", args.labels.display()))?;
+        let indices: Vec<usize> = (0..tasks.len()).collect();
+        let references = setup.references(&tasks, &indices, &labels)?;
+        let (seeds, _) = setup.seeds(&tasks, source)?;
+        Ok(Self {
+            setup,
+            tasks,
+            seeds,
+            references,
+        })
     }
-    let labels = LabelSet::read(&args.labels)
-        .with_context(|| format!("reading {}", args.labels.display()))?;
-    let indices: Vec<usize> = (0..tasks.len()).collect();
-    let references = setup.references(&tasks, &indices, &labels)?;
-    Ok((setup, tasks, references))
+
+    /// Every task rolled out by `controller` under `executor` (`what` names the setting while
+    /// it runs), with the statistics of the path lengths and of their ratios to ℓ_ref.
+    fn roll_out(
+        &self,
+        controller: ControllerKind,
+        executor: &ExecutorConfig,
+        what: &str,
+    ) -> anyhow::Result<(Vec<Trajectory>, CellStats)> {
+        let trajectories =
+            self.setup
+                .rollouts(&self.tasks, &self.seeds, controller, executor, what)?;
+        let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
+        let all: Vec<usize> = (0..self.tasks.len()).collect();
+        let stats = cell_stats(&lengths, &self.references, &all).context("no tasks")?;
+        Ok((trajectories, stats))
+    }
+}
+
+/// Runs the controller ablation `name` on the worker threads of `args`: `table` sweeps the tasks
+/// with seeds from `source` into the record and its page, written as `ablate-<name>.{json,md}`
+/// with the wall time of the whole run.
+fn ablate<R: Serialize>(
+    args: &ControlArgs,
+    name: &str,
+    source: SeedSource,
+    table: impl FnOnce(&Sweep) -> anyhow::Result<(R, String)> + Send,
+) -> anyhow::Result<()> {
+    let pool = workspace::thread_pool(args.threads)?;
+    pool.install(|| {
+        let started = Instant::now();
+        let sweep = Sweep::prepare(args, &source)?;
+        let (record, mut md) = table(&sweep)?;
+        md += &format!(
+            "\nRun: {:.1} s wall on {} threads ({}); every trajectory passed the independent checker.\n",
+            started.elapsed().as_secs_f64(),
+            rayon::current_num_threads(),
+            workspace::machine()
+        );
+        workspace::write_results(&args.out_dir, &format!("ablate-{name}"), &record, &md)
+    })
 }
 
 /// Table 3: the classical controller from q0_seed under every gain setting.
 pub fn classical_weights(args: &ControlArgs) -> anyhow::Result<()> {
-    let pool = workspace::thread_pool(args.threads)?;
-    pool.install(|| {
-        let started = Instant::now();
-        let (setup, tasks, references) = prepare(args)?;
-        let (seeds, _) = setup.seeds(&tasks, &SeedSource::Generating)?;
+    ablate(args, "classical-weights", SeedSource::Generating, |sweep| {
         let grid = GainGrid::default();
-        let all: Vec<usize> = (0..tasks.len()).collect();
         let mut rows = Vec::new();
         for gains in grid.settings() {
-            let executor = ExecutorConfig { gains: gains.clone(), ..setup.executor.clone() };
+            let executor = ExecutorConfig {
+                gains: gains.clone(),
+                ..sweep.setup.executor.clone()
+            };
             let what = format!("{}/{}/{}", gains.k_mu, gains.k_jl, gains.k_theta);
-            let trajectories = setup.rollouts(&tasks, &seeds, ControllerKind::Classical, &executor, &what)?;
-            let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
+            let (_, stats) = sweep.roll_out(ControllerKind::Classical, &executor, &what)?;
             rows.push(Row {
                 setting: gains,
-                stats: cell_stats(&lengths, &references, &all).context("no tasks")?,
+                stats,
                 switches_per_episode: None,
             });
         }
-        let mut md = String::from(
-            "# Ablation: classical secondary-objective weights (Table 3)\n\nWritten by `cargo xtask ablate classical-weights`. \
-             Do not edit by hand. Classical controller from q0_seed; ratio to the protocol's reference length ℓ_ref. \
-             The first three rows use one objective alone.\n\n\
-             | k_μ | k_jl | k_θ | path length (m) mean / std / min / max | ratio to ℓ_ref (%) mean / std / min / max |\n|---|---|---|---|---|\n",
-        );
-        let best = rows
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.stats.ratio_percent.mean.total_cmp(&b.1.stats.ratio_percent.mean))
-            .map(|(i, _)| i);
-        for (i, row) in rows.iter().enumerate() {
-            let gain = |v: f64| if v == 0.0 { "—".to_string() } else { format!("{v}") };
-            let mark = if Some(i) == best { " **(best)**" } else { "" };
-            md += &format!(
-                "| {} | {} | {} | {} | {}{mark} |\n",
-                gain(row.setting.k_mu),
-                gain(row.setting.k_jl),
-                gain(row.setting.k_theta),
-                four(&row.stats.length_m, 3),
-                four(&row.stats.ratio_percent, 1)
-            );
-        }
-        let record = WeightsAblation { grid, task_count: tasks.len(), rows };
-        finish(args, "classical-weights", &record, md, started)
+        let md = weights_markdown(&rows);
+        Ok((
+            WeightsAblation {
+                grid,
+                task_count: sweep.tasks.len(),
+                rows,
+            },
+            md,
+        ))
     })
+}
+
+/// The page of Table 3: one row per gain setting, the best ratio marked.
+fn weights_markdown(rows: &[Row<ClassicalGains>]) -> String {
+    let mut md = String::from(
+        "# Ablation: classical secondary-objective weights (Table 3)\n\nWritten by `cargo xtask ablate classical-weights`. \
+         Do not edit by hand. Classical controller from q0_seed; ratio to the protocol's reference length ℓ_ref. \
+         The first three rows use one objective alone.\n\n\
+         | k_μ | k_jl | k_θ | path length (m) mean / std / min / max | ratio to ℓ_ref (%) mean / std / min / max |\n|---|---|---|---|---|\n",
+    );
+    let best = rows
+        .iter()
+        .enumerate()
+        .max_by(|a, b| {
+            a.1.stats
+                .ratio_percent
+                .mean
+                .total_cmp(&b.1.stats.ratio_percent.mean)
+        })
+        .map(|(i, _)| i);
+    for (i, row) in rows.iter().enumerate() {
+        let gain = |v: f64| {
+            if v == 0.0 {
+                "—".to_string()
+            } else {
+                format!("{v}")
+            }
+        };
+        let mark = if Some(i) == best { " **(best)**" } else { "" };
+        md += &format!(
+            "| {} | {} | {} | {} | {}{mark} |\n",
+            gain(row.setting.k_mu),
+            gain(row.setting.k_jl),
+            gain(row.setting.k_theta),
+            four(&row.stats.length_m, 3),
+            four(&row.stats.ratio_percent, 1)
+        );
+    }
+    md
 }
 
 /// Table 6: the hybrid controller from DP seeds under every switch setting and boundary measure.
 pub fn switching(args: &ControlArgs) -> anyhow::Result<()> {
-    let pool = workspace::thread_pool(args.threads)?;
-    pool.install(|| {
-        let started = Instant::now();
-        let (setup, tasks, references) = prepare(args)?;
-        let (seeds, _) = setup.seeds(&tasks, &SeedSource::Dp)?;
+    ablate(args, "switching", SeedSource::Dp, |sweep| {
         let grid = SwitchGrid::default();
-        let all: Vec<usize> = (0..tasks.len()).collect();
-        let thresholds: Vec<(f64, f64)> =
-            grid.single.iter().map(|&t| (t, t)).chain(grid.hysteresis.iter().copied()).collect();
+        let thresholds: Vec<(f64, f64)> = grid
+            .single
+            .iter()
+            .map(|&t| (t, t))
+            .chain(grid.hysteresis.iter().copied())
+            .collect();
         let mut rows = Vec::new();
         let mut md = String::from(
             "# Ablation: switching thresholds and boundary measure (Table 6)\n\nWritten by `cargo xtask ablate switching`. \
@@ -248,15 +326,20 @@ pub fn switching(args: &ControlArgs) -> anyhow::Result<()> {
         for measure in &grid.measures {
             for &(tau_enter, tau_exit) in &thresholds {
                 let executor = ExecutorConfig {
-                    switch: SwitchConfig { tau_enter, tau_exit },
+                    switch: SwitchConfig {
+                        tau_enter,
+                        tau_exit,
+                    },
                     measure: measure.clone(),
-                    ..setup.executor.clone()
+                    ..sweep.setup.executor.clone()
                 };
                 let what = format!("{} {tau_enter}/{tau_exit}", measure.name());
-                let trajectories = setup.rollouts(&tasks, &seeds, ControllerKind::Hybrid, &executor, &what)?;
-                let lengths: Vec<f64> = trajectories.iter().map(|t| t.path_length_m).collect();
-                let switches: Vec<f64> = trajectories.iter().map(|t| count_switches(t) as f64).collect();
-                let stats = cell_stats(&lengths, &references, &all).context("no tasks")?;
+                let (trajectories, stats) =
+                    sweep.roll_out(ControllerKind::Hybrid, &executor, &what)?;
+                let switches: Vec<f64> = trajectories
+                    .iter()
+                    .map(|t| count_switches(t) as f64)
+                    .collect();
                 let switches_per_episode = Summary::of(&switches).map(|s| s.mean);
                 md += &format!(
                     "| {} | ({tau_enter:.2}, {tau_exit:.2}) | {:.2} | {} | {} |\n",
@@ -266,35 +349,23 @@ pub fn switching(args: &ControlArgs) -> anyhow::Result<()> {
                     four(&stats.ratio_percent, 1)
                 );
                 rows.push(Row {
-                    setting: SwitchSetting { measure: measure.clone(), tau_enter, tau_exit },
+                    setting: SwitchSetting {
+                        measure: measure.clone(),
+                        tau_enter,
+                        tau_exit,
+                    },
                     stats,
                     switches_per_episode,
                 });
             }
         }
-        let record = SwitchingAblation { grid, task_count: tasks.len(), rows };
-        finish(args, "switching", &record, md, started)
+        Ok((
+            SwitchingAblation {
+                grid,
+                task_count: sweep.tasks.len(),
+                rows,
+            },
+            md,
+        ))
     })
-}
-
-fn finish(
-    args: &ControlArgs,
-    name: &str,
-    record: &impl Serialize,
-    mut md: String,
-    started: Instant,
-) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&args.out_dir)?;
-    let json_path = args.out_dir.join(format!("ablate-{name}.json"));
-    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(record)? + "\n")?;
-    md += &format!(
-        "\nRun: {:.1} s wall on {} threads ({}); every trajectory passed the independent checker.\n",
-        started.elapsed().as_secs_f64(),
-        rayon::current_num_threads(),
-        workspace::machine()
-    );
-    let md_path = args.out_dir.join(format!("ablate-{name}.md"));
-    emg_io::write_atomically(&md_path, md)?;
-    println!("wrote {} and {}", json_path.display(), md_path.display());
-    Ok(())
 }

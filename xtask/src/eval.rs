@@ -281,8 +281,6 @@ fn write_protocol(
         .map(|raw| summarize(raw, &buckets))
         .collect::<Result<Vec<_>, _>>()?;
     let seconds = started.elapsed().as_secs_f64();
-    std::fs::create_dir_all(&args.out_dir)?;
-    let json_path = args.out_dir.join(format!("{name}.json"));
     let mut rollout = RolloutConfig::default();
     args.velocity_limits.apply(&mut rollout.constraints);
     args.surface.apply(&mut rollout.constraints);
@@ -295,7 +293,6 @@ fn write_protocol(
         sets,
         surface_clearance_m: args.surface_clearance,
     };
-    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
     let mut md = format!(
         "# Evaluation protocol: seeds × controllers\n\nWritten by `cargo xtask eval`. Do not edit by hand. \
          Every trajectory behind these tables passed the independent checker. Unseen = the evaluation set \
@@ -318,10 +315,7 @@ fn write_protocol(
             workspace::machine()
         ),
     };
-    let md_path = args.out_dir.join(format!("{name}.md"));
-    emg_io::write_atomically(&md_path, md)?;
-    println!("wrote {} and {}", json_path.display(), md_path.display());
-    Ok(())
+    workspace::write_results(&args.out_dir, name, &record, &md)
 }
 
 /// What the run says about the work surface: a constraint or not, and which tasks it kept.
@@ -499,19 +493,12 @@ fn run_controller(
         independently_checked: checked,
     };
     let name = args.name.clone().unwrap_or_else(|| kind.name().into());
-    std::fs::create_dir_all(&args.out_dir)?;
-    let json_path = args.out_dir.join(format!("{name}.json"));
-    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&result)? + "\n")?;
-    let md_path = args.out_dir.join(format!("{name}.md"));
-    emg_io::write_atomically(
-        &md_path,
-        markdown(
-            &result,
-            rollout_seconds,
-            check_seconds,
-            pool.current_num_threads(),
-        ),
-    )?;
+    let md = markdown(
+        &result,
+        rollout_seconds,
+        check_seconds,
+        pool.current_num_threads(),
+    );
     println!(
         "path length mean {:.3} m (std {:.3}, min {:.3}, max {:.3}) over {} tasks; rollouts {:.2} s wall",
         result.path_length_m.mean,
@@ -521,8 +508,7 @@ fn run_controller(
         result.task_count,
         rollout_seconds
     );
-    println!("wrote {} and {}", json_path.display(), md_path.display());
-    Ok(())
+    workspace::write_results(&args.out_dir, &name, &result, &md)
 }
 
 fn markdown(

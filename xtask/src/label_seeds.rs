@@ -262,6 +262,20 @@ struct Report {
     seeds: Vec<SeedRow>,
 }
 
+/// What one seed of one task reaches.
+struct SeedOutcome {
+    /// The classical controller's path length from the seed (from `q0_seed` where the
+    /// heuristic found none).
+    length_m: f64,
+    /// The time the heuristic took to find the seed (ms; none for `q0_seed` and where it
+    /// found none).
+    generation_ms: Option<f64>,
+    /// Whether there was a seed.
+    found: bool,
+}
+
+/// Writes `labels.{json,md}`: the labelling throughput, the label manifests and the seeds
+/// (`q0_seed`, `q_mu`, `q_jl`) against the labels of the evaluation set.
 fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()> {
     let read_manifest = |name: &str| -> anyhow::Result<Manifest> {
         let path = args.out_dir.join(format!("{name}.manifest.json"));
@@ -279,30 +293,63 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
             args.out_dir.join("eval-v1.labels").display()
         );
     }
-
     let sample = &tasks[..args.throughput_tasks.min(tasks.len())];
+    let throughput_seconds = labelling_seconds(robot, sample, config);
+    let reference = reference_lengths(robot, &tasks, &labels, config);
+    let outcomes = seed_outcomes(robot, &tasks, config);
+    let report = Report {
+        labels_dir: workspace::relative(&args.out_dir),
+        threads: rayon::current_num_threads(),
+        throughput_tasks: sample.len(),
+        throughput_seconds,
+        throughput_tasks_per_s: sample.len() as f64 / throughput_seconds,
+        eval,
+        train,
+        heuristic: HeuristicConfig::default(),
+        reference: "longest label of the task (classical rollout); q0_seed's length where the task has no label",
+        seeds: seed_rows(&outcomes, &reference)?,
+    };
+    workspace::write_results(&args.results_dir, "labels", &report, &markdown(&report))
+}
+
+/// The wall time (s) of labelling `sample` on the worker threads.
+fn labelling_seconds(robot: &Robot, sample: &[Task], config: &LabelConfig) -> f64 {
     let bar = progress::bar(sample.len() as u64, "throughput");
     let started = Instant::now();
     sample.par_iter().enumerate().for_each(|(i, task)| {
         label_task(robot, task, i as u32, config);
         bar.inc(1);
     });
-    let throughput_seconds = started.elapsed().as_secs_f64();
+    let seconds = started.elapsed().as_secs_f64();
     bar.finish();
+    seconds
+}
 
-    let reference: Vec<f64> = labels
+/// The reference length of each task: its longest label, `q0_seed`'s classical length where it
+/// has none.
+fn reference_lengths(
+    robot: &Robot,
+    tasks: &[Task],
+    labels: &LabelSet,
+    config: &LabelConfig,
+) -> Vec<f64> {
+    labels
         .tasks()
         .iter()
-        .zip(&tasks)
+        .zip(tasks)
         .map(|(t, task)| {
             t.labels.first().map_or_else(
                 || classical_length(robot, task, config, &seed_of(task)),
                 |l| l.length_m,
             )
         })
-        .collect();
+        .collect()
+}
+
+/// The outcomes of `q0_seed`, `q_mu` and `q_jl`, in that order, for every task in turn.
+fn seed_outcomes(robot: &Robot, tasks: &[Task], config: &LabelConfig) -> Vec<SeedOutcome> {
     let bar = progress::bar(tasks.len() as u64 * 3, "seeds");
-    let rows: Vec<(f64, Option<f64>, Option<f64>, bool)> = tasks
+    let outcomes = tasks
         .par_iter()
         .flat_map_iter(|task| {
             let seed = classical_length(robot, task, config, &seed_of(task));
@@ -318,35 +365,45 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
                     &HeuristicConfig::default(),
                     &config.projection,
                 ) {
-                    Ok(h) => (
-                        classical_length(robot, task, config, &h.q),
-                        Some(h.generation_time.as_secs_f64() * 1e3),
-                        true,
-                    ),
-                    Err(_) => (seed, None, false),
+                    Ok(h) => SeedOutcome {
+                        length_m: classical_length(robot, task, config, &h.q),
+                        generation_ms: Some(h.generation_time.as_secs_f64() * 1e3),
+                        found: true,
+                    },
+                    Err(_) => SeedOutcome {
+                        length_m: seed,
+                        generation_ms: None,
+                        found: false,
+                    },
                 }
             });
             bar.inc(3);
-            std::iter::once((seed, None, None, true)).chain(
-                heuristics
-                    .into_iter()
-                    .map(|(length, ms, ok)| (length, ms, ms, ok)),
-            )
+            let given = SeedOutcome {
+                length_m: seed,
+                generation_ms: None,
+                found: true,
+            };
+            std::iter::once(given).chain(heuristics)
         })
         .collect();
     bar.finish();
+    outcomes
+}
+
+/// One row per seed of [`seed_outcomes`]: its generation times, path lengths, ratios to
+/// `reference` and the tasks it found no seed for.
+fn seed_rows(outcomes: &[SeedOutcome], reference: &[f64]) -> anyhow::Result<Vec<SeedRow>> {
     let names = ["q0_seed", "q_mu", "q_jl"];
-    let seeds = names
+    names
         .iter()
         .enumerate()
         .map(|(k, &name)| -> anyhow::Result<SeedRow> {
-            let column: Vec<&(f64, Option<f64>, Option<f64>, bool)> =
-                rows.iter().skip(k).step_by(3).collect();
-            let lengths: Vec<f64> = column.iter().map(|r| r.0).collect();
-            let mut times: Vec<f64> = column.iter().filter_map(|r| r.1).collect();
+            let column: Vec<&SeedOutcome> = outcomes.iter().skip(k).step_by(3).collect();
+            let lengths: Vec<f64> = column.iter().map(|r| r.length_m).collect();
+            let mut times: Vec<f64> = column.iter().filter_map(|r| r.generation_ms).collect();
             let ratio: Vec<f64> = lengths
                 .iter()
-                .zip(&reference)
+                .zip(reference)
                 .map(|(l, r)| 100.0 * l / r.max(1e-9))
                 .collect();
             times.sort_by(f64::total_cmp);
@@ -360,29 +417,10 @@ fn report(args: &Args, robot: &Robot, config: &LabelConfig) -> anyhow::Result<()
                 generation_ms_p95: quantile(0.95),
                 path_length_m: Summary::of(&lengths).context("no tasks")?,
                 ratio_to_reference_percent: Summary::of(&ratio).context("no tasks")?,
-                failed_tasks: column.iter().filter(|r| !r.3).count(),
+                failed_tasks: column.iter().filter(|r| !r.found).count(),
             })
         })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let report = Report {
-        labels_dir: workspace::relative(&args.out_dir),
-        threads: rayon::current_num_threads(),
-        throughput_tasks: sample.len(),
-        throughput_seconds,
-        throughput_tasks_per_s: sample.len() as f64 / throughput_seconds,
-        eval,
-        train,
-        heuristic: HeuristicConfig::default(),
-        reference: "longest label of the task (classical rollout); q0_seed's length where the task has no label",
-        seeds,
-    };
-    std::fs::create_dir_all(&args.results_dir)?;
-    let json = args.results_dir.join("labels.json");
-    emg_io::write_atomically(&json, serde_json::to_string_pretty(&report)? + "\n")?;
-    let md = args.results_dir.join("labels.md");
-    emg_io::write_atomically(&md, markdown(&report))?;
-    println!("wrote {} and {}", json.display(), md.display());
-    Ok(())
+        .collect()
 }
 
 fn seed_of(task: &Task) -> emg_kinematics::JointVector {

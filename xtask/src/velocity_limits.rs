@@ -171,8 +171,6 @@ pub fn run(
     }
     VelocityLimits::On.apply(&mut setup.rollout.constraints);
 
-    std::fs::create_dir_all(out_dir)?;
-    let json_path = out_dir.join("velocity-limits.json");
     let record = serde_json::json!({
         "robot": setup.robot.name(),
         "tasks": workspace::relative(tasks_path),
@@ -181,14 +179,8 @@ pub fn run(
         "velocity_limits_rad_per_s": limits,
         "controllers": comparisons,
     });
-    emg_io::write_atomically(&json_path, serde_json::to_string_pretty(&record)? + "\n")?;
-    let md_path = out_dir.join("velocity-limits.md");
-    emg_io::write_atomically(
-        &md_path,
-        markdown(setup, &comparisons, tasks.len(), tasks_path),
-    )?;
-    println!("wrote {} and {}", json_path.display(), md_path.display());
-    Ok(())
+    let md = markdown(setup, &comparisons, tasks.len(), tasks_path);
+    workspace::write_results(out_dir, "velocity-limits", &record, &md)
 }
 
 fn markdown(setup: &Setup, rows: &[Comparison], count: usize, tasks_path: &Path) -> String {
