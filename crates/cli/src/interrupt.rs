@@ -82,6 +82,22 @@ impl<'a> Watched<'a> {
         self.bar.finish_and_clear();
     }
 
+    /// What the job watched came to: its value, the bar cleared; its error; or, where it stopped
+    /// on request (an error `is_stop` tells), the error of [`Watched::stopped`].
+    pub fn outcome<T, E>(&self, result: Result<T, E>, is_stop: impl Fn(&E) -> bool) -> Result<T>
+    where
+        E: std::error::Error + Send + Sync + 'static,
+    {
+        match result {
+            Err(e) if is_stop(&e) => Err(self.stopped()),
+            result => {
+                let value = result?;
+                self.finish();
+                Ok(value)
+            }
+        }
+    }
+
     /// The error a job stopped on request ends with: the signal received, and that nothing was
     /// written.
     pub fn stopped(&self) -> anyhow::Error {

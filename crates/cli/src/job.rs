@@ -9,9 +9,9 @@ use emg_job::JobPlanError;
 
 use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
-use crate::job_input::{JobInput, Ready, print_size};
+use crate::job_input::{JobInput, Ready};
 use crate::output::{progress_bar, write_text};
-use crate::program::write_program;
+use crate::program::{ProgramOutput, write_program};
 
 /// Options of `emg job`.
 #[derive(Debug, Args)]
@@ -40,30 +40,16 @@ pub struct JobArgs {
 /// planning, and then nothing is written.
 pub fn run(args: &JobArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
-    let exported = args
-        .export
-        .map(|format| exporting::beside_program(&args.out, format));
-    let mut outputs = vec![("--out", args.out.as_path())];
-    outputs.extend(exported.as_deref().map(|path| ("--export", path)));
-    outputs.extend(args.html.as_deref().map(|path| ("--html", path)));
-    emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    exporting::refuse_program_export(args.export, &args.urscript, &input.robot)?;
-    let Ready { job, planner } = input.ready()?;
-    print_size(&job);
-    let watch = Watched::new(progress_bar(job.strokes.len() as u64, "strokes"), interrupt);
-    let file = match planner.plan(&job, &watch) {
-        Err(JobPlanError::Stopped(_)) => return Err(watch.stopped()),
-        planned => planned?,
-    };
-    watch.finish();
-    write_program(
-        &file,
-        &args.out,
-        args.export,
-        &args.urscript,
-        &input.robot,
-        planner.robot(),
+    let program = ProgramOutput::new(&args.out, args.export, &args.urscript);
+    program.refuse(
+        input,
+        &[program.exported(), ("--html", args.html.as_deref())],
     )?;
+    let Ready { job, planner } = input.ready()?;
+    let watch = Watched::new(progress_bar(job.strokes.len() as u64, "strokes"), interrupt);
+    let planned = planner.plan(&job, &watch);
+    let file = watch.outcome(planned, |e| matches!(e, JobPlanError::Stopped(_)))?;
+    write_program(&file, &program, &input.robot, planner.robot())?;
     if let Some(path) = &args.html {
         write_text(
             path,

@@ -99,7 +99,7 @@ impl JobInput {
         files
     }
 
-    /// The job read and its planner set up.
+    /// The job read (its size printed, [`print_size`]) and its planner set up.
     pub fn ready(&self) -> Result<Ready> {
         let robot = robot::load_robot(&self.robot, None, None)?;
         let drawing = self.drawing_tolerance()?;
@@ -125,6 +125,7 @@ impl JobInput {
         let planner = Planner::new(robot, models, config)?;
         let recorded_as = robot::reference(&self.robot)?.to_string();
         let planner = JobPlanner::new(planner, &self.robot, recorded_as)?;
+        print_size(&job);
         Ok(Ready { job, planner })
     }
 
@@ -156,7 +157,7 @@ impl JobInput {
 }
 
 /// Prints a job's size before it is planned: its strokes and their length.
-pub fn print_size(job: &Job) {
+fn print_size(job: &Job) {
     println!(
         "{}, {:.3} m to draw",
         count(job.strokes.len(), "stroke"),

@@ -13,9 +13,9 @@ use emg_job::{
 
 use crate::exporting;
 use crate::interrupt::{Interrupt, Watched};
-use crate::job_input::{JobInput, Ready, print_size};
+use crate::job_input::{JobInput, Ready};
 use crate::output::{progress_bar, write_text};
-use crate::program::write_program;
+use crate::program::{ProgramOutput, write_program};
 
 /// Options of `emg place`.
 #[derive(Debug, Args)]
@@ -106,15 +106,15 @@ fn parse_range(value: &str) -> Result<[f64; 2], String> {
 /// the search, and then nothing is written.
 pub fn run(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     let input = &args.input;
-    let exported = args
-        .export
-        .map(|format| exporting::beside_program(&args.out, format));
-    let mut outputs = vec![("--out", args.out.as_path())];
-    outputs.extend(args.map.as_deref().map(|path| ("--map", path)));
-    outputs.extend(args.job_out.as_deref().map(|path| ("--job-out", path)));
-    outputs.extend(exported.as_deref().map(|path| ("--export", path)));
-    emg_io::refuse_overwriting(&input.files(), &outputs)?;
-    exporting::refuse_program_export(args.export, &args.urscript, &input.robot)?;
+    let program = ProgramOutput::new(&args.out, args.export, &args.urscript);
+    program.refuse(
+        input,
+        &[
+            ("--map", args.map.as_deref()),
+            ("--job-out", args.job_out.as_deref()),
+            program.exported(),
+        ],
+    )?;
     let region = Region {
         moving: args.moving,
         x_m: args.x,
@@ -132,27 +132,16 @@ pub fn run(args: &PlaceArgs, interrupt: &Interrupt) -> Result<()> {
     region.validate()?;
     settings.validate()?;
     let Ready { job, planner } = input.ready()?;
-    print_size(&job);
     let watch = Watched::new(progress_bar(0, "places"), interrupt);
-    let placement = match planner.place(&job, &region, &settings, args.score, &watch) {
-        Err(PlaceError::Stopped(_)) => return Err(watch.stopped()),
-        placed => placed?,
-    };
-    watch.finish();
+    let placed = planner.place(&job, &region, &settings, args.score, &watch);
+    let placement = watch.outcome(placed, |e| matches!(e, PlaceError::Stopped(_)))?;
     print_places(&placement);
     let best = placement.best();
-    let program = best
+    let chosen_program = best
         .program
         .as_deref()
         .expect("the chosen place was planned");
-    write_program(
-        program,
-        &args.out,
-        args.export,
-        &args.urscript,
-        &input.robot,
-        planner.robot(),
-    )?;
+    write_program(chosen_program, &program, &input.robot, planner.robot())?;
     if let Some(path) = &args.map {
         write_text(path, &placement_map(&placement, args.score))?;
         println!("wrote {}", path.display());

@@ -1,31 +1,82 @@
 //! A job's program (an `emg-job/3` file): read back from a file, and its summary printed and
 //! the program written and exported as `emg job` and `emg place` write it.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use emg_io::ExportFormat;
 use emg_kinematics::Robot;
 
 use crate::exporting::{self, UrScriptArgs};
+use crate::job_input::JobInput;
 use crate::output::{count, write_text};
 
-/// Prints `file`'s summary, writes it to `out` and, where `export` asks, writes it for the
-/// robot's own stack beside `out` (`urscript`'s options; the arm `robot` read from
+/// Where `emg job` and `emg place` write a job's program: to `out` and, where `export` asks,
+/// for the robot's own stack beside it (`urscript`'s options).
+pub struct ProgramOutput<'a> {
+    /// The program file (`--out`).
+    out: &'a Path,
+    /// The export's format and file (beside `out`), where asked.
+    export: Option<(ExportFormat, PathBuf)>,
+    /// How a URScript export is written.
+    urscript: &'a UrScriptArgs,
+}
+
+impl<'a> ProgramOutput<'a> {
+    /// The program written to `out`, exported as `export` asks.
+    pub fn new(out: &'a Path, export: Option<ExportFormat>, urscript: &'a UrScriptArgs) -> Self {
+        let export = export.map(|format| (format, exporting::beside_program(out, format)));
+        Self {
+            out,
+            export,
+            urscript,
+        }
+    }
+
+    /// The export's file as an overwrite refusal names it, where one is asked for.
+    pub fn exported(&self) -> (&'static str, Option<&Path>) {
+        (
+            "--export",
+            self.export.as_ref().map(|(_, path)| path.as_path()),
+        )
+    }
+
+    /// Refuses, before anything is planned, a run that would write `--out` or one of `outputs`
+    /// (option and file where asked, in that order) over one of `input`'s files or over one
+    /// another, or export the program for a robot it cannot run on.
+    pub fn refuse(&self, input: &JobInput, outputs: &[(&str, Option<&Path>)]) -> Result<()> {
+        let mut written = vec![("--out", self.out)];
+        written.extend(
+            outputs
+                .iter()
+                .filter_map(|&(option, path)| path.map(|path| (option, path))),
+        );
+        emg_io::refuse_overwriting(&input.files(), &written)?;
+        let format = self.export.as_ref().map(|&(format, _)| format);
+        exporting::refuse_program_export(format, self.urscript, &input.robot)
+    }
+}
+
+/// Prints `file`'s summary, writes it where `output` says (the arm `robot` read from
 /// `robot_file`).
 pub fn write_program(
     file: &emg_job::JobFile,
-    out: &Path,
-    export: Option<ExportFormat>,
-    urscript: &UrScriptArgs,
+    output: &ProgramOutput<'_>,
     robot_file: &Path,
     robot: &Robot,
 ) -> Result<()> {
     print_summary(file);
-    write_text(out, &(serde_json::to_string(file)? + "\n"))?;
-    println!("wrote {}", out.display());
-    if let Some(format) = export {
-        let text = exporting::export_program(file, format, urscript, out, robot_file, robot)?;
+    write_text(output.out, &(serde_json::to_string(file)? + "\n"))?;
+    println!("wrote {}", output.out.display());
+    if let Some((format, _)) = output.export {
+        let text = exporting::export_program(
+            file,
+            format,
+            output.urscript,
+            output.out,
+            robot_file,
+            robot,
+        )?;
         println!("{text}");
     }
     Ok(())
