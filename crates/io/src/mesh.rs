@@ -44,6 +44,25 @@ pub enum MeshError {
     },
 }
 
+/// The triangles of `faces`, each its three corners (`None` for a vertex the file does not
+/// hold, which makes the `kind` file at `path` malformed).
+fn triangles_of(
+    faces: impl Iterator<Item = [Option<Vec3>; 3]>,
+    path: &str,
+    kind: &'static str,
+) -> Result<Vec<[Vec3; 3]>, MeshError> {
+    faces
+        .map(|corners| match corners {
+            [Some(a), Some(b), Some(c)] => Ok([a, b, c]),
+            _ => Err(MeshError::Malformed {
+                path: path.to_string(),
+                kind,
+                message: "a face names a vertex the file does not hold".into(),
+            }),
+        })
+        .collect()
+}
+
 /// The triangles of the mesh file at `path` (in the file's units).
 pub fn read_mesh(path: &Path) -> Result<Vec<[Vec3; 3]>, MeshError> {
     let name = path.display().to_string();
@@ -83,28 +102,19 @@ pub fn read_mesh(path: &Path) -> Result<Vec<[Vec3; 3]>, MeshError> {
                     kind: "OBJ",
                     message: e.to_string(),
                 })?;
-            let mut triangles = Vec::new();
-            for model in &models {
+            let faces = models.iter().flat_map(|model| {
                 let mesh = &model.mesh;
-                let vertex = |i: u32| {
+                let vertex = move |i: u32| {
                     let k = 3 * i as usize;
                     mesh.positions
                         .get(k..k + 3)
                         .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
                 };
-                for face in mesh.indices.chunks_exact(3) {
-                    let corners = [vertex(face[0]), vertex(face[1]), vertex(face[2])];
-                    let [Some(a), Some(b), Some(c)] = corners else {
-                        return Err(MeshError::Malformed {
-                            path: name.clone(),
-                            kind: "OBJ",
-                            message: "a face names a vertex the file does not hold".into(),
-                        });
-                    };
-                    triangles.push([a, b, c]);
-                }
-            }
-            triangles
+                mesh.indices
+                    .chunks_exact(3)
+                    .map(move |face| [vertex(face[0]), vertex(face[1]), vertex(face[2])])
+            });
+            triangles_of(faces, &name, "OBJ")?
         }
         "dae" => {
             let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
@@ -117,25 +127,15 @@ pub fn read_mesh(path: &Path) -> Result<Vec<[Vec3; 3]>, MeshError> {
                     kind: "COLLADA",
                     message: e.to_string(),
                 })?;
-            let mut triangles = Vec::new();
-            for mesh in &scene.meshes {
-                let vertex = |i: u32| {
+            let faces = scene.meshes.iter().flat_map(|mesh| {
+                let vertex = move |i: u32| {
                     mesh.vertices
                         .get(i as usize)
                         .map(|p| Vec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
                 };
-                for face in &mesh.faces {
-                    let [Some(a), Some(b), Some(c)] = face.map(vertex) else {
-                        return Err(MeshError::Malformed {
-                            path: name.clone(),
-                            kind: "COLLADA",
-                            message: "a face names a vertex the file does not hold".into(),
-                        });
-                    };
-                    triangles.push([a, b, c]);
-                }
-            }
-            triangles
+                mesh.faces.iter().map(move |face| face.map(vertex))
+            });
+            triangles_of(faces, &name, "COLLADA")?
         }
         _ => return Err(MeshError::Unsupported { path: name }),
     };

@@ -74,16 +74,18 @@ impl Cubic {
     /// on its end point leaves the direction to the next control point); `None` for a point.
     pub fn start_tangent(&self) -> Option<V2> {
         let [a, b, c, d] = self.p;
-        [b - a, c - a, d - a]
-            .into_iter()
-            .find(|v| v.norm() > self.negligible())
-            .map(|v| v.normalize())
+        self.first_direction([b - a, c - a, d - a])
     }
 
     /// The unit tangent at the end (see [`Cubic::start_tangent`]).
     pub fn end_tangent(&self) -> Option<V2> {
         let [a, b, c, d] = self.p;
-        [d - c, d - b, d - a]
+        self.first_direction([d - c, d - b, d - a])
+    }
+
+    /// The direction of the first of `handles` that is not negligible, as a unit vector.
+    fn first_direction(&self, handles: [V2; 3]) -> Option<V2> {
+        handles
             .into_iter()
             .find(|v| v.norm() > self.negligible())
             .map(|v| v.normalize())

@@ -149,19 +149,25 @@ pub(crate) fn deviation(curve: &Cubic, pieces: &[Piece]) -> f64 {
     let polyline: Vec<V2> = (0..=POLYLINE_SEGMENTS)
         .map(|i| curve.point(i as f64 / POLYLINE_SEGMENTS as f64))
         .collect();
-    let pieces_to_curve = pieces
-        .iter()
-        .flat_map(|piece| {
+    let pieces_to_curve = farthest_from_polyline(
+        pieces.iter().flat_map(|piece| {
             (1..=PIECE_SAMPLES).map(move |i| piece.point(i as f64 / (PIECE_SAMPLES + 1) as f64))
-        })
+        }),
+        &polyline,
+    );
+    curve_to_pieces.max(pieces_to_curve)
+}
+
+/// The largest distance of `points` from the polyline through `polyline`'s points.
+fn farthest_from_polyline(points: impl Iterator<Item = V2>, polyline: &[V2]) -> f64 {
+    points
         .map(|p| {
             polyline
                 .windows(2)
                 .map(|w| segment_distance(p, w[0], w[1]))
                 .fold(f64::INFINITY, f64::min)
         })
-        .fold(0.0, f64::max);
-    curve_to_pieces.max(pieces_to_curve)
+        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]
@@ -210,16 +216,12 @@ mod tests {
             .iter()
             .map(|p| distance_to(pieces, *p))
             .fold(0.0, f64::max);
-        let back = pieces
-            .iter()
-            .flat_map(|piece| (0..=200).map(move |i| piece.point(i as f64 / 200.0)))
-            .map(|p| {
-                samples
-                    .windows(2)
-                    .map(|w| segment_distance(p, w[0], w[1]))
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .fold(0.0, f64::max);
+        let back = farthest_from_polyline(
+            pieces
+                .iter()
+                .flat_map(|piece| (0..=200).map(move |i| piece.point(i as f64 / 200.0))),
+            &samples,
+        );
         there.max(back)
     }
 
