@@ -640,6 +640,21 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
 }
 
 fn markdown(record: &Record) -> String {
+    let mut md = comparison(record);
+    md.push('\n');
+    md.push_str(&job_table(&record.rows));
+    if !record.large.is_empty() {
+        md.push_str(&large::markdown(&record.large));
+    }
+    if !record.ur_programs.is_empty() {
+        md.push_str(&ur_programs::markdown(&record.ur_programs));
+    }
+    md
+}
+
+/// The page's head: what was planned and how, and `emg job` against the baseline summed over
+/// the jobs, with the planning time of the jobs timed on one thread.
+fn comparison(record: &Record) -> String {
     let rows = &record.rows;
     let sum = |value: fn(&JobRow) -> f64| rows.iter().map(value).sum::<f64>();
     let count = |value: fn(&JobRow) -> usize| rows.iter().map(value).sum::<usize>();
@@ -714,8 +729,13 @@ fn markdown(record: &Record) -> String {
             ));
         }
     }
-    md.push('\n');
-    md.push_str(
+    md
+}
+
+/// One row per job: its strokes, lengths, durations, moves and planning time beside the
+/// baseline's.
+fn job_table(rows: &[JobRow]) -> String {
+    let mut md = String::from(
         "| job | strokes | complete / resumed / short | drawn (m) | of (m) | pen down (s) | pen up (s) | \
          moves straight / sampled | planning (s) | baseline drawn (m) | baseline colliding moves |\n\
          |---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -739,12 +759,6 @@ fn markdown(record: &Record) -> String {
             r.baseline_colliding_moves,
             r.baseline_moves
         ));
-    }
-    if !record.large.is_empty() {
-        md.push_str(&large::markdown(&record.large));
-    }
-    if !record.ur_programs.is_empty() {
-        md.push_str(&ur_programs::markdown(&record.ur_programs));
     }
     md
 }

@@ -415,6 +415,11 @@ fn continuity(records: &[TaskLimit]) -> Vec<ContinuityBucket> {
 }
 
 fn markdown(record: &Record) -> String {
+    by_bound_section(record) + &continuity_section(record) + &by_limit_section(record)
+}
+
+/// The page's head, what ℓ* and the bound are, and the section by bucket of the bound.
+fn by_bound_section(record: &Record) -> String {
     let limit = &record.identity.limit;
     let mut md = format!(
         "# Best-known lengths (ℓ*) and the reachability bound\n\nWritten by `cargo xtask limit` and \
@@ -473,7 +478,13 @@ fn markdown(record: &Record) -> String {
             short.join(", ")
         );
     }
-    md += &format!(
+    md
+}
+
+/// The section on the tasks whose ℓ* ends short: how many a chain of valid configurations
+/// joins, per bucket of the bound.
+fn continuity_section(record: &Record) -> String {
+    let mut md = format!(
         "\n## Where ℓ* ends short: do the bound's points join into one motion?\n\nThe bound \
          only says that every point up to it has a valid configuration. For each task, valid \
          configurations at {:.0} % of the scan (the scan's own, then the cone IK from {} seeded \
@@ -498,7 +509,12 @@ fn markdown(record: &Record) -> String {
             row.bucket, row.short, row.joined, row.missing_m, row.missing_joined_m
         );
     }
-    md += &format!(
+    md
+}
+
+/// The section by bucket of ℓ*.
+fn by_limit_section(record: &Record) -> String {
+    let mut md = format!(
         "\n## By bucket of ℓ*\n\nBuckets by ℓ* (Easy ≥ {} m, Difficult < {} m); shares are task \
          means of the ratio.\n\n\
          | bucket | tasks | ℓ* (m, mean / std / min / max) | bound (m) | ℓ* / bound | Hybrid + DP / ℓ* | \

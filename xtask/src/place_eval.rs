@@ -363,6 +363,18 @@ fn write_map(path: &Path, placement: &Placement) -> anyhow::Result<()> {
 }
 
 fn markdown(record: &Record) -> String {
+    let mut md = comparison(record);
+    if let Some(twenty) = record.rows.iter().find(|r| r.job == TWENTY) {
+        md.push_str(&twenty_job(record, twenty));
+    }
+    md.push_str(&job_table(&record.rows));
+    md.push_str("\n![heat map of the 20-stroke job](../figures/placement-map.svg)\n");
+    md
+}
+
+/// The page's head: what was searched and how, and `emg place` against the usual approach
+/// and against the places each score ranks first or drawn at random.
+fn comparison(record: &Record) -> String {
     let rows = &record.rows;
     let unfinished = |complete: usize, row: &PlaceRow| complete < row.strokes;
     let ours_short = rows
@@ -375,8 +387,7 @@ fn markdown(record: &Record) -> String {
         .count();
     let sum = |value: fn(&PlaceRow) -> f64| rows.iter().map(value).sum::<f64>();
     let count = |value: fn(&PlaceRow) -> usize| rows.iter().map(value).sum::<usize>();
-    let twenty = rows.iter().find(|r| r.job == TWENTY);
-    let mut md = format!(
+    format!(
         "# Placement ({})\n\n\
          Written by `{}` on {} ({} threads). Each job's part is searched over shifts x in \
          [{}, {}] m and y in [{}, {}] m along its axes and turns in [{}°, {}°] about its \
@@ -433,30 +444,37 @@ fn markdown(record: &Record) -> String {
             .filter(|r| r.random_best_m > r.chosen_m + SAME_LENGTH_M)
             .count(),
         rows.len(),
-    );
-    if let Some(twenty) = twenty {
-        let t = &record.top_twenty;
-        md.push_str(&format!(
-            "{TWENTY}: {} places screened in {:.1} s; the chosen place draws {:.3} m, the best \
-             of the 20 best refined places, each planned, {:.3} m ({}); the places found on one \
-             thread are {}.\n\n",
-            twenty.screened,
-            twenty.screening_s,
-            t.chosen_m,
-            t.best_of_top_m,
-            if t.chosen_m >= t.best_of_top_m - SAME_LENGTH_M {
-                "the chosen place draws as much as any"
-            } else {
-                "one of them draws more"
-            },
-            if t.same_on_one_thread {
-                "the same"
-            } else {
-                "different"
-            },
-        ));
-    }
-    md.push_str(
+    )
+}
+
+/// The paragraph on the 20-stroke job (`twenty`): its screening and its chosen place against
+/// the best refined places.
+fn twenty_job(record: &Record, twenty: &PlaceRow) -> String {
+    let t = &record.top_twenty;
+    format!(
+        "{TWENTY}: {} places screened in {:.1} s; the chosen place draws {:.3} m, the best \
+         of the 20 best refined places, each planned, {:.3} m ({}); the places found on one \
+         thread are {}.\n\n",
+        twenty.screened,
+        twenty.screening_s,
+        t.chosen_m,
+        t.best_of_top_m,
+        if t.chosen_m >= t.best_of_top_m - SAME_LENGTH_M {
+            "the chosen place draws as much as any"
+        } else {
+            "one of them draws more"
+        },
+        if t.same_on_one_thread {
+            "the same"
+        } else {
+            "different"
+        },
+    )
+}
+
+/// One row per job: its places' lengths, completeness and screening.
+fn job_table(rows: &[PlaceRow]) -> String {
+    let mut md = String::from(
         "| job | strokes | of (m) | where it stands (m) | `emg place` (m) | complete | program (s) | usual approach (m) | complete | IK score's top places: unfinished / planned (of) | bound's top places: unfinished / planned (of) | most drawn at a random place (m) | screened | screening (s) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
@@ -483,6 +501,5 @@ fn markdown(record: &Record) -> String {
             r.screening_s
         ));
     }
-    md.push_str("\n![heat map of the 20-stroke job](../figures/placement-map.svg)\n");
     md
 }

@@ -526,70 +526,87 @@ fn markdown(record: &Record) -> String {
             .sum::<usize>(),
     );
     for kind in [Kind::Lines, Kind::Paths] {
-        let rows: Vec<&Row> = record.rows.iter().filter(|r| r.kind == kind).collect();
-        let Some(first) = rows.first() else { continue };
-        let buckets: Vec<String> = first
-            .bound_shares
-            .iter()
-            .map(|b| b.bucket.clone())
-            .collect();
-        md.push_str(match kind {
-            Kind::Lines => "## Lines\n\n",
-            Kind::Paths => "## Paths\n\n",
-        });
-        md.push_str(
-            "Σ plan / Σ bound per bucket of the bound at the row's tolerance (tasks in the \
-             bucket in brackets), the motions the line tolerance ended and, of them, those it \
-             ended more than one grid step of the scan (1 cm) short of the bound (the others \
-             end where the scan found no valid configuration one grid step further: the end of \
-             the arm's reach along the line or path)",
-        );
-        md.push_str(match kind {
-            Kind::Lines => ", and the mean plan time on its thread.\n\n",
-            Kind::Paths => ", the paths planned to their end, and the mean plan time.\n\n",
-        });
-        md.push_str("| tolerance | step |");
-        for bucket in &buckets {
-            md.push_str(&format!(" {bucket} |"));
-        }
-        md.push_str(" ended by the tolerance | of them short of the bound |");
-        if kind == Kind::Paths {
-            md.push_str(" completed |");
-        }
-        md.push_str(" ms per plan | checker failures |\n|---|---|");
-        md.push_str(&"---|".repeat(buckets.len() + 4 + usize::from(kind == Kind::Paths)));
-        md.push('\n');
-        for row in rows {
-            let total = row.lengths_m.len().max(1);
-            md.push_str(&format!(
-                "| {} mm | {} |",
-                row.setting.tolerance_mm,
-                row.setting.step_name()
-            ));
-            for share in &row.bound_shares {
-                md.push_str(&format!(" {:.3} ({}) |", share.share, share.tasks));
-            }
-            for ended in [
-                row.ended_by_line_tolerance,
-                row.ended_by_line_tolerance_short,
-            ] {
-                md.push_str(&format!(
-                    " {ended} ({:.1} %) |",
-                    100.0 * ended as f64 / total as f64
-                ));
-            }
-            if kind == Kind::Paths {
-                md.push_str(&format!(" {} of {} |", row.completed, row.lengths_m.len()));
-            }
-            md.push_str(&format!(
-                " {:.1} | {} |\n",
-                row.plan_ms_mean, row.checker_failures
-            ));
-        }
-        md.push('\n');
-        md.push_str(&loose_bounds(record, kind));
+        md.push_str(&kind_section(record, kind));
     }
-    md.push_str("## Paths completed at 20 mm and not at 0.1 mm (corrected step)\n\n");
+    md.push_str(&unfinished_section(record));
+    md
+}
+
+/// The section of the lines or of the paths: per row its shares of the bound per bucket, the
+/// motions the tolerance ended, the plan time and the checker's failures, then the loose
+/// bounds; empty where no row planned `kind`.
+fn kind_section(record: &Record, kind: Kind) -> String {
+    let rows: Vec<&Row> = record.rows.iter().filter(|r| r.kind == kind).collect();
+    let Some(first) = rows.first() else {
+        return String::new();
+    };
+    let buckets: Vec<String> = first
+        .bound_shares
+        .iter()
+        .map(|b| b.bucket.clone())
+        .collect();
+    let mut md = String::from(match kind {
+        Kind::Lines => "## Lines\n\n",
+        Kind::Paths => "## Paths\n\n",
+    });
+    md.push_str(
+        "Σ plan / Σ bound per bucket of the bound at the row's tolerance (tasks in the \
+         bucket in brackets), the motions the line tolerance ended and, of them, those it \
+         ended more than one grid step of the scan (1 cm) short of the bound (the others \
+         end where the scan found no valid configuration one grid step further: the end of \
+         the arm's reach along the line or path)",
+    );
+    md.push_str(match kind {
+        Kind::Lines => ", and the mean plan time on its thread.\n\n",
+        Kind::Paths => ", the paths planned to their end, and the mean plan time.\n\n",
+    });
+    md.push_str("| tolerance | step |");
+    for bucket in &buckets {
+        md.push_str(&format!(" {bucket} |"));
+    }
+    md.push_str(" ended by the tolerance | of them short of the bound |");
+    if kind == Kind::Paths {
+        md.push_str(" completed |");
+    }
+    md.push_str(" ms per plan | checker failures |\n|---|---|");
+    md.push_str(&"---|".repeat(buckets.len() + 4 + usize::from(kind == Kind::Paths)));
+    md.push('\n');
+    for row in rows {
+        let total = row.lengths_m.len().max(1);
+        md.push_str(&format!(
+            "| {} mm | {} |",
+            row.setting.tolerance_mm,
+            row.setting.step_name()
+        ));
+        for share in &row.bound_shares {
+            md.push_str(&format!(" {:.3} ({}) |", share.share, share.tasks));
+        }
+        for ended in [
+            row.ended_by_line_tolerance,
+            row.ended_by_line_tolerance_short,
+        ] {
+            md.push_str(&format!(
+                " {ended} ({:.1} %) |",
+                100.0 * ended as f64 / total as f64
+            ));
+        }
+        if kind == Kind::Paths {
+            md.push_str(&format!(" {} of {} |", row.completed, row.lengths_m.len()));
+        }
+        md.push_str(&format!(
+            " {:.1} | {} |\n",
+            row.plan_ms_mean, row.checker_failures
+        ));
+    }
+    md.push('\n');
+    md.push_str(&loose_bounds(record, kind));
+    md
+}
+
+/// The section of the paths the corrected step completes at 20 mm and not at the tightest
+/// tolerance, each with what its bound says.
+fn unfinished_section(record: &Record) -> String {
+    let mut md = String::from("## Paths completed at 20 mm and not at 0.1 mm (corrected step)\n\n");
     if record.unfinished_at_tightest.is_empty() {
         md.push_str(
             "None: every path the corrected step completes at 20 mm it completes at 0.1 mm.\n",

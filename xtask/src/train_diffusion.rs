@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::Context;
 use emg_diffusion::{Backend, DiffusionConfig, TrainConfig, Trainer, TrainingSet, training_set};
 use emg_io::read_tasks;
+use emg_kinematics::Robot;
 use emg_seeding::{LabelSet, hex};
 use serde::{Deserialize, Serialize};
 
@@ -100,81 +101,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let robot = workspace::load_robot(&args.robot)?;
     // The denoiser's samples are the arm's joint configurations.
     run_config.network.data_dim = robot.dof();
-    let tasks = read_tasks(&args.tasks, &robot)
-        .with_context(|| format!("reading {}", args.tasks.display()))?;
-    let labels = LabelSet::read(&args.labels).with_context(|| {
-        format!(
-            "reading {} (create it with `cargo xtask label-seeds`)",
-            args.labels.display()
-        )
-    })?;
-    let name = format!(
-        "{} (task set sha256 {})",
-        workspace::relative(&args.labels),
-        hex(labels.task_set_sha256())
-    );
-    let data = training_set(&robot, &tasks, &labels, &name)?;
-    println!(
-        "{} training pairs from {} labelled tasks; mirror augmentation {}",
-        data.len(),
-        labels.tasks().len(),
-        if data.has_mirror() {
-            "on"
-        } else {
-            "off (the robot is not mirror-symmetric)"
-        }
-    );
-
+    let (labels, data) = labelled_training_set(args, &robot)?;
     if let Some(steps) = args.measure_backends {
         return measure_backends(&run_config, &data, steps, &args.results);
     }
     let backend = Backend::from(args.backend);
-    let mut trainer = if args.checkpoint.join("state.json").exists() {
-        let trainer = Trainer::resume(
-            &args.checkpoint,
-            run_config.network.clone(),
-            run_config.training.clone(),
-            backend,
-            &data,
-        )?;
-        println!(
-            "resuming from step {} ({})",
-            trainer.step_count(),
-            args.checkpoint.display()
-        );
-        trainer
-    } else {
-        Trainer::new(
-            run_config.network.clone(),
-            run_config.training.clone(),
-            backend,
-            &data,
-        )?
-    };
-    let total = run_config.training.steps;
-    let bar = progress::bar(total as u64, "training");
-    bar.set_position(trainer.step_count() as u64);
+    let mut trainer = open_trainer(args, &run_config, backend, &data)?;
     let started = Instant::now();
-    let mut recent = 0.0;
-    while trainer.step_count() < total {
-        let loss = trainer.train_step(&data);
-        recent = if recent == 0.0 {
-            loss
-        } else {
-            0.98 * recent + 0.02 * loss
-        };
-        bar.inc(1);
-        if trainer.step_count() % 50 == 0 {
-            bar.set_message(format!("loss {recent:.4}"));
-        }
-        if trainer.step_count() % run_config.training.checkpoint_every_steps == 0 {
-            trainer.save_checkpoint(&args.checkpoint)?;
-            write_loss_curve(&trainer, &args.results)?;
-        }
-    }
-    bar.finish();
-    trainer.save_checkpoint(&args.checkpoint)?;
-    write_loss_curve(&trainer, &args.results)?;
+    train(args, &run_config, &mut trainer, &data)?;
     if let Some(dir) = args.out.parent() {
         std::fs::create_dir_all(dir)?;
     }
@@ -200,6 +134,103 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         serde_json::to_string_pretty(&card)? + "\n",
     )?;
     println!("wrote {} and its .json", workspace::relative(&args.out));
+    Ok(())
+}
+
+/// The labels of `--labels` and the training pairs they make on the tasks of `--tasks`.
+fn labelled_training_set(args: &Args, robot: &Robot) -> anyhow::Result<(LabelSet, TrainingSet)> {
+    let tasks = read_tasks(&args.tasks, robot)
+        .with_context(|| format!("reading {}", args.tasks.display()))?;
+    let labels = LabelSet::read(&args.labels).with_context(|| {
+        format!(
+            "reading {} (create it with `cargo xtask label-seeds`)",
+            args.labels.display()
+        )
+    })?;
+    let name = format!(
+        "{} (task set sha256 {})",
+        workspace::relative(&args.labels),
+        hex(labels.task_set_sha256())
+    );
+    let data = training_set(robot, &tasks, &labels, &name)?;
+    println!(
+        "{} training pairs from {} labelled tasks; mirror augmentation {}",
+        data.len(),
+        labels.tasks().len(),
+        if data.has_mirror() {
+            "on"
+        } else {
+            "off (the robot is not mirror-symmetric)"
+        }
+    );
+    Ok((labels, data))
+}
+
+/// The trainer resumed from the checkpoint of `--checkpoint`, or a new one where there is none.
+fn open_trainer(
+    args: &Args,
+    run_config: &RunConfig,
+    backend: Backend,
+    data: &TrainingSet,
+) -> anyhow::Result<Trainer> {
+    Ok(if args.checkpoint.join("state.json").exists() {
+        let trainer = Trainer::resume(
+            &args.checkpoint,
+            run_config.network.clone(),
+            run_config.training.clone(),
+            backend,
+            data,
+        )?;
+        println!(
+            "resuming from step {} ({})",
+            trainer.step_count(),
+            args.checkpoint.display()
+        );
+        trainer
+    } else {
+        Trainer::new(
+            run_config.network.clone(),
+            run_config.training.clone(),
+            backend,
+            data,
+        )?
+    })
+}
+
+/// Trains to the configured step count, checkpointing and writing the loss curve on the way
+/// and at the end.
+fn train(
+    args: &Args,
+    run_config: &RunConfig,
+    trainer: &mut Trainer,
+    data: &TrainingSet,
+) -> anyhow::Result<()> {
+    let total = run_config.training.steps;
+    let bar = progress::bar(total as u64, "training");
+    bar.set_position(trainer.step_count() as u64);
+    let mut recent = 0.0;
+    while trainer.step_count() < total {
+        let loss = trainer.train_step(data);
+        recent = if recent == 0.0 {
+            loss
+        } else {
+            0.98 * recent + 0.02 * loss
+        };
+        bar.inc(1);
+        if trainer.step_count().is_multiple_of(50) {
+            bar.set_message(format!("loss {recent:.4}"));
+        }
+        if trainer
+            .step_count()
+            .is_multiple_of(run_config.training.checkpoint_every_steps)
+        {
+            trainer.save_checkpoint(&args.checkpoint)?;
+            write_loss_curve(trainer, &args.results)?;
+        }
+    }
+    bar.finish();
+    trainer.save_checkpoint(&args.checkpoint)?;
+    write_loss_curve(trainer, &args.results)?;
     Ok(())
 }
 
