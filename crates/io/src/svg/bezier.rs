@@ -151,6 +151,16 @@ fn quadratic_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
 }
 
 #[cfg(test)]
+impl Cubic {
+    /// The curve through the control points `points`, each `(x, y)`.
+    pub(crate) fn from_xy(points: [(f64, f64); 4]) -> Self {
+        Self {
+            p: points.map(|(x, y)| V2::new(x, y)),
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -167,25 +177,11 @@ mod tests {
 
     #[test]
     fn an_s_curve_has_one_inflection_in_its_middle() {
-        let s = Cubic {
-            p: [
-                V2::new(0.0, 0.0),
-                V2::new(1.0, 1.0),
-                V2::new(2.0, -1.0),
-                V2::new(3.0, 0.0),
-            ],
-        };
+        let s = Cubic::from_xy([(0.0, 0.0), (1.0, 1.0), (2.0, -1.0), (3.0, 0.0)]);
         let inflections = s.inflections();
         assert_eq!(inflections.len(), 1);
         assert!((inflections[0] - 0.5).abs() < 1e-12);
-        let arch = Cubic {
-            p: [
-                V2::new(0.0, 0.0),
-                V2::new(0.0, 1.0),
-                V2::new(1.0, 1.0),
-                V2::new(1.0, 0.0),
-            ],
-        };
+        let arch = Cubic::from_xy([(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)]);
         assert!(arch.inflections().is_empty());
         let top = arch
             .extreme_points()
@@ -197,14 +193,7 @@ mod tests {
 
     #[test]
     fn splitting_keeps_the_curve_and_its_tangent() {
-        let c = Cubic {
-            p: [
-                V2::new(0.0, 0.0),
-                V2::new(1.0, 2.0),
-                V2::new(3.0, 2.0),
-                V2::new(4.0, 0.0),
-            ],
-        };
+        let c = Cubic::from_xy([(0.0, 0.0), (1.0, 2.0), (3.0, 2.0), (4.0, 0.0)]);
         let (left, right, tangent) = c.split(0.3);
         for k in 0..=10 {
             let u = k as f64 / 10.0;

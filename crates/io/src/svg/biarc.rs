@@ -225,23 +225,17 @@ mod tests {
         there.max(back)
     }
 
-    fn cubic(points: [(f64, f64); 4]) -> Cubic {
-        Cubic {
-            p: points.map(|(x, y)| V2::new(x, y)),
-        }
-    }
-
     #[test]
     fn curves_are_fitted_within_the_tolerance_as_smooth_chains() {
         let curves = [
             // An arch, an S (one inflection), a loop-like hook, a quarter circle as SVG writers
             // draw it, and a hairpin bend of 4 mm radius (metres, a drawing about 0.1 m
             // across).
-            cubic([(0.0, 0.0), (0.0, 0.05), (0.05, 0.05), (0.05, 0.0)]),
-            cubic([(0.0, 0.0), (0.03, 0.04), (0.06, -0.04), (0.09, 0.0)]),
-            cubic([(0.0, 0.0), (0.1, 0.1), (-0.05, 0.1), (0.02, 0.0)]),
-            cubic([(0.1, 0.0), (0.1, 0.055228), (0.055228, 0.1), (0.0, 0.1)]),
-            cubic([(0.0, 0.0), (0.08, 0.0), (0.08, 0.02), (0.0, 0.04)]),
+            Cubic::from_xy([(0.0, 0.0), (0.0, 0.05), (0.05, 0.05), (0.05, 0.0)]),
+            Cubic::from_xy([(0.0, 0.0), (0.03, 0.04), (0.06, -0.04), (0.09, 0.0)]),
+            Cubic::from_xy([(0.0, 0.0), (0.1, 0.1), (-0.05, 0.1), (0.02, 0.0)]),
+            Cubic::from_xy([(0.1, 0.0), (0.1, 0.055228), (0.055228, 0.1), (0.0, 0.1)]),
+            Cubic::from_xy([(0.0, 0.0), (0.08, 0.0), (0.08, 0.02), (0.0, 0.04)]),
         ];
         for tolerance in [5e-5, 1e-5, 1e-6] {
             for curve in &curves {
@@ -259,7 +253,7 @@ mod tests {
 
     #[test]
     fn a_tighter_tolerance_takes_more_arcs() {
-        let s = cubic([(0.0, 0.0), (0.03, 0.04), (0.06, -0.04), (0.09, 0.0)]);
+        let s = Cubic::from_xy([(0.0, 0.0), (0.03, 0.04), (0.06, -0.04), (0.09, 0.0)]);
         let coarse = fitted(&s, 1e-4).len();
         let fine = fitted(&s, 1e-6).len();
         assert!(coarse >= 4, "an S takes at least two biarcs: {coarse}");
@@ -270,7 +264,7 @@ mod tests {
     fn a_quarter_circle_becomes_arcs_of_its_radius() {
         // The standard cubic of a quarter circle of radius 0.1 m (off the circle by 2.7e-4 r).
         let k = 0.1 * 0.552_284_749_831;
-        let quarter = cubic([(0.1, 0.0), (0.1, k), (k, 0.1), (0.0, 0.1)]);
+        let quarter = Cubic::from_xy([(0.1, 0.0), (0.1, k), (k, 0.1), (0.0, 0.1)]);
         let pieces = fitted(&quarter, 5e-5);
         assert!(pieces.len() <= 4, "{} pieces", pieces.len());
         for piece in &pieces {
@@ -285,7 +279,7 @@ mod tests {
 
     #[test]
     fn a_straight_curve_is_one_line_and_a_nearly_straight_one_stays_smooth() {
-        let straight = cubic([(0.0, 0.0), (0.01, 0.0), (0.02, 0.0), (0.03, 0.0)]);
+        let straight = Cubic::from_xy([(0.0, 0.0), (0.01, 0.0), (0.02, 0.0), (0.03, 0.0)]);
         assert_eq!(
             fitted(&straight, 5e-5),
             vec![Piece::Line {
@@ -295,7 +289,7 @@ mod tests {
         );
         // Bowed by 10 µm: within the tolerance, but it leaves at an angle to its chord, so it
         // becomes large arcs that keep its tangents rather than a line with corners.
-        let bowed = cubic([(0.0, 0.0), (0.01, 1e-5), (0.02, 1e-5), (0.03, 0.0)]);
+        let bowed = Cubic::from_xy([(0.0, 0.0), (0.01, 1e-5), (0.02, 1e-5), (0.03, 0.0)]);
         let pieces = fitted(&bowed, 5e-5);
         assert_smooth_chain(&bowed, &pieces);
         assert!(pieces.iter().all(|p| matches!(p, Piece::Arc { .. })));
@@ -304,7 +298,7 @@ mod tests {
     #[test]
     fn a_cusp_is_fitted_on_both_sides() {
         // Handles crossed: the curve turns back sharply (a cusp-like point near its middle).
-        let cusp = cubic([(0.0, 0.0), (0.06, 0.04), (0.0, 0.04), (0.06, 0.0)]);
+        let cusp = Cubic::from_xy([(0.0, 0.0), (0.06, 0.04), (0.0, 0.04), (0.06, 0.0)]);
         let mut out = Vec::new();
         let (ta, tb) = (cusp.start_tangent().unwrap(), cusp.end_tangent().unwrap());
         fit_cubic(&cusp, ta, tb, 5e-5, 1e-4, &mut out);

@@ -452,14 +452,12 @@ mod tests {
     #[test]
     fn nearly_smooth_joints_are_made_smooth_within_the_tolerance() {
         // A line, then a curve leaving 0.05 rad (2.9°) off the line's direction.
-        let curve = Cubic {
-            p: [
-                V2::new(0.01, 0.0),
-                V2::new(0.02, 0.01 * libm::tan(0.05)),
-                V2::new(0.03, 0.01),
-                V2::new(0.03, 0.02),
-            ],
-        };
+        let curve = Cubic::from_xy([
+            (0.01, 0.0),
+            (0.02, 0.01 * libm::tan(0.05)),
+            (0.03, 0.01),
+            (0.03, 0.02),
+        ]);
         let path = subpath(
             (0.0, 0.0),
             vec![line(0.01, 0.0), Segment::Cubic(curve)],
