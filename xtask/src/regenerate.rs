@@ -14,6 +14,7 @@
 use std::process::Command;
 
 use anyhow::{Context, bail};
+use emg_planner::SHIPPED_ROBOTS;
 
 use crate::workspace;
 
@@ -31,43 +32,56 @@ pub struct Args {
 /// One pipeline run.
 struct Stage {
     /// The stage's name (the journal's and `--from`'s).
-    name: &'static str,
+    name: String,
     /// The `cargo xtask` arguments.
-    args: &'static [&'static str],
+    args: Vec<&'static str>,
     /// The files it writes, relative to the workspace root.
+    writes: Vec<String>,
+}
+
+/// A stage as [`TABLE`] states it: the FR3's where the pipeline runs for every shipped arm.
+struct Template {
+    name: &'static str,
+    args: &'static [&'static str],
     writes: &'static [&'static str],
 }
 
-/// Every stage, each after the ones whose files it reads.
-const STAGES: &[Stage] = &[
-    Stage {
-        name: "tasks",
-        args: &["make-tasks"],
-        writes: &[
-            "data/tasks/eval-v1.tasks",
-            "data/tasks/train-v1.tasks",
-            "data/tasks/tasks-v1.manifest.json",
-        ],
+/// A row of [`TABLE`].
+enum Row {
+    /// A stage run once.
+    Once(Template),
+    /// Stages run for each shipped arm in turn, all of one arm's before the next arm's: the
+    /// FR3's as stated, each other arm's named `<name>-<arm>`, its arguments followed by
+    /// `--robot <arm>` and `other_arms_args`, its files in the arm's sub-directories.
+    EveryArm {
+        stages: &'static [Template],
+        other_arms_args: &'static [&'static str],
     },
-    Stage {
-        name: "tasks-iiwa14",
-        args: &["make-tasks", "--robot", "iiwa14", "--train-count", "20000"],
-        writes: &[
-            "data/iiwa14/tasks/eval-v1.tasks",
-            "data/iiwa14/tasks/train-v1.tasks",
-            "data/iiwa14/tasks/tasks-v1.manifest.json",
-        ],
+}
+
+/// A pipeline run once for every shipped arm, with the same arguments on each.
+const fn every_arm(stage: &'static Template) -> Row {
+    Row::EveryArm {
+        stages: std::slice::from_ref(stage),
+        other_arms_args: &[],
+    }
+}
+
+/// Every stage, each after the ones whose files it reads ([`stages`] spells them out).
+const TABLE: &[Row] = &[
+    Row::EveryArm {
+        stages: &[Template {
+            name: "tasks",
+            args: &["make-tasks"],
+            writes: &[
+                "data/tasks/eval-v1.tasks",
+                "data/tasks/train-v1.tasks",
+                "data/tasks/tasks-v1.manifest.json",
+            ],
+        }],
+        other_arms_args: &["--train-count", "20000"],
     },
-    Stage {
-        name: "tasks-ur5e",
-        args: &["make-tasks", "--robot", "ur5e", "--train-count", "20000"],
-        writes: &[
-            "data/ur5e/tasks/eval-v1.tasks",
-            "data/ur5e/tasks/train-v1.tasks",
-            "data/ur5e/tasks/tasks-v1.manifest.json",
-        ],
-    },
-    Stage {
+    every_arm(&Template {
         name: "labels",
         args: &["label-seeds"],
         writes: &[
@@ -76,28 +90,8 @@ const STAGES: &[Stage] = &[
             "data/labels/train-v1.labels",
             "data/labels/train-v1.manifest.json",
         ],
-    },
-    Stage {
-        name: "labels-iiwa14",
-        args: &["label-seeds", "--robot", "iiwa14"],
-        writes: &[
-            "data/iiwa14/labels/eval-v1.labels",
-            "data/iiwa14/labels/eval-v1.manifest.json",
-            "data/iiwa14/labels/train-v1.labels",
-            "data/iiwa14/labels/train-v1.manifest.json",
-        ],
-    },
-    Stage {
-        name: "labels-ur5e",
-        args: &["label-seeds", "--robot", "ur5e"],
-        writes: &[
-            "data/ur5e/labels/eval-v1.labels",
-            "data/ur5e/labels/eval-v1.manifest.json",
-            "data/ur5e/labels/train-v1.labels",
-            "data/ur5e/labels/train-v1.manifest.json",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "diffusion",
         args: &["train-diffusion"],
         writes: &[
@@ -106,28 +100,8 @@ const STAGES: &[Stage] = &[
             "docs/results/diffusion-training.csv",
             "docs/results/diffusion-training.svg",
         ],
-    },
-    Stage {
-        name: "diffusion-iiwa14",
-        args: &["train-diffusion", "--robot", "iiwa14"],
-        writes: &[
-            "data/iiwa14/models/diffusion-v1.weights",
-            "data/iiwa14/models/diffusion-v1.json",
-            "docs/results/iiwa14/diffusion-training.csv",
-            "docs/results/iiwa14/diffusion-training.svg",
-        ],
-    },
-    Stage {
-        name: "diffusion-ur5e",
-        args: &["train-diffusion", "--robot", "ur5e"],
-        writes: &[
-            "data/ur5e/models/diffusion-v1.weights",
-            "data/ur5e/models/diffusion-v1.json",
-            "docs/results/ur5e/diffusion-training.csv",
-            "docs/results/ur5e/diffusion-training.svg",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "ppo",
         args: &["train-ppo"],
         writes: &[
@@ -137,30 +111,8 @@ const STAGES: &[Stage] = &[
             "docs/results/ppo-learning-curve.csv",
             "docs/results/ppo-learning-curve.svg",
         ],
-    },
-    Stage {
-        name: "ppo-iiwa14",
-        args: &["train-ppo", "--robot", "iiwa14"],
-        writes: &[
-            "data/iiwa14/models/ppo-v1.weights",
-            "data/iiwa14/models/ppo-v1.json",
-            "docs/results/iiwa14/ppo-training.md",
-            "docs/results/iiwa14/ppo-learning-curve.csv",
-            "docs/results/iiwa14/ppo-learning-curve.svg",
-        ],
-    },
-    Stage {
-        name: "ppo-ur5e",
-        args: &["train-ppo", "--robot", "ur5e"],
-        writes: &[
-            "data/ur5e/models/ppo-v1.weights",
-            "data/ur5e/models/ppo-v1.json",
-            "docs/results/ur5e/ppo-training.md",
-            "docs/results/ur5e/ppo-learning-curve.csv",
-            "docs/results/ur5e/ppo-learning-curve.svg",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "search-eval",
         args: &["search-eval"],
         writes: &[
@@ -168,127 +120,38 @@ const STAGES: &[Stage] = &[
             "docs/results/search.md",
             "docs/figures/search-budget.svg",
         ],
-    },
-    Stage {
-        name: "search-eval-iiwa14",
-        args: &["search-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/search.json",
-            "docs/results/iiwa14/search.md",
-            "docs/figures/iiwa14/search-budget.svg",
-        ],
-    },
-    Stage {
-        name: "search-eval-ur5e",
-        args: &["search-eval", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/search.json",
-            "docs/results/ur5e/search.md",
-            "docs/figures/ur5e/search-budget.svg",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "cartesian-eval",
         args: &["cartesian-eval"],
         writes: &["docs/results/cartesian.json", "docs/results/cartesian.md"],
-    },
-    Stage {
-        name: "cartesian-eval-iiwa14",
-        args: &["cartesian-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/cartesian.json",
-            "docs/results/iiwa14/cartesian.md",
-        ],
-    },
-    Stage {
-        name: "cartesian-eval-ur5e",
-        args: &["cartesian-eval", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/cartesian.json",
-            "docs/results/ur5e/cartesian.md",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "path-eval",
         args: &["path-eval"],
         writes: &["docs/results/paths.json", "docs/results/paths.md"],
-    },
-    Stage {
-        name: "path-eval-iiwa14",
-        args: &["path-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/paths.json",
-            "docs/results/iiwa14/paths.md",
-        ],
-    },
-    Stage {
-        name: "path-eval-ur5e",
-        args: &["path-eval", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/paths.json", "docs/results/ur5e/paths.md"],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "precision-eval",
         args: &["precision-eval"],
         writes: &["docs/results/precision.json", "docs/results/precision.md"],
-    },
-    Stage {
-        name: "precision-eval-iiwa14",
-        args: &["precision-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/precision.json",
-            "docs/results/iiwa14/precision.md",
-        ],
-    },
-    Stage {
-        name: "precision-eval-ur5e",
-        args: &["precision-eval", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/precision.json",
-            "docs/results/ur5e/precision.md",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "gap-eval",
         args: &["gap-eval"],
         writes: &["docs/results/gaps.json", "docs/results/gaps.md"],
-    },
-    Stage {
-        name: "gap-eval-iiwa14",
-        args: &["gap-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/gaps.json",
-            "docs/results/iiwa14/gaps.md",
-        ],
-    },
-    Stage {
-        name: "gap-eval-ur5e",
-        args: &["gap-eval", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/gaps.json", "docs/results/ur5e/gaps.md"],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "job-eval",
         args: &["job-eval"],
         writes: &["docs/results/jobs.json", "docs/results/jobs.md"],
-    },
-    Stage {
-        name: "job-eval-iiwa14",
-        args: &["job-eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/jobs.json",
-            "docs/results/iiwa14/jobs.md",
-        ],
-    },
-    Stage {
-        name: "job-eval-ur5e",
-        args: &["job-eval", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/jobs.json", "docs/results/ur5e/jobs.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "corpus-eval",
         args: &["corpus-eval", "--every", "20"],
         writes: &["docs/results/corpus.json", "docs/results/corpus.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "place-eval",
         args: &["place-eval"],
         writes: &[
@@ -296,62 +159,33 @@ const STAGES: &[Stage] = &[
             "docs/results/placement.md",
             "docs/figures/placement-map.svg",
         ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "labels-report",
         args: &["label-seeds", "--report"],
         writes: &["docs/results/labels.json", "docs/results/labels.md"],
-    },
-    Stage {
-        name: "labels-report-iiwa14",
-        args: &["label-seeds", "--report", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/labels.json",
-            "docs/results/iiwa14/labels.md",
-        ],
-    },
-    Stage {
-        name: "labels-report-ur5e",
-        args: &["label-seeds", "--report", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/labels.json",
-            "docs/results/ur5e/labels.md",
-        ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "eval",
         args: &["eval"],
         writes: &["docs/results/eval.json", "docs/results/eval.md"],
-    },
-    Stage {
-        name: "eval-iiwa14",
-        args: &["eval", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/eval.json",
-            "docs/results/iiwa14/eval.md",
-        ],
-    },
-    Stage {
-        name: "eval-ur5e",
-        args: &["eval", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/eval.json", "docs/results/ur5e/eval.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-classical",
         args: &["eval", "--controller", "classical"],
         writes: &["docs/results/classical.json", "docs/results/classical.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-rl",
         args: &["eval", "--controller", "rl"],
         writes: &["docs/results/rl.json", "docs/results/rl.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-hybrid",
         args: &["eval", "--controller", "hybrid"],
         writes: &["docs/results/hybrid.json", "docs/results/hybrid.md"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-classical-k_lat-0",
         args: &[
             "eval",
@@ -366,32 +200,16 @@ const STAGES: &[Stage] = &[
             "docs/results/classical-k_lat-0.json",
             "docs/results/classical-k_lat-0.md",
         ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "velocity-limits",
         args: &["eval", "--compare-velocity-limits"],
         writes: &[
             "docs/results/velocity-limits.json",
             "docs/results/velocity-limits.md",
         ],
-    },
-    Stage {
-        name: "velocity-limits-iiwa14",
-        args: &["eval", "--compare-velocity-limits", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/velocity-limits.json",
-            "docs/results/iiwa14/velocity-limits.md",
-        ],
-    },
-    Stage {
-        name: "velocity-limits-ur5e",
-        args: &["eval", "--compare-velocity-limits", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/velocity-limits.json",
-            "docs/results/ur5e/velocity-limits.md",
-        ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-surface-on",
         args: &[
             "eval",
@@ -406,8 +224,8 @@ const STAGES: &[Stage] = &[
             "docs/results/eval-surface-on.json",
             "docs/results/eval-surface-on.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-cell-surface-off",
         args: &[
             "eval",
@@ -422,8 +240,8 @@ const STAGES: &[Stage] = &[
             "docs/results/eval-cell-surface-off.json",
             "docs/results/eval-cell-surface-off.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "eval-cell-surface-on",
         args: &[
             "eval",
@@ -440,40 +258,40 @@ const STAGES: &[Stage] = &[
             "docs/results/eval-cell-surface-on.json",
             "docs/results/eval-cell-surface-on.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "ablate-classical-weights",
         args: &["ablate", "classical-weights"],
         writes: &[
             "docs/results/ablate-classical-weights.json",
             "docs/results/ablate-classical-weights.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "ablate-switching",
         args: &["ablate", "switching"],
         writes: &[
             "docs/results/ablate-switching.json",
             "docs/results/ablate-switching.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "ablate-cfg-scale",
         args: &["ablate", "cfg-scale"],
         writes: &[
             "docs/results/ablate-cfg-scale.json",
             "docs/results/ablate-cfg-scale.md",
         ],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "ablate-ddim-steps",
         args: &["ablate", "ddim-steps"],
         writes: &[
             "docs/results/ablate-ddim-steps.json",
             "docs/results/ablate-ddim-steps.md",
         ],
-    },
-    Stage {
+    }),
+    every_arm(&Template {
         name: "timing",
         args: &["timing"],
         writes: &[
@@ -481,79 +299,43 @@ const STAGES: &[Stage] = &[
             "docs/results/timing.md",
             "docs/figures/timing-durations.svg",
         ],
-    },
-    Stage {
-        name: "timing-iiwa14",
-        args: &["timing", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/timing.json",
-            "docs/results/iiwa14/timing.md",
-            "docs/figures/iiwa14/timing-durations.svg",
+    }),
+    Row::EveryArm {
+        stages: &[
+            Template {
+                name: "limit",
+                args: &["limit"],
+                writes: &[],
+            },
+            Template {
+                name: "limit-merge",
+                args: &["limit", "--merge"],
+                writes: &["docs/results/limit.json", "docs/results/limit.md"],
+            },
         ],
+        other_arms_args: &[],
     },
-    Stage {
-        name: "timing-ur5e",
-        args: &["timing", "--robot", "ur5e"],
-        writes: &[
-            "docs/results/ur5e/timing.json",
-            "docs/results/ur5e/timing.md",
-            "docs/figures/ur5e/timing-durations.svg",
-        ],
-    },
-    Stage {
-        name: "limit",
-        args: &["limit"],
-        writes: &[],
-    },
-    Stage {
-        name: "limit-merge",
-        args: &["limit", "--merge"],
-        writes: &["docs/results/limit.json", "docs/results/limit.md"],
-    },
-    Stage {
-        name: "limit-iiwa14",
-        args: &["limit", "--robot", "iiwa14"],
-        writes: &[],
-    },
-    Stage {
-        name: "limit-merge-iiwa14",
-        args: &["limit", "--merge", "--robot", "iiwa14"],
-        writes: &[
-            "docs/results/iiwa14/limit.json",
-            "docs/results/iiwa14/limit.md",
-        ],
-    },
-    Stage {
-        name: "limit-ur5e",
-        args: &["limit", "--robot", "ur5e"],
-        writes: &[],
-    },
-    Stage {
-        name: "limit-merge-ur5e",
-        args: &["limit", "--merge", "--robot", "ur5e"],
-        writes: &["docs/results/ur5e/limit.json", "docs/results/ur5e/limit.md"],
-    },
-    Stage {
+    Row::Once(Template {
         name: "figure-dp-seeds",
         args: &["figure-dp-seeds"],
         writes: &["docs/figures/dp-seeds.svg"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "figure-branches",
         args: &["figure-branches"],
         writes: &["docs/figures/self-motion-branches.svg"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "readme-picture",
         args: &["readme-picture"],
         writes: &["docs/figures/readme-demo.png"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "readme-job-picture",
         args: &["readme-picture", "--job"],
         writes: &["docs/figures/job-demo.png"],
-    },
-    Stage {
+    }),
+    Row::Once(Template {
         name: "report",
         args: &["report"],
         writes: &[
@@ -563,15 +345,75 @@ const STAGES: &[Stage] = &[
             "docs/figures/path-lengths.svg",
             "docs/figures/hybrid-trace.svg",
         ],
-    },
+    }),
 ];
+
+/// The directories a shipped arm other than the FR3 keeps its own files in, each under a
+/// sub-directory of its own.
+const ARM_DIRECTORIES: [&str; 3] = ["data/", "docs/results/", "docs/figures/"];
+
+/// Every stage of [`TABLE`], in order.
+fn stages() -> Vec<Stage> {
+    let mut stages = Vec::new();
+    for row in TABLE {
+        match row {
+            Row::Once(template) => stages.push(template.stage()),
+            Row::EveryArm {
+                stages: templates,
+                other_arms_args,
+            } => {
+                for arm in SHIPPED_ROBOTS {
+                    for template in *templates {
+                        stages.push(match arm.data_subdir() {
+                            "" => template.stage(),
+                            subdir => template.other_arm(arm.name, subdir, other_arms_args),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    stages
+}
+
+impl Template {
+    /// The stage as stated.
+    fn stage(&self) -> Stage {
+        Stage {
+            name: self.name.to_string(),
+            args: self.args.to_vec(),
+            writes: self.writes.iter().map(|file| file.to_string()).collect(),
+        }
+    }
+
+    /// The stage for the shipped arm `arm` whose files lie in the sub-directory `subdir`:
+    /// `--robot <arm>` and `more_args` after the stated arguments.
+    fn other_arm(&self, arm: &'static str, subdir: &str, more_args: &[&'static str]) -> Stage {
+        let in_subdir = |file: &&str| {
+            let (dir, rest) = ARM_DIRECTORIES
+                .iter()
+                .find_map(|dir| file.strip_prefix(dir).map(|rest| (dir, rest)))
+                .unwrap_or_else(|| panic!("{file} lies outside every arm's directories"));
+            format!("{dir}{subdir}/{rest}")
+        };
+        let mut args = self.args.to_vec();
+        args.extend(["--robot", arm]);
+        args.extend(more_args);
+        Stage {
+            name: format!("{}-{arm}", self.name),
+            args,
+            writes: self.writes.iter().map(in_subdir).collect(),
+        }
+    }
+}
 
 /// Runs the stages not yet done (or those from `--from` on), or lists them.
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    let stages = stages();
     if args.list {
-        for stage in STAGES {
+        for stage in &stages {
             println!("{:<24} cargo xtask {}", stage.name, stage.args.join(" "));
-            for file in stage.writes {
+            for file in &stage.writes {
                 println!("{:<24}   → {file}", "");
             }
         }
@@ -581,11 +423,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&journal).with_context(|| format!("creating {}", journal.display()))?;
     let first = match &args.from {
         None => 0,
-        Some(name) => STAGES
+        Some(name) => stages
             .iter()
-            .position(|stage| stage.name == name)
+            .position(|stage| &stage.name == name)
             .with_context(|| {
-                let names: Vec<&str> = STAGES.iter().map(|stage| stage.name).collect();
+                let names: Vec<&str> = stages.iter().map(|stage| stage.name.as_str()).collect();
                 format!(
                     "--from: no stage '{name}' (the stages: {})",
                     names.join(", ")
@@ -593,7 +435,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             })?,
     };
     let done = |stage: &Stage| journal.join(format!("{}.done", stage.name));
-    for stage in &STAGES[first..] {
+    for stage in &stages[first..] {
         let marker = done(stage);
         if marker.exists() {
             std::fs::remove_file(&marker)
@@ -601,20 +443,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
     let xtask = std::env::current_exe().context("locating the xtask binary")?;
-    for (index, stage) in STAGES.iter().enumerate() {
+    for (index, stage) in stages.iter().enumerate() {
         if index < first || done(stage).exists() {
-            println!("[{}/{}] {}: done", index + 1, STAGES.len(), stage.name);
+            println!("[{}/{}] {}: done", index + 1, stages.len(), stage.name);
             continue;
         }
         println!(
             "[{}/{}] {}: cargo xtask {}",
             index + 1,
-            STAGES.len(),
+            stages.len(),
             stage.name,
             stage.args.join(" ")
         );
         let status = Command::new(&xtask)
-            .args(stage.args)
+            .args(&stage.args)
             .current_dir(workspace::root())
             .status()
             .with_context(|| format!("starting stage {}", stage.name))?;
@@ -638,7 +480,7 @@ mod tests {
 
     /// The files the stages write, relative to the workspace root.
     fn written() -> Vec<PathBuf> {
-        STAGES
+        stages()
             .iter()
             .flat_map(|stage| stage.writes.iter().map(PathBuf::from))
             .collect()
@@ -702,9 +544,10 @@ mod tests {
 
     #[test]
     fn stage_names_are_unique() {
-        for (i, stage) in STAGES.iter().enumerate() {
+        let stages = stages();
+        for (i, stage) in stages.iter().enumerate() {
             assert!(
-                STAGES[..i].iter().all(|s| s.name != stage.name),
+                stages[..i].iter().all(|s| s.name != stage.name),
                 "{} twice",
                 stage.name
             );
