@@ -491,37 +491,51 @@ fn shortest_cycle<'a>(
 mod tests {
     use super::*;
 
-    fn write(dir: &Path, name: &str, text: &str) {
-        let path = dir.join(name);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(path, text).unwrap();
+    /// A crate's sources in a temporary directory, its root `lib.rs`.
+    struct Sources(tempfile::TempDir);
+
+    impl Sources {
+        fn new() -> Self {
+            Self(tempfile::tempdir().unwrap())
+        }
+
+        /// Writes `text` as the source file `name`.
+        fn write(&self, name: &str, text: &str) {
+            let path = self.0.path().join(name);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, text).unwrap();
+        }
+
+        /// The import circles of the crate.
+        fn circles(&self) -> Vec<Circle> {
+            crate_circles(&self.0.path().join("lib.rs")).unwrap()
+        }
+
+        /// The crate's one import circle.
+        fn only_circle(&self) -> Circle {
+            let mut circles = self.circles();
+            assert_eq!(circles.len(), 1, "{circles:?}");
+            circles.remove(0)
+        }
     }
 
     #[test]
     fn a_module_reaching_back_to_the_root_is_a_circle_and_test_code_is_not() {
-        let dir = tempfile::tempdir().unwrap();
-        let src = dir.path();
-        write(src, "lib.rs", "mod a;\nmod b;\npub use a::Thing;\n");
-        write(
-            src,
+        let src = Sources::new();
+        src.write("lib.rs", "mod a;\nmod b;\npub use a::Thing;\n");
+        src.write(
             "a.rs",
             "pub struct Thing;\nfn f() -> usize { crate::b::ONE }\n",
         );
-        write(
-            src,
+        src.write(
             "b.rs",
             "pub const ONE: usize = 1;\n#[cfg(test)]\nmod tests { use crate::a::Thing; }\n",
         );
-        assert!(crate_circles(&src.join("lib.rs")).unwrap().is_empty());
+        assert!(src.circles().is_empty());
 
-        write(
-            src,
-            "b.rs",
-            "pub const ONE: usize = 1;\nuse crate::Thing;\n",
-        );
-        let circles = crate_circles(&src.join("lib.rs")).unwrap();
-        assert_eq!(circles.len(), 1, "{circles:?}");
-        let members: Vec<String> = circles[0]
+        src.write("b.rs", "pub const ONE: usize = 1;\nuse crate::Thing;\n");
+        let members: Vec<String> = src
+            .only_circle()
             .cycle
             .iter()
             .map(|(module, _)| display_module(module))
@@ -531,39 +545,26 @@ mod tests {
 
     #[test]
     fn child_and_super_paths_resolve_to_their_modules() {
-        let dir = tempfile::tempdir().unwrap();
-        let src = dir.path();
-        write(src, "lib.rs", "mod order;\nmod tour;\n");
-        write(src, "order.rs", "mod near;\npub fn f() { near::g() }\n");
-        write(
-            src,
-            "order/near.rs",
-            "pub fn g() { super::super::tour::h() }\n",
-        );
-        write(src, "tour.rs", "pub fn h() {}\n");
-        assert!(crate_circles(&src.join("lib.rs")).unwrap().is_empty());
+        let src = Sources::new();
+        src.write("lib.rs", "mod order;\nmod tour;\n");
+        src.write("order.rs", "mod near;\npub fn f() { near::g() }\n");
+        src.write("order/near.rs", "pub fn g() { super::super::tour::h() }\n");
+        src.write("tour.rs", "pub fn h() {}\n");
+        assert!(src.circles().is_empty());
 
-        write(
-            src,
-            "tour.rs",
-            "pub fn h() {}\nfn i() { crate::order::f() }\n",
-        );
-        let circles = crate_circles(&src.join("lib.rs")).unwrap();
-        assert_eq!(circles.len(), 1, "{circles:?}");
-        assert_eq!(circles[0].cycle.len(), 3, "{}", circles[0]);
+        src.write("tour.rs", "pub fn h() {}\nfn i() { crate::order::f() }\n");
+        let circle = src.only_circle();
+        assert_eq!(circle.cycle.len(), 3, "{circle}");
     }
 
     #[test]
     fn globs_inline_modules_and_test_code_inside_items() {
-        let dir = tempfile::tempdir().unwrap();
-        let src = dir.path();
-        write(
-            src,
+        let src = Sources::new();
+        src.write(
             "lib.rs",
             "mod outer {\n    pub mod inner;\n    pub fn f() { inner::g() }\n}\n",
         );
-        write(
-            src,
+        src.write(
             "outer/inner.rs",
             concat!(
                 "pub(in crate::outer) fn g() {}\n",
@@ -572,12 +573,15 @@ mod tests {
                 "#[cfg(test)]\nmod tests { use super::super::*; }\n",
             ),
         );
-        assert!(crate_circles(&src.join("lib.rs")).unwrap().is_empty());
+        assert!(src.circles().is_empty());
 
-        write(src, "outer/inner.rs", "use super::*;\npub fn g() {}\n");
-        let circles = crate_circles(&src.join("lib.rs")).unwrap();
-        assert_eq!(circles.len(), 1, "{circles:?}");
-        let members: Vec<String> = circles[0].members.iter().map(display_module).collect();
+        src.write("outer/inner.rs", "use super::*;\npub fn g() {}\n");
+        let members: Vec<String> = src
+            .only_circle()
+            .members
+            .iter()
+            .map(display_module)
+            .collect();
         assert_eq!(members, ["crate::outer", "crate::outer::inner"]);
     }
 
