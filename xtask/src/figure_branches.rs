@@ -146,12 +146,8 @@ fn join(backward: &SelfMotionWalk, forward: &SelfMotionWalk, length_m: f64) -> B
 }
 
 fn draw(args: &Args, robot: &emg_kinematics::Robot, branches: &[Branch]) -> anyhow::Result<()> {
-    if let Some(dir) = args.out.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
     let height = 260 * branches.len() as u32;
-    let root = SVGBackend::new(&args.out, (900, height)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(&args.out, (900, height))?;
     let limits = robot.limits();
     for (b, (branch, area)) in branches
         .iter()

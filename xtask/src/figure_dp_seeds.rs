@@ -116,11 +116,7 @@ fn ik_valid_seeds(args: &Args, robot: &Robot, task: &Task) -> anyhow::Result<Vec
 
 /// The stick figures of `drawn` beside `task`'s line, in a side and a top view.
 fn draw(args: &Args, task: &Task, drawn: &[Drawn]) -> anyhow::Result<()> {
-    if let Some(dir) = args.out.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
-    let root = SVGBackend::new(&args.out, (1100, 520)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(&args.out, (1100, 520))?;
     let (left, right) = root.split_horizontally(550);
     let line_end = task.p0 + task.d * 0.8;
     for (area, (a, b), title) in [

@@ -709,8 +709,7 @@ fn histogram(
         })
         .collect();
     let top = counts.iter().flatten().copied().max().unwrap_or(1) as f64 * 1.1;
-    let root = SVGBackend::new(path, (800, 420)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(path, (800, 420))?;
     let mut chart = ChartBuilder::on(&root)
         .margin(10)
         .x_label_area_size(35)
@@ -803,8 +802,7 @@ fn draw_trace(
 ) -> anyhow::Result<()> {
     let limits = setup.robot.limits();
     let (mid, half) = (limits.mid()[5], limits.half_range()[5]);
-    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(path, (800, 560))?;
     let (upper, lower) = root.split_vertically(260);
     let end = trajectory.steps.last().map_or(1.0, |s| s.time_s).max(0.1);
     let colour = |c: Option<emg_control::ActingController>| match c {

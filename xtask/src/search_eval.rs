@@ -476,9 +476,6 @@ fn budget_name(row: &Row) -> String {
 /// Σ length / Σ bound against the search budget, one line per bucket of the bound and one for
 /// all tasks, with the pipeline's share of all tasks as a horizontal line.
 fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
     let searched: Vec<&Row> = record
         .rows
         .iter()
@@ -496,8 +493,7 @@ fn draw(record: &Record, path: &Path) -> anyhow::Result<()> {
         .find(|r| r.budget_steps.is_none())
         .and_then(|r| r.bound_shares.last())
         .map_or(0.0, |all| all.share);
-    let root = SVGBackend::new(path, (720, 420)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(path, (720, 420))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!(

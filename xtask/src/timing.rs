@@ -407,16 +407,12 @@ fn markdown(record: &Record) -> String {
 /// Each task's duration against its path's TCP travel, with the line of a motion at the
 /// requested tool speed throughout: how far the joint limits keep the tool below it.
 fn draw(outcomes: &[Outcome], record: &Record, path: &Path) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir)?;
-    }
     let axis_end = |value: fn(&Outcome) -> f64| {
         outcomes.iter().map(value).fold(0.0, f64::max).max(1e-3) * 1.05
     };
     let (longest, slowest) = (axis_end(|o| o.path_travel_m), axis_end(|o| o.duration_s));
     let speed = record.tool_speed_m_per_s;
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(path, (720, 480))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!(

@@ -12,7 +12,7 @@ use emg_seeding::{LabelSet, hex};
 use serde::{Deserialize, Serialize};
 
 use crate::backend_choice::BackendChoice;
-use crate::{progress, workspace};
+use crate::{figure, progress, workspace};
 
 /// Options of `train-diffusion`.
 #[derive(clap::Args)]
@@ -289,8 +289,7 @@ fn write_loss_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()> {
         return Ok(());
     }
     let path = results.join("diffusion-training.svg");
-    let root = SVGBackend::new(&path, (720, 420)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(&path, (720, 420))?;
     let max_step = log.last().map_or(1, |r| r.step) as f64;
     let (low, high) = log.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
         (lo.min(r.loss), hi.max(r.loss))

@@ -15,7 +15,7 @@ use emg_seeding::LabelSet;
 use serde::{Deserialize, Serialize};
 
 use crate::backend_choice::BackendChoice;
-use crate::{progress, workspace};
+use crate::{figure, progress, workspace};
 
 /// Options of `train-ppo`.
 #[derive(clap::Args)]
@@ -268,8 +268,7 @@ fn write_learning_curve(trainer: &Trainer, results: &Path) -> anyhow::Result<()>
         return Ok(());
     }
     let path = results.join("ppo-learning-curve.svg");
-    let root = SVGBackend::new(&path, (720, 420)).into_drawing_area();
-    root.fill(&WHITE)?;
+    let root = figure::canvas(&path, (720, 420))?;
     let max_x = points.last().map_or(1.0, |p| p.0).max(1e-3);
     let max_y = points.iter().fold(0.0f64, |m, p| m.max(p.1)) * 1.1;
     let mut chart = ChartBuilder::on(&root)
