@@ -659,6 +659,15 @@ fn comparison(record: &Record) -> String {
     let sum = |value: fn(&JobRow) -> f64| rows.iter().map(value).sum::<f64>();
     let count = |value: fn(&JobRow) -> usize| rows.iter().map(value).sum::<usize>();
     let strokes = count(|r| r.strokes);
+    // Σ of a duration and of its pen-up and pen-down parts (s).
+    let split = |up: fn(&JobRow) -> f64, down: fn(&JobRow) -> f64| {
+        format!(
+            "{:.1} (pen up {:.1}, pen down {:.1})",
+            rows.iter().map(|r| up(r) + down(r)).sum::<f64>(),
+            sum(up),
+            sum(down)
+        )
+    };
     let mut md = format!(
         "# Jobs ({})\n\n\
          Written by `{}` on {}. Every SVG of `{}` placed pen down at {} places in front of the \
@@ -675,8 +684,8 @@ fn comparison(record: &Record) -> String {
          | pen-down length drawn (Σ of {:.3} m) | {:.3} ({:.1} %) | {:.3} ({:.1} %) |\n\
          | strokes complete / resumed / short (of {strokes}) | {} / {} / {} | — |\n\
          | moves colliding | 0 of {} (checked) | {} of {} |\n\
-         | program duration, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | {:.1} |\n\
-         | least duration at the arm's limits, Σ (s) | {:.1} (pen up {:.1}, pen down {:.1}) | — |\n\
+         | program duration, Σ (s) | {} | {:.1} |\n\
+         | least duration at the arm's limits, Σ (s) | {} | — |\n\
          | pen-up time / pen-down time | {:.2} | — |\n\
          | planning time per stroke, mean (ms, {} threads) | {:.1} | — |\n\
          | programs the checker refuses | {} of {} | — |\n\
@@ -699,13 +708,9 @@ fn comparison(record: &Record) -> String {
         count(|r| r.straight_moves + r.sampled_moves),
         count(|r| r.baseline_colliding_moves),
         count(|r| r.baseline_moves),
-        sum(|r| r.pen_up_s + r.pen_down_s),
-        sum(|r| r.pen_up_s),
-        sum(|r| r.pen_down_s),
+        split(|r| r.pen_up_s, |r| r.pen_down_s),
         sum(|r| r.baseline_duration_s),
-        sum(|r| r.least_pen_up_s + r.least_pen_down_s),
-        sum(|r| r.least_pen_up_s),
-        sum(|r| r.least_pen_down_s),
+        split(|r| r.least_pen_up_s, |r| r.least_pen_down_s),
         sum(|r| r.pen_up_s) / sum(|r| r.pen_down_s).max(f64::MIN_POSITIVE),
         record.threads,
         1e3 * sum(|r| r.planning_s) / strokes.max(1) as f64,
