@@ -84,14 +84,10 @@ impl StrokePlan {
 
 /// Plans `path` with `planner` as `request` asks (the search): from `start_s` along it, then
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
-/// `settings.min_gain_m`, up to `settings.max_parts` parts that stop short (a part that stopped
-/// only at the rollout's step cap, the arm still able to go on, is not counted). Where no
-/// motion starts or gains, the stretch is skipped by `settings.min_gain_m`, doubled for each
-/// search in a row that gained nothing after the first [`EVEN_SKIPS`] (such searches are not
-/// counted), so the searches a stroke gets grow
-/// with what is left of it and a stretch out of reach costs a number of searches that grows
-/// with the logarithm of its length; [`Stopped`] where `watch` asks to stop (asked before each
-/// search and between a search's rollouts).
+/// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by
+/// `settings.min_gain_m`, up to `settings.max_parts` searches (a part that stopped only at the
+/// rollout's step cap, the arm still able to go on, is not counted); [`Stopped`] where `watch`
+/// asks to stop (asked before each search and between a search's rollouts).
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,
@@ -110,10 +106,8 @@ pub fn plan_stroke(
     };
     // How far the stroke is drawn or given up.
     let mut done = start_s;
-    // The parts counted against `settings.max_parts`.
+    // The searches counted against `settings.max_parts`.
     let mut counted = 0;
-    // Searches in a row that gained nothing.
-    let mut fruitless = 0;
     // How far along the stroke a search looks: twice what one rollout can draw at most (its
     // step cap at the commanded speed), so a long stroke is not scanned beyond any use.
     let rollout = &planner.config().rollout;
@@ -183,12 +177,11 @@ pub fn plan_stroke(
                 if part.trajectory.termination != Termination::StepCap {
                     counted += 1;
                 }
-                fruitless = 0;
                 plan.parts.push(part);
             }
             _ => {
-                done = (done + fruitless_skip_m(settings.min_gain_m, fruitless)).min(length);
-                fruitless += 1;
+                counted += 1;
+                done = (done + settings.min_gain_m).min(length);
             }
         }
         watch.searched(done - before);
@@ -199,8 +192,7 @@ pub fn plan_stroke(
 /// `plan` finished from its stroke's other end: where its forward parts stop short of the end by
 /// more than `settings.min_gain_m`, the stretch from there (`settings.overlap_m` back) to the
 /// end is planned from the end back ([`plan_stroke`] on the reversed stretch), and its parts
-/// are added as backward parts (those that start past the forward reach by more than
-/// `settings.min_gain_m`): the two sides meet where both reach. Its searches are counted;
+/// are added as backward parts: the two sides meet where both reach. Its searches are counted;
 /// the plan is left as it is where that stretch cannot be reversed.
 pub fn finish_from_the_end(
     planner: &Planner,
@@ -229,20 +221,12 @@ pub fn finish_from_the_end(
             at_s: length - stop.at_s,
             ..stop
         }));
-    // A part that starts no further than `settings.min_gain_m` past the forward parts' reach
-    // draws only what they draw (the searches from the end skipped there over a stretch out of
-    // reach): it is not kept.
-    plan.parts.extend(
-        back_plan
-            .parts
-            .into_iter()
-            .map(|part| StrokePart {
-                from_s: length - part.from_s,
-                backward: true,
-                ..part
-            })
-            .filter(|part| part.from_s > reached + settings.min_gain_m),
-    );
+    plan.parts
+        .extend(back_plan.parts.into_iter().map(|part| StrokePart {
+            from_s: length - part.from_s,
+            backward: true,
+            ..part
+        }));
     Ok(plan)
 }
 
@@ -257,18 +241,6 @@ pub fn reachable_start_s(path: &Path, robot: &Robot) -> f64 {
         .map(|k| length * k as f64 / samples as f64)
         .min_by(|a, b| away(*a).total_cmp(&away(*b)))
         .unwrap_or(0.0)
-}
-
-/// Searches in a row that gain nothing before the skip starts to double: a gap up to this many
-/// times `settings.min_gain_m` long is crossed at that step.
-const EVEN_SKIPS: usize = 3;
-
-/// How far a search that gained nothing skips along the stroke (m), after `before` searches in
-/// a row that gained nothing: `min_gain_m` for the first [`EVEN_SKIPS`], then doubled each
-/// time, so that a stretch out of reach `L` long costs about `log2(L / min_gain_m)` searches.
-fn fruitless_skip_m(min_gain_m: f64, before: usize) -> f64 {
-    let doublings = before.saturating_sub(EVEN_SKIPS - 1).min(60);
-    min_gain_m * 2f64.powi(doublings as i32)
 }
 
 /// Whether a part ends at the stroke's end.
