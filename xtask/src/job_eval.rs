@@ -594,7 +594,7 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
     let mut motions = Vec::new();
     for oriented in &ordering.sequence {
         let path = oriented.path(&job.strokes);
-        let plan = plan_stroke(planner, &request, &path, 0.0, &settings, &Unwatched)
+        let plan = plan_stroke(planner, &request, &path, 0.0, &settings, None, &Unwatched)
             .expect("an unwatched stroke is never stopped");
         motions.extend(
             plan.parts

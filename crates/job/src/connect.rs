@@ -330,6 +330,7 @@ impl<'a> Joining<'a> {
             &plan.path,
             resume_s,
             self.connector().settings,
+            Some(self.connector().free),
             watch,
         )?;
         self.searches += rest.searches;

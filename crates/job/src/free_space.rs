@@ -43,6 +43,10 @@ pub const TIP_CLEARANCE_MARGIN_M: f64 = 5e-5;
 /// point's travel) along a pen-up move ([`FreeSpace::move_free`]).
 pub const TIP_CHECKS_PER_STEP: f64 = 10.0;
 
+/// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
+/// into free space (near an obstacle, say).
+pub const LIFT_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
+
 /// Planes closer than this (m, and the same in the cosine of their normals) are one surface.
 const SAME_PLANE: f64 = 1e-6;
 
@@ -430,6 +434,16 @@ impl<'a> FreeSpace<'a> {
     pub fn reach_point(&self, q: &JointVector, target: &Vec3) -> Option<JointVector> {
         project_to_point(self.robot, q, target)
             .filter(|reached| self.free(reached) && self.edge_free(q, reached))
+    }
+
+    /// The configuration near `q` with the TCP lifted `lift_m` along the unit vector `up`
+    /// ([`FreeSpace::reach_point`]), else half or a quarter of that ([`LIFT_SHARES`]): where
+    /// the tool leaves or meets the part. `None` where none of them is free.
+    pub fn lifted(&self, q: &JointVector, up: &Vec3, lift_m: f64) -> Option<JointVector> {
+        let tcp = self.robot.forward(q).tcp();
+        LIFT_SHARES
+            .iter()
+            .find_map(|share| self.reach_point(q, &(tcp + up * (lift_m * share))))
     }
 
     /// A free move from `a` to `b`: the straight edge where it is free, else a path of dual

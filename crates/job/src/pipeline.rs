@@ -56,6 +56,7 @@ pub fn plan_job(
         &ordering.sequence,
         &drawn,
         settings,
+        &free,
         watch,
     )?;
     let connector = Connector {

@@ -6,9 +6,10 @@
 //! 1. **screened** on a coarse grid by a cheap score: the reachability bound of every stroke
 //!    (the part under the strokes kept off, as the job plans; in the shortest order the sum
 //!    of its two ways' bounds, as the job draws a short stroke from both ends, for a closed
-//!    one the better of its start and [`reachable_start_s`]),
-//!    Σ min(bound, length) / Σ length, from a coarse scan ([`PlaceSettings::coarse_grid_m`],
-//!    fewer restarts);
+//!    one the better of its start and [`reachable_start_s`]), and between them the points
+//!    with a configuration, a grid step each (the job's searches skip ahead to where a motion
+//!    starts again), Σ min(bound, length) / Σ length, from a coarse scan
+//!    ([`PlaceSettings::coarse_grid_m`], fewer restarts);
 //! 2. **refined**: the best [`PlaceSettings::refine`] of them, and the places half a grid step
 //!    round the best one, scored again by the full scan;
 //! 3. **certified**: the best [`PlaceSettings::certify`] planned as full jobs ([`plan_job`]),
@@ -516,21 +517,41 @@ pub fn place_score(
                         reach(robot, &task, &constraints, config, &[]).reachable_m
                     })
                 };
-                // In the shortest order a stroke left short is drawn from both ends, and a closed
-                // one may be started where the arm reaches it (`plan_job`): it scores what one
-                // motion from each end could reach, from the better of those starts.
-                let both_ends = |path: &Path, forward: f64| {
-                    if forward >= path.length_m() {
+                // The points of a stretch with a configuration, a grid step each: no motion
+                // draws more of it.
+                let points_m = |path: &Path| {
+                    Task::on_path(robot, path.clone(), None).map_or(0.0, |task| {
+                        let (found, _) = reachable_points(robot, &task, &constraints, config);
+                        (found as f64 * config.grid_m).min(path.length_m())
+                    })
+                };
+                // The job draws what one motion from the start reaches; in the shortest order
+                // also what one from the end reaches, and a closed stroke may be started where
+                // the arm reaches it (`plan_job`); between them its searches skip ahead to
+                // where a motion starts again (`plan_stroke`), which draws at most the points
+                // there with a configuration.
+                let shortest = moved.settings.order == Order::Shortest;
+                let drawable = |path: &Path, forward: f64| {
+                    let length = path.length_m();
+                    if forward >= length {
                         return forward;
                     }
-                    forward + path.reversed().map_or(0.0, |reversed| bound_of(&reversed))
+                    let backward = if shortest {
+                        path.reversed().map_or(0.0, |reversed| bound_of(&reversed))
+                    } else {
+                        0.0
+                    };
+                    let between = path
+                        .stretch(forward, length - backward)
+                        .map_or(0.0, |middle| points_m(&middle));
+                    forward + backward + between
                 };
-                let mut bound = reach(robot, &task, &constraints, config, &[]).reachable_m;
-                if bound < stroke.length_m() && moved.settings.order == Order::Shortest {
-                    bound = both_ends(stroke, bound);
+                let forward = reach(robot, &task, &constraints, config, &[]).reachable_m;
+                let mut bound = drawable(stroke, forward);
+                if bound < stroke.length_m() && shortest {
                     let restarted = stroke.started_at(reachable_start_s(stroke, robot));
-                    if let Some(restarted) = restarted.filter(|_| bound < stroke.length_m()) {
-                        bound = bound.max(both_ends(&restarted, bound_of(&restarted)));
+                    if let Some(restarted) = restarted {
+                        bound = bound.max(drawable(&restarted, bound_of(&restarted)));
                     }
                 }
                 reached += bound.min(stroke.length_m());

@@ -8,6 +8,7 @@ use emg_planner::{PlanRequest, Planner};
 use rayon::prelude::*;
 
 use crate::claims::{COVERAGE_SLACK_M, Coverage, Stretch};
+use crate::free_space::FreeSpace;
 use crate::measures::SAME_LENGTH_M;
 use crate::order::Oriented;
 use crate::spec::{JobSettings, Order};
@@ -45,7 +46,8 @@ pub(crate) fn cascade(on_part: Planner, home: Option<&JointVector>) -> Vec<Plann
 
 /// The plan-strokes stage: each stroke of `sequence` (among the `drawn` paths) planned as the
 /// first planner of `cascade` that draws it whole plans it, else as the narrowest that draws
-/// the most (to [`SAME_LENGTH_M`]); in parallel, the result independent of the number of
+/// the most (to [`SAME_LENGTH_M`]), each part's tool able to lift off its start into `free`;
+/// in parallel, the result independent of the number of
 /// threads. `watch` is told the planning progress in stroke lengths.
 pub(crate) fn plan_strokes(
     cascade: &[Planner],
@@ -53,6 +55,7 @@ pub(crate) fn plan_strokes(
     sequence: &[Oriented],
     drawn: &[Path],
     settings: &JobSettings,
+    free: &FreeSpace,
     watch: &dyn Watch,
 ) -> Result<Vec<PlannedStroke>, Stopped> {
     let progress = PlanningProgress::new(watch, drawn.iter().map(Path::length_m));
@@ -65,7 +68,7 @@ pub(crate) fn plan_strokes(
             let mut best: Option<PlannedStroke> = None;
             for (rank, planner) in cascade.iter().enumerate() {
                 let (oriented, plan) =
-                    planned_stroke(planner, request, oriented, drawn, settings, watch)?;
+                    planned_stroke(planner, request, oriented, drawn, settings, free, watch)?;
                 let drawn_m = plan.planned_m();
                 if best
                     .as_ref()
@@ -105,6 +108,7 @@ fn planned_stroke(
     oriented: Oriented,
     drawn: &[Path],
     settings: &JobSettings,
+    free: &FreeSpace,
     watch: &dyn Watch,
 ) -> Result<(Oriented, StrokePlan), Stopped> {
     let plan = plan_stroke(
@@ -113,17 +117,18 @@ fn planned_stroke(
         &oriented.path(drawn),
         0.0,
         settings,
+        Some(free),
         watch,
     )?;
     match settings.order {
         Order::Shortest => {
             let (oriented, plan) = the_way_drawing_more((oriented, plan), drawn, |path| {
-                plan_stroke(planner, request, path, 0.0, settings, watch)
+                plan_stroke(planner, request, path, 0.0, settings, Some(free), watch)
             })?;
-            let plan = finish_from_the_end(planner, request, plan, settings, watch)?;
+            let plan = finish_from_the_end(planner, request, plan, settings, Some(free), watch)?;
             let plan = started_where_it_draws(plan, planner.robot(), |path| {
-                let plan = plan_stroke(planner, request, path, 0.0, settings, watch)?;
-                finish_from_the_end(planner, request, plan, settings, watch)
+                let plan = plan_stroke(planner, request, path, 0.0, settings, Some(free), watch)?;
+                finish_from_the_end(planner, request, plan, settings, Some(free), watch)
             })?;
             Ok((oriented, plan))
         }
@@ -136,11 +141,13 @@ fn planned_stroke(
 pub const CLOSED_STARTS: usize = 8;
 
 /// `plan` of a closed stroke ([`Path::is_closed`]) whose start no part covers, started again
-/// elsewhere on it where that draws more by [`SAME_LENGTH_M`] (`replan`, both ends): a closed
-/// stroke may start anywhere, and one starting out of reach draws little from either end. The
-/// new start is the middle of the longest stretch a part covers; where none covers any, the
-/// [`CLOSED_STARTS`] points from [`reachable_start_s`] round the loop in turn, until one draws
-/// half the loop, the one that draws most kept. The searches of all are counted.
+/// elsewhere on it (`replan`, both ends) where that draws more by [`SAME_LENGTH_M`], or as much
+/// in fewer parts: a closed stroke may start anywhere, and one starting out of reach draws
+/// little from either end. The new start is where the longest stretch no part covers ends (the
+/// stretches either side of the start counted as one), so that one motion from there may draw
+/// the rest; where no part covers any, the [`CLOSED_STARTS`] points from [`reachable_start_s`]
+/// round the loop in turn, until one draws half the loop, the one that draws most kept. The
+/// searches of all are counted.
 fn started_where_it_draws(
     plan: StrokePlan,
     robot: &Robot,
@@ -149,16 +156,13 @@ fn started_where_it_draws(
     let path = &plan.path.clone();
     let length = path.length_m();
     let stretches: Vec<Stretch> = plan.parts.iter().map(StrokePart::planned).collect();
-    let whole = Coverage::of(length, &stretches).whole();
+    let undrawn = Coverage::of(length, &stretches).undrawn;
     let start_covered = stretches.iter().any(|s| s.from_s <= COVERAGE_SLACK_M);
-    if !path.is_closed() || whole || start_covered {
+    if !path.is_closed() || undrawn.is_empty() || start_covered {
         return Ok(plan);
     }
-    let longest = stretches
-        .iter()
-        .max_by(|a, b| a.length_m().total_cmp(&b.length_m()));
-    let starts: Vec<f64> = match longest {
-        Some(stretch) => vec![0.5 * (stretch.from_s + stretch.to_s)],
+    let starts: Vec<f64> = match longest_gap_end_s(&undrawn, length) {
+        Some(end_s) => vec![end_s],
         None => {
             let first = reachable_start_s(path, robot);
             (0..CLOSED_STARTS)
@@ -172,7 +176,10 @@ fn started_where_it_draws(
             continue;
         };
         let mut other = replan(&rotated)?;
-        if other.planned_m() >= best.planned_m() + SAME_LENGTH_M {
+        let as_much = other.planned_m() >= best.planned_m() - SAME_LENGTH_M;
+        if other.planned_m() >= best.planned_m() + SAME_LENGTH_M
+            || (as_much && other.parts.len() < best.parts.len())
+        {
             other.searches += best.searches;
             best = other;
         } else {
@@ -183,6 +190,29 @@ fn started_where_it_draws(
         }
     }
     Ok(best)
+}
+
+/// Where the longest of the `undrawn` stretches of a closed stroke `length` long ends, the
+/// stretch that ends at the stroke's end and the one that starts at its start counted as one
+/// (the loop's seam lies within it); `None` where every stretch is undrawn (no part drew any).
+fn longest_gap_end_s(undrawn: &[Stretch], length: f64) -> Option<f64> {
+    let at_start = undrawn.first().filter(|gap| gap.from_s <= COVERAGE_SLACK_M);
+    let at_end = undrawn
+        .last()
+        .filter(|gap| gap.to_s >= length - COVERAGE_SLACK_M);
+    let across_seam = match (at_start, at_end) {
+        (Some(first), Some(last)) if undrawn.len() > 1 => {
+            Some((first.length_m() + last.length_m(), first.to_s))
+        }
+        _ => None,
+    };
+    let whole_loop = undrawn.len() == 1 && undrawn[0].length_m() >= length - COVERAGE_SLACK_M;
+    let longest = undrawn
+        .iter()
+        .map(|gap| (gap.length_m(), gap.to_s % length))
+        .chain(across_seam)
+        .max_by(|a, b| a.0.total_cmp(&b.0))?;
+    (!whole_loop).then_some(longest.1)
 }
 
 /// The stroke `planned` drawn the way that draws more: where its plan leaves some of it
@@ -212,5 +242,28 @@ fn the_way_drawing_more(
     } else {
         first.searches += second.searches;
         Ok((oriented, first))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gap(from_s: f64, to_s: f64) -> Stretch {
+        Stretch { from_s, to_s }
+    }
+
+    #[test]
+    fn a_loop_starts_where_its_longest_gap_ends_the_seam_joining_two() {
+        // The stretches either side of the seam make one gap 0.25 m long, longer than 0.2 m
+        // in the middle.
+        let undrawn = [gap(0.0, 0.12), gap(0.3, 0.5), gap(0.87, 1.0)];
+        assert_eq!(longest_gap_end_s(&undrawn, 1.0), Some(0.12));
+        let undrawn = [gap(0.0, 0.05), gap(0.3, 0.6), gap(0.95, 1.0)];
+        assert_eq!(longest_gap_end_s(&undrawn, 1.0), Some(0.6));
+        // A gap ending at the seam alone ends at the start.
+        assert_eq!(longest_gap_end_s(&[gap(0.7, 1.0)], 1.0), Some(0.0));
+        // Nothing covered: no gap ends anywhere.
+        assert_eq!(longest_gap_end_s(&[gap(0.0, 1.0)], 1.0), None);
     }
 }

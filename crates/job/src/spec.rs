@@ -92,10 +92,12 @@ pub struct JobSettings {
     /// along it (m).
     pub overlap_m: f64,
     /// A stroke is resumed while a part gains at least this much (m); where a part gains
-    /// less, the stretch is skipped by this much and reported out of reach.
+    /// less, the stretch is skipped by this much, doubled for each search in a row before it
+    /// that gained nothing, and reported out of reach.
     pub min_gain_m: f64,
-    /// Searches a stroke is planned with at most; a part that stopped only at the rollout's
-    /// step cap (the arm still able to go on) is not counted.
+    /// Parts stopping short of the stroke's end a stroke is planned with at most; a part that
+    /// stopped only at the rollout's step cap (the arm still able to go on) is not counted,
+    /// nor a search that gained nothing (it skips ahead, `min_gain_m`).
     pub max_parts: usize,
     /// Seed of the sampling planner of the free moves.
     pub seed: u64,

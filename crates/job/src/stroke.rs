@@ -8,6 +8,7 @@ use emg_kinematics::Robot;
 use emg_planner::{PlanRequest, Planner};
 
 use crate::claims::{Coverage, OnStroke, Stretch};
+use crate::free_space::FreeSpace;
 use crate::shortfall::{Shortfall, Stop};
 use crate::spec::JobSettings;
 use crate::watch::{Stopped, Watch};
@@ -71,29 +72,27 @@ impl StrokePlan {
         let stretches: Vec<Stretch> = self.parts.iter().map(StrokePart::planned).collect();
         Coverage::of(self.path.length_m(), &stretches).drawn_m
     }
-
-    /// How far along the stroke its forward parts reach (m; 0 with none).
-    fn forward_reach_s(&self) -> f64 {
-        self.parts
-            .iter()
-            .filter(|part| !part.backward)
-            .map(StrokePart::reached_s)
-            .fold(0.0, f64::max)
-    }
 }
 
 /// Plans `path` with `planner` as `request` asks (the search): from `start_s` along it, then
 /// from where each part stopped (`settings.overlap_m` back), while a part gains at least
-/// `settings.min_gain_m`; a stretch where no motion starts or gains is skipped by
-/// `settings.min_gain_m`, up to `settings.max_parts` searches (a part that stopped only at the
-/// rollout's step cap, the arm still able to go on, is not counted); [`Stopped`] where `watch`
-/// asks to stop (asked before each search and between a search's rollouts).
+/// `settings.min_gain_m`, up to `settings.max_parts` parts that stop short (a part that stopped
+/// only at the rollout's step cap, the arm still able to go on, is not counted). Where no
+/// motion starts or gains, the stretch is skipped by `settings.min_gain_m`, doubled for each
+/// search in a row that gained nothing after the first [`EVEN_SKIPS`] (such searches are not
+/// counted), so the searches a stroke gets grow
+/// with what is left of it and a stretch out of reach costs a number of searches that grows
+/// with the logarithm of its length. Where `free` is given, a part whose tool cannot lift off
+/// its start into it ([`FreeSpace::lifted`]) gains nothing: the connect stage could not set
+/// the tool down there. [`Stopped`] where `watch` asks to stop (asked before each search and
+/// between a search's rollouts).
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,
     path: &Path,
     start_s: f64,
     settings: &JobSettings,
+    free: Option<&FreeSpace>,
     watch: &dyn Watch,
 ) -> Result<StrokePlan, Stopped> {
     let length = path.length_m();
@@ -106,8 +105,10 @@ pub fn plan_stroke(
     };
     // How far the stroke is drawn or given up.
     let mut done = start_s;
-    // The searches counted against `settings.max_parts`.
+    // The parts counted against `settings.max_parts`.
     let mut counted = 0;
+    // Searches in a row that gained nothing.
+    let mut fruitless = 0;
     // How far along the stroke a search looks: twice what one rollout can draw at most (its
     // step cap at the commanded speed), so a long stroke is not scanned beyond any use.
     let rollout = &planner.config().rollout;
@@ -147,6 +148,15 @@ pub fn plan_stroke(
         if watch.stop_requested() {
             return Err(Stopped);
         }
+        let part = part.and_then(|part| match free {
+            Some(free) if starts(&part) && !lifts_off(free, &part, settings.lift()) => {
+                Err(format!(
+                    "the tool cannot lift {} m (or a quarter of it) off its start into free space",
+                    settings.lift()
+                ))
+            }
+            _ => Ok(part),
+        });
         let part = match part {
             Ok(part) => {
                 let stop = Stop::of_motion(part.reached_s(), &part.trajectory.termination);
@@ -163,12 +173,7 @@ pub fn plan_stroke(
         };
         let gained = part
             .as_ref()
-            .filter(|part| {
-                !matches!(
-                    part.trajectory.termination,
-                    Termination::InvalidStart { .. }
-                )
-            })
+            .filter(|part| starts(part))
             .map_or(0.0, |part| part.reached_s() - done);
         let before = done;
         match part {
@@ -177,11 +182,12 @@ pub fn plan_stroke(
                 if part.trajectory.termination != Termination::StepCap {
                     counted += 1;
                 }
+                fruitless = 0;
                 plan.parts.push(part);
             }
             _ => {
-                counted += 1;
-                done = (done + settings.min_gain_m).min(length);
+                done = (done + fruitless_skip_m(settings.min_gain_m, fruitless)).min(length);
+                fruitless += 1;
             }
         }
         watch.searched(done - before);
@@ -189,44 +195,66 @@ pub fn plan_stroke(
     Ok(plan)
 }
 
-/// `plan` finished from its stroke's other end: where its forward parts stop short of the end by
-/// more than `settings.min_gain_m`, the stretch from there (`settings.overlap_m` back) to the
-/// end is planned from the end back ([`plan_stroke`] on the reversed stretch), and its parts
-/// are added as backward parts: the two sides meet where both reach. Its searches are counted;
-/// the plan is left as it is where that stretch cannot be reversed.
+/// `plan` finished from the far side of each gap its forward parts leave (a stretch they do not
+/// cover, longer than `settings.min_gain_m`, the one up to the stroke's end included): the
+/// stretch from the gap's start (`settings.overlap_m` back) to its end is planned from its end
+/// back ([`plan_stroke`] on the reversed stretch), and its parts are added as backward parts
+/// (those that start past the gap's start by more than `settings.min_gain_m`): the two sides of
+/// each gap meet where both reach. Their searches are counted; a gap whose stretch cannot be
+/// reversed is left as it is.
 pub fn finish_from_the_end(
     planner: &Planner,
     request: &PlanRequest,
     mut plan: StrokePlan,
     settings: &JobSettings,
+    free: Option<&FreeSpace>,
     watch: &dyn Watch,
 ) -> Result<StrokePlan, Stopped> {
     let length = plan.path.length_m();
-    let reached = plan.forward_reach_s();
-    if reached >= length - settings.min_gain_m {
-        return Ok(plan);
+    let forward: Vec<Stretch> = plan
+        .parts
+        .iter()
+        .filter(|part| !part.backward)
+        .map(StrokePart::planned)
+        .collect();
+    let gaps = Coverage::of(length, &forward).undrawn;
+    for gap in gaps
+        .iter()
+        .filter(|gap| gap.length_m() > settings.min_gain_m)
+    {
+        let from = (gap.from_s - settings.overlap_m).max(0.0);
+        let Some(back) = plan.path.stretch(from, gap.to_s).and_then(|s| s.reversed()) else {
+            continue;
+        };
+        let back_plan = plan_stroke(planner, request, &back, 0.0, settings, free, watch)?;
+        plan.searches += back_plan.searches;
+        let unsearched_here = plan
+            .unsearched_from_s
+            .is_some_and(|s| (gap.from_s..=gap.to_s).contains(&s));
+        if unsearched_here && back_plan.unsearched_from_s.is_none() {
+            plan.unsearched_from_s = None;
+        }
+        // A part `from_s` along the reversed stretch starts `gap.to_s − from_s` along the stroke.
+        plan.stops
+            .extend(back_plan.stops.into_iter().map(|stop| Stop {
+                at_s: gap.to_s - stop.at_s,
+                ..stop
+            }));
+        // A part that starts no further than `settings.min_gain_m` into the gap draws only what
+        // the forward parts draw (the searches from the gap's end skipped there over a stretch
+        // out of reach): it is not kept.
+        plan.parts.extend(
+            back_plan
+                .parts
+                .into_iter()
+                .map(|part| StrokePart {
+                    from_s: gap.to_s - part.from_s,
+                    backward: true,
+                    ..part
+                })
+                .filter(|part| part.from_s > gap.from_s + settings.min_gain_m),
+        );
     }
-    let from = (reached - settings.overlap_m).max(0.0);
-    let Some(back) = plan.path.stretch(from, length).and_then(|s| s.reversed()) else {
-        return Ok(plan);
-    };
-    let back_plan = plan_stroke(planner, request, &back, 0.0, settings, watch)?;
-    plan.searches += back_plan.searches;
-    if back_plan.unsearched_from_s.is_none() {
-        plan.unsearched_from_s = None;
-    }
-    // A part `from_s` along the reversed stretch starts `length − from_s` along the stroke.
-    plan.stops
-        .extend(back_plan.stops.into_iter().map(|stop| Stop {
-            at_s: length - stop.at_s,
-            ..stop
-        }));
-    plan.parts
-        .extend(back_plan.parts.into_iter().map(|part| StrokePart {
-            from_s: length - part.from_s,
-            backward: true,
-            ..part
-        }));
     Ok(plan)
 }
 
@@ -241,6 +269,34 @@ pub fn reachable_start_s(path: &Path, robot: &Robot) -> f64 {
         .map(|k| length * k as f64 / samples as f64)
         .min_by(|a, b| away(*a).total_cmp(&away(*b)))
         .unwrap_or(0.0)
+}
+
+/// Searches in a row that gain nothing before the skip starts to double: a gap up to this many
+/// times `settings.min_gain_m` long is crossed at that step.
+const EVEN_SKIPS: usize = 6;
+
+/// How far a search that gained nothing skips along the stroke (m), after `before` searches in
+/// a row that gained nothing: `min_gain_m` for the first [`EVEN_SKIPS`], then doubled each
+/// time, so that a stretch out of reach `L` long costs about `log2(L / min_gain_m)` searches.
+fn fruitless_skip_m(min_gain_m: f64, before: usize) -> f64 {
+    let doublings = before.saturating_sub(EVEN_SKIPS - 1).min(60);
+    min_gain_m * 2f64.powi(doublings as i32)
+}
+
+/// Whether the motion of `part` starts (its start keeps every constraint).
+fn starts(part: &StrokePart) -> bool {
+    !matches!(
+        part.trajectory.termination,
+        Termination::InvalidStart { .. }
+    )
+}
+
+/// Whether the tool of `part` can lift off the part's start into `free` (`lift_m` or a share).
+fn lifts_off(free: &FreeSpace, part: &StrokePart, lift_m: f64) -> bool {
+    part.trajectory
+        .steps
+        .first()
+        .is_some_and(|step| free.lifted(&step.q, &-part.task.n, lift_m).is_some())
 }
 
 /// Whether a part ends at the stroke's end.

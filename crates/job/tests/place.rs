@@ -1,8 +1,7 @@
-//! The placement screen against what the job draws: near the edge of the FR3's reach, where
-//! the signature's long stroke drawn from one end draws a tenth of what it draws from the
-//! other, the screened score of every place of a small grid is at least the share the job
-//! planned there draws; and places are planned until no refined place left unplanned scores
-//! above what the chosen one draws.
+//! The placement screen against what the job draws: near the edge of the FR3's reach the
+//! screened score of every place of a small grid is at least the share the job planned there
+//! draws; and places are planned until no refined place left unplanned scores above what the
+//! chosen one draws.
 
 mod common;
 
@@ -11,8 +10,9 @@ use emg_job::{Moving, PlaceSettings, Region, Score, Unwatched, place_job};
 use emg_planner::PlanRequest;
 
 /// The signature 0.4 m wide near the edge of the FR3's reach placed over a 3 × 3 grid of shifts
-/// `x_m` along x (and 0 to 0.2 m along y) with `certify` places planned at least.
-fn placed(x_m: [f64; 2], certify: usize) -> (emg_job::Placement, f64) {
+/// `x_m` along x (and 0 to 0.2 m along y) with `certify` places planned at least, each stroke
+/// planned in `max_parts` parts at most.
+fn placed(x_m: [f64; 2], certify: usize, max_parts: usize) -> (emg_job::Placement, f64) {
     let (planner, timing, _, file) = common::setup("fr3");
     let robot = planner.robot();
     let svg = common::workspace().join("crates/io/tests/data/icons/signature.svg");
@@ -21,7 +21,8 @@ fn placed(x_m: [f64; 2], certify: usize) -> (emg_job::Placement, f64) {
         width_m: Some(0.4),
         ..SvgPlacement::default()
     };
-    let job = common::drawing(robot, &svg, &placement);
+    let mut job = common::drawing(robot, &svg, &placement);
+    job.settings.max_parts = max_parts;
     let region = Region {
         moving: Moving::Part,
         x_m,
@@ -58,7 +59,8 @@ fn placed(x_m: [f64; 2], certify: usize) -> (emg_job::Placement, f64) {
 #[test]
 fn the_screened_score_bounds_the_share_drawn_at_every_place() {
     // Every screened place refined, and every refined place planned.
-    let (found, slack) = placed([-0.1, 0.2], 9 + 8);
+    let default = emg_job::JobSettings::default().max_parts;
+    let (found, slack) = placed([-0.1, 0.2], 9 + 8, default);
     let mut partial = 0;
     for certified in &found.certified {
         let drawn = certified.drawn_m / certified.total_m;
@@ -76,14 +78,19 @@ fn the_screened_score_bounds_the_share_drawn_at_every_place() {
 
 #[test]
 fn places_are_planned_until_none_left_scores_above_the_chosen_one() {
-    // Farther out, where the first place planned draws a quarter of the job and others score
-    // more than that.
-    let (found, _) = placed([0.3, 0.45], 1);
+    // Farther out, each stroke in one part each way, where the first place planned draws
+    // less than others score.
+    let (found, _) = placed([0.3, 0.45], 1, 1);
     let chosen = &found.certified[0];
     let drawn = chosen.drawn_m / chosen.total_m;
     assert!(
         found.certified.len() > 1,
-        "only the first place was planned"
+        "only the first place was planned: drew {drawn:.3}; refined {:?}",
+        found
+            .refined
+            .iter()
+            .map(|r| (r.place.x_m, r.place.y_m, r.score))
+            .collect::<Vec<_>>()
     );
     for refined in &found.refined {
         let planned = found

@@ -35,10 +35,6 @@ pub const MAX_HELD_UP_DEPTH: usize = 3;
 /// a torch's lift, clear of what lies on the part.
 pub const CLEARANCE_LIFT_M: f64 = 0.03;
 
-/// The shares of the job's lift height tried in turn where the tool cannot lift the whole of it
-/// into free space (near an obstacle, say).
-const LIFT_SHARES: [f64; 3] = [1.0, 0.5, 0.25];
-
 /// A stroke part made ready to join the program: timed, with its free configurations above
 /// its start and end and the free move to the first from where the arm was.
 pub(super) struct Placed {
@@ -80,12 +76,8 @@ impl Connector<'_> {
         let end = timed.samples[timed.samples.len() - 1].q;
         // The tool lifts the job's height where that is free, else half or a quarter of it.
         let above = |q: &JointVector, what: &str| {
-            LIFT_SHARES
-                .iter()
-                .find_map(|share| {
-                    let lift = -part.task.n * (self.settings.lift() * share);
-                    self.free.reach_point(q, &(robot.forward(q).tcp() + lift))
-                })
+            self.free
+                .lifted(q, &-part.task.n, self.settings.lift())
                 .ok_or_else(|| {
                     format!(
                         "the tool cannot lift {} m (or a quarter of it) off its {what} into free \
