@@ -91,6 +91,18 @@ fn the_ur5e_house_program_reads_back_within_the_tolerance_and_cone() {
 }
 
 #[test]
+fn a_cusp_the_samples_turn_at_is_not_cut_short_by_a_line_or_a_blend() {
+    // The anchor's arrowheads turn back at cusps. A line or blend ending short of where the
+    // samples turned left the reader's progress before the cusp, and the line back out then
+    // lay 0.53 mm (a line) or 0.57 mm (a blend) from the stroke it had reached.
+    let tmp = temp_dir("ur-anchor");
+    let icon = Path::new(env!("CARGO_MANIFEST_DIR")).join("../io/tests/data/icons/anchor.svg");
+    let (script, plan) = exported(&icon, tmp.path(), &["--width", "0.15"]);
+    let report = read_back(&script, &plan).unwrap_or_else(|e| panic!("{e}"));
+    assert_reads_back(&report, &plan);
+}
+
+#[test]
 fn a_hundred_stroke_ur5e_program_reads_back() {
     let tmp = temp_dir("ur-hundred");
     let drawing = tmp.path().join("scatter.svg");

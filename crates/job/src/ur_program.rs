@@ -470,7 +470,7 @@ impl Writer<'_> {
             let radius = kept.get(n + 2).map_or(0.0, |&m| {
                 blend_radius(
                     [&poses[i], &poses[j], &poses[m]],
-                    progress[i],
+                    [progress[i], progress[j]],
                     task,
                     self.tolerance,
                     self.cone_deg,
@@ -528,9 +528,14 @@ fn furthest(i: usize, last: usize, mut fits: impl FnMut(usize) -> bool) -> usize
 /// The indices of the stroke's samples kept as targets (the first and the last among them) and
 /// the largest distance from the stroke found on the lines between them: each line within
 /// [`CHORD_SHARE`] of the `tolerance` of `task` and its slerped tool axis within `cone_deg` at
-/// every sample between its ends (taken at the sample's projection on it, and measured from the
-/// path point the sample before it reached, `progress`, as well as from the whole path), and no
-/// joint turning more than [`MAX_TARGET_TURN_RAD`] from its start to any sample up to its end.
+/// every sample between its ends (taken at the sample's projection on it) and at its end,
+/// measured from the path point reached, the progress followed along the line from the
+/// samples' progress (`progress`) at its start as the reader follows it, as well as from the
+/// whole path; following the line reaches as far along the stroke as the samples do at its end
+/// (a line that cuts a corner short of where the samples turned would leave the reader's
+/// progress before the corner); and no joint turns more than [`MAX_TARGET_TURN_RAD`] from its
+/// start to any sample up to its end. Two neighbouring samples always fit where the samples
+/// keep the tolerance: the line between them is followed as the samples are.
 fn stroke_targets(
     poses: &[Pose],
     progress: &[f64],
@@ -548,22 +553,22 @@ fn stroke_targets(
         let chord = b - a;
         let length2 = chord.norm_squared();
         let mut largest: f64 = 0.0;
+        let mut s = progress[i];
         for k in i + 1..=j {
             if (qs[k] - qs[i]).amax() > MAX_TARGET_TURN_RAD {
                 return None;
             }
-            if k == j {
-                break;
-            }
-            let u = if length2 > 0.0 {
+            let u = if k == j {
+                1.0
+            } else if length2 > 0.0 {
                 ((poses[k].position - a).dot(&chord) / length2).clamp(0.0, 1.0)
             } else {
                 0.0
             };
             let point = a + chord * u;
-            let distance = task
-                .distance(&point)
-                .max(task.along(&point, progress[k - 1]).lateral.norm());
+            let along = task.along(&point, s);
+            s = along.s_m;
+            let distance = task.distance(&point).max(along.lateral.norm());
             let rotation = poses[i]
                 .rotation
                 .try_slerp(&poses[j].rotation, u, 1e-12)
@@ -574,7 +579,7 @@ fn stroke_targets(
             }
             largest = largest.max(distance);
         }
-        Some(largest)
+        (s >= progress[j] - SAME_PROGRESS_M).then_some(largest)
     };
     let mut i = 0;
     while i < last {
@@ -586,15 +591,21 @@ fn stroke_targets(
     (kept, worst)
 }
 
+/// How far (m) following a line between two targets may end behind the samples' progress at
+/// its end and still count as reaching it (rounding only).
+const SAME_PROGRESS_M: f64 = 1e-9;
+
 /// The radius of the blend at target `j` between the lines from target `i` and to target `m`
 /// (m): at most [`BLEND_LENGTH_SHARE`] of the shorter line, halved until its arc ([`blend_arc`])
 /// lies within [`CHORD_SHARE`] of the `tolerance` of `task` (measured from the path point
 /// reached, followed along the arc from `from_s`, the progress at `a`, and from the whole path)
-/// and its tool axis within `cone_deg` of the task's normal; 0 (no blend) where no radius tried
-/// does.
+/// and its tool axis within `cone_deg` of the task's normal, the progress followed to its end
+/// reaching `at_b_s`, the samples' progress at `b` (an arc that turns short of a corner the
+/// samples came to would leave the reader's progress before it); 0 (no blend) where no radius
+/// tried does.
 fn blend_radius(
     [a, b, c]: [&Pose; 3],
-    from_s: f64,
+    [from_s, at_b_s]: [f64; 2],
     task: &Task,
     tolerance: f64,
     cone_deg: f64,
@@ -611,7 +622,7 @@ fn blend_radius(
             task.distance(&pose.position).max(along.lateral.norm()) <= CHORD_SHARE * tolerance
                 && tool_angle_deg(&(pose.rotation * Vec3::z()), &task.n) <= cone_deg
         });
-        if fits {
+        if fits && s >= at_b_s - SAME_PROGRESS_M {
             return radius;
         }
         radius /= 2.0;
