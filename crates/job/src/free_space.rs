@@ -436,6 +436,14 @@ impl<'a> FreeSpace<'a> {
             .filter(|reached| self.free(reached) && self.edge_free(q, reached))
     }
 
+    /// Why a tool cannot lift `lift_m` off the `what` (start or end) of a stroke part where
+    /// [`FreeSpace::lifted`] finds no configuration.
+    pub fn cannot_lift(lift_m: f64, what: &str) -> String {
+        format!(
+            "the tool cannot lift {lift_m} m (or a quarter of it) off its {what} into free space"
+        )
+    }
+
     /// The configuration near `q` with the TCP lifted `lift_m` along the unit vector `up`
     /// ([`FreeSpace::reach_point`]), else half or a quarter of that ([`LIFT_SHARES`]): where
     /// the tool leaves or meets the part. `None` where none of them is free.

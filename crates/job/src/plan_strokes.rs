@@ -47,8 +47,8 @@ pub(crate) fn cascade(on_part: Planner, home: Option<&JointVector>) -> Vec<Plann
 /// The plan-strokes stage: each stroke of `sequence` (among the `drawn` paths) planned as the
 /// first planner of `cascade` that draws it whole plans it, else as the narrowest that draws
 /// the most (to [`SAME_LENGTH_M`]), each part's tool able to lift off its start into `free`;
-/// in parallel, the result independent of the number of
-/// threads. `watch` is told the planning progress in stroke lengths.
+/// in parallel, the result independent of the number of threads. `watch` is told the planning
+/// progress in stroke lengths.
 pub(crate) fn plan_strokes(
     cascade: &[Planner],
     request: &PlanRequest,

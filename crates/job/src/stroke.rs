@@ -80,9 +80,8 @@ impl StrokePlan {
 /// only at the rollout's step cap, the arm still able to go on, is not counted). Where no
 /// motion starts or gains, the stretch is skipped by `settings.min_gain_m`, doubled for each
 /// search in a row that gained nothing after the first [`EVEN_SKIPS`] (such searches are not
-/// counted), so the searches a stroke gets grow
-/// with what is left of it and a stretch out of reach costs a number of searches that grows
-/// with the logarithm of its length. Where `free` is given, a part whose tool cannot lift off
+/// counted), so the searches a stroke gets grow with what is left of it and a stretch out of
+/// reach costs a number of searches that grows with the logarithm of its length. Where `free` is given, a part whose tool cannot lift off
 /// its start into it ([`FreeSpace::lifted`]) gains nothing: the connect stage could not set
 /// the tool down there. [`Stopped`] where `watch` asks to stop (asked before each search and
 /// between a search's rollouts).
@@ -150,10 +149,7 @@ pub fn plan_stroke(
         }
         let part = part.and_then(|part| match free {
             Some(free) if starts(&part) && !lifts_off(free, &part, settings.lift()) => {
-                Err(format!(
-                    "the tool cannot lift {} m (or a quarter of it) off its start into free space",
-                    settings.lift()
-                ))
+                Err(FreeSpace::cannot_lift(settings.lift(), "start"))
             }
             _ => Ok(part),
         });

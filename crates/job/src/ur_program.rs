@@ -534,8 +534,8 @@ fn furthest(i: usize, last: usize, mut fits: impl FnMut(usize) -> bool) -> usize
 /// whole path; following the line reaches as far along the stroke as the samples do at its end
 /// (a line that cuts a corner short of where the samples turned would leave the reader's
 /// progress before the corner); and no joint turns more than [`MAX_TARGET_TURN_RAD`] from its
-/// start to any sample up to its end. Two neighbouring samples always fit where the samples
-/// keep the tolerance: the line between them is followed as the samples are.
+/// start to any sample up to its end. The line between two neighbouring samples is followed
+/// as the samples are; where even it does not fit, it is kept ([`furthest`]).
 fn stroke_targets(
     poses: &[Pose],
     progress: &[f64],

@@ -78,13 +78,7 @@ impl Connector<'_> {
         let above = |q: &JointVector, what: &str| {
             self.free
                 .lifted(q, &-part.task.n, self.settings.lift())
-                .ok_or_else(|| {
-                    format!(
-                        "the tool cannot lift {} m (or a quarter of it) off its {what} into free \
-                         space",
-                        self.settings.lift()
-                    )
-                })
+                .ok_or_else(|| FreeSpace::cannot_lift(self.settings.lift(), what))
         };
         let above_start = above(&start, "start")?;
         let above_end = above(&end, "end")?;
