@@ -19,7 +19,7 @@ use crate::measures::SAME_LENGTH_M;
 use crate::order::Oriented;
 use crate::plan_strokes::PlannedStroke;
 use crate::program::{Program, SegmentKind, StrokeReport};
-use crate::shortfall::{self, LeftOut, Stop};
+use crate::shortfall::{self, LeftOut, Shortfall, Stop};
 use crate::stroke::{StrokePart, StrokePlan, plan_stroke};
 use crate::watch::{Stopped, Watch};
 
@@ -237,7 +237,7 @@ impl<'a> Joining<'a> {
                     joining.parts_left_out.push(format!("part {index}: {why}"));
                     joining.left_out.push(LeftOut {
                         planned: planned.planned(),
-                        why: why.to_string(),
+                        why,
                     });
                 }
                 (again.then_some(planned.from_s), None)
@@ -295,7 +295,7 @@ impl<'a> Joining<'a> {
         candidates: &[StrokePart],
         from: Option<JointVector>,
         seed: u64,
-    ) -> Result<(StrokePart, Placed), String> {
+    ) -> Result<(StrokePart, Placed), Shortfall> {
         let connector = self.connector();
         let robot = connector.free.robot();
         // The way the tool rose off the last part, which it may rise further along.

@@ -3,7 +3,7 @@
 //! the stroke's end, each part left out its stretch and why, and each stretch the program does
 //! not draw is given the cause found at its start.
 
-use emg_control::{Termination, Violation};
+use emg_control::{Termination, Violation, WORK_SURFACE};
 use serde::{Deserialize, Serialize};
 
 use crate::claims::{COVERAGE_SLACK_M, Stretch};
@@ -25,10 +25,16 @@ pub enum Shortfall {
         /// What the search found.
         why: String,
     },
-    /// A part was planned there but left out of the program: no safe move reaches it, or it
-    /// cannot be timed (`why`).
+    /// A part was planned there but left out of the program: no safe move reaches it, or the
+    /// tool cannot lift off it (`why`).
     LeftOut {
         /// Why the part was left out.
+        why: String,
+    },
+    /// A part was planned there but its motion cannot be timed within the joint limits (`why`):
+    /// it is left out of the program.
+    Untimed {
+        /// What the timing found.
         why: String,
     },
     /// The stroke's searches (`settings.max_parts`) were spent before it: it was not searched.
@@ -39,13 +45,24 @@ pub enum Shortfall {
 }
 
 impl Shortfall {
-    /// Short machine-readable name: `reach`, `no_start`, `left_out`, `not_searched`,
+    /// Short machine-readable name of the cause: where the arm stopped, what its next step
+    /// broke (`self_collision`: the arm itself; `part`: the part drawn on, its work surface;
+    /// `scene`: another obstacle; `reach`: a joint limit, the tool cone or the line tolerance);
+    /// else `no_start`, `left_out`, `untimed`, `not_searched` (the search budget) or
     /// `timed_short`.
     pub fn label(&self) -> &'static str {
         match self {
-            Self::Reach { .. } => "reach",
+            Self::Reach { violation } => match violation {
+                Violation::SelfCollision { .. } => "self_collision",
+                Violation::SceneContact { obstacle, .. } if obstacle == WORK_SURFACE => "part",
+                Violation::SceneContact { .. } => "scene",
+                Violation::JointLimit { .. }
+                | Violation::ToolCone { .. }
+                | Violation::LineTolerance { .. } => "reach",
+            },
             Self::NoStart { .. } => "no_start",
             Self::LeftOut { .. } => "left_out",
+            Self::Untimed { .. } => "untimed",
             Self::NotSearched => "not_searched",
             Self::TimedShort => "timed_short",
         }
@@ -58,6 +75,7 @@ impl std::fmt::Display for Shortfall {
             Self::Reach { violation } => write!(f, "out of reach: {violation}"),
             Self::NoStart { why } => write!(f, "no motion starts there: {why}"),
             Self::LeftOut { why } => write!(f, "planned but left out: {why}"),
+            Self::Untimed { why } => write!(f, "planned but cannot be timed: {why}"),
             Self::NotSearched => write!(
                 f,
                 "not searched: the stroke's searches (settings.max_parts) were spent"
@@ -99,8 +117,8 @@ impl Stop {
 pub struct LeftOut {
     /// The stretch of the stroke the part was planned over.
     pub planned: Stretch,
-    /// Why it was left out.
-    pub why: String,
+    /// Why it was left out: [`Shortfall::LeftOut`] or [`Shortfall::Untimed`].
+    pub why: Shortfall,
 }
 
 /// Why `undrawn`, a stretch of a stroke its program does not draw, is not drawn: a part left
@@ -119,9 +137,7 @@ pub fn cause(
         .iter()
         .find(|part| overlap(part.planned) > COVERAGE_SLACK_M)
     {
-        return Shortfall::LeftOut {
-            why: part.why.clone(),
-        };
+        return part.why.clone();
     }
     let near = |stop: &&Stop| {
         (undrawn.from_s - COVERAGE_SLACK_M..=undrawn.to_s + COVERAGE_SLACK_M).contains(&stop.at_s)
@@ -242,22 +258,48 @@ mod tests {
 
     #[test]
     fn a_part_left_out_over_a_stretch_is_its_cause_whatever_stopped_near() {
+        let untimed = Shortfall::Untimed {
+            why: "a joint still breaks its acceleration limit".into(),
+        };
         let left_out = [LeftOut {
             planned: stretch(0.0, 0.3),
-            why: "it cannot be timed".into(),
+            why: untimed.clone(),
         }];
         let stops = [Stop {
             at_s: 0.3,
             why: reach(2),
         }];
-        assert_eq!(
-            cause(stretch(0.0, 0.35), &stops, &left_out, None),
-            Shortfall::LeftOut {
-                why: "it cannot be timed".into()
-            }
-        );
+        assert_eq!(cause(stretch(0.0, 0.35), &stops, &left_out, None), untimed);
+        assert_eq!(untimed.label(), "untimed");
         // A part left out elsewhere is not this stretch's cause.
         assert_eq!(cause(stretch(0.3, 0.4), &stops, &left_out, None), reach(2));
+    }
+
+    #[test]
+    fn a_stop_is_labelled_by_what_the_next_step_broke() {
+        let contact = |obstacle: &str| Shortfall::Reach {
+            violation: Violation::SceneContact {
+                link: "fr3_link7".into(),
+                obstacle: obstacle.into(),
+                clearance_m: -1e-3,
+            },
+        };
+        let itself = Shortfall::Reach {
+            violation: Violation::SelfCollision {
+                first_link: "fr3_link2".into(),
+                second_link: "fr3_link6".into(),
+                clearance_m: 0.0,
+            },
+        };
+        let cone = Shortfall::Reach {
+            violation: Violation::ToolCone { angle_deg: 31.0 },
+        };
+        assert_eq!(reach(6).label(), "reach");
+        assert_eq!(cone.label(), "reach");
+        assert_eq!(itself.label(), "self_collision");
+        assert_eq!(contact(WORK_SURFACE).label(), "part");
+        assert_eq!(contact("fixture").label(), "scene");
+        assert_eq!(Shortfall::NotSearched.label(), "not_searched");
     }
 
     #[test]

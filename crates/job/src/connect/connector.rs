@@ -7,6 +7,7 @@ use emg_timing::time_blended_move;
 
 use crate::free_space::{FreeSpace, PEN_UP_CLEARANCE_SHARE};
 use crate::program::{Program, SegmentKind};
+use crate::shortfall::Shortfall;
 use crate::spec::JobSettings;
 use crate::stroke::StrokePart;
 
@@ -66,19 +67,21 @@ impl Connector<'_> {
         part: &StrokePart,
         from: Option<(JointVector, Option<Vec3>)>,
         seed: u64,
-    ) -> Result<(StrokePart, Placed), String> {
+    ) -> Result<(StrokePart, Placed), Shortfall> {
         let robot = self.free.robot();
         let timed = self
             .timing
             .time(robot, &part.task, self.free.constraints(), &part.trajectory)
-            .map_err(|e| format!("cannot be timed: {e}"))?;
+            .map_err(|e| Shortfall::Untimed { why: e.to_string() })?;
         let start = timed.samples[0].q;
         let end = timed.samples[timed.samples.len() - 1].q;
         // The tool lifts the job's height where that is free, else half or a quarter of it.
         let above = |q: &JointVector, what: &str| {
             self.free
                 .lifted(q, &-part.task.n, self.settings.lift())
-                .ok_or_else(|| FreeSpace::cannot_lift(self.settings.lift(), what))
+                .ok_or_else(|| Shortfall::LeftOut {
+                    why: FreeSpace::cannot_lift(self.settings.lift(), what),
+                })
         };
         let above_start = above(&start, "start")?;
         let above_end = above(&end, "end")?;
@@ -86,11 +89,11 @@ impl Connector<'_> {
             None => (Vec::new(), false),
             Some((from, risen)) => self
                 .travel(&from, risen, &above_start, &-part.task.n, seed)
-                .ok_or_else(|| {
-                    format!(
+                .ok_or_else(|| Shortfall::LeftOut {
+                    why: format!(
                         "no free move to its start found in {} samples",
                         self.settings.rrt_max_samples
-                    )
+                    ),
                 })?,
         };
         Ok((
