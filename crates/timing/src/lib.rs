@@ -2,7 +2,7 @@
 //! limits (libfranka stops a motion whose acceleration jumps):
 //!
 //! 1. [`SmoothPath`]: a natural cubic spline ([`JointSpline`], C²) through the planned
-//!    waypoints (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits,
+//!    waypoints (on a path, their step-to-step jitter of posture smoothed out, every TCP kept) (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits,
 //!    [`CLEARANCE_INSET_M`] clear of the arm's own links and [`CONE_INSET_DEG`] inside the tool
 //!    cone where they ride them), checked against every task constraint on a dense sampling and
 //!    refined where it fails;
@@ -49,7 +49,7 @@ pub use limits::{
 pub use motion::{MAX_SAMPLES, MotionDefinition, ProfileGrid, SplineStretch};
 pub use path::{
     CHECKS_PER_SEGMENT, KNOT_STEP_M_PER_RAD, KNOT_STRIDE, LINE_CHECK_MARGIN_M, MAX_REFINEMENTS,
-    MIN_KNOT_STEP_M, SmoothPath,
+    MIN_KNOT_STEP_M, SMOOTHING_ROUNDS, SmoothPath,
 };
 pub use profile::{PathState, SmoothedProfile, SpeedProfile};
 pub use retime::{

@@ -1,12 +1,13 @@
 //! The smooth joint path of a planned motion: a natural cubic spline through every
-//! [`KNOT_STRIDE`]-th waypoint (the controller's step-to-step jitter left out, so the joints'
-//! accelerations along the path stay low), each inner one moved a hair inside the joint limits,
+//! [`KNOT_STRIDE`]-th waypoint, on request of the waypoints with their postures evened out
+//! (the controller's step-to-step jitter left out, so the joints' accelerations along the path
+//! stay low, every TCP kept), each inner one moved a hair inside the joint limits,
 //! clear of the arm's own links and inside the tool cone ([`crate::inset`]), parametrised by
 //! the distance the TCP travels between waypoints, checked against every task constraint on a
 //! dense sampling and refined where it fails.
 
 use emg_control::{ConstraintConfig, Task, Violation, first_violation, onto_task};
-use emg_kinematics::{JointVector, Robot};
+use emg_kinematics::{DampingConfig, JointVector, Robot, Vec3, damped_pseudo_inverse};
 
 use crate::inset::{inset, tool_angle_gradient};
 use crate::spline::JointSpline;
@@ -48,7 +49,11 @@ pub struct SmoothPath {
 
 impl SmoothPath {
     /// The smooth path through `waypoints` (each holding the constraints, as a rollout's steps
-    /// do). The parameter of waypoint `k` is the TCP distance travelled along the polyline of
+    /// do), where `even_postures` asks for it their postures evened out first (every TCP kept:
+    /// each inner one replaced by the mean `(q[k-1] + 2 q[k] + q[k+1]) / 4`
+    /// [`SMOOTHING_ROUNDS`] times, then moved until its TCP lies where the waypoint's did). The
+    /// parameter of
+    /// waypoint `k` is the TCP distance travelled along the polyline of
     /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
     /// largest joint change, per step); the spline passes through the first, every
     /// [`KNOT_STRIDE`]-th and the last waypoint, each inner one moved
@@ -80,10 +85,18 @@ impl SmoothPath {
         constraints: &ConstraintConfig,
         waypoints: &[JointVector],
         from_s: f64,
+        even_postures: bool,
     ) -> Self {
         assert!(!waypoints.is_empty(), "a path needs a waypoint");
         let valid = |q: &JointVector| {
             first_violation(robot, task, &robot.forward(q), constraints).is_none()
+        };
+        let smoothed_path;
+        let waypoints = if even_postures {
+            smoothed_path = smoothed(robot, task, constraints, waypoints);
+            &smoothed_path[..]
+        } else {
+            waypoints
         };
         let mut params = Vec::with_capacity(waypoints.len());
         let mut previous = (waypoints[0], robot.forward(&waypoints[0]).tcp());
@@ -194,6 +207,59 @@ impl SmoothPath {
     pub fn start(&self) -> JointVector {
         self.start
     }
+}
+
+/// Rounds of the `(1, 2, 1) / 4` mean a path's waypoints are smoothed by before the spline is
+/// fitted through them.
+pub const SMOOTHING_ROUNDS: usize = 4;
+
+/// `waypoints` with the controller's step-to-step jitter smoothed out: each inner one replaced
+/// by the mean `(q[k-1] + 2 q[k] + q[k+1]) / 4` of its neighbours, [`SMOOTHING_ROUNDS`] times,
+/// then moved back until its TCP lies where the waypoint's did ([`moved_to`]); the waypoint
+/// itself where that does not converge or breaks a constraint. Only the tool's orientation and
+/// the arm's posture are smoothed: every TCP stays where the controller put it.
+fn smoothed(
+    robot: &Robot,
+    task: &Task,
+    constraints: &ConstraintConfig,
+    waypoints: &[JointVector],
+) -> Vec<JointVector> {
+    let mut out = waypoints.to_vec();
+    if out.len() < 3 {
+        return out;
+    }
+    for _ in 0..SMOOTHING_ROUNDS {
+        let before = out.clone();
+        for k in 1..out.len() - 1 {
+            out[k] = (before[k - 1] + before[k] * 2.0 + before[k + 1]) / 4.0;
+        }
+    }
+    for k in 1..out.len() - 1 {
+        let tcp = robot.forward(&waypoints[k]).tcp();
+        out[k] = moved_to(robot, &out[k], &tcp)
+            .filter(|q| first_violation(robot, task, &robot.forward(q), constraints).is_none())
+            .unwrap_or(waypoints[k]);
+    }
+    out
+}
+
+/// Newton steps that move a configuration's TCP onto a point, at most this many.
+const MOVE_STEPS: usize = 12;
+
+/// `q` moved by damped least-squares steps until its TCP lies within a nanometre of `target`;
+/// `None` where it does not get there in [`MOVE_STEPS`].
+fn moved_to(robot: &Robot, q: &JointVector, target: &Vec3) -> Option<JointVector> {
+    let mut q = *q;
+    let damping = DampingConfig::default();
+    for _ in 0..MOVE_STEPS {
+        let kinematics = robot.forward(&q);
+        let error = target - kinematics.tcp();
+        if error.norm() < 1e-9 {
+            return Some(q);
+        }
+        q += damped_pseudo_inverse(kinematics.jacobian(), &damping).matrix * error;
+    }
+    None
 }
 
 /// Points a check interval is scanned at for the peak inside it, where its value rises at the
@@ -375,4 +441,66 @@ fn peaks(
                 .collect::<Vec<_>>()
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use emg_control::{ClassicalController, RolloutConfig, rollout};
+
+    use super::*;
+
+    /// The sum over inner waypoints of `|q[k-1] - 2 q[k] + q[k+1]|²`: how much the joint path
+    /// bends from step to step.
+    fn bending(waypoints: &[JointVector]) -> f64 {
+        waypoints
+            .windows(3)
+            .map(|w| (w[0] - w[1] * 2.0 + w[2]).norm_squared())
+            .sum()
+    }
+
+    #[test]
+    fn smoothing_keeps_every_tcp_and_takes_out_the_step_to_step_jitter() {
+        let urdf = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../data/robots/fr3_pen.urdf"
+        );
+        let robot = Robot::from_urdf_file(urdf, "link0", "pen_tip").unwrap();
+        let seed = robot.mid_range();
+        let kinematics = robot.forward(&seed);
+        let direction = Vec3::new(0.0, 1.0, 0.0);
+        let task = Task::new(
+            &robot,
+            kinematics.tcp(),
+            direction,
+            kinematics.tool_axis(),
+            Some(seed),
+        )
+        .unwrap();
+        let config = RolloutConfig::default();
+        let mut controller = ClassicalController::default();
+        let steps = rollout(&robot, &task, &seed, &mut controller, &config).steps;
+        // The controller's steps, each shaken by a posture change that keeps its TCP.
+        let waypoints: Vec<JointVector> = steps
+            .iter()
+            .enumerate()
+            .map(|(k, step)| {
+                let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+                let mut shaken = step.q;
+                shaken[6] += sign * 0.02;
+                shaken[4] -= sign * 0.01;
+                let tcp = robot.forward(&step.q).tcp();
+                moved_to(&robot, &shaken, &tcp).unwrap()
+            })
+            .collect();
+        let smooth = smoothed(&robot, &task, &config.constraints, &waypoints);
+        assert_eq!(smooth.len(), waypoints.len());
+        assert_eq!(smooth[0], waypoints[0]);
+        assert_eq!(smooth[smooth.len() - 1], waypoints[waypoints.len() - 1]);
+        for (q, original) in smooth.iter().zip(&waypoints) {
+            let moved = (robot.forward(q).tcp() - robot.forward(original).tcp()).norm();
+            assert!(moved < 1e-8, "a TCP moved by {moved} m");
+        }
+        let (before, after) = (bending(&waypoints), bending(&smooth));
+        assert!(after < 0.05 * before, "bending {before} → {after}");
+    }
 }

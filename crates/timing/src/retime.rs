@@ -180,6 +180,10 @@ pub const MAX_FORCED_RESTS: usize = 32;
 /// along the path sample by sample ([`Task::along`]) within the line tolerance of the point it
 /// reached. Where one is not, the motion is timed again through the waypoints before it only,
 /// and its report says where and why it was cut.
+///
+/// On a path the waypoints' postures are evened out first (every TCP kept, [`SmoothPath::fit`]),
+/// which lets the tool keep its speed through curves; where that motion is cut before the
+/// motion through the postures as planned, or cannot be timed, the latter is taken.
 pub fn time_motion(
     robot: &Robot,
     task: &Task,
@@ -187,17 +191,41 @@ pub fn time_motion(
     waypoints: &[JointVector],
     request: &TimingRequest,
 ) -> Result<TimedMotion, TimingError> {
-    let problem = TimingProblem {
+    let problem = |even_postures| TimingProblem {
         robot,
         task,
         constraints,
         request,
+        even_postures,
     };
+    if task.path.is_none() {
+        return time_within_tolerance(&problem(false), waypoints);
+    }
+    let evened = match time_within_tolerance(&problem(true), waypoints) {
+        Ok(motion) => motion,
+        Err(_) => return time_within_tolerance(&problem(false), waypoints),
+    };
+    let Some((evened_end, _)) = evened.report.cut.clone() else {
+        return Ok(evened);
+    };
+    let planned = time_within_tolerance(&problem(false), waypoints)?;
+    Ok(match &planned.report.cut {
+        Some((planned_end, _)) if *planned_end <= evened_end => evened,
+        _ => planned,
+    })
+}
+
+/// The motion of [`time_motion`] for `problem`, cut before the first sample that leaves the
+/// line tolerance of a path.
+fn time_within_tolerance(
+    problem: &TimingProblem,
+    waypoints: &[JointVector],
+) -> Result<TimedMotion, TimingError> {
     let mut end = waypoints.len();
     let mut cut = None;
     loop {
-        let mut motion = time_rested(&problem, &waypoints[..end])?;
-        let Some((time_s, distance_m)) = first_sample_off(&problem, &motion) else {
+        let mut motion = time_rested(problem, &waypoints[..end])?;
+        let Some((time_s, distance_m)) = first_sample_off(problem, &motion) else {
             if motion.report.cut.is_none() {
                 motion.report.cut = cut;
             }
@@ -229,6 +257,8 @@ struct TimingProblem<'a> {
     task: &'a Task,
     constraints: &'a ConstraintConfig,
     request: &'a TimingRequest,
+    /// Whether the waypoints' postures are evened out before the spline is fitted.
+    even_postures: bool,
 }
 
 /// The time (s) of the first sample of `motion` whose TCP, followed along a path task sample by
@@ -473,8 +503,9 @@ fn time_stretch(
         task,
         constraints,
         request,
+        even_postures,
     } = *problem;
-    let path = SmoothPath::fit(robot, task, constraints, waypoints, from_s);
+    let path = SmoothPath::fit(robot, task, constraints, waypoints, from_s, even_postures);
     let cut = path
         .cut
         .as_ref()
