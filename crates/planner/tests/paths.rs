@@ -2,7 +2,8 @@
 //! population planned by the search (a small budget, so that the test stays short), timed rest
 //! to rest within each arm's joint limits (at rest at the rectangle's corners) and their files
 //! verified as `emg check` verifies them; the search never returns less than the pipeline's plan
-//! and a plan that reaches the end says so.
+//! and a plan that reaches the end says so; a circle is drawn at the requested tool speed for
+//! most of its motion.
 
 mod common;
 
