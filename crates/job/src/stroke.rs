@@ -81,10 +81,10 @@ impl StrokePlan {
 /// motion starts or gains, the stretch is skipped by `settings.min_gain_m`, doubled for each
 /// search in a row that gained nothing after the first [`EVEN_SKIPS`] (such searches are not
 /// counted), so the searches a stroke gets grow with what is left of it and a stretch out of
-/// reach costs a number of searches that grows with the logarithm of its length. Where `free` is given, a part whose tool cannot lift off
-/// its start into it ([`FreeSpace::lifted`]) gains nothing: the connect stage could not set
-/// the tool down there. [`Stopped`] where `watch` asks to stop (asked before each search and
-/// between a search's rollouts).
+/// reach costs a number of searches that grows with the logarithm of its length. Where `free`
+/// is given, a part whose tool cannot lift off its start into it ([`FreeSpace::lifted`]) gains
+/// nothing: the connect stage could not set the tool down there. [`Stopped`] where `watch` asks
+/// to stop (asked before each search and between a search's rollouts).
 pub fn plan_stroke(
     planner: &Planner,
     request: &PlanRequest,

@@ -181,9 +181,10 @@ impl JobPlan {
     }
 
     /// Every stroke's outcome in drawing order (dicts: `stroke`, `reversed`, `length_m`,
-    /// `drawn_m`, `parts`, `unreached`, `unreached_at`, `unreached_causes` (dicts with a `cause`:
-    /// `reach`, `no_start`, `left_out`, `untimed`, `not_searched`, `timed_short`), `parts_left_out`, and
-    /// `unsearched_from_s` where the stroke's searches were spent before its end).
+    /// `drawn_m`, `parts`, `unreached`, `unreached_at`, `unreached_causes` (dicts with a
+    /// `cause`: `reach`, `no_start`, `left_out`, `untimed`, `not_searched`, `timed_short`),
+    /// `parts_left_out`, and `unsearched_from_s` where the stroke's searches were spent before
+    /// its end).
     #[getter]
     fn strokes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         python(py, &self.file.strokes)

@@ -2,9 +2,10 @@
 //! limits (libfranka stops a motion whose acceleration jumps):
 //!
 //! 1. [`SmoothPath`]: a natural cubic spline ([`JointSpline`], C²) through the planned
-//!    waypoints (on a path, their step-to-step jitter of posture smoothed out, every TCP kept) (inner ones moved [`JOINT_INSET_RAD`] inside the joint limits,
-//!    [`CLEARANCE_INSET_M`] clear of the arm's own links and [`CONE_INSET_DEG`] inside the tool
-//!    cone where they ride them), checked against every task constraint on a dense sampling and
+//!    waypoints (on a path, their step-to-step jitter of posture smoothed out, every TCP kept;
+//!    inner ones moved [`JOINT_INSET_RAD`] inside the joint limits, [`CLEARANCE_INSET_M`] clear
+//!    of the arm's own links and [`CONE_INSET_DEG`] inside the tool cone where they ride them),
+//!    checked against every task constraint on a dense sampling and
 //!    refined where it fails;
 //! 2. [`topp_ra`]: the time-optimal path speed under joint velocity and acceleration limits and
 //!    a tool-speed cap (Pham & Pham 2018), from rest to rest;

@@ -52,9 +52,8 @@ impl SmoothPath {
     /// do), where `even_postures` asks for it their postures evened out first (every TCP kept:
     /// each inner one replaced by the mean `(q[k-1] + 2 q[k] + q[k+1]) / 4`
     /// [`SMOOTHING_ROUNDS`] times, then moved until its TCP lies where the waypoint's did). The
-    /// parameter of
-    /// waypoint `k` is the TCP distance travelled along the polyline of
-    /// the waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
+    /// parameter of waypoint `k` is the TCP distance travelled along the polyline of the
+    /// waypoints' TCPs (at least [`MIN_KNOT_STEP_M`], and [`KNOT_STEP_M_PER_RAD`] times the
     /// largest joint change, per step); the spline passes through the first, every
     /// [`KNOT_STRIDE`]-th and the last waypoint, each inner one moved
     /// [`JOINT_INSET_RAD`](crate::JOINT_INSET_RAD) inside the joint limits, about its TCP to
@@ -63,13 +62,13 @@ impl SmoothPath {
     /// them (when the moved configuration holds every constraint). It is checked at
     /// [`CHECKS_PER_SEGMENT`] points inside each segment, at the joints' turning points and at
     /// the peaks of the tool angle and of the distance from the line or path; a segment that
-    /// breaks a constraint gets back the middle waypoint
-    /// it skipped, or, between consecutive waypoints, their chord midpoint (moved onto the line
-    /// or path where it lies more than half the tolerance off, [`onto_task`], on a path toward
-    /// the point its progress reaches from the segment's first knot's) moved likewise as a
-    /// new knot (when that holds the constraints and the two lie [`MIN_KNOT_STEP_M`] apart at
-    /// least twice over, up to [`MAX_REFINEMENTS`] midpoints in all),
-    /// else the path ends at the segment's first waypoint.
+    /// breaks a constraint gets back the middle waypoint it skipped, or, between consecutive
+    /// waypoints, their chord midpoint (moved onto the line or path where it lies more than
+    /// half the tolerance off, [`onto_task`], on a path toward the point its progress reaches
+    /// from the segment's first knot's) moved likewise as a new knot (when that holds the
+    /// constraints and the two lie [`MIN_KNOT_STEP_M`] apart at least twice over, up to
+    /// [`MAX_REFINEMENTS`] midpoints in all), else the path ends at the segment's first
+    /// waypoint.
     ///
     /// On a path the TCP's distance is measured from the path point its progress has reached
     /// ([`Task::along`]), followed from `from_s` (the first waypoint's progress) knot by knot,
