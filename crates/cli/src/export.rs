@@ -18,8 +18,9 @@ pub struct ExportArgs {
     /// emg-joint-trajectory/2) or a job's program (emg-job/3).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file) or `urscript` (a
-    /// program for a Universal Robots e-Series controller; six-joint UR arms only).
+    /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file), `urscript` (a
+    /// program for a Universal Robots e-Series controller; six-joint UR arms only) or `rapid`
+    /// (a module for an ABB controller; a job's program on a six-joint ABB arm only).
     #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub format: ExportFormat,
     /// The file to write (a URScript motion too long for one program is split where the arm

@@ -1,5 +1,6 @@
 //! Writing a joint trajectory or a job's program for a robot's own stack (a ROS 2
-//! `JointTrajectory` in an MCAP bag, or a URScript program), by [`emg_io::export`]: what
+//! `JointTrajectory` in an MCAP bag, a URScript program, or a job's program as a RAPID module),
+//! by [`emg_io::export`], `emg_job::ur_program` and `emg_job::rapid_program`: what
 //! `emg export`, `emg plan --export`, `emg job --export` and `emg place --export` share.
 
 use std::path::{Path, PathBuf};
@@ -84,13 +85,14 @@ pub fn export_to(
 }
 
 /// The file `--export FORMAT` of `emg job` and `emg place` writes beside the program `out`:
-/// its extension `.mcap` or `.script`.
+/// its extension `.mcap`, `.script` or `.mod`.
 pub fn beside_program(out: &Path, format: ExportFormat) -> PathBuf {
     out.with_extension(format.extension())
 }
 
 /// Refuses, before anything is planned, `--export FORMAT` of a program for a robot it cannot run
-/// on (URScript for an arm that is not a Universal Robots arm).
+/// on (URScript for an arm that is not a Universal Robots arm, RAPID for one without six
+/// joints).
 pub fn refuse_program_export(
     format: Option<ExportFormat>,
     urscript: &UrScriptArgs,
@@ -101,7 +103,7 @@ pub fn refuse_program_export(
     };
     let robot = robot::load_robot(robot_file, None, None)?;
     refuse_format(format, robot_file, &robot)
-        .context("--export urscript: nothing was planned or written")?;
+        .with_context(|| format!("--export {format}: nothing was planned or written"))?;
     if format == ExportFormat::UrScript {
         writes_native(urscript, robot_file)
             .context("--export urscript: nothing was planned or written")?;
@@ -151,6 +153,9 @@ pub fn export_job(
 ) -> Result<String> {
     if target.format == ExportFormat::UrScript && writes_native(target.urscript, robot_file)? {
         return native_ur_program(file, target.out, input, robot_file, robot);
+    }
+    if target.format == ExportFormat::Rapid {
+        return rapid_module(file, target.out, input, robot_file, robot);
     }
     let options = ExportOptions {
         tolerance_rad: target.thinning_tolerance,
@@ -207,8 +212,23 @@ fn native_ur_program(
     Ok(format!("{}\n  wrote {}", export.summary, out.display()))
 }
 
+/// Writes the job's program `file` (read from `input`) as one RAPID module to `out`; returns
+/// what to print.
+fn rapid_module(
+    file: &emg_job::JobFile,
+    out: &Path,
+    input: &Path,
+    robot_file: &Path,
+    robot: &Robot,
+) -> Result<String> {
+    let reference = robot::reference(robot_file)?.to_string();
+    let export = emg_job::rapid_program::rapid_program_export(file, robot, &reference, out)?;
+    export.write(&[("job program", input), ("robot", robot_file)])?;
+    Ok(format!("{}\n  wrote {}", export.summary, out.display()))
+}
+
 /// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when
-/// shipped, else by its joint names).
+/// shipped, else by its joint names), and RAPID for an arm that has not six joints.
 pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> Result<()> {
     let names = robot.joint_names();
     let is_ur = match shipped_profile(robot_file) {
@@ -222,6 +242,11 @@ pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> 
                 joints: names.len(),
                 names: names.join(", "),
             },
+        ));
+    }
+    if format == ExportFormat::Rapid && robot.dof() != 6 {
+        return Err(anyhow::Error::new(
+            emg_job::rapid_program::RapidProgramError::Joints(robot.dof()),
         ));
     }
     Ok(())

@@ -22,8 +22,9 @@ pub struct JobArgs {
     /// The program to write (an emg-job/3 file; missing parent directories are created).
     #[arg(long, value_name = "FILE", default_value = "job.json")]
     pub out: PathBuf,
-    /// Also export the program for a robot's own stack: `ros2-mcap` or `urscript`, written
-    /// beside `--out` (its extension `.mcap` or `.script`; see docs/robot-export.md).
+    /// Also export the program for a robot's own stack: `ros2-mcap`, `urscript` or `rapid`
+    /// (an ABB controller's module), written beside `--out` (its extension `.mcap`, `.script`
+    /// or `.mod`; see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
     /// How a URScript export is written.

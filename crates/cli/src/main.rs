@@ -131,8 +131,8 @@ pub enum Command {
     ImportRobot(import::ImportArgs),
     /// Export a joint trajectory for a robot's own stack: `ros2-mcap` (a ROS 2
     /// trajectory_msgs/msg/JointTrajectory in an MCAP bag, joint names as the vendor's driver
-    /// names them) or `urscript` (a program for a Universal Robots e-Series controller); see
-    /// docs/robot-export.md.
+    /// names them), `urscript` (a program for a Universal Robots e-Series controller) or `rapid`
+    /// (a job's program as a module for an ABB controller); see docs/robot-export.md.
     Export(export::ExportArgs),
     /// Plan a job: a job file or an SVG drawing, every stroke to the limit (resumed after a
     /// reconfiguration where one motion cannot finish it), safe moves between strokes, one timed

@@ -382,7 +382,7 @@ fn wrong_inputs_are_refused_and_nothing_is_written() {
     let bad = examples.join("bad.joint_trajectory.json");
     let bad = bad.to_str().unwrap();
     let out = |name: &str| dir.path().join(name);
-    let cases: [(Vec<&str>, &str, i32); 5] = [
+    let cases: [(Vec<&str>, &str, i32); 6] = [
         (
             vec![
                 "--format",
@@ -418,8 +418,13 @@ fn wrong_inputs_are_refused_and_nothing_is_written() {
         ),
         (
             vec!["--format", "ros3", "--out", "c.mcap"],
-            "unknown export format 'ros3': give ros2-mcap or urscript",
+            "unknown export format 'ros3': give ros2-mcap, urscript or rapid",
             2,
+        ),
+        (
+            vec!["--format", "rapid", "--out", "c.mod", "--robot", "fr3"],
+            "rapid is written from a job's program",
+            1,
         ),
         (
             vec!["--format", "ros2-mcap", "--out", bad, "--robot", "fr3"],

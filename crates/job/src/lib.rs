@@ -17,9 +17,11 @@
 //! beside them: [`verify_job`] re-checks a written program with the independent checker, and
 //! [`place_job`] runs [`plan_job`] at the best places for the part.
 
+mod abb_configuration;
 pub mod branch;
 pub mod claims;
 pub mod connect;
+mod controller_targets;
 pub mod demo_jobs;
 pub mod free_space;
 pub mod measures;
@@ -31,6 +33,7 @@ pub mod place;
 pub mod plan_error;
 pub mod plan_strokes;
 pub mod program;
+pub mod rapid_program;
 pub mod reorder;
 pub mod setting;
 pub mod setup;
@@ -44,6 +47,7 @@ pub mod verify;
 pub mod watch;
 pub mod write;
 
+pub use abb_configuration::AbbConfiguration;
 pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES, choose_branches};
 pub use claims::{COVERAGE_SLACK_M, Coverage, OnStroke, Stretch, part_coverage};
 pub use connect::{

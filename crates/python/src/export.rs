@@ -14,7 +14,7 @@ use crate::robot::Robot;
 /// What an export wrote.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]
 pub struct ExportReport {
-    /// `"ros2-mcap"` or `"urscript"`.
+    /// `"ros2-mcap"`, `"urscript"` or `"rapid"`.
     format: &'static str,
     /// The files written (several URScript programs for a motion split where it rests).
     files: Vec<PathBuf>,
@@ -35,7 +35,8 @@ pub struct ExportReport {
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"` or `"urscript"`) to `out`, for its own
+/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"`, `"urscript"`, or `"rapid"` for a job's
+/// program on a six-joint ABB arm: one RAPID module) to `out`, for its own
 /// robot or `robot` (a shipped robot's name or a robot file), as `emg export` does: nothing is
 /// written on an error, and `out` never replaces `path`. `urscript` is `"native"` (one program of
 /// movej, movel and blended movep with the tool's output: a job's program on the shipped UR5e,
@@ -117,6 +118,10 @@ pub fn export(
     let export = match (&job, format, native) {
         (Some(job), ExportFormat::UrScript, Some(true) | None) if frames => {
             emg_job::ur_program::ur_program_export(job, &robot.inner, &robot.reference, &out)
+                .map_err(|e| InputError::new_err(message(&e)))?
+        }
+        (Some(job), ExportFormat::Rapid, _) => {
+            emg_job::rapid_program::rapid_program_export(job, &robot.inner, &robot.reference, &out)
                 .map_err(|e| InputError::new_err(message(&e)))?
         }
         (_, ExportFormat::UrScript, Some(true)) => {

@@ -7,6 +7,9 @@
 //!   stays within a tolerance of every sample ([`ThinningReport`]);
 //! * [`ExportFormat::UrScript`]: a URScript program for a six-joint Universal Robots arm on an
 //!   e-Series controller, `movej` to the start, then a `servoj` target every 2 ms.
+//!
+//! A job's program is also written as a controller's own program ([`ExportFormat::Rapid`], and
+//! URScript's native form) by `emg_job`, from its targets rather than its samples.
 
 mod drivers;
 mod ros2_mcap;
@@ -42,17 +45,25 @@ pub enum ExportFormat {
     Ros2Mcap,
     /// `urscript`: a URScript program for a Universal Robots e-Series controller.
     UrScript,
+    /// `rapid`: a RAPID module for an ABB controller, written from a job's program only
+    /// (`emg_job::rapid_program`).
+    Rapid,
 }
 
 impl ExportFormat {
     /// Every format, by name.
-    pub const ALL: [ExportFormat; 2] = [ExportFormat::Ros2Mcap, ExportFormat::UrScript];
+    pub const ALL: [ExportFormat; 3] = [
+        ExportFormat::Ros2Mcap,
+        ExportFormat::UrScript,
+        ExportFormat::Rapid,
+    ];
 
     /// The name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             ExportFormat::Ros2Mcap => "ros2-mcap",
             ExportFormat::UrScript => "urscript",
+            ExportFormat::Rapid => "rapid",
         }
     }
 
@@ -61,6 +72,7 @@ impl ExportFormat {
         match self {
             ExportFormat::Ros2Mcap => "mcap",
             ExportFormat::UrScript => "script",
+            ExportFormat::Rapid => "mod",
         }
     }
 }
@@ -86,7 +98,7 @@ impl std::str::FromStr for ExportFormat {
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
     /// The format's name is none of [`ExportFormat::ALL`].
-    #[error("unknown export format '{0}': give ros2-mcap or urscript")]
+    #[error("unknown export format '{0}': give ros2-mcap, urscript or rapid")]
     UnknownFormat(String),
     /// The input cannot be read.
     #[error("cannot read {path}: {source}")]
@@ -131,6 +143,13 @@ pub enum ExportError {
         /// Its joint names, joined.
         names: String,
     },
+    /// A format written from a job's program only, asked for a joint trajectory.
+    #[error(
+        "{0} is written from a job's program (emg-job/3, which `emg job` writes), through \
+         targets the controller interpolates: a joint trajectory has no strokes to write it from; \
+         export it with --format ros2-mcap"
+    )]
+    ProgramOnly(ExportFormat),
     /// A stretch between rests needs more `servoj` lines than one program holds.
     #[error(
         "urscript: the motion runs without rest from t = {from_s:.3} s to {to_s:.3} s, {lines} \
@@ -321,6 +340,7 @@ pub fn export(
     match format {
         ExportFormat::Ros2Mcap => ros2(trajectory, out, robot, options),
         ExportFormat::UrScript => ur_script(trajectory, out, robot, options),
+        ExportFormat::Rapid => Err(ExportError::ProgramOnly(format)),
     }
 }
 
