@@ -20,6 +20,7 @@ mod figure;
 mod figure_branches;
 mod figure_dp_seeds;
 mod gap_eval;
+mod import_arms;
 mod import_circles;
 mod job_eval;
 mod label_seeds;
@@ -119,6 +120,9 @@ enum Command {
     Regenerate(regenerate::Args),
     /// Fail where the modules of a crate import each other in a circle (each circle listed).
     ImportCircles(import_circles::Args),
+    /// Import the industrial arms shipped for their controllers' own programs (the ABB IRB 120
+    /// of PyPI's compas-fab 2.0.1) into data/robots/, each checked against its data sheet.
+    ImportArms(import_arms::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -148,5 +152,6 @@ fn main() -> anyhow::Result<()> {
         Command::GapEval(args) => gap_eval::run(&args),
         Command::Regenerate(args) => regenerate::run(&args),
         Command::ImportCircles(args) => import_circles::run(&args),
+        Command::ImportArms(args) => import_arms::run(&args),
     }
 }

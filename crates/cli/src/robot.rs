@@ -38,10 +38,10 @@ pub fn default_robot() -> PathBuf {
     SHIPPED_ROBOTS[0].path(&data_dir())
 }
 
-/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) gives its file, anything else is a
-/// path to an existing robot file.
+/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`) gives its file,
+/// anything else is a path to an existing robot file.
 pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
-    let names: Vec<_> = SHIPPED_ROBOTS.iter().map(|r| r.name).collect();
+    let names: Vec<_> = ShippedRobot::all().map(|r| r.name).collect();
     let path = data_dir().robot_file(value);
     if value.is_empty() || !path.exists() {
         return Err(format!(
@@ -85,7 +85,8 @@ pub fn shipped(robot: &Path) -> Option<emg_planner::ShippedRobot> {
     emg_planner::ShippedRobot::by_path(robot, &data_dir())
 }
 
-/// Whether `robot` is one of the shipped robots' files.
+/// Whether `robot` is the file of one of the shipped robots whose capsules were written by hand
+/// ([`SHIPPED_ROBOTS`]; an industrial arm's were fitted by `emg import-robot`).
 pub fn is_shipped(robot: &Path) -> bool {
     let data = data_dir();
     SHIPPED_ROBOTS
@@ -145,6 +146,10 @@ mod tests {
             None
         );
         assert!(parse_robot("").unwrap_err().contains("iiwa14"));
+        // An industrial arm is shipped by name, without trained models.
+        let irb120 = parse_robot("irb120").unwrap();
+        assert!(irb120.ends_with("data/robots/irb120_pen.urdf"));
+        assert_eq!(shipped_model(&irb120, "ppo-v1.weights"), None);
     }
 
     #[test]

@@ -76,7 +76,7 @@ pub use seed::{
     CHAIN_SOURCE, FAR_END_SOURCE, SCAN_SOURCE, Seed, SeedError, SeedSource, prepare_seed,
     seed_source_meaning,
 };
-pub use shipped::{DataDir, SHIPPED_ROBOTS, ShippedRobot};
+pub use shipped::{DataDir, INDUSTRIAL_ROBOTS, SHIPPED_ROBOTS, ShippedRobot};
 pub use timing::{
     ASSUMED_LIMITS, DEFAULT_RATE_HZ, MotionTiming, TimingSetupError, limits_file_beside,
 };

@@ -26,16 +26,19 @@ impl DataDir {
         &self.0
     }
 
-    /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`) gives its file
-    /// here, anything else is a path to a robot file.
+    /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`,
+    /// `irb120`) gives its file here, anything else is a path to a robot file.
     pub fn robot_file(&self, value: &str) -> PathBuf {
         ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(self))
     }
 
     /// Model file `name` (e.g. [`crate::POLICY_WEIGHTS_FILE`]) shipped here for the robot file
-    /// `robot`, when that file is one of the shipped robots.
+    /// `robot`, when that file is one of the shipped robots with trained models
+    /// ([`SHIPPED_ROBOTS`]; an [`INDUSTRIAL_ROBOTS`] arm plans by search alone).
     pub fn shipped_model(&self, robot: &Path, name: &str) -> Option<PathBuf> {
-        ShippedRobot::by_path(robot, self).map(|r| r.data_dir(self).join("models").join(name))
+        ShippedRobot::by_path(robot, self)
+            .filter(|r| r.trained)
+            .map(|r| r.data_dir(self).join("models").join(name))
     }
 }
 
@@ -50,11 +53,14 @@ pub struct ShippedRobot {
     /// The vendor's home or ready pose (rad, one value per joint, base to tip): where a job's
     /// program starts and ends unless it is given another home.
     pub home: &'static [f64],
+    /// Whether trained models and published results ship for it ([`SHIPPED_ROBOTS`]), else
+    /// it plans by search alone ([`INDUSTRIAL_ROBOTS`]).
+    pub trained: bool,
 }
 
-/// The shipped robots: the paper's Franka FR3 (whose data keep the top level of the data
-/// directory), the KUKA LBR iiwa 14 R820 (`iiwa14/`) and the six-joint Universal Robots UR5e
-/// (`ur5e/`), all holding the same pen.
+/// The shipped robots with trained models and published results: the paper's Franka FR3 (whose
+/// data keep the top level of the data directory), the KUKA LBR iiwa 14 R820 (`iiwa14/`) and
+/// the six-joint Universal Robots UR5e (`ur5e/`), all holding the same pen.
 pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
     ShippedRobot {
         name: "fr3",
@@ -71,6 +77,7 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
             FRAC_PI_2,
             FRAC_PI_4,
         ],
+        trained: true,
     },
     ShippedRobot {
         name: "iiwa14",
@@ -79,6 +86,7 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
         // KUKA's home position of the LBR iiwa: every axis at zero, the arm upright (the
         // "candle" pose Sunrise's HOME frame holds by default).
         home: &[0.0; 7],
+        trained: true,
     },
     ShippedRobot {
         name: "ur5e",
@@ -87,20 +95,39 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
         // Universal Robots' default Home position in PolyScope: the arm upright, shoulder lift
         // and wrist 1 at −π/2, every other joint at zero.
         home: &[0.0, -FRAC_PI_2, 0.0, -FRAC_PI_2, 0.0, 0.0],
+        trained: true,
     },
 ];
 
+/// The industrial arms shipped for their controllers' own programs, planned by search alone
+/// (no trained models): the ABB IRB 120-3/0.58 (`cargo xtask import-arms`, a straight tool
+/// 0.1 m beyond its flange).
+pub const INDUSTRIAL_ROBOTS: [ShippedRobot; 1] = [ShippedRobot {
+    name: "irb120",
+    file: "irb120_pen.urdf",
+    data_subdir: "irb120",
+    // ABB's calibration position: every axis at zero, the upper arm level and the flange facing
+    // forward.
+    home: &[0.0; 6],
+    trained: false,
+}];
+
 impl ShippedRobot {
+    /// Every shipped robot: [`SHIPPED_ROBOTS`], then [`INDUSTRIAL_ROBOTS`].
+    pub fn all() -> impl Iterator<Item = Self> {
+        SHIPPED_ROBOTS.into_iter().chain(INDUSTRIAL_ROBOTS)
+    }
+
     /// The shipped robot called `name`.
     pub fn by_name(name: &str) -> Option<Self> {
-        SHIPPED_ROBOTS.into_iter().find(|r| r.name == name)
+        Self::all().find(|r| r.name == name)
     }
 
     /// The shipped robot whose file in `data` is `path` (compared after resolving links and
     /// `..`).
     pub fn by_path(path: &Path, data: &DataDir) -> Option<Self> {
         let path = canonical(path);
-        SHIPPED_ROBOTS.into_iter().find(|r| r.path(data) == path)
+        Self::all().find(|r| r.path(data) == path)
     }
 
     /// Its robot file in `data` (canonical when it exists).
