@@ -5,6 +5,8 @@
 //! the task and the constraints, and runs [`emg_verify::check_replay`]. The layouts and what is
 //! verified are documented in `docs/joint-trajectory-format.md`.
 
+mod exported;
+mod rapid;
 mod script;
 
 use std::path::{Path, PathBuf};
@@ -27,12 +29,13 @@ use crate::robot;
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json`, `<stem>.csv`, a job's
-    /// program (emg-job/3) or a URScript program exported from one for the UR5e (`.script`).
+    /// program (emg-job/3), a URScript program exported from one for the UR5e (`.script`) or a
+    /// RAPID module exported from one for the IRB 120 (`.mod`).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// A URScript program's job program (emg-job/3), which it is read back against. Default: the
-    /// `.json` of the script's name (`drawing.job.script` and `drawing.job-part1.script` →
-    /// `drawing.job.json`).
+    /// A URScript program's or RAPID module's job program (emg-job/3), which it is read back
+    /// against. Default: the `.json` of its name (`drawing.job.script`,
+    /// `drawing.job-part1.script` and `drawing.job.mod` → `drawing.job.json`).
     #[arg(long, value_name = "JOB")]
     pub program: Option<PathBuf>,
     /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`) or a robot file (URDF). Default: the
@@ -67,6 +70,14 @@ pub fn run(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
     if file.extension().is_some_and(|e| e == "script") {
         return script::check_script(
+            file,
+            args.program.as_deref(),
+            args.robot.as_deref(),
+            &args.chain,
+        );
+    }
+    if file.extension().is_some_and(|e| e == "mod") {
+        return rapid::check_module(
             file,
             args.program.as_deref(),
             args.robot.as_deref(),

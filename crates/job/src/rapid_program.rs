@@ -25,7 +25,8 @@
 //!   as its TCP zone; no zone reaches past half of either neighbouring line
 //!   ([`crate::controller_targets::BLEND_LENGTH_SHARE`]).
 //! * No two consecutive targets of a stroke lie closer than [`MIN_TARGET_SPACING_M`]: a closer
-//!   inner target is left out.
+//!   inner target is left out (the reader checks the path that leaves, within the whole
+//!   tolerance).
 //!
 //! The frames and joint values are the controller's where the description is ROS-Industrial's
 //! ABB description (its base frame ABB's base frame, its joint values and zeros ABB's axes').
@@ -43,6 +44,30 @@ use crate::tool_output::ToolOutput;
 /// The closest two consecutive targets of a stroke may lie (m): closer targets leave the
 /// controller's path planner no room for their zones.
 pub const MIN_TARGET_SPACING_M: f64 = 1e-4;
+
+/// The places in `kept` (indices of `poses`, the first where the tool stands) of the targets
+/// written: every one after the first, but an inner one closer than [`MIN_TARGET_SPACING_M`]
+/// to the last written (or to the start), and the inner one before the last where the last
+/// lies that close to it (the stroke part comes to rest there: its last samples crowd).
+fn spaced(poses: &[Pose], kept: &[usize]) -> Vec<usize> {
+    let position = |n: usize| poses[kept[n]].position;
+    let last = kept.len() - 1;
+    let mut written: Vec<usize> = Vec::new();
+    for n in 1..=last {
+        let before = written.last().map_or(position(0), |&m| position(m));
+        if n < last && (position(n) - before).norm() < MIN_TARGET_SPACING_M {
+            continue;
+        }
+        if n == last
+            && let Some(&m) = written.last()
+            && (position(n) - position(m)).norm() < MIN_TARGET_SPACING_M
+        {
+            written.pop();
+        }
+        written.push(n);
+    }
+    written
+}
 
 /// `MoveAbsJ`'s speed between strokes (ABB's predefined speeddata): the axes' own limits bound
 /// it.
@@ -437,8 +462,8 @@ impl Writer<'_> {
     }
 
     /// A stroke part whose samples are `qs`, along `task`, the tool at rest on its start: the
-    /// tool on, a `MoveL` run through its targets (inner targets closer than
-    /// [`MIN_TARGET_SPACING_M`] to the one before left out), the tool off.
+    /// tool on, a `MoveL` run through its targets held [`MIN_TARGET_SPACING_M`] apart
+    /// ([`spaced`]), the tool off.
     fn stroke(&mut self, qs: &[JointVector], task: &Task) {
         let run = self.rules.stroke(qs, task);
         self.program.worst_chord_m = self.program.worst_chord_m.max(run.worst_chord_m);
@@ -447,14 +472,7 @@ impl Writer<'_> {
         if self.tool.lead_s > 0.0 {
             self.line(&format!("WaitTime {};", self.tool.lead_s));
         }
-        let last = run.kept.len() - 1;
-        let mut written = run.poses[run.kept[0]].position;
-        for n in 1..=last {
-            let position = run.poses[run.kept[n]].position;
-            if n < last && (position - written).norm() < MIN_TARGET_SPACING_M {
-                continue;
-            }
-            written = position;
+        for n in spaced(&run.poses, &run.kept) {
             self.move_l(&qs[run.kept[n]], run.speeds[n], run.radii[n]);
         }
         if self.tool.lag_s > 0.0 {
@@ -514,6 +532,21 @@ mod tests {
         ] {
             assert_eq!(zone_size_mm(radius_m), expected, "{radius_m}");
         }
+    }
+
+    #[test]
+    fn targets_closer_than_the_spacing_are_left_out_the_last_kept() {
+        let poses: Vec<Pose> = [0.0, 0.05e-3, 0.3e-3, 0.35e-3, 0.6e-3, 0.65e-3]
+            .iter()
+            .map(|&x| Pose {
+                position: Vec3::new(x, 0.0, 0.0),
+                rotation: UnitQuaternion::identity(),
+            })
+            .collect();
+        let kept: Vec<usize> = (0..poses.len()).collect();
+        // 0.05 mm from the start: out; 0.35 after 0.3: out; the last, 0.05 after 0.6, in its
+        // place.
+        assert_eq!(spaced(&poses, &kept), vec![2, 5]);
     }
 
     #[test]

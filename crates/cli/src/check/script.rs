@@ -6,12 +6,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+
+use super::exported::Exported;
 use emg_io::DriverProfile;
 use emg_planner::ShippedRobot;
 
 use crate::options::ChainArgs;
 use crate::output::count;
-use crate::program::read_job_file;
 use crate::robot;
 
 /// The job's program a script `file` was exported from by default: the `.json` of its name, a
@@ -51,29 +52,18 @@ pub fn check_script(
     robot: Option<&Path>,
     chain: &ChainArgs,
 ) -> Result<()> {
-    let text =
-        std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
-    let program_path = program.map_or_else(|| program_beside(file), Path::to_path_buf);
-    let job = read_job_file(&program_path)
-        .with_context(|| {
-            format!(
-                "a URScript program is read back against the job's program it was exported \
-                 from: name it with --program JOB (default {})",
-                program_beside(file).display()
-            )
-        })?
-        .ok_or_else(|| {
-            anyhow!(
-                "{} is not a job's program (emg-job/3): name the one {} was exported from with \
-                 --program JOB",
-                program_path.display(),
-                file.display()
-            )
-        })?;
-    let robot_path = match robot {
-        Some(path) => path.to_path_buf(),
-        None => robot::resolve(&job.robot, &program_path)?,
-    };
+    let Exported {
+        text,
+        job,
+        program_path,
+        robot_path,
+    } = Exported::read(
+        file,
+        &program_beside(file),
+        program,
+        robot,
+        "URScript program",
+    )?;
     let ur5e = ShippedRobot::by_path(&robot_path, &robot::data_dir())
         .and_then(|shipped| DriverProfile::for_shipped(shipped.name))
         .is_some_and(DriverProfile::has_ur_controller_frames);

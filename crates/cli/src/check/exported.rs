@@ -1,0 +1,63 @@
+//! What `emg check` reads a controller's program against: the job's program it was exported
+//! from, and that program's robot.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow};
+
+use crate::program::read_job_file;
+use crate::robot;
+
+/// A controller's program, with the job's program it was exported from and the robot file.
+pub struct Exported {
+    /// The controller's program's text.
+    pub text: String,
+    /// The job's program.
+    pub job: emg_job::JobFile,
+    /// Where it was read.
+    pub program_path: PathBuf,
+    /// The robot file: `--robot`, else the job's program's `robot` field.
+    pub robot_path: PathBuf,
+}
+
+impl Exported {
+    /// Reads the controller's program `file` (a `kind`), the job's program `program` (default
+    /// `beside`) and resolves its robot (`robot`, else the program's own).
+    pub fn read(
+        file: &Path,
+        beside: &Path,
+        program: Option<&Path>,
+        robot: Option<&Path>,
+        kind: &str,
+    ) -> Result<Self> {
+        let text = std::fs::read_to_string(file)
+            .with_context(|| format!("cannot read {}", file.display()))?;
+        let program_path = program.map_or_else(|| beside.to_path_buf(), Path::to_path_buf);
+        let job = read_job_file(&program_path)
+            .with_context(|| {
+                format!(
+                    "a {kind} is read back against the job's program it was exported from: name \
+                     it with --program JOB (default {})",
+                    beside.display()
+                )
+            })?
+            .ok_or_else(|| {
+                anyhow!(
+                    "{} is not a job's program (emg-job/3): name the one {} was exported from \
+                     with --program JOB",
+                    program_path.display(),
+                    file.display()
+                )
+            })?;
+        let robot_path = match robot {
+            Some(path) => path.to_path_buf(),
+            None => robot::resolve(&job.robot, &program_path)?,
+        };
+        Ok(Self {
+            text,
+            job,
+            program_path,
+            robot_path,
+        })
+    }
+}

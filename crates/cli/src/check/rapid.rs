@@ -1,0 +1,86 @@
+//! `emg check PROGRAM.mod`: a RAPID module exported for the ABB IRB 120 read back against the
+//! job's program it was exported from by the independent reader ([`emg_rapid_check`]), which
+//! shares no code with the writer: every target solved by its own inverse kinematics from its
+//! configuration data, the moves interpolated as the controller does.
+
+use std::path::Path;
+
+use anyhow::{Result, anyhow, bail};
+use emg_planner::ShippedRobot;
+
+use super::exported::Exported;
+use crate::options::ChainArgs;
+use crate::output::count;
+use crate::robot;
+
+/// Runs `emg check` on a RAPID module `file`: prints what was read and `OK`, or fails naming the
+/// line and what the arm would do wrong there. `program` and `robot` are `--program` and
+/// `--robot`, `chain` the chain's ends.
+pub fn check_module(
+    file: &Path,
+    program: Option<&Path>,
+    robot: Option<&Path>,
+    chain: &ChainArgs,
+) -> Result<()> {
+    let Exported {
+        text,
+        job,
+        program_path,
+        robot_path,
+    } = Exported::read(
+        file,
+        &file.with_extension("json"),
+        program,
+        robot,
+        "RAPID module",
+    )?;
+    let irb120 = ShippedRobot::by_path(&robot_path, &robot::data_dir())
+        .is_some_and(|shipped| shipped.name == "irb120");
+    if !irb120 {
+        bail!(
+            "{} is a program for robot {}: RAPID modules are read back for the shipped irb120 \
+             only (its closed-form kinematics)",
+            program_path.display(),
+            robot_path.display()
+        );
+    }
+    let (_, model) = chain.robot_and_checker(&robot_path)?;
+    let report = emg_rapid_check::read_rapid(&text, &job, &model)
+        .map_err(|e| anyhow!("{} does not hold up: {e}", file.display()))?;
+    let constraints = &job.constraints;
+    println!(
+        "{}: RAPID read back against {}, robot {}",
+        file.display(),
+        program_path.display(),
+        robot_path.display()
+    );
+    println!(
+        "  {} moves ({} MoveAbsJ, {} MoveL), {} declared; every target the plan's \
+         configuration by its configuration data (within {:.1e} rad), targets at least {:.3} mm \
+         apart; {} switched on and off where they start and end",
+        report.move_abs_j + report.move_l,
+        report.move_abs_j,
+        report.move_l,
+        count(report.declared_zones, "zone"),
+        report.worst_target_rad,
+        report.least_spacing_m * 1e3,
+        count(report.stroke_parts, "stroke part"),
+    );
+    println!(
+        "  while the tool is on the TCP stays within {:.3} mm of its stroke (line {} mm) and the \
+         tool axis within {:.1}° of its normal (cone {}°); {} configurations checked, clear of \
+         the arm and the part (least self-clearance {:.1} mm)",
+        report.worst_deviation_m * 1e3,
+        constraints.line_tolerance_m * 1e3,
+        report.worst_tool_angle_deg,
+        constraints.theta_max_deg,
+        report.samples,
+        report.least_clearance_m * 1e3,
+    );
+    println!(
+        "  the strokes covered {:.4} m of the {:.4} m the program draws",
+        report.covered_m, report.drawn_m
+    );
+    println!("OK");
+    Ok(())
+}
