@@ -1,0 +1,195 @@
+//! The RAPID modules `emg job --export rapid` writes for the ABB IRB 120, read back by the
+//! independent reader (`emg-rapid-check`: its own parser, the arm's closed form from
+//! `rs-opw-kinematics`, ABB's configuration data computed from that geometry, the checker's
+//! clearances) and checked against the job's plan; the module of a small job kept word for word;
+//! edits of a module refused at their line.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{data_dir, emg, read, temp_dir, text};
+use emg_rapid_check::{RapidReport, ReadError, read_rapid};
+use emg_verify::ReferenceModel;
+
+/// The shipped IRB 120's checker, base `base_link`, tip `pen_tip`.
+fn irb120_checker() -> ReferenceModel {
+    ReferenceModel::from_urdf_file(
+        &data_dir().join("robots/irb120_pen.urdf"),
+        "base_link",
+        "pen_tip",
+    )
+    .expect("the IRB 120's checker")
+}
+
+/// A drawing of `../shared/cases/`.
+fn case(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/cases")
+        .join(name)
+}
+
+/// `drawing` planned on the IRB 120 by `emg job ... --export rapid` (with `extra` arguments)
+/// into `dir`: the module, its plan and the module's path.
+fn exported(drawing: &Path, dir: &Path, extra: &[&str]) -> (String, emg_job::JobFile, PathBuf) {
+    let out = dir.join("drawing.job.json");
+    let mut args = vec![
+        "job",
+        drawing.to_str().expect("utf-8 path"),
+        "--robot",
+        "irb120",
+        "--out",
+        out.to_str().expect("utf-8 path"),
+        "--export",
+        "rapid",
+    ];
+    args.extend_from_slice(extra);
+    let run = emg(&args);
+    assert!(
+        run.status.success(),
+        "emg job failed:\n{}\n{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
+    let module = out.with_extension("mod");
+    let plan = emg_job::JobFile::parse(&read(&out)).expect("the plan parses");
+    (read(&module), plan, module)
+}
+
+/// Checks what every module that reads back must show.
+fn assert_reads_back(report: &RapidReport, plan: &emg_job::JobFile) {
+    let parts = plan
+        .segments
+        .iter()
+        .filter(|s| matches!(s.kind, emg_job::SegmentKind::Stroke { .. }))
+        .count();
+    assert_eq!(report.stroke_parts, parts);
+    assert!(report.worst_target_rad <= 1e-6, "{report:?}");
+    assert!(report.least_spacing_m >= 1e-4, "{report:?}");
+    assert!(report.worst_deviation_m <= plan.constraints.line_tolerance_m);
+    assert!(report.worst_tool_angle_deg <= plan.constraints.theta_max_deg);
+    assert!(report.covered_m >= report.drawn_m - 1e-3 * parts as f64);
+}
+
+/// `module` with line `line` (1-based) passed through `edit`.
+fn with_line(module: &str, line: usize, edit: impl Fn(&str) -> String) -> String {
+    module
+        .lines()
+        .enumerate()
+        .map(|(k, l)| {
+            if k + 1 == line {
+                edit(l)
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+/// The 1-based number of the first line of `module` that `is` says is it.
+fn line_of(module: &str, is: impl Fn(&str) -> bool) -> usize {
+    module.lines().position(is).expect("the line is there") + 1
+}
+
+#[test]
+fn the_house_module_reads_back_every_target_the_plans_configuration() {
+    let dir = temp_dir("rapid-house");
+    let (module, plan, path) = exported(&case("pen-drag-house.svg"), dir.path(), &[]);
+    let report = read_rapid(&module, &plan, &irb120_checker()).expect("the module reads back");
+    eprintln!("{report:#?}");
+    assert_reads_back(&report, &plan);
+    // `emg check` reads it beside its plan.
+    let run = emg(&["check", path.to_str().expect("utf-8 path")]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    assert!(text(&run.stdout).contains("RAPID read back"));
+}
+
+/// A small job whose module is kept word for word in `tests/data/irb120-triangle.mod`: any
+/// change of the writer shows there. `EMG_WRITE_GOLDEN=1` writes it again.
+#[test]
+fn a_small_job_writes_the_module_kept_word_for_word() {
+    let dir = temp_dir("rapid-golden");
+    let drawing = dir.path().join("triangle.svg");
+    std::fs::write(
+        &drawing,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 10 10\">\
+         <polygon fill=\"none\" stroke=\"black\" points=\"1,1 9,1 5,8\"/></svg>\n",
+    )
+    .expect("drawing written");
+    let (module, plan, _) = exported(&drawing, dir.path(), &["--width", "0.05"]);
+    // The header names the robot by its digest, no directory of this machine.
+    assert!(!module.contains(dir.path().to_str().expect("utf-8 path")));
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/irb120-triangle.mod");
+    if std::env::var_os("EMG_WRITE_GOLDEN").is_some() {
+        std::fs::write(&golden, &module).expect("golden written");
+    }
+    assert_eq!(
+        module,
+        read(&golden),
+        "the module differs from {}: if the change is meant, write it again with \
+         EMG_WRITE_GOLDEN=1",
+        golden.display()
+    );
+    let report = read_rapid(&module, &plan, &irb120_checker()).expect("the module reads back");
+    assert_reads_back(&report, &plan);
+    assert_eq!(report.stroke_parts, 1);
+}
+
+#[test]
+fn edits_of_a_module_are_refused_at_their_line() {
+    let dir = temp_dir("rapid-edits");
+    let (module, plan, _) = exported(&case("pen-drag-house.svg"), dir.path(), &[]);
+    let checker = irb120_checker();
+    let refused = |edited: &str| -> ReadError {
+        read_rapid(edited, &plan, &checker).expect_err("an edited module is refused")
+    };
+    let stroke_target = line_of(&module, |l| l.contains("MoveL") && l.contains("zEmg"));
+    // A target moved by a millimetre.
+    let moved = with_line(&module, stroke_target, |l| {
+        let at = l.find("[[").expect("a robtarget") + 2;
+        let end = at + l[at..].find(',').expect("x");
+        let x: f64 = l[at..end].parse().expect("x in mm");
+        format!("{}{:.6}{}", &l[..at], x + 1.0, &l[end..])
+    });
+    let error = refused(&moved);
+    assert_eq!(error.line, stroke_target, "{error}");
+    // A configuration bit flipped: cfx's axis-5 bit.
+    let flipped = with_line(&module, stroke_target, |l| {
+        let conf = l.find("], [").expect("after the position") + 4;
+        let conf = conf + l[conf..].find("], [").expect("after the orientation") + 4;
+        let end = conf + l[conf..].find(']').expect("confdata");
+        let mut values: Vec<i32> = l[conf..end]
+            .split(',')
+            .map(|v| v.trim().parse().expect("an integer"))
+            .collect();
+        values[3] ^= 1;
+        let values: Vec<String> = values.iter().map(i32::to_string).collect();
+        format!("{}{}{}", &l[..conf], values.join(", "), &l[end..])
+    });
+    let error = refused(&flipped);
+    assert_eq!(error.line, stroke_target, "{error}");
+    assert!(error.problem.contains("configuration"), "{error}");
+    // A zone that is not defined.
+    let undefined = with_line(&module, stroke_target, |l| {
+        let at = l.find("zEmg").expect("a declared zone");
+        let end = at + l[at..].find(',').expect("the zone's end");
+        format!("{}zEmgNone{}", &l[..at], &l[end..])
+    });
+    let error = refused(&undefined);
+    assert_eq!(error.line, stroke_target, "{error}");
+    assert!(error.problem.contains("not defined"), "{error}");
+    // The tool never switched on for the first stroke part.
+    let switch = line_of(&module, |l| l.trim() == "SetDO doEmgTool0, 1;");
+    let unswitched = with_line(&module, switch, |_| "    ! SetDO left out".to_string());
+    let error = refused(&unswitched);
+    assert!(error.problem.contains("switches"), "{error}");
+    // The tool on a tenth of a millimetre off the pen's axis.
+    let tool = line_of(&module, |l| l.contains("PERS tooldata"));
+    let off_axis = with_line(&module, tool, |l| {
+        l.replacen("[[0.000000, ", "[[0.100000, ", 1)
+    });
+    let error = refused(&off_axis);
+    assert_eq!(error.line, tool, "{error}");
+}
