@@ -28,6 +28,7 @@ use crate::task_set_options::ROBOT_WITH_JOINT_LIMITS;
 use crate::{progress, workspace};
 
 mod large;
+mod rapid_programs;
 mod ur_programs;
 
 /// The icons, robot file and output directory of an evaluation of jobs on icons.
@@ -201,6 +202,16 @@ pub struct Record {
     /// On the UR5e, each program of `rows` exported both ways and read back.
     #[serde(default)]
     pub ur_programs: Vec<ur_programs::UrRow>,
+    /// On the IRB 120, each program of `rows` written as a RAPID module and read back.
+    #[serde(default)]
+    pub rapid_programs: Vec<rapid_programs::RapidRow>,
+}
+
+/// The readers of the controllers' own programs a job-eval arm has: the UR5e's native
+/// programs, the IRB 120's RAPID modules.
+struct Readers<'a> {
+    ur: Option<ur_programs::UrArm<'a>>,
+    rapid: Option<rapid_programs::RapidArm<'a>>,
 }
 
 /// Plans, checks and compares every job; writes the record and its table.
@@ -219,14 +230,25 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             profile,
             checker: &checker,
         });
+    // The arm whose controller's frames a RAPID module is written in: the IRB 120.
+    let rapid_arm = (shipped.name == "irb120").then(|| rapid_programs::RapidArm {
+        robot: planner.robot(),
+        robot_file: &args.common.robot,
+        checker: &checker,
+    });
+    let readers = Readers {
+        ur: ur_arm,
+        rapid: rapid_arm,
+    };
     let jobs = jobs(&args.common.icons, planner, home)?;
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
-    let mut ur_rows = Vec::new();
+    let (mut ur_rows, mut rapid_rows) = (Vec::new(), Vec::new());
     for (name, job) in &jobs {
-        let (row, ur_row) = evaluate(&job_planner, &checker, (name, job), ur_arm.as_ref())?;
+        let (row, ur_row, rapid_row) = evaluate(&job_planner, &checker, (name, job), &readers)?;
         rows.push(row);
         ur_rows.extend(ur_row);
+        rapid_rows.extend(rapid_row);
         bar.inc(1);
     }
     bar.finish();
@@ -256,6 +278,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         rows,
         large: large_rows,
         ur_programs: ur_rows,
+        rapid_programs: rapid_rows,
     };
     workspace::write_results(&args.common.out_dir, "jobs", &record, &markdown(&record))?;
     ensure_checked(&record)
@@ -332,7 +355,8 @@ fn one_thread_times(
     Ok(one_thread_s)
 }
 
-/// An error where a program fails the checker or a UR program does not read back.
+/// An error where a program fails the checker, or a UR program or RAPID module does not read
+/// back.
 fn ensure_checked(record: &Record) -> anyhow::Result<()> {
     let failures = record
         .rows
@@ -350,10 +374,16 @@ fn ensure_checked(record: &Record) -> anyhow::Result<()> {
         .ur_programs
         .iter()
         .filter_map(|r| r.failure.as_deref())
+        .chain(
+            record
+                .rapid_programs
+                .iter()
+                .filter_map(|r| r.failure.as_deref()),
+        )
         .collect();
     anyhow::ensure!(
         unread.is_empty(),
-        "{} UR programs do not read back:\n{}",
+        "{} controller programs do not read back:\n{}",
         unread.len(),
         unread.join("\n")
     );
@@ -433,22 +463,31 @@ fn in_travel_order(job: &Job) -> Job {
     listed
 }
 
-/// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e (`ur_arm`)
-/// its program exported both ways and read back.
+/// `job` (named `name`) planned, checked and compared with the baseline; on the UR5e its
+/// program exported both ways and read back, on the IRB 120 written as a RAPID module and read
+/// back (`readers`).
 fn evaluate(
     job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
     (name, job): (&str, &Job),
-    ur_arm: Option<&ur_programs::UrArm<'_>>,
-) -> anyhow::Result<(JobRow, Option<ur_programs::UrRow>)> {
+    readers: &Readers<'_>,
+) -> anyhow::Result<(
+    JobRow,
+    Option<ur_programs::UrRow>,
+    Option<rapid_programs::RapidRow>,
+)> {
     let planner = job_planner.planner();
     let started = Instant::now();
     let planned = job_planner.plan(job, &Unwatched);
     let planning_s = started.elapsed().as_secs_f64();
     let baseline = baseline(planner, job_planner.timing(), job);
     let total_m: f64 = job.strokes.iter().map(|s| s.length_m()).sum();
-    let ur_row = match (&planned, ur_arm) {
+    let ur_row = match (&planned, &readers.ur) {
         (Ok(program), Some(arm)) => Some(ur_programs::read_back(arm, name, program)),
+        _ => None,
+    };
+    let rapid_row = match (&planned, &readers.rapid) {
+        (Ok(program), Some(arm)) => Some(rapid_programs::read_back(arm, name, program)),
         _ => None,
     };
     let row = match planned {
@@ -513,7 +552,7 @@ fn evaluate(
             baseline_colliding_moves: baseline.colliding,
         },
     };
-    Ok((row, ur_row))
+    Ok((row, ur_row, rapid_row))
 }
 
 /// The largest distance of a joint from its home value over `program`'s points (rad).
@@ -645,6 +684,9 @@ fn markdown(record: &Record) -> String {
     md.push_str(&job_table(&record.rows));
     if !record.large.is_empty() {
         md.push_str(&large::markdown(&record.large));
+    }
+    if !record.rapid_programs.is_empty() {
+        md.push_str(&rapid_programs::markdown(&record.rapid_programs));
     }
     if !record.ur_programs.is_empty() {
         md.push_str(&ur_programs::markdown(&record.ur_programs));

@@ -209,8 +209,9 @@ pub fn verify_file(
         .map(|_| ())
 }
 
-/// The [`PlannerSetup`] of the shipped robot file `robot` and the first `count` tasks of
-/// `task_file`; `command` names the caller in errors.
+/// The [`PlannerSetup`] of the shipped robot file `robot` (its trained models, where it has
+/// them) and the first `count` tasks of `task_file` (not read where `count` is 0); `command`
+/// names the caller in errors.
 pub fn planner_setup(
     robot: &Path,
     task_file: &Path,
@@ -221,8 +222,18 @@ pub fn planner_setup(
     let checker = load_checker(robot, &model)?;
     let shipped = ShippedRobot::by_path(robot, &data_dir())
         .with_context(|| format!("{command} needs a shipped robot's models"))?;
-    let models = Models::shipped(&model, &shipped.data_dir(&data_dir()))?;
-    let mut tasks = read_tasks(task_file, &model)?;
+    // An industrial arm ships without trained models: it plans by search alone.
+    let models = if shipped.trained {
+        Models::shipped(&model, &shipped.data_dir(&data_dir()))?
+    } else {
+        Models::load(&model, None, None)?
+    };
+    // No tasks asked for: none read (an industrial arm has no task sets).
+    let mut tasks = if count == 0 {
+        Vec::new()
+    } else {
+        read_tasks(task_file, &model)?
+    };
     anyhow::ensure!(
         count <= tasks.len(),
         "{command} --tasks {count}: {} holds {} tasks",

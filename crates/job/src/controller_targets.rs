@@ -113,6 +113,54 @@ pub(crate) struct TargetRules<'a> {
     /// The plan's tool speed (m/s).
     pub(crate) tool_speed: f64,
     pub(crate) corner: Corner,
+    /// How far the arm reaches, where every point of the controller's path is held within it.
+    pub(crate) reach: Option<WristReach>,
+}
+
+/// How far a six-joint arm with a spherical wrist reaches: its wrist centre at most the
+/// stretched elbow's distance from axis 2. A controller that interpolates in Cartesian space
+/// faults where its path leaves that, and a plan that reaches as far as the arm does runs
+/// along its edge, where a straight line between two of its poses may step over it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WristReach {
+    /// The TCP's distance from the wrist centre along the tool axis (m).
+    wrist_back_m: f64,
+    /// The stretched elbow's distance from axis 2's origin to the wrist centre (m).
+    reach_m: f64,
+}
+
+/// How far (m) beyond the stretched elbow's reach a point of the controller's path may lie: the
+/// plan's own poses stand on that edge to rounding.
+const REACH_ROUNDING_M: f64 = 1e-7;
+
+impl WristReach {
+    /// The reach of `robot`, whose wrist centre is axis 5's origin and whose TCP lies on axis 6
+    /// (checked at the calibration pose; `None` where it does not).
+    pub(crate) fn of(robot: &Robot) -> Option<Self> {
+        if robot.dof() != 6 {
+            return None;
+        }
+        let kinematics = robot.forward(&robot.joint_vector(&[0.0; 6]));
+        let (o2, o3, wrist) = (
+            kinematics.joint_origin(1),
+            kinematics.joint_origin(2),
+            kinematics.joint_origin(4),
+        );
+        let offset = kinematics.tcp() - wrist;
+        let axis = kinematics.tool_axis();
+        (offset.cross(&axis).norm() < 1e-9).then(|| Self {
+            wrist_back_m: offset.dot(&axis),
+            reach_m: (o3 - o2).norm() + (wrist - o3).norm(),
+        })
+    }
+
+    /// Whether the TCP pose `pose` keeps its wrist centre within reach of axis 2 where it
+    /// stands at the configuration `near`.
+    fn holds(&self, robot: &Robot, pose: &Pose, near: &JointVector) -> bool {
+        let wrist = pose.position - pose.rotation * Vec3::z() * self.wrist_back_m;
+        let shoulder = robot.forward(near).joint_origin(1);
+        (wrist - shoulder).norm() <= self.reach_m + REACH_ROUNDING_M
+    }
 }
 
 /// A stroke part's targets: the pose of each of the plan's samples, the samples kept as
@@ -154,8 +202,18 @@ impl TargetRules<'_> {
                 s
             })
             .collect();
-        let (kept, worst_chord_m) =
-            stroke_targets(&poses, &progress, qs, task, self.tolerance, self.cone_deg);
+        let reachable = |pose: &Pose, near: &JointVector| {
+            self.reach
+                .is_none_or(|reach| reach.holds(self.robot, pose, near))
+        };
+        let (kept, worst_chord_m) = stroke_targets(
+            &poses,
+            &progress,
+            qs,
+            task,
+            (self.tolerance, self.cone_deg),
+            &reachable,
+        );
         let radii = (0..kept.len())
             .map(|n| {
                 if n == 0 || n + 1 == kept.len() {
@@ -167,7 +225,7 @@ impl TargetRules<'_> {
                     [progress[i], progress[j]],
                     task,
                     (self.tolerance, self.cone_deg),
-                    self.corner,
+                    (self.corner, &reachable, &qs[j]),
                 )
             })
             .collect();
@@ -321,16 +379,17 @@ fn furthest(i: usize, last: usize, mut fits: impl FnMut(usize) -> bool) -> usize
 /// samples' progress (`progress`) at its start as the reader follows it, as well as from the
 /// whole path; following the line reaches as far along the stroke as the samples do at its end
 /// (a line that cuts a corner short of where the samples turned would leave the reader's
-/// progress before the corner); and no joint turns more than [`MAX_TARGET_TURN_RAD`] from its
-/// start to any sample up to its end. The line between two neighbouring samples is followed
+/// progress before the corner); no joint turns more than [`MAX_TARGET_TURN_RAD`] from its
+/// start to any sample up to its end; and each point taken is `reachable` (with the sample's
+/// configuration as the one near it). The line between two neighbouring samples is followed
 /// as the samples are; where even it does not fit, it is kept ([`furthest`]).
 pub(crate) fn stroke_targets(
     poses: &[Pose],
     progress: &[f64],
     qs: &[JointVector],
     task: &Task,
-    tolerance: f64,
-    cone_deg: f64,
+    (tolerance, cone_deg): (f64, f64),
+    reachable: &dyn Fn(&Pose, &JointVector) -> bool,
 ) -> (Vec<usize>, f64) {
     let last = poses.len().saturating_sub(1);
     let mut kept = vec![0];
@@ -362,7 +421,16 @@ pub(crate) fn stroke_targets(
                 .try_slerp(&poses[j].rotation, u, 1e-12)
                 .unwrap_or(poses[i].rotation);
             let axis = rotation * Vec3::z();
-            if distance > CHORD_SHARE * tolerance || tool_angle_deg(&axis, &task.n) > cone_deg {
+            if distance > CHORD_SHARE * tolerance
+                || tool_angle_deg(&axis, &task.n) > cone_deg
+                || !reachable(
+                    &Pose {
+                        position: point,
+                        rotation,
+                    },
+                    &qs[k],
+                )
+            {
                 return None;
             }
             largest = largest.max(distance);
@@ -389,14 +457,14 @@ const SAME_PROGRESS_M: f64 = 1e-9;
 /// reached, followed along the arc from `from_s`, the progress at `a`, and from the whole path)
 /// and its tool axis within `cone_deg` of the task's normal, the progress followed to its end
 /// reaching `at_b_s`, the samples' progress at `b` (an arc that turns short of a corner the
-/// samples came to would leave the reader's progress before it); 0 (no blend) where no radius
-/// tried does.
+/// samples came to would leave the reader's progress before it), and every pose `reachable`
+/// near the configuration `near` at `b`; 0 (no blend) where no radius tried does.
 fn blend_radius(
     [a, b, c]: [&Pose; 3],
     [from_s, at_b_s]: [f64; 2],
     task: &Task,
     (tolerance, cone_deg): (f64, f64),
-    corner: Corner,
+    (corner, reachable, near): (Corner, &dyn Fn(&Pose, &JointVector) -> bool, &JointVector),
 ) -> f64 {
     let shorter = (b.position - a.position)
         .norm()
@@ -409,6 +477,7 @@ fn blend_radius(
             s = along.s_m;
             task.distance(&pose.position).max(along.lateral.norm()) <= CHORD_SHARE * tolerance
                 && tool_angle_deg(&(pose.rotation * Vec3::z()), &task.n) <= cone_deg
+                && reachable(pose, near)
         });
         if fits && s >= at_b_s - SAME_PROGRESS_M {
             return radius;

@@ -36,7 +36,7 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 
 use crate::abb_configuration::AbbConfiguration;
-use crate::controller_targets::{Corner, Pose, TargetRules};
+use crate::controller_targets::{Corner, Pose, TargetRules, WristReach};
 use crate::free_space::FreeSpace;
 use crate::program::{JobFile, SegmentKind};
 use crate::tool_output::ToolOutput;
@@ -289,6 +289,7 @@ pub fn rapid_program(
             rate_hz: file.rate_hz,
             tool_speed: file.limits.tool_speed_m_per_s,
             corner: Corner::Parabola,
+            reach: WristReach::of(robot),
         },
         part: part_frame(file),
         tool: file.settings.tool_output,

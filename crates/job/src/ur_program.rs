@@ -161,6 +161,7 @@ pub fn ur_program(
             rate_hz: file.rate_hz,
             tool_speed: file.limits.tool_speed_m_per_s,
             corner: Corner::Arc,
+            reach: None,
         },
         tool: file.settings.tool_output,
         joint_speed,

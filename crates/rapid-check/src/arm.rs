@@ -73,6 +73,11 @@ impl Pose {
 /// `[cf1, cf4, cf6, cfx]`.
 pub type Configuration = [i32; 4];
 
+/// How far (m) beyond the stretched elbow's reach a wrist centre may lie and be solved on that
+/// edge: a plan that reaches as far as the arm does runs along it, and its poses, printed to a
+/// nanometre and interpolated, stray past it by about 1e-7 m.
+pub const REACH_SLACK_M: f64 = 1e-6;
+
 /// The IRB 120 as the reader solves it.
 pub struct Irb120 {
     kinematics: OPWKinematics,
@@ -186,11 +191,28 @@ impl Irb120 {
     }
 
     /// Every solution of the flange pose `flange` within `limits` (axes 1, 4 and 6 also a turn
-    /// either way, where the limits allow).
+    /// either way, where the limits allow). A pose whose wrist centre lies beyond the stretched
+    /// elbow's reach by at most [`REACH_SLACK_M`] (where a plan runs along the edge of the
+    /// workspace, as far as it reaches) is solved with the wrist centre on that edge.
     pub fn solutions(&self, flange: &Pose, limits: &[(f64, f64)]) -> Vec<[f64; 6]> {
         let within = |q: &[f64; 6]| q.iter().zip(limits).all(|(v, (lo, hi))| v >= lo && v <= hi);
+        let mut solved = self.kinematics.inverse(&opw_pose(flange));
+        let (wrist, reach) = self.wrist_reach(flange);
+        if solved.is_empty() && wrist > reach && wrist <= reach + REACH_SLACK_M {
+            let p = &self.parameters;
+            let centre = flange.position - flange.rotation * Vec3::z() * p.c4;
+            let across = Vec3::new(centre.x, centre.y, 0.0);
+            let shoulder =
+                across.try_normalize(1e-12).unwrap_or(Vec3::x()) * p.a1 + Vec3::z() * p.c1;
+            let inward = (shoulder - centre).normalize() * (wrist - reach + 1e-12);
+            let edge = Pose {
+                position: flange.position + inward,
+                rotation: flange.rotation,
+            };
+            solved = self.kinematics.inverse(&opw_pose(&edge));
+        }
         let mut out = Vec::new();
-        for solution in self.kinematics.inverse(&opw_pose(flange)) {
+        for solution in solved {
             for turns1 in -1..=1 {
                 for turns4 in -1..=1 {
                     for turns6 in -2..=2 {
@@ -232,6 +254,16 @@ impl Irb120 {
             [only] => Ok(*only),
             _ => Err(matching.len()),
         }
+    }
+
+    /// How far (m) the wrist centre of `flange` lies from axis 2 (with axis 1 turned toward
+    /// it), and the farthest the arm reaches it (the elbow stretched).
+    pub fn wrist_reach(&self, flange: &Pose) -> (f64, f64) {
+        let p = &self.parameters;
+        let wrist = flange.position - flange.rotation * Vec3::z() * p.c4;
+        let across = (wrist.x * wrist.x + wrist.y * wrist.y).sqrt();
+        let from_shoulder = ((across - p.a1).powi(2) + (wrist.z - p.c1).powi(2)).sqrt();
+        (from_shoulder, p.c2 + (p.a2 * p.a2 + p.c3 * p.c3).sqrt())
     }
 
     /// The solution of `flange` within `limits` nearest `previous` (largest joint change), with

@@ -23,7 +23,7 @@ mod error;
 mod parse;
 mod read;
 
-pub use arm::{Configuration, Irb120, Pose};
+pub use arm::{BOUNDARY_SLACK, Configuration, Irb120, Pose, REACH_SLACK_M};
 pub use error::ReadError;
 pub use parse::{Argument, Declaration, Instruction, Module, Value, parse_module};
 pub use read::{

@@ -693,9 +693,14 @@ impl<'a> Reading<'a> {
     ) -> Result<[f64; 6], ReadError> {
         let flange = pose.then(&self.tool.inverse());
         let Some((q, change)) = self.arm.follow(&flange, &joints, &self.limits) else {
+            let (wrist, reach) = self.arm.wrist_reach(&flange);
             return fail(
                 line,
-                format!("{:?} is out of reach", pose.position.as_slice()),
+                format!(
+                    "{:?} is out of reach: its wrist centre lies {wrist:.6} m from axis 2, which \
+                     the arm reaches {reach:.6} m from (or a joint limit stands in the way)",
+                    pose.position.as_slice()
+                ),
             );
         };
         if change > MAX_JOINT_JUMP_RAD {
