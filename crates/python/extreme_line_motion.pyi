@@ -369,7 +369,7 @@ class ExportReport:
 
 def export(
     path: PathLike,
-    format: Literal["ros2-mcap", "urscript"],
+    format: Literal["ros2-mcap", "urscript", "rapid"],
     out: PathLike,
     robot: Optional[PathLike] = None,
     tolerance_rad: Optional[float] = None,
@@ -382,5 +382,7 @@ def export(
     ``/emg/tool_output``, std_msgs/msg/Bool) or ``"urscript"``: ``urscript="native"`` (one
     program of movej, movel and blended movep through the plan's poses, the tool switched by its
     output; a job's program on the shipped UR5e, its default there) or ``"servoj"`` (a servoj
-    target every 2 ms, at most ``max_servoj_lines`` per program, default 2500). Raises InputError
-    for a wrong input, writing nothing."""
+    target every 2 ms, at most ``max_servoj_lines`` per program, default 2500), or ``"rapid"``
+    (a job's program on a six-joint ABB arm, the shipped ``irb120``: one RAPID module of MoveAbsJ
+    and MoveL with zones, configuration data and the tool's SetDO). Raises InputError for a
+    wrong input, writing nothing."""

@@ -129,6 +129,9 @@ pub(crate) struct WristReach {
     reach_m: f64,
 }
 
+/// Whether a TCP pose is within the arm's reach, given a configuration of the plan near it.
+type Reachable<'a> = &'a dyn Fn(&Pose, &JointVector) -> bool;
+
 /// How far (m) beyond the stretched elbow's reach a point of the controller's path may lie: the
 /// plan's own poses stand on that edge to rounding.
 const REACH_ROUNDING_M: f64 = 1e-7;
@@ -389,7 +392,7 @@ pub(crate) fn stroke_targets(
     qs: &[JointVector],
     task: &Task,
     (tolerance, cone_deg): (f64, f64),
-    reachable: &dyn Fn(&Pose, &JointVector) -> bool,
+    reachable: Reachable<'_>,
 ) -> (Vec<usize>, f64) {
     let last = poses.len().saturating_sub(1);
     let mut kept = vec![0];
@@ -464,7 +467,7 @@ fn blend_radius(
     [from_s, at_b_s]: [f64; 2],
     task: &Task,
     (tolerance, cone_deg): (f64, f64),
-    (corner, reachable, near): (Corner, &dyn Fn(&Pose, &JointVector) -> bool, &JointVector),
+    (corner, reachable, near): (Corner, Reachable<'_>, &JointVector),
 ) -> f64 {
     let shorter = (b.position - a.position)
         .norm()

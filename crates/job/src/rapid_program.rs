@@ -91,7 +91,7 @@ const MIN_ZONE_MM: f64 = 0.01;
 /// radius was chosen for. `None` below [`MIN_ZONE_MM`].
 fn zone_size_mm(radius_m: f64) -> Option<f64> {
     let radius_mm = radius_m * 1e3;
-    if !(radius_mm >= MIN_ZONE_MM) {
+    if radius_mm.is_nan() || radius_mm < MIN_ZONE_MM {
         return None;
     }
     let decade = libm::floor(libm::log10(radius_mm)) as i32;

@@ -140,6 +140,22 @@ def test_a_job_exports_as_one_native_ur_program(tmp_path):
         elm.export(job, "urscript", tmp_path / "x.script", urscript="fast")
 
 
+def test_a_job_exports_as_one_rapid_module(tmp_path):
+    """A job's program on the IRB 120 as one RAPID module: the tool switched on and off once per
+    stroke part, each stroke a MoveL run; a joint trajectory is refused."""
+    icon = Path(__file__).resolve().parents[2] / "io" / "tests" / "data" / "icons" / "pencil.svg"
+    job = tmp_path / "pencil.job.json"
+    elm.Planner("irb120").plan_job(icon).write(job)
+    parts = sum(1 for s in json.loads(job.read_text())["segments"] if s["kind"] == "stroke")
+    out = tmp_path / "pencil.job.mod"
+    report = elm.export(job, "rapid", out)
+    assert report.files == [out] and "RAPID for an ABB controller" in report.summary
+    lines = [line.strip() for line in out.read_text().splitlines()]
+    assert lines[0] == "MODULE EmgJob" and lines[-1] == "ENDMODULE"
+    assert lines.count("SetDO doEmgTool0, 1;") == parts
+    assert sum(line.startswith("MoveL ") for line in lines) >= parts
+
+
 def test_urscript_and_wrong_inputs(ur5e_line, tmp_path):
     report = elm.export(ur5e_line, "urscript", tmp_path / "demo.script")
     assert report.servoj_targets > 0

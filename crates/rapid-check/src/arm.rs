@@ -266,15 +266,32 @@ impl Irb120 {
         (from_shoulder, p.c2 + (p.a2 * p.a2 + p.c3 * p.c3).sqrt())
     }
 
-    /// The solution of `flange` within `limits` nearest `previous` (largest joint change), with
-    /// that change: how the controller follows a Cartesian path.
+    /// The solution of `flange` within `limits` nearest `previous` (largest joint change) among
+    /// those whose wrist holds the bits of `cfx` ([`Irb120::holds`]'s slack; all where none
+    /// does), with that change: how the controller follows a Cartesian path, keeping the
+    /// configuration.
     pub fn follow(
         &self,
         flange: &Pose,
         previous: &[f64; 6],
         limits: &[(f64, f64)],
+        cfx: i32,
     ) -> Option<([f64; 6], f64)> {
-        self.solutions(flange, limits)
+        let solutions = self.solutions(flange, limits);
+        let holding: Vec<[f64; 6]> = solutions
+            .iter()
+            .copied()
+            .filter(|q| {
+                let sides = self.sides(q);
+                (0..3).all(|bit| on_side(sides[bit], cfx & (4 >> bit) != 0))
+            })
+            .collect();
+        let candidates = if holding.is_empty() {
+            solutions
+        } else {
+            holding
+        };
+        candidates
             .into_iter()
             .map(|q| {
                 let change = q

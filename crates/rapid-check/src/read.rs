@@ -122,8 +122,9 @@ struct State {
     drawn: Vec<Vec3>,
     progress_m: f64,
     covered: Vec<Vec<Stretch>>,
-    /// The pending fly-by run: each target's pose, joints, zone radius (m) and line.
-    run: Vec<(Pose, [f64; 6], f64, usize)>,
+    /// The pending fly-by run: each target's pose, joints, zone radius (m), line and
+    /// configuration data.
+    run: Vec<(Pose, [f64; 6], f64, usize, Configuration)>,
     /// The pending fly-by joint moves: each target, zone radius (m) and line.
     joint_run: Vec<([f64; 6], f64, usize)>,
     last_target: Option<Pose>,
@@ -287,7 +288,7 @@ impl<'a> Reading<'a> {
             }
             let tcp_mm = items[1].number("pzone_tcp", zone.line)?;
             let orientation_mm = items[2].number("pzone_ori", zone.line)?;
-            if !(tcp_mm > 0.0) || orientation_mm > tcp_mm {
+            if tcp_mm.is_nan() || tcp_mm <= 0.0 || orientation_mm > tcp_mm {
                 return fail(
                     zone.line,
                     format!(
@@ -565,7 +566,7 @@ impl<'a> Reading<'a> {
                 }
                 state.last_target = Some(pose);
                 let radius = self.zone(zone, line)?;
-                state.run.push((pose, q, radius, line));
+                state.run.push((pose, q, radius, line, configuration));
                 state.at_rest = radius == 0.0;
                 if radius == 0.0 {
                     self.end_run(state)?;
@@ -607,17 +608,17 @@ impl<'a> Reading<'a> {
         let mut joints = joints;
         let mut from = start;
         for k in 1..corners.len() {
-            let line = run[k - 1].3;
+            let (line, held) = (run[k - 1].3, run[k - 1].4);
             let (a, b) = (corners[k - 1], corners[k]);
             let length = (b.position - a.position).norm().max(1e-12);
             let entry = b.toward(&a, radius(k) / length);
             // The straight line up to where the next zone begins.
-            joints = self.follow_segment(state, &from, &entry, joints, line)?;
+            joints = self.follow_segment(state, [&from, &entry], joints, (line, held))?;
             if radius(k) > 0.0 {
                 let c = corners[k + 1];
                 let out_length = (c.position - b.position).norm().max(1e-12);
                 let exit = b.toward(&c, radius(k) / out_length);
-                joints = self.follow_corner(state, [&entry, &b, &exit], joints, line)?;
+                joints = self.follow_corner(state, [&entry, &b, &exit], joints, (line, held))?;
                 from = exit;
             } else {
                 from = b;
@@ -641,17 +642,16 @@ impl<'a> Reading<'a> {
     fn follow_segment(
         &self,
         state: &mut State,
-        a: &Pose,
-        b: &Pose,
+        [a, b]: [&Pose; 2],
         joints: [f64; 6],
-        line: usize,
+        at: (usize, Configuration),
     ) -> Result<[f64; 6], ReadError> {
         let (distance, angle) = a.difference(b);
         let count = ((distance / PATH_STEP_M).max(angle / 1e-3)).ceil().max(1.0) as usize;
         let mut joints = joints;
         for k in 1..=count {
             let pose = a.toward(b, k as f64 / count as f64);
-            joints = self.sample(state, &pose, joints, line)?;
+            joints = self.sample(state, &pose, joints, at)?;
         }
         Ok(joints)
     }
@@ -662,7 +662,7 @@ impl<'a> Reading<'a> {
         state: &mut State,
         [entry, target, exit]: [&Pose; 3],
         joints: [f64; 6],
-        line: usize,
+        at: (usize, Configuration),
     ) -> Result<[f64; 6], ReadError> {
         let length =
             (target.position - entry.position).norm() + (exit.position - target.position).norm();
@@ -677,22 +677,25 @@ impl<'a> Reading<'a> {
                 position,
                 rotation: entry.toward(exit, t).rotation,
             };
-            joints = self.sample(state, &pose, joints, line)?;
+            joints = self.sample(state, &pose, joints, at)?;
         }
         Ok(joints)
     }
 
-    /// One sample of a Cartesian path: its joints by the solution nearest the last, no joint
-    /// jumping, the configuration checked, and while the tool is on, the TCP on its task.
+    /// One sample of a Cartesian path toward the target of line `line` whose configuration
+    /// data are `held`: its joints by the solution nearest the last among those holding the
+    /// data's `cfx` (`ConfL \On`: the controller keeps the configuration; past a singularity,
+    /// where two solutions meet, it leaves on the one the data name), no joint jumping, the
+    /// configuration checked, and while the tool is on, the TCP on its task.
     fn sample(
         &self,
         state: &mut State,
         pose: &Pose,
         joints: [f64; 6],
-        line: usize,
+        (line, held): (usize, Configuration),
     ) -> Result<[f64; 6], ReadError> {
         let flange = pose.then(&self.tool.inverse());
-        let Some((q, change)) = self.arm.follow(&flange, &joints, &self.limits) else {
+        let Some((q, change)) = self.arm.follow(&flange, &joints, &self.limits, held[3]) else {
             let (wrist, reach) = self.arm.wrist_reach(&flange);
             return fail(
                 line,
