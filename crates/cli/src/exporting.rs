@@ -151,11 +151,22 @@ pub fn export_job(
     robot_file: &Path,
     robot: &Robot,
 ) -> Result<String> {
+    let arm = (robot_file, robot);
     if target.format == ExportFormat::UrScript && writes_native(target.urscript, robot_file)? {
-        return native_ur_program(file, target.out, input, robot_file, robot);
+        let write: ControllerProgram = |file, robot, reference, out| {
+            Ok(emg_job::ur_program::ur_program_export(
+                file, robot, reference, out,
+            )?)
+        };
+        return controller_program(write, file, target.out, input, arm);
     }
     if target.format == ExportFormat::Rapid {
-        return rapid_module(file, target.out, input, robot_file, robot);
+        let write: ControllerProgram = |file, robot, reference, out| {
+            Ok(emg_job::rapid_program::rapid_program_export(
+                file, robot, reference, out,
+            )?)
+        };
+        return controller_program(write, file, target.out, input, arm);
     }
     let options = ExportOptions {
         tolerance_rad: target.thinning_tolerance,
@@ -197,32 +208,22 @@ fn writes_native(urscript: &UrScriptArgs, robot_file: &Path) -> Result<bool> {
     }
 }
 
-/// Writes the job's program `file` (read from `input`) as one native UR program to `out`;
-/// returns what to print.
-fn native_ur_program(
-    file: &emg_job::JobFile,
-    out: &Path,
-    input: &Path,
-    robot_file: &Path,
-    robot: &Robot,
-) -> Result<String> {
-    let reference = robot::reference(robot_file)?.to_string();
-    let export = emg_job::ur_program::ur_program_export(file, robot, &reference, out)?;
-    export.write(&[("job program", input), ("robot", robot_file)])?;
-    Ok(format!("{}\n  wrote {}", export.summary, out.display()))
-}
+/// The writer of a controller's own program from a job's program: the program `file` for the
+/// arm `robot`, recorded as written for the robot reference, into `out`.
+type ControllerProgram =
+    fn(&emg_job::JobFile, &Robot, &str, &Path) -> Result<emg_io::Export, anyhow::Error>;
 
-/// Writes the job's program `file` (read from `input`) as one RAPID module to `out`; returns
-/// what to print.
-fn rapid_module(
+/// Writes the job's program `file` (read from `input`) as one controller's program by `write`
+/// (a native UR program, a RAPID module) to `out`; returns what to print.
+fn controller_program(
+    write: ControllerProgram,
     file: &emg_job::JobFile,
     out: &Path,
     input: &Path,
-    robot_file: &Path,
-    robot: &Robot,
+    (robot_file, robot): (&Path, &Robot),
 ) -> Result<String> {
     let reference = robot::reference(robot_file)?.to_string();
-    let export = emg_job::rapid_program::rapid_program_export(file, robot, &reference, out)?;
+    let export = write(file, robot, &reference, out)?;
     export.write(&[("job program", input), ("robot", robot_file)])?;
     Ok(format!("{}\n  wrote {}", export.summary, out.display()))
 }

@@ -19,6 +19,7 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
 
 use crate::free_space::FreeSpace;
+use crate::program::{JobFile, SegmentKind};
 
 /// Share of the line tolerance that the path the controller interpolates (each straight line
 /// between two targets of a stroke, each corner's path) may lie from the stroke: the rest is
@@ -97,6 +98,100 @@ impl Corner {
             Self::Parabola => corner_parabola([a, b, c], radius),
         }
     }
+}
+
+/// One segment of a job's program as a controller's program is written from it: a comment
+/// line's text saying what it is, and the segment.
+pub(crate) enum Step<'a> {
+    /// A stroke part: its samples' configurations along its task.
+    Stroke {
+        comment: String,
+        qs: &'a [JointVector],
+        task: &'a Task,
+    },
+    /// A move between strokes (a lift, a set-down, a move): its joint vertices and samples,
+    /// whether it starts at a stroke's end and whether it ends at a stroke's start.
+    Move {
+        comment: String,
+        vertices: Vec<JointVector>,
+        qs: &'a [JointVector],
+        off_stroke: bool,
+        onto_stroke: bool,
+    },
+}
+
+/// The configurations of every sample of each segment of `file`.
+pub(crate) fn segment_configurations(file: &JobFile) -> Vec<Vec<JointVector>> {
+    file.segments
+        .iter()
+        .map(|segment| {
+            file.segment_samples(segment)
+                .iter()
+                .map(|sample| sample.q)
+                .collect()
+        })
+        .collect()
+}
+
+/// Each segment of `file` (whose samples' configurations are `samples`, from
+/// [`segment_configurations`]) as a [`Step`] for `robot`, in order, to `visit`; the index of a
+/// stroke segment without its task, where one is.
+pub(crate) fn walk<'a>(
+    file: &'a JobFile,
+    robot: &Robot,
+    samples: &'a [Vec<JointVector>],
+    mut visit: impl FnMut(Step<'a>),
+) -> Result<(), usize> {
+    let is_stroke = |index: usize| {
+        file.segments
+            .get(index)
+            .is_some_and(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
+    };
+    for (index, (segment, qs)) in file.segments.iter().zip(samples).enumerate() {
+        let duration = segment.end_s - segment.start_s;
+        match segment.kind {
+            SegmentKind::Stroke {
+                stroke,
+                part,
+                from_s,
+                backward,
+            } => {
+                let task = segment.task.as_ref().ok_or(index)?;
+                let way = if backward {
+                    " back toward its start"
+                } else {
+                    ""
+                };
+                visit(Step::Stroke {
+                    comment: format!(
+                        "stroke {stroke}, part {part}: from {from_s:.4} m along it{way}, \
+                         {duration:.3} s"
+                    ),
+                    qs,
+                    task,
+                });
+            }
+            kind => {
+                let what = match kind {
+                    SegmentKind::Retreat => "lift",
+                    SegmentKind::Approach => "set-down",
+                    _ => "move",
+                };
+                visit(Step::Move {
+                    comment: format!("{what}: {duration:.3} s in the plan"),
+                    vertices: segment
+                        .vertices
+                        .iter()
+                        .map(|v| robot.joint_vector(v))
+                        .collect(),
+                    qs,
+                    off_stroke: index > 0 && is_stroke(index - 1),
+                    onto_stroke: is_stroke(index + 1),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// How a program's targets are chosen for one job: its arm and space, the stroke's tolerances,

@@ -36,9 +36,11 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 
 use crate::abb_configuration::AbbConfiguration;
-use crate::controller_targets::{Corner, Pose, TargetRules, WristReach};
+use crate::controller_targets::{
+    Corner, Pose, Step, TargetRules, WristReach, segment_configurations, walk,
+};
 use crate::free_space::FreeSpace;
-use crate::program::{JobFile, SegmentKind};
+use crate::program::JobFile;
 use crate::tool_output::ToolOutput;
 
 /// The closest two consecutive targets of a stroke may lie (m): closer targets leave the
@@ -304,16 +306,7 @@ pub fn rapid_program(
             worst_chord_m: 0.0,
         },
     };
-    let samples: Vec<Vec<JointVector>> = file
-        .segments
-        .iter()
-        .map(|segment| {
-            file.segment_samples(segment)
-                .iter()
-                .map(|sample| sample.q)
-                .collect()
-        })
-        .collect();
+    let samples = segment_configurations(file);
     writer.line("ConfJ \\On;");
     writer.line("ConfL \\On;");
     writer.switch(false);
@@ -326,65 +319,33 @@ pub fn rapid_program(
         writer.line("! the program's start, from wherever the arm stands: clear that way");
         writer.move_abs_j(&start, 0.0);
     }
-    let is_stroke = |index: usize| {
-        file.segments
-            .get(index)
-            .is_some_and(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
-    };
-    for (index, (segment, qs)) in file.segments.iter().zip(&samples).enumerate() {
-        let duration = segment.end_s - segment.start_s;
-        match segment.kind {
-            SegmentKind::Stroke {
-                stroke,
-                part,
-                from_s,
-                backward,
-            } => {
-                let task = segment
-                    .task
-                    .as_ref()
-                    .ok_or(RapidProgramError::NoTask(index))?;
-                writer.line(&format!(
-                    "! stroke {stroke}, part {part}: from {from_s:.4} m along it{}, {duration:.3} s",
-                    if backward {
-                        " back toward its start"
-                    } else {
-                        ""
-                    },
-                ));
-                writer.stroke(qs, task);
-            }
-            kind => {
-                let vertices: Vec<JointVector> = segment
-                    .vertices
-                    .iter()
-                    .map(|v| robot.joint_vector(v))
-                    .collect();
-                writer.line(&format!(
-                    "! {}: {duration:.3} s in the plan",
-                    match kind {
-                        SegmentKind::Retreat => "lift",
-                        SegmentKind::Approach => "set-down",
-                        _ => "move",
-                    },
-                ));
-                let targets = writer.rules.free_move(
-                    &vertices,
-                    qs,
-                    index > 0 && is_stroke(index - 1),
-                    is_stroke(index + 1),
-                );
-                for target in targets {
-                    if target.straight {
-                        let speed = writer.rules.tool_speed;
-                        writer.move_l(&target.q, speed, 0.0);
-                    } else {
-                        writer.move_abs_j(&target.q, target.radius);
-                    }
+    walk(file, robot, &samples, |step| match step {
+        Step::Stroke { comment, qs, task } => {
+            writer.line(&format!("! {comment}"));
+            writer.stroke(qs, task);
+        }
+        Step::Move {
+            comment,
+            vertices,
+            qs,
+            off_stroke,
+            onto_stroke,
+        } => {
+            writer.line(&format!("! {comment}"));
+            for target in writer
+                .rules
+                .free_move(&vertices, qs, off_stroke, onto_stroke)
+            {
+                if target.straight {
+                    let speed = writer.rules.tool_speed;
+                    writer.move_l(&target.q, speed, 0.0);
+                } else {
+                    writer.move_abs_j(&target.q, target.radius);
                 }
             }
         }
-    }
+    })
+    .map_err(RapidProgramError::NoTask)?;
     writer.finish(header);
     Ok(writer.program)
 }

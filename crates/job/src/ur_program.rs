@@ -28,9 +28,9 @@
 use emg_control::Task;
 use emg_kinematics::{JointVector, Robot};
 
-use crate::controller_targets::{Corner, Pose, TargetRules};
+use crate::controller_targets::{Corner, Pose, Step, TargetRules, segment_configurations, walk};
 use crate::free_space::FreeSpace;
-use crate::program::{JobFile, SegmentKind};
+use crate::program::JobFile;
 use crate::tool_output::{OutputBank, ToolOutput};
 
 /// The tool's acceleration along `movel` and `movep` (m/s²): URScript's default.
@@ -185,16 +185,7 @@ pub fn ur_program(
         pose_text(&Pose::from_matrix(offset, &offset_rotation))
     ));
     writer.switch(false);
-    let samples: Vec<Vec<JointVector>> = file
-        .segments
-        .iter()
-        .map(|segment| {
-            file.segment_samples(segment)
-                .iter()
-                .map(|sample| sample.q)
-                .collect()
-        })
-        .collect();
+    let samples = segment_configurations(file);
     match (&file.home, samples.first().and_then(|s| s.first())) {
         (Some(home), _) => writer.program.text.push_str(&emg_io::home_check(home)),
         (None, Some(first)) => {
@@ -203,55 +194,23 @@ pub fn ur_program(
         }
         (None, None) => {}
     }
-    let is_stroke = |index: usize| {
-        file.segments
-            .get(index)
-            .is_some_and(|s| matches!(s.kind, SegmentKind::Stroke { .. }))
-    };
-    for (index, (segment, qs)) in file.segments.iter().zip(&samples).enumerate() {
-        match segment.kind {
-            SegmentKind::Stroke {
-                stroke,
-                part,
-                from_s,
-                backward,
-            } => {
-                let task = segment.task.as_ref().ok_or(UrProgramError::NoTask(index))?;
-                writer.line(&format!(
-                    "# stroke {stroke}, part {part}: from {from_s:.4} m along it{}, {:.3} s",
-                    if backward {
-                        " back toward its start"
-                    } else {
-                        ""
-                    },
-                    segment.end_s - segment.start_s
-                ));
-                writer.stroke(qs, task);
-            }
-            kind => {
-                let vertices: Vec<JointVector> = segment
-                    .vertices
-                    .iter()
-                    .map(|v| robot.joint_vector(v))
-                    .collect();
-                writer.line(&format!(
-                    "# {}: {:.3} s in the plan",
-                    match kind {
-                        SegmentKind::Retreat => "lift",
-                        SegmentKind::Approach => "set-down",
-                        _ => "move",
-                    },
-                    segment.end_s - segment.start_s
-                ));
-                writer.free_move(
-                    &vertices,
-                    qs,
-                    index > 0 && is_stroke(index - 1),
-                    is_stroke(index + 1),
-                );
-            }
+    walk(file, robot, &samples, |step| match step {
+        Step::Stroke { comment, qs, task } => {
+            writer.line(&format!("# {comment}"));
+            writer.stroke(qs, task);
         }
-    }
+        Step::Move {
+            comment,
+            vertices,
+            qs,
+            off_stroke,
+            onto_stroke,
+        } => {
+            writer.line(&format!("# {comment}"));
+            writer.free_move(&vertices, qs, off_stroke, onto_stroke);
+        }
+    })
+    .map_err(UrProgramError::NoTask)?;
     writer.program.text.push_str("end\n");
     Ok(writer.program)
 }
