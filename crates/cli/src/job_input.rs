@@ -47,7 +47,9 @@ pub struct JobInput {
     /// corner, passed at rest.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub corner_tolerance: Option<f64>,
-    /// SVG only: where the drawing's centre goes (m, base frame).
+    /// SVG only: where the drawing's centre goes (m, base frame). Default: 0.45,0,0.25, or on
+    /// an arm that reaches it only folded or stretched, in front of its shoulder where it
+    /// reaches (docs/jobs.md).
     #[arg(long, value_name = "X,Y,Z", value_parser = options::parse_vec3, allow_hyphen_values = true)]
     pub origin: Option<[f64; 3]>,
     /// SVG only: the surface normal the pen points along.
@@ -173,7 +175,7 @@ fn read_job(
     robot: &emg_kinematics::Robot,
 ) -> Result<Job> {
     let mut job = if let Some(tolerance) = tolerance {
-        let placement = placement(args)?;
+        let placement = placement(args, robot)?;
         let options = tolerance.svg_options();
         let drawing = read_svg_file(&args.file, &placement, &options)?;
         if drawing.dropped_tiny > 0 {
@@ -219,9 +221,10 @@ fn read_job(
     Ok(job)
 }
 
-/// The drawing's placement: the default with what the options set.
-fn placement(args: &JobInput) -> Result<Placement> {
-    let mut placement = Placement::default();
+/// The drawing's placement: the default for `robot` ([`emg_job::default_placement`]) with what
+/// the options set.
+fn placement(args: &JobInput, robot: &emg_kinematics::Robot) -> Result<Placement> {
+    let mut placement = emg_job::default_placement(robot);
     if let Some(origin) = args.origin {
         placement.origin_m = origin;
     }

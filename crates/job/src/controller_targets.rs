@@ -20,6 +20,7 @@ use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
 
 use crate::free_space::FreeSpace;
 use crate::program::{JobFile, SegmentKind};
+use crate::reach::WristReach;
 
 /// Share of the line tolerance that the path the controller interpolates (each straight line
 /// between two targets of a stroke, each corner's path) may lie from the stroke: the rest is
@@ -212,55 +213,6 @@ pub(crate) struct TargetRules<'a> {
     pub(crate) reach: Option<WristReach>,
 }
 
-/// How far a six-joint arm with a spherical wrist reaches: its wrist centre at most the
-/// stretched elbow's distance from axis 2. A controller that interpolates in Cartesian space
-/// faults where its path leaves that, and a plan that reaches as far as the arm does runs
-/// along its edge, where a straight line between two of its poses may step over it.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct WristReach {
-    /// The TCP's distance from the wrist centre along the tool axis (m).
-    wrist_back_m: f64,
-    /// The stretched elbow's distance from axis 2's origin to the wrist centre (m).
-    reach_m: f64,
-}
-
-/// Whether a TCP pose is within the arm's reach, given a configuration of the plan near it.
-type Reachable<'a> = &'a dyn Fn(&Pose, &JointVector) -> bool;
-
-/// How far (m) beyond the stretched elbow's reach a point of the controller's path may lie: the
-/// plan's own poses stand on that edge to rounding.
-const REACH_ROUNDING_M: f64 = 1e-7;
-
-impl WristReach {
-    /// The reach of `robot`, whose wrist centre is axis 5's origin and whose TCP lies on axis 6
-    /// (checked at the calibration pose; `None` where it does not).
-    pub(crate) fn of(robot: &Robot) -> Option<Self> {
-        if robot.dof() != 6 {
-            return None;
-        }
-        let kinematics = robot.forward(&robot.joint_vector(&[0.0; 6]));
-        let (o2, o3, wrist) = (
-            kinematics.joint_origin(1),
-            kinematics.joint_origin(2),
-            kinematics.joint_origin(4),
-        );
-        let offset = kinematics.tcp() - wrist;
-        let axis = kinematics.tool_axis();
-        (offset.cross(&axis).norm() < 1e-9).then(|| Self {
-            wrist_back_m: offset.dot(&axis),
-            reach_m: (o3 - o2).norm() + (wrist - o3).norm(),
-        })
-    }
-
-    /// Whether the TCP pose `pose` keeps its wrist centre within reach of axis 2 where it
-    /// stands at the configuration `near`.
-    fn holds(&self, robot: &Robot, pose: &Pose, near: &JointVector) -> bool {
-        let wrist = pose.position - pose.rotation * Vec3::z() * self.wrist_back_m;
-        let shoulder = robot.forward(near).joint_origin(1);
-        (wrist - shoulder).norm() <= self.reach_m + REACH_ROUNDING_M
-    }
-}
-
 /// A stroke part's targets: the pose of each of the plan's samples, the samples kept as
 /// targets (the first and the last among them), the corner radius at each kept sample (0 at
 /// the two ends and where the corner stays sharp), and the tool speed into each (none into the
@@ -285,6 +237,9 @@ pub(crate) struct FreeTarget {
     /// The corner radius (m) at it: 0 where the tool stops there.
     pub(crate) radius: f64,
 }
+
+/// Whether a TCP pose is within the arm's reach, given a configuration of the plan near it.
+type Reachable<'a> = &'a dyn Fn(&Pose, &JointVector) -> bool;
 
 impl TargetRules<'_> {
     /// The targets of the stroke part whose samples are `qs`, along `task`.

@@ -34,6 +34,7 @@ pub mod plan_error;
 pub mod plan_strokes;
 pub mod program;
 pub mod rapid_program;
+mod reach;
 pub mod reorder;
 pub mod setting;
 pub mod setup;
@@ -75,6 +76,7 @@ pub use program::{
     JOB_FILE_FORMAT, JobFile, JobFileError, JobSummary, MAX_PROGRAM_S, Program, Segment,
     SegmentKind, StrokeReport,
 };
+pub use reach::{WristReach, default_placement};
 pub use reorder::{MIN_SAVED_S, in_order, reorder_by_move_time};
 pub use setting::InvalidSetting;
 pub use setup::{JobPlanner, job_config, job_timing};

@@ -36,11 +36,10 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
 
 use crate::abb_configuration::AbbConfiguration;
-use crate::controller_targets::{
-    Corner, Pose, Step, TargetRules, WristReach, segment_configurations, walk,
-};
+use crate::controller_targets::{Corner, Pose, Step, TargetRules, segment_configurations, walk};
 use crate::free_space::FreeSpace;
 use crate::program::JobFile;
+use crate::reach::WristReach;
 use crate::tool_output::ToolOutput;
 
 /// The closest two consecutive targets of a stroke may lie (m): closer targets leave the

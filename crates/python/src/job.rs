@@ -62,7 +62,7 @@ pub(crate) fn read_job(
     {
         let placement = match placement {
             Some(dict) => placement_of(&dumps(dict.as_any())?)?,
-            None => emg_io::Placement::default(),
+            None => emg_job::default_placement(robot),
         };
         let tolerance = emg_job::DrawingTolerance::new(
             tolerance_mm * 1e-3,
