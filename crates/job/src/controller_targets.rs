@@ -257,7 +257,7 @@ impl TargetRules<'_> {
             .collect();
         let reachable = |pose: &Pose, near: &JointVector| {
             self.reach
-                .is_none_or(|reach| reach.holds(self.robot, pose, near))
+                .is_none_or(|reach| reach.holds(self.robot, (&pose.position, &pose.rotation), near))
         };
         let (kept, worst_chord_m) = stroke_targets(
             &poses,

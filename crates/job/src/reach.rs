@@ -3,8 +3,7 @@
 
 use emg_io::Placement;
 use emg_kinematics::{JointVector, Robot, Vec3};
-
-use crate::controller_targets::Pose;
+use nalgebra::UnitQuaternion;
 
 /// How far a six-joint arm with a spherical wrist reaches: its wrist centre at most the
 /// stretched elbow's distance from axis 2. A controller that interpolates in Cartesian space
@@ -43,10 +42,15 @@ impl WristReach {
         })
     }
 
-    /// Whether the TCP pose `pose` keeps its wrist centre within reach of axis 2 where it
-    /// stands at the configuration `near`.
-    pub(crate) fn holds(&self, robot: &Robot, pose: &Pose, near: &JointVector) -> bool {
-        let wrist = pose.position - pose.rotation * Vec3::z() * self.wrist_back_m;
+    /// Whether the TCP at `position` turned by `rotation` keeps its wrist centre within reach
+    /// of axis 2 where it stands at the configuration `near`.
+    pub(crate) fn holds(
+        &self,
+        robot: &Robot,
+        (position, rotation): (&Vec3, &UnitQuaternion<f64>),
+        near: &JointVector,
+    ) -> bool {
+        let wrist = position - rotation * Vec3::z() * self.wrist_back_m;
         let shoulder = robot.forward(near).joint_origin(1);
         (wrist - shoulder).norm() <= self.reach_m + REACH_ROUNDING_M
     }

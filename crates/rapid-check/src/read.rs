@@ -3,10 +3,10 @@
 
 use std::collections::BTreeMap;
 
-use emg_control::{ConstraintConfig, task_bounds};
-use emg_job::{Coverage, JobFile, SegmentKind, Stretch, with_part};
+use emg_job::JobFile;
 use emg_kinematics::Vec3;
-use emg_verify::{Bounds, Joints, Line, ReferenceModel};
+use emg_program_check::{Drawing, PlanChecks};
+use emg_verify::ReferenceModel;
 
 use crate::arm::{Configuration, Irb120, Pose};
 use crate::error::{ReadError, fail};
@@ -26,11 +26,6 @@ pub const TARGET_MATCH_RAD: f64 = 1e-6;
 pub const TOOL_MATCH: f64 = 1e-6;
 /// The closest two consecutive Cartesian targets may lie (m).
 pub const MIN_TARGET_SPACING_M: f64 = 1e-4;
-/// Coverage the tool may fall short of the plan's claims, per stroke part (m).
-pub const COVERAGE_ALLOWANCE_M: f64 = 1e-3;
-/// Rounding slack of the tolerance (m) and cone (degrees) checks.
-const SLACK_M: f64 = 1e-9;
-const SLACK_DEG: f64 = 1e-6;
 
 /// ABB's predefined zones: name and TCP zone (mm).
 const PREDEFINED_ZONES: [(&str, f64); 14] = [
@@ -79,26 +74,11 @@ pub struct RapidReport {
     pub drawn_m: f64,
 }
 
-/// A stroke part of the plan as the reader checks it.
-struct StrokePart {
-    segment: usize,
-    place: usize,
-    from_s: f64,
-    backward: bool,
-    line: Line,
-    bounds: Bounds,
-    start: Vec3,
-    end: Vec3,
-}
-
 /// What the module declares and the plan holds.
 struct Reading<'a> {
     arm: Irb120,
-    model: &'a ReferenceModel,
-    limits: Vec<(f64, f64)>,
-    collision_margin_m: f64,
-    free: Option<(Line, Bounds)>,
-    parts: Vec<StrokePart>,
+    /// The plan's side: its stroke parts and the checks against them.
+    plan: PlanChecks<'a>,
     /// The plan's configurations: its samples and its moves' vertices.
     configurations: Vec<[f64; 6]>,
     /// The TCP in the flange frame (`tooldata`).
@@ -117,11 +97,8 @@ struct State {
     /// Whether the arm is at rest (the last move ended `fine`).
     at_rest: bool,
     conf_linear: bool,
-    tool_on: bool,
-    parts_on: usize,
-    drawn: Vec<Vec3>,
-    progress_m: f64,
-    covered: Vec<Vec<Stretch>>,
+    /// What the arm has drawn so far.
+    drawing: Drawing,
     /// The pending fly-by run: each target's pose, joints, zone radius (m), line and
     /// configuration data.
     run: Vec<(Pose, [f64; 6], f64, usize, Configuration)>,
@@ -144,11 +121,7 @@ pub fn read_rapid(
         joints: None,
         at_rest: true,
         conf_linear: false,
-        tool_on: false,
-        parts_on: 0,
-        drawn: Vec::new(),
-        progress_m: 0.0,
-        covered: vec![Vec::new(); file.strokes.len()],
+        drawing: reading.plan.start(file.strokes.len()),
         run: Vec::new(),
         joint_run: Vec::new(),
         last_target: None,
@@ -181,44 +154,24 @@ pub fn read_rapid(
             "the module ends on a fly-by point: its last move is not fine",
         );
     }
-    if state.tool_on {
-        return fail(last_line, "the module ends with the tool on");
-    }
-    if state.parts_on != reading.parts.len() {
-        return fail(
-            last_line,
-            format!(
-                "the tool switches on {} times; the plan draws {} stroke parts",
-                state.parts_on,
-                reading.parts.len()
-            ),
-        );
-    }
+    let drawing = &state.drawing;
+    reading
+        .plan
+        .finish(drawing)
+        .or_else(|problem| fail(last_line, problem))?;
+    let covered = reading
+        .plan
+        .covered(drawing, file)
+        .or_else(|problem| fail(0, problem))?;
     let mut report = state.report;
-    for (stroke, covered) in file.strokes.iter().zip(&state.covered) {
-        report.covered_m += Coverage::of(stroke.length_m, covered).drawn_m;
-        report.drawn_m += stroke.drawn_m;
-    }
-    let allowance = COVERAGE_ALLOWANCE_M * reading.parts.len() as f64;
-    if report.covered_m < report.drawn_m - allowance {
-        return fail(
-            0,
-            format!(
-                "the tool covers {:.6} m of the strokes; the plan draws {:.6} m",
-                report.covered_m, report.drawn_m
-            ),
-        );
-    }
+    report.stroke_parts = drawing.parts_on;
+    report.samples = drawing.samples;
+    report.worst_deviation_m = drawing.worst_deviation_m;
+    report.worst_tool_angle_deg = drawing.worst_tool_angle_deg;
+    report.least_clearance_m = drawing.least_clearance_m;
+    report.covered_m = covered.covered_m;
+    report.drawn_m = covered.drawn_m;
     Ok(report)
-}
-
-/// The checker's joint vector of `q`.
-fn checker_joints(q: &[f64; 6]) -> Joints {
-    let mut joints = Joints::zeros();
-    for (i, value) in q.iter().enumerate() {
-        joints[i] = *value;
-    }
-    joints
 }
 
 /// The largest change of any joint from `a` to `b` (rad).
@@ -240,9 +193,6 @@ fn frame(value: &Value, what: &str, line: usize) -> Result<Pose, ReadError> {
 
 impl<'a> Reading<'a> {
     fn new(module: &Module, file: &JobFile, model: &'a ReferenceModel) -> Result<Self, ReadError> {
-        if file.joint_names.len() != 6 || model.limits().len() != 6 {
-            return fail(0, "the plan is not a six-joint arm's");
-        }
         let declared = |data_type: &str| {
             let found: Vec<_> = module
                 .declarations
@@ -300,63 +250,12 @@ impl<'a> Reading<'a> {
             }
             zones.insert(zone.name.clone(), tcp_mm / 1e3);
         }
-        let points = file.points();
-        let mut configurations: Vec<[f64; 6]> = points
+        let plan = PlanChecks::new(file, model).or_else(|problem| fail(0, problem))?;
+        let mut configurations: Vec<[f64; 6]> = file
+            .points()
             .iter()
             .map(|p| std::array::from_fn(|i| p.positions[i]))
             .collect();
-        let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
-        let on_part = with_part(&file.constraints, &file.surfaces);
-        let free_config = ConstraintConfig {
-            line_tolerance_m: f64::INFINITY,
-            theta_max_deg: 180.0,
-            ..on_part.clone()
-        };
-        let free = file
-            .surfaces
-            .first()
-            .map(|task| (task.into(), task_bounds(task, &free_config)));
-        let tcp_of = |q: &[f64; 6]| model.tcp_frame(&checker_joints(q)).0;
-        let mut parts = Vec::new();
-        for (segment, s) in file.segments.iter().enumerate() {
-            let SegmentKind::Stroke {
-                stroke,
-                from_s,
-                backward,
-                ..
-            } = s.kind
-            else {
-                continue;
-            };
-            let Some(task) = &s.task else {
-                return fail(
-                    0,
-                    format!("the plan's segment {segment} is a stroke without its task"),
-                );
-            };
-            let place = file
-                .strokes
-                .iter()
-                .position(|r| r.stroke == stroke)
-                .ok_or_else(|| {
-                    ReadError::at(0, format!("the plan's stroke {stroke} has no report"))
-                })?;
-            let first = times.partition_point(|t| *t < s.start_s - 1e-9);
-            let last = times.partition_point(|t| *t <= s.end_s + 1e-9);
-            if first >= last {
-                return fail(0, format!("the plan's segment {segment} holds no sample"));
-            }
-            parts.push(StrokePart {
-                segment,
-                place,
-                from_s,
-                backward,
-                line: task.into(),
-                bounds: task_bounds(task, &on_part),
-                start: tcp_of(&configurations[first]),
-                end: tcp_of(&configurations[last - 1]),
-            });
-        }
         for segment in &file.segments {
             for vertex in &segment.vertices {
                 if vertex.len() >= 6 {
@@ -367,7 +266,7 @@ impl<'a> Reading<'a> {
         let arm = Irb120::default();
         // The tool the module names is the checker's tip on the arm's flange.
         if let Some(q) = configurations.first() {
-            let (position, rotation) = model.tcp_frame(&checker_joints(q));
+            let (position, rotation) = model.tcp_frame(&emg_program_check::checker_joints(q));
             let tip = arm.flange(q).then(&tool);
             let axis = tip.rotation * Vec3::z();
             let (distance, angle) = (
@@ -387,11 +286,7 @@ impl<'a> Reading<'a> {
         let tool_output = file.settings.tool_output;
         Ok(Self {
             arm,
-            model,
-            limits: model.limits(),
-            collision_margin_m: file.constraints.collision_margin_m,
-            free,
-            parts,
+            plan,
             configurations,
             tool,
             work_object,
@@ -463,9 +358,9 @@ impl<'a> Reading<'a> {
                     );
                 }
                 let on = (level.number("SetDO's value", line)? != 0.0) == self.on_level;
-                if on && !state.tool_on {
+                if on && !state.drawing.tool_on {
                     self.switch_on(state, line)?;
-                } else if !on && state.tool_on {
+                } else if !on && state.drawing.tool_on {
                     self.switch_off(state, line)?;
                 }
             }
@@ -475,7 +370,7 @@ impl<'a> Reading<'a> {
                     return fail(line, "MoveAbsJ without its target, speed, zone and tool");
                 };
                 self.check_frames(instruction, tool)?;
-                if state.tool_on {
+                if state.drawing.tool_on {
                     return fail(line, "MoveAbsJ with the tool on");
                 }
                 if !state.run.is_empty() {
@@ -529,7 +424,7 @@ impl<'a> Reading<'a> {
                 let flange = pose.then(&self.tool.inverse());
                 let q = self
                     .arm
-                    .solve(&flange, configuration, &self.limits)
+                    .solve(&flange, configuration, self.plan.limits())
                     .map_err(|count| {
                         ReadError::at(
                             line,
@@ -695,7 +590,10 @@ impl<'a> Reading<'a> {
         (line, held): (usize, Configuration),
     ) -> Result<[f64; 6], ReadError> {
         let flange = pose.then(&self.tool.inverse());
-        let Some((q, change)) = self.arm.follow(&flange, &joints, &self.limits, held[3]) else {
+        let Some((q, change)) = self
+            .arm
+            .follow(&flange, &joints, self.plan.limits(), held[3])
+        else {
             let (wrist, reach) = self.arm.wrist_reach(&flange);
             return fail(
                 line,
@@ -713,7 +611,7 @@ impl<'a> Reading<'a> {
             );
         }
         self.check_configuration(state, &q, line)?;
-        if state.tool_on {
+        if state.drawing.tool_on {
             self.check_on_task(state, pose, line)?;
         }
         Ok(q)
@@ -789,89 +687,24 @@ impl<'a> Reading<'a> {
         Ok(())
     }
 
-    /// Checks a configuration the arm passes: the joint limits and the checker's clearances.
+    /// Checks a configuration the arm passes ([`PlanChecks::configuration`]).
     fn check_configuration(
         &self,
         state: &mut State,
         q: &[f64; 6],
         line: usize,
     ) -> Result<(), ReadError> {
-        state.report.samples += 1;
-        for (i, (value, (low, high))) in q.iter().zip(&self.limits).enumerate() {
-            if !(value >= low && value <= high) {
-                return fail(
-                    line,
-                    format!("axis {} = {value} leaves its limits [{low}, {high}]", i + 1),
-                );
-            }
-        }
-        let joints = checker_joints(q);
-        let (clearance, a, b) = self.model.min_clearance(&joints);
-        state.report.least_clearance_m = state.report.least_clearance_m.min(clearance);
-        if clearance < self.collision_margin_m - SLACK_M {
-            return fail(
-                line,
-                format!("{a} and {b} come within {:.2} mm at {q:?}", clearance * 1e3),
-            );
-        }
-        let scene = if state.tool_on {
-            let part = &self.parts[state.parts_on - 1];
-            Some((&part.line, &part.bounds))
-        } else {
-            self.free.as_ref().map(|(line, bounds)| (line, bounds))
-        };
-        if let Some((task, bounds)) = scene
-            && let Some((margin, link, obstacle)) = self.model.scene_margin(&joints, task, bounds)
-            && margin < -SLACK_M
-        {
-            return fail(
-                line,
-                format!(
-                    "{link} comes {:.2} mm into {obstacle} at {q:?}",
-                    -margin * 1e3
-                ),
-            );
-        }
-        Ok(())
+        self.plan
+            .configuration(&mut state.drawing, q)
+            .or_else(|problem| fail(line, problem))
     }
 
-    /// Checks a TCP pose while the tool is on: within the tolerance of the stroke part's task,
-    /// measured from where along it the tool has reached, and the tool axis within the cone.
+    /// Checks a TCP pose while the tool is on ([`PlanChecks::on_task`]).
     fn check_on_task(&self, state: &mut State, pose: &Pose, line: usize) -> Result<(), ReadError> {
-        let part = &self.parts[state.parts_on - 1];
-        let (progress_m, deviation) = part.line.follow(&pose.position, state.progress_m);
-        state.progress_m = progress_m;
         let axis = pose.rotation * Vec3::z();
-        let angle = libm::acos(axis.dot(&part.line.n).clamp(-1.0, 1.0)).to_degrees();
-        let report = &mut state.report;
-        report.worst_deviation_m = report.worst_deviation_m.max(deviation);
-        report.worst_tool_angle_deg = report.worst_tool_angle_deg.max(angle);
-        if deviation > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the TCP lies {:.4} mm from stroke part {} (segment {}); the tolerance is \
-                     {:.4} mm",
-                    deviation * 1e3,
-                    state.parts_on - 1,
-                    part.segment,
-                    part.bounds.line_tolerance_m * 1e3
-                ),
-            );
-        }
-        if angle > part.bounds.theta_max_deg + SLACK_DEG {
-            return fail(
-                line,
-                format!(
-                    "the tool axis leans {angle:.3}° from the normal of stroke part {}; the cone \
-                     is {}°",
-                    state.parts_on - 1,
-                    part.bounds.theta_max_deg
-                ),
-            );
-        }
-        state.drawn.push(pose.position);
-        Ok(())
+        self.plan
+            .on_task(&mut state.drawing, &pose.position, &axis)
+            .or_else(|problem| fail(line, problem))
     }
 
     /// The TCP where the arm stands.
@@ -882,70 +715,24 @@ impl<'a> Reading<'a> {
         Ok(self.arm.flange(&joints).then(&self.tool))
     }
 
-    /// The tool switched on: the next stroke part of the plan starts, the TCP at its start.
+    /// The tool switched on ([`PlanChecks::switch_on`]).
     fn switch_on(&self, state: &mut State, line: usize) -> Result<(), ReadError> {
-        let Some(part) = self.parts.get(state.parts_on) else {
-            return fail(
-                line,
-                format!(
-                    "the tool switches on a {}th time; the plan draws {} stroke parts",
-                    state.parts_on + 1,
-                    self.parts.len()
-                ),
-            );
-        };
         let pose = self.tcp(state, line)?;
-        let off = (pose.position - part.start).norm();
-        if off > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the tool switches on {:.4} mm from the start of stroke part {} (segment {})",
-                    off * 1e3,
-                    state.parts_on,
-                    part.segment
-                ),
-            );
-        }
-        state.tool_on = true;
-        state.parts_on += 1;
-        state.report.stroke_parts += 1;
-        state.drawn.clear();
-        state.progress_m = 0.0;
-        self.check_on_task(state, &pose, line)
+        self.plan
+            .switch_on(
+                &mut state.drawing,
+                &pose.position,
+                &(pose.rotation * Vec3::z()),
+            )
+            .or_else(|problem| fail(line, problem))
     }
 
-    /// The tool switched off: the stroke part ends, the TCP at its end; what it covered counts.
+    /// The tool switched off ([`PlanChecks::switch_off`]).
     fn switch_off(&self, state: &mut State, line: usize) -> Result<(), ReadError> {
-        let part = &self.parts[state.parts_on - 1];
         let pose = self.tcp(state, line)?;
-        let off = (pose.position - part.end).norm();
-        if off > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the tool switches off {:.4} mm from the end of stroke part {} (segment {})",
-                    off * 1e3,
-                    state.parts_on - 1,
-                    part.segment
-                ),
-            );
-        }
-        state.tool_on = false;
-        if let Some((least, greatest)) = part.line.covered(state.drawn.drain(..)) {
-            state.covered[part.place].push(if part.backward {
-                Stretch {
-                    from_s: part.from_s - greatest,
-                    to_s: part.from_s - least,
-                }
-            } else {
-                Stretch {
-                    from_s: part.from_s + least,
-                    to_s: part.from_s + greatest,
-                }
-            });
-        }
-        Ok(())
+        self.plan
+            .switch_off(&mut state.drawing, &pose.position)
+            .or_else(|problem| fail(line, problem))
     }
 }
 

@@ -27,9 +27,8 @@ mod ur5e;
 pub use error::ReadError;
 pub use geometry::{Pose, Rotation, angle_deg, wrap};
 pub use native::{
-    COVERAGE_ALLOWANCE_M, JOINT_MATCH_RAD, JOINT_STEP_RAD, JointPiece, MAX_JOINT_JUMP_RAD,
-    NativeReport, PATH_STEP_M, POSE_MATCH, Piece, TURN_STEP_RAD, movej_path, movep_path,
-    read_native,
+    JOINT_MATCH_RAD, JOINT_STEP_RAD, JointPiece, MAX_JOINT_JUMP_RAD, NativeReport, PATH_STEP_M,
+    POSE_MATCH, Piece, TURN_STEP_RAD, movej_path, movep_path, read_native,
 };
 pub use script::{Form, Output, Program, Statement, parse_program};
 pub use servoj::{

@@ -6,15 +6,15 @@
 
 use std::f64::consts::PI;
 
-use emg_control::{ConstraintConfig, task_bounds};
-use emg_job::{Coverage, JobFile, SegmentKind, Stretch, with_part};
+use emg_job::JobFile;
 use emg_kinematics::Vec3;
-use emg_verify::{Bounds, Line, ReferenceModel};
+use emg_program_check::{Drawing, PlanChecks};
+use emg_verify::ReferenceModel;
 
 use crate::error::{ReadError, fail};
-use crate::geometry::{Pose, Rotation, angle_deg};
+use crate::geometry::{Pose, Rotation};
 use crate::script::{Form, Output, Statement, parse_program};
-use crate::ur5e::{checker_joints, checker_tcp, largest_change, ur5e_flange, ur5e_follow};
+use crate::ur5e::{checker_tcp, largest_change, ur5e_flange, ur5e_follow};
 
 /// Largest spacing (m) of the TCP samples along an interpolated Cartesian path.
 pub const PATH_STEP_M: f64 = 1e-4;
@@ -35,15 +35,6 @@ pub const JOINT_MATCH_RAD: f64 = 1e-9;
 /// How closely (m, and rad of rotation) a Cartesian target must equal the TCP pose of a
 /// configuration of the plan.
 pub const POSE_MATCH: f64 = 1e-6;
-
-/// How far (m) below its plan's drawn length each stroke part's covered length may fall.
-pub const COVERAGE_ALLOWANCE_M: f64 = 1e-3;
-
-/// Rounding slack (m) of the distance checks, the checker's own.
-const SLACK_M: f64 = 1e-9;
-
-/// Rounding slack (degrees) of the tool-angle check, the checker's own.
-const SLACK_DEG: f64 = 1e-6;
 
 /// One piece of an interpolated Cartesian path.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -458,66 +449,6 @@ impl PoseIndex {
     }
 }
 
-/// A stroke part of the plan as the reader checks it.
-struct StrokePart {
-    /// Its segment's index.
-    segment: usize,
-    /// Its stroke's place in the file's `strokes`.
-    place: usize,
-    /// Arc length along the stroke where its task starts (m).
-    from_s: f64,
-    /// Whether its task runs from `from_s` back toward the stroke's start.
-    backward: bool,
-    /// Its task as the checker reads it.
-    line: Line,
-    /// The bounds its samples keep (the part in the scene).
-    bounds: Bounds,
-    /// The TCP at its first and last sample.
-    start: Vec3,
-    /// See `start`.
-    end: Vec3,
-}
-
-/// Which way the tool switches.
-#[derive(Clone, Copy)]
-enum Switch {
-    /// On, at the start of a stroke part.
-    On,
-    /// Off, at the end of a stroke part.
-    Off,
-}
-
-impl StrokePart {
-    /// Fails unless the TCP at `pose`, where the tool switches at line `line`, lies within the
-    /// line tolerance of this part's start (switching on) or end (switching off); `index` is
-    /// the part's number in the plan.
-    fn check_switch(
-        &self,
-        line: usize,
-        pose: &Pose,
-        index: usize,
-        switch: Switch,
-    ) -> Result<(), ReadError> {
-        let (way, place, point) = match switch {
-            Switch::On => ("on", "start", self.start),
-            Switch::Off => ("off", "end", self.end),
-        };
-        let off = (pose.position - point).norm();
-        if off > self.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the tool switches {way} {:.4} mm from the {place} of stroke part {index} \
-                     (segment {})",
-                    off * 1e3,
-                    self.segment
-                ),
-            );
-        }
-        Ok(())
-    }
-}
-
 /// What the reader found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NativeReport {
@@ -562,12 +493,8 @@ pub struct NativeReport {
 /// What a reading needs of the plan and the checker.
 struct Reading<'a> {
     model: &'a ReferenceModel,
-    limits: Vec<(f64, f64)>,
-    collision_margin_m: f64,
-    /// The line and bounds of the moves between strokes (the part in the scene), if the plan
-    /// has a part.
-    free: Option<(Line, Bounds)>,
-    parts: Vec<StrokePart>,
+    /// The plan's side: its stroke parts and the checks against them.
+    plan: PlanChecks<'a>,
     joints_index: JointIndex,
     poses_index: PoseIndex,
     /// The level of the tool output that switches the tool on.
@@ -582,17 +509,10 @@ struct State {
     joints: Option<[f64; 6]>,
     /// The commanded TCP pose (once known).
     pose: Option<Pose>,
-    /// The tool output and whether the tool is on.
+    /// The tool output.
     output: Option<Output>,
-    tool_on: bool,
-    /// Stroke parts switched on so far.
-    parts_on: usize,
-    /// The TCP samples of the stroke part being drawn.
-    drawn: Vec<Vec3>,
-    /// How far along its task the last of them stands (m, [`emg_verify::Line::follow`]).
-    progress_m: f64,
-    /// Per stroke (its place), the stretches covered.
-    covered: Vec<Vec<Stretch>>,
+    /// What the arm has drawn so far.
+    drawing: Drawing,
     /// The pending `movep` run: each target, its radius and its line.
     run: Vec<(Pose, f64, usize)>,
     /// The pending run of blended `movej`: each target, its radius and its line.
@@ -616,11 +536,7 @@ pub fn read_native(
         joints: None,
         pose: None,
         output: None,
-        tool_on: false,
-        parts_on: 0,
-        drawn: Vec::new(),
-        progress_m: 0.0,
-        covered: vec![Vec::new(); file.strokes.len()],
+        drawing: reading.plan.start(file.strokes.len()),
         run: Vec::new(),
         joint_run: Vec::new(),
         report: NativeReport {
@@ -649,106 +565,36 @@ pub fn read_native(
     reading.end_run(&mut state)?;
     reading.end_joint_run(&mut state)?;
     let last_line = text.lines().count();
-    if state.tool_on {
-        return fail(last_line, "the program ends with the tool on");
-    }
-    if state.parts_on != reading.parts.len() {
-        return fail(
-            last_line,
-            format!(
-                "the tool switches on {} times; the plan draws {} stroke parts",
-                state.parts_on,
-                reading.parts.len()
-            ),
-        );
-    }
+    let drawing = &state.drawing;
+    reading
+        .plan
+        .finish(drawing)
+        .or_else(|problem| fail(last_line, problem))?;
+    let covered = reading
+        .plan
+        .covered(drawing, file)
+        .or_else(|problem| fail(0, problem))?;
     let mut report = state.report;
-    for (report_of_stroke, covered) in file.strokes.iter().zip(&state.covered) {
-        let coverage = Coverage::of(report_of_stroke.length_m, covered);
-        report
-            .per_stroke
-            .push((coverage.drawn_m, report_of_stroke.drawn_m));
-        report.covered_m += coverage.drawn_m;
-        report.drawn_m += report_of_stroke.drawn_m;
-    }
-    let allowance = COVERAGE_ALLOWANCE_M * reading.parts.len() as f64;
-    if report.covered_m < report.drawn_m - allowance {
-        return fail(
-            0,
-            format!(
-                "the tool covers {:.6} m of the strokes; the plan draws {:.6} m",
-                report.covered_m, report.drawn_m
-            ),
-        );
-    }
+    report.stroke_parts = drawing.parts_on;
+    report.samples = drawing.samples;
+    report.worst_deviation_m = drawing.worst_deviation_m;
+    report.worst_tool_angle_deg = drawing.worst_tool_angle_deg;
+    report.least_clearance_m = drawing.least_clearance_m;
+    report.per_stroke = covered.per_stroke;
+    report.covered_m = covered.covered_m;
+    report.drawn_m = covered.drawn_m;
     Ok(report)
 }
 
 impl<'a> Reading<'a> {
     /// What the reading needs of `file` and `model`.
     fn new(file: &JobFile, model: &'a ReferenceModel, on_level: bool) -> Result<Self, ReadError> {
-        if file.joint_names.len() != 6 || model.limits().len() != 6 {
-            return fail(0, "the plan is not a six-joint arm's");
-        }
-        let points = file.points();
-        let configurations: Vec<[f64; 6]> = points
+        let plan = PlanChecks::new(file, model).or_else(|problem| fail(0, problem))?;
+        let configurations: Vec<[f64; 6]> = file
+            .points()
             .iter()
             .map(|p| std::array::from_fn(|i| p.positions[i]))
             .collect();
-        let times: Vec<f64> = points.iter().map(|p| p.time_from_start.seconds()).collect();
-        let on_part = with_part(&file.constraints, &file.surfaces);
-        let free_config = ConstraintConfig {
-            line_tolerance_m: f64::INFINITY,
-            theta_max_deg: 180.0,
-            ..on_part.clone()
-        };
-        let free = file
-            .surfaces
-            .first()
-            .map(|task| (task.into(), task_bounds(task, &free_config)));
-        let mut parts = Vec::new();
-        for (segment, s) in file.segments.iter().enumerate() {
-            let SegmentKind::Stroke {
-                stroke,
-                from_s,
-                backward,
-                ..
-            } = s.kind
-            else {
-                continue;
-            };
-            let Some(task) = &s.task else {
-                return fail(
-                    0,
-                    format!("the plan's segment {segment} is a stroke without its task"),
-                );
-            };
-            let place = file
-                .strokes
-                .iter()
-                .position(|r| r.stroke == stroke)
-                .ok_or_else(|| ReadError {
-                    program: None,
-                    line: 0,
-                    problem: format!("the plan's stroke {stroke} has no report"),
-                })?;
-            let first = times.partition_point(|t| *t < s.start_s - 1e-9);
-            let last = times.partition_point(|t| *t <= s.end_s + 1e-9);
-            if first >= last {
-                return fail(0, format!("the plan's segment {segment} holds no sample"));
-            }
-            let tcp = |k: usize| checker_tcp(model, &configurations[k]).position;
-            parts.push(StrokePart {
-                segment,
-                place,
-                from_s,
-                backward,
-                line: task.into(),
-                bounds: task_bounds(task, &on_part),
-                start: tcp(first),
-                end: tcp(last - 1),
-            });
-        }
         // The samples, then the vertices of the moves' joint-space polylines (which a blended
         // move's samples pass by, not through).
         let mut joints: Vec<[f64; 6]> = configurations;
@@ -764,10 +610,7 @@ impl<'a> Reading<'a> {
         poses.sort_by(|a, b| a.position.x.total_cmp(&b.position.x));
         Ok(Self {
             model,
-            limits: model.limits(),
-            collision_margin_m: file.constraints.collision_margin_m,
-            free,
-            parts,
+            plan,
             joints_index: JointIndex(joints),
             poses_index: PoseIndex(poses),
             on_level,
@@ -815,9 +658,9 @@ impl<'a> Reading<'a> {
                 }
                 // Writing the level the output holds changes nothing.
                 let on = level == self.on_level;
-                if on && !state.tool_on {
+                if on && !state.drawing.tool_on {
                     self.switch_on(state, line)?;
-                } else if !on && state.tool_on {
+                } else if !on && state.drawing.tool_on {
                     self.switch_off(state, line)?;
                 }
             }
@@ -836,7 +679,7 @@ impl<'a> Reading<'a> {
             }
             Statement::MoveJ { q, radius_m } => {
                 state.report.movej += 1;
-                if state.tool_on {
+                if state.drawing.tool_on {
                     return fail(line, "movej with the tool on");
                 }
                 if !self.joints_index.holds(&q) {
@@ -959,55 +802,16 @@ impl<'a> Reading<'a> {
         self.arrive(state, end, last_line)
     }
 
-    /// Checks a configuration the arm passes: the joint limits and the checker's clearances
-    /// (its own links; the part and the scene by the bounds of the stroke part being drawn, or
-    /// of the moves between strokes).
+    /// Checks a configuration the arm passes ([`PlanChecks::configuration`]).
     fn check_configuration(
         &self,
         state: &mut State,
         q: &[f64; 6],
         line: usize,
     ) -> Result<(), ReadError> {
-        state.report.samples += 1;
-        for (i, (value, (low, high))) in q.iter().zip(&self.limits).enumerate() {
-            if !(value >= low && value <= high) {
-                return fail(
-                    line,
-                    format!(
-                        "joint {} = {value} leaves its limits [{low}, {high}]",
-                        i + 1
-                    ),
-                );
-            }
-        }
-        let joints = checker_joints(q);
-        let (clearance, a, b) = self.model.min_clearance(&joints);
-        state.report.least_clearance_m = state.report.least_clearance_m.min(clearance);
-        if clearance < self.collision_margin_m - SLACK_M {
-            return fail(
-                line,
-                format!("{a} and {b} come within {:.2} mm at {q:?}", clearance * 1e3),
-            );
-        }
-        let scene = if state.tool_on {
-            let part = &self.parts[state.parts_on - 1];
-            Some((&part.line, &part.bounds))
-        } else {
-            self.free.as_ref().map(|(line, bounds)| (line, bounds))
-        };
-        if let Some((task, bounds)) = scene
-            && let Some((margin, link, obstacle)) = self.model.scene_margin(&joints, task, bounds)
-            && margin < -SLACK_M
-        {
-            return fail(
-                line,
-                format!(
-                    "{link} comes {:.2} mm into {obstacle} at {q:?}",
-                    -margin * 1e3
-                ),
-            );
-        }
-        Ok(())
+        self.plan
+            .configuration(&mut state.drawing, q)
+            .or_else(|problem| fail(line, problem))
     }
 
     /// The controller following Cartesian `pieces` (each with its line) to the target `end`,
@@ -1062,7 +866,7 @@ impl<'a> Reading<'a> {
                 }
                 joints = solution.q;
                 self.check_configuration(state, &joints, *piece_line)?;
-                if state.tool_on {
+                if state.drawing.tool_on {
                     self.check_on_task(state, &pose, *piece_line)?;
                 }
             }
@@ -1073,91 +877,30 @@ impl<'a> Reading<'a> {
         Ok(())
     }
 
-    /// Checks a TCP pose while the tool is on: within the tolerance of the stroke part's task
-    /// and the tool axis within the cone round its normal, as the checker measures them.
+    /// Checks a TCP pose while the tool is on ([`PlanChecks::on_task`]).
     fn check_on_task(&self, state: &mut State, pose: &Pose, line: usize) -> Result<(), ReadError> {
-        let part = &self.parts[state.parts_on - 1];
-        let (progress_m, deviation) = part.line.follow(&pose.position, state.progress_m);
-        state.progress_m = progress_m;
-        let angle = angle_deg(&pose.rotation.column(2), &part.line.n);
-        let report = &mut state.report;
-        report.worst_deviation_m = report.worst_deviation_m.max(deviation);
-        report.worst_tool_angle_deg = report.worst_tool_angle_deg.max(angle);
-        if deviation > part.bounds.line_tolerance_m + SLACK_M {
-            return fail(
-                line,
-                format!(
-                    "the TCP {:?} lies {:.4} mm from stroke part {} (segment {}); the tolerance \
-                     is {:.4} mm",
-                    pose.position.as_slice(),
-                    deviation * 1e3,
-                    state.parts_on - 1,
-                    part.segment,
-                    part.bounds.line_tolerance_m * 1e3
-                ),
-            );
-        }
-        if angle > part.bounds.theta_max_deg + SLACK_DEG {
-            return fail(
-                line,
-                format!(
-                    "the tool axis leans {angle:.3}° from the normal of stroke part {}; the cone \
-                     is {}°",
-                    state.parts_on - 1,
-                    part.bounds.theta_max_deg
-                ),
-            );
-        }
-        state.drawn.push(pose.position);
-        Ok(())
+        let axis = pose.rotation.column(2);
+        self.plan
+            .on_task(&mut state.drawing, &pose.position, &axis)
+            .or_else(|problem| fail(line, problem))
     }
 
-    /// The tool switched on at line `line`: the next stroke part of the plan starts, the TCP
-    /// at its start.
+    /// The tool switched on at line `line` ([`PlanChecks::switch_on`]).
     fn switch_on(&self, state: &mut State, line: usize) -> Result<(), ReadError> {
-        let Some(part) = self.parts.get(state.parts_on) else {
-            return fail(
-                line,
-                format!(
-                    "the tool switches on a {}th time; the plan draws {} stroke parts",
-                    state.parts_on + 1,
-                    self.parts.len()
-                ),
-            );
-        };
         let Some(pose) = state.pose else {
             return fail(line, "the tool switches on before the first move");
         };
-        part.check_switch(line, &pose, state.parts_on, Switch::On)?;
-        state.tool_on = true;
-        state.parts_on += 1;
-        state.report.stroke_parts += 1;
-        state.drawn.clear();
-        state.progress_m = 0.0;
-        self.check_on_task(state, &pose, line)
+        let axis = pose.rotation.column(2);
+        self.plan
+            .switch_on(&mut state.drawing, &pose.position, &axis)
+            .or_else(|problem| fail(line, problem))
     }
 
-    /// The tool switched off at line `line`: the stroke part ends, the TCP at its end; what it
-    /// covered is measured.
+    /// The tool switched off at line `line` ([`PlanChecks::switch_off`]).
     fn switch_off(&self, state: &mut State, line: usize) -> Result<(), ReadError> {
-        let part = &self.parts[state.parts_on - 1];
         let pose = self.current_pose(state, line)?;
-        part.check_switch(line, &pose, state.parts_on - 1, Switch::Off)?;
-        state.tool_on = false;
-        if let Some((least, greatest)) = part.line.covered(state.drawn.drain(..)) {
-            // Along the stroke, the task runs on from `from_s`, or back toward its start.
-            state.covered[part.place].push(if part.backward {
-                Stretch {
-                    from_s: part.from_s - greatest,
-                    to_s: part.from_s - least,
-                }
-            } else {
-                Stretch {
-                    from_s: part.from_s + least,
-                    to_s: part.from_s + greatest,
-                }
-            });
-        }
-        Ok(())
+        self.plan
+            .switch_off(&mut state.drawing, &pose.position)
+            .or_else(|problem| fail(line, problem))
     }
 }
