@@ -121,7 +121,8 @@ enum Command {
     /// Fail where the modules of a crate import each other in a circle (each circle listed).
     ImportCircles(import_circles::Args),
     /// Import the industrial arms shipped for their controllers' own programs (the ABB IRB 120
-    /// of PyPI's compas-fab 2.0.1) into data/robots/, each checked against its data sheet.
+    /// of PyPI's compas-fab 2.0.1, the KUKA KR 16-2 of rtb-data 2.0.0) into data/robots/, each
+    /// checked against its data sheet.
     ImportArms(import_arms::Args),
 }
 

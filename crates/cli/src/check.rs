@@ -38,7 +38,7 @@ pub struct CheckArgs {
     /// `drawing.job-part1.script` and `drawing.job.mod` → `drawing.job.json`).
     #[arg(long, value_name = "JOB")]
     pub program: Option<PathBuf>,
-    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`) or a robot file (URDF). Default: the
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`, `kr16`) or a robot file (URDF). Default: the
     /// file's `robot` field (a JSON file, or the --task-from file for a CSV), else `fr3`.
     #[arg(long, value_name = "NAME|URDF", value_parser = robot::parse_robot)]
     pub robot: Option<PathBuf>,

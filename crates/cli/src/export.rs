@@ -28,7 +28,7 @@ pub struct ExportArgs {
     /// are created).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
-    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`) or a robot file (URDF). Default:
+    /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`, `kr16`) or a robot file (URDF). Default:
     /// the file's `robot` field.
     #[arg(long, value_name = "NAME|URDF", value_parser = robot::parse_robot)]
     pub robot: Option<PathBuf>,

@@ -229,7 +229,8 @@ fn controller_program(
 }
 
 /// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when
-/// shipped, else by its joint names), and RAPID for an arm that has not six joints.
+/// shipped, else by its joint names), and RAPID for an arm that has not six joints or is a
+/// shipped arm of another vendor.
 pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> Result<()> {
     let names = robot.joint_names();
     let is_ur = match shipped_profile(robot_file) {
@@ -249,6 +250,16 @@ pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> 
         return Err(anyhow::Error::new(
             emg_job::rapid_program::RapidProgramError::Joints(robot.dof()),
         ));
+    }
+    if format == ExportFormat::Rapid
+        && let Some(shipped) = robot::shipped(robot_file)
+        && shipped.name != "irb120"
+    {
+        anyhow::bail!(
+            "rapid runs on ABB controllers: robot {} is the shipped {}, not an ABB arm",
+            robot_file.display(),
+            shipped.name
+        );
     }
     Ok(())
 }

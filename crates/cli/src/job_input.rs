@@ -19,7 +19,7 @@ pub struct JobInput {
     /// The job: a job file (JSON, docs/jobs.md) or an SVG drawing (every subpath a stroke).
     #[arg(value_name = "JOB")]
     pub file: PathBuf,
-    /// Robot: fr3, iiwa14, ur5e, irb120, or a URDF path.
+    /// Robot: fr3, iiwa14, ur5e, irb120, kr16, or a URDF path.
     #[arg(long, value_parser = robot::parse_robot, default_value = "fr3")]
     pub robot: PathBuf,
     /// The strokes' line tolerance (mm).

@@ -38,7 +38,7 @@ pub fn default_robot() -> PathBuf {
     SHIPPED_ROBOTS[0].path(&data_dir())
 }
 
-/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`) gives its file,
+/// Parses `--robot`: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`, `kr16`) gives its file,
 /// anything else is a path to an existing robot file.
 pub fn parse_robot(value: &str) -> Result<PathBuf, String> {
     let names: Vec<_> = ShippedRobot::all().map(|r| r.name).collect();

@@ -138,6 +138,31 @@ fn a_small_job_writes_the_module_kept_word_for_word() {
 }
 
 #[test]
+fn rapid_for_an_arm_of_another_vendor_is_refused_before_anything_is_planned() {
+    let dir = temp_dir("rapid-kuka");
+    let out = dir.path().join("k.job.json");
+    for robot in ["kr16", "ur5e", "fr3"] {
+        let run = emg(&[
+            "job",
+            case("pen-drag-house.svg").to_str().expect("utf-8 path"),
+            "--robot",
+            robot,
+            "--out",
+            out.to_str().expect("utf-8 path"),
+            "--export",
+            "rapid",
+        ]);
+        assert_eq!(run.status.code(), Some(1), "{robot}");
+        assert!(
+            text(&run.stderr).contains("rapid"),
+            "{robot}: {}",
+            text(&run.stderr)
+        );
+        assert!(!out.exists(), "{robot}: nothing is planned or written");
+    }
+}
+
+#[test]
 fn edits_of_a_module_are_refused_at_their_line() {
     let dir = temp_dir("rapid-edits");
     let (module, plan, _) = exported(&case("pen-drag-house.svg"), dir.path(), &[]);

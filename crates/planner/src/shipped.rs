@@ -27,7 +27,7 @@ impl DataDir {
     }
 
     /// The robot file `value` selects: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`,
-    /// `irb120`) gives its file here, anything else is a path to a robot file.
+    /// `irb120`, `kr16`) gives its file here, anything else is a path to a robot file.
     pub fn robot_file(&self, value: &str) -> PathBuf {
         ShippedRobot::by_name(value).map_or_else(|| PathBuf::from(value), |r| r.path(self))
     }
@@ -100,17 +100,28 @@ pub const SHIPPED_ROBOTS: [ShippedRobot; 3] = [
 ];
 
 /// The industrial arms shipped for their controllers' own programs, planned by search alone
-/// (no trained models): the ABB IRB 120-3/0.58 (`cargo xtask import-arms`, a straight tool
-/// 0.1 m beyond its flange).
-pub const INDUSTRIAL_ROBOTS: [ShippedRobot; 1] = [ShippedRobot {
-    name: "irb120",
-    file: "irb120_pen.urdf",
-    data_subdir: "irb120",
-    // ABB's calibration position: every axis at zero, the upper arm level and the flange facing
-    // forward.
-    home: &[0.0; 6],
-    trained: false,
-}];
+/// (no trained models), each holding a straight tool 0.1 m beyond its flange (`cargo xtask
+/// import-arms`): the ABB IRB 120-3/0.58 and the KUKA KR 16-2.
+pub const INDUSTRIAL_ROBOTS: [ShippedRobot; 2] = [
+    ShippedRobot {
+        name: "irb120",
+        file: "irb120_pen.urdf",
+        data_subdir: "irb120",
+        // ABB's calibration position: every axis at zero, the upper arm level and the flange
+        // facing forward.
+        home: &[0.0; 6],
+        trained: false,
+    },
+    ShippedRobot {
+        name: "kr16",
+        file: "kr16_pen.urdf",
+        data_subdir: "kr16",
+        // KUKA's HOME position: A2 at −90° (the lower arm upright), A3 at +90° (the forearm
+        // level), the others at zero.
+        home: &[0.0, -FRAC_PI_2, FRAC_PI_2, 0.0, 0.0, 0.0],
+        trained: false,
+    },
+];
 
 impl ShippedRobot {
     /// Every shipped robot: [`SHIPPED_ROBOTS`], then [`INDUSTRIAL_ROBOTS`].

@@ -1,5 +1,5 @@
 MODULE EmgJob
-  ! written by emg from a job's program for robot shipped:irb120@sha256:2167c0fc3f4f4dc611aa9959ad7ed989be7b825aeda868d710e5e1a60f195f88
+  ! written by emg from a job's program for robot shipped:irb120@sha256:ad8d635d2e8d92439b91485371492532308c4e43f19277eaac685c9afea51de6
   ! for an ABB controller (IRC5, OmniCore): load the module and run main (docs/robot-export.md)
   ! targets in mm in wobjdata wEmgPart, orientations as quaternions [q1, q2, q3, q4] = [w, x, y, z], configuration data [cf1, cf4, cf6, cfx] of the planned joints; axes in degrees
   ! the tool: standard digital output 0, high switches it on; lead 0 s, lag 0 s; digital output signal doEmgTool0 switches it: define it in the I/O configuration or rename it
