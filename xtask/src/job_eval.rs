@@ -628,7 +628,12 @@ fn baseline(planner: &Planner, timing: &MotionTiming, job: &Job) -> Baseline {
         ..job.settings.clone()
     };
     let ordering = order_strokes(&job.strokes, Order::Shortest);
-    let request = PlanRequest::default();
+    // The controller `emg job` plans with: the hybrid where a policy is trained for the arm,
+    // else the classical.
+    let request = PlanRequest {
+        controller: planner.models().best_controller(),
+        ..PlanRequest::default()
+    };
     let constraints = &planner.config().rollout.constraints;
     let mut motions = Vec::new();
     for oriented in &ordering.sequence {

@@ -69,6 +69,18 @@ const fn every_arm(stage: &'static Template) -> Row {
 
 /// Every stage, each after the ones whose files it reads ([`stages`] spells them out).
 const TABLE: &[Row] = &[
+    Row::Once(Template {
+        name: "import-arms",
+        args: &["import-arms"],
+        writes: &[
+            "data/robots/irb120_pen.urdf",
+            "data/robots/irb120_pen.srdf",
+            "data/robots/irb120_pen.joint_limits.yaml",
+            "data/robots/kr16_pen.urdf",
+            "data/robots/kr16_pen.srdf",
+            "data/robots/kr16_pen.joint_limits.yaml",
+        ],
+    }),
     Row::EveryArm {
         stages: &[Template {
             name: "tasks",
@@ -145,6 +157,14 @@ const TABLE: &[Row] = &[
         name: "job-eval",
         args: &["job-eval"],
         writes: &["docs/results/jobs.json", "docs/results/jobs.md"],
+    }),
+    Row::Once(Template {
+        name: "job-eval-irb120",
+        args: &["job-eval", "--robot", "irb120"],
+        writes: &[
+            "docs/results/irb120/jobs.json",
+            "docs/results/irb120/jobs.md",
+        ],
     }),
     Row::Once(Template {
         name: "corpus-eval",
