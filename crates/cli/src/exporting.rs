@@ -1,6 +1,7 @@
 //! Writing a joint trajectory or a job's program for a robot's own stack (a ROS 2
-//! `JointTrajectory` in an MCAP bag, a URScript program, or a job's program as a RAPID module),
-//! by [`emg_io::export`], `emg_job::ur_program` and `emg_job::rapid_program`: what
+//! `JointTrajectory` in an MCAP bag, a URScript program, or a job's program as a RAPID module
+//! or a KRL program), by [`emg_io::export`], `emg_job::ur_program`, `emg_job::rapid_program`
+//! and `emg_job::krl_program`: what
 //! `emg export`, `emg plan --export`, `emg job --export` and `emg place --export` share.
 
 use std::path::{Path, PathBuf};
@@ -85,9 +86,13 @@ pub fn export_to(
 }
 
 /// The file `--export FORMAT` of `emg job` and `emg place` writes beside the program `out`:
-/// its extension `.mcap`, `.script` or `.mod`.
+/// its extension `.mcap`, `.script` or `.mod`; a KRL program's `.src` (its `.dat` beside it)
+/// named as KRL allows ([`emg_job::krl_program::krl_path_beside`]).
 pub fn beside_program(out: &Path, format: ExportFormat) -> PathBuf {
-    out.with_extension(format.extension())
+    match format {
+        ExportFormat::Krl => emg_job::krl_program::krl_path_beside(out),
+        _ => out.with_extension(format.extension()),
+    }
 }
 
 /// Refuses, before anything is planned, `--export FORMAT` of a program for a robot it cannot run
@@ -153,20 +158,29 @@ pub fn export_job(
 ) -> Result<String> {
     let arm = (robot_file, robot);
     if target.format == ExportFormat::UrScript && writes_native(target.urscript, robot_file)? {
-        let write: ControllerProgram = |file, robot, reference, out| {
+        let write = |file: &_, robot: &_, reference: &_, out: &_| {
             Ok(emg_job::ur_program::ur_program_export(
                 file, robot, reference, out,
             )?)
         };
-        return controller_program(write, file, target.out, input, arm);
+        return controller_program(&write, file, target.out, input, arm);
     }
     if target.format == ExportFormat::Rapid {
-        let write: ControllerProgram = |file, robot, reference, out| {
+        let write = |file: &_, robot: &_, reference: &_, out: &_| {
             Ok(emg_job::rapid_program::rapid_program_export(
                 file, robot, reference, out,
             )?)
         };
-        return controller_program(write, file, target.out, input, arm);
+        return controller_program(&write, file, target.out, input, arm);
+    }
+    if target.format == ExportFormat::Krl {
+        let tool = krl_tool(robot_file, robot)?;
+        let write = |file: &_, robot: &_, reference: &_, out: &_| {
+            Ok(emg_job::krl_program::krl_program_export(
+                file, robot, &tool, reference, out,
+            )?)
+        };
+        return controller_program(&write, file, target.out, input, arm);
     }
     let options = ExportOptions {
         tolerance_rad: target.thinning_tolerance,
@@ -210,13 +224,27 @@ fn writes_native(urscript: &UrScriptArgs, robot_file: &Path) -> Result<bool> {
 
 /// The writer of a controller's own program from a job's program: the program `file` for the
 /// arm `robot`, recorded as written for the robot reference, into `out`.
-type ControllerProgram =
-    fn(&emg_job::JobFile, &Robot, &str, &Path) -> Result<emg_io::Export, anyhow::Error>;
+type ControllerProgram<'a> =
+    &'a dyn Fn(&emg_job::JobFile, &Robot, &str, &Path) -> Result<emg_io::Export, anyhow::Error>;
+
+/// The TCP of `robot` (read from `robot_file`) in the frame of its flange, ROS-Industrial's
+/// `tool0`: where a KRL program's `TOOL_DATA` comes from.
+pub fn krl_tool(robot_file: &Path, robot: &Robot) -> Result<nalgebra::Isometry3<f64>> {
+    let flange = Robot::from_urdf_file(robot_file, robot.base_link(), "tool0").with_context(|| {
+        format!(
+            "a KRL program gives its tool in the flange's frame: robot {} has no chain from {} \
+             to tool0 (ROS-Industrial's flange link)",
+            robot_file.display(),
+            robot.base_link()
+        )
+    })?;
+    Ok(emg_job::krl_program::tool_in_flange(robot, &flange)?)
+}
 
 /// Writes the job's program `file` (read from `input`) as one controller's program by `write`
-/// (a native UR program, a RAPID module) to `out`; returns what to print.
+/// (a native UR program, a RAPID module, a KRL program) to `out`; returns what to print.
 fn controller_program(
-    write: ControllerProgram,
+    write: ControllerProgram<'_>,
     file: &emg_job::JobFile,
     out: &Path,
     input: &Path,
@@ -225,12 +253,17 @@ fn controller_program(
     let reference = robot::reference(robot_file)?.to_string();
     let export = write(file, robot, &reference, out)?;
     export.write(&[("job program", input), ("robot", robot_file)])?;
-    Ok(format!("{}\n  wrote {}", export.summary, out.display()))
+    let written: Vec<String> = export
+        .files
+        .iter()
+        .map(|(path, _)| path.display().to_string())
+        .collect();
+    Ok(format!("{}\n  wrote {}", export.summary, written.join(", ")))
 }
 
 /// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when
-/// shipped, else by its joint names), and RAPID for an arm that has not six joints or is a
-/// shipped arm of another vendor.
+/// shipped, else by its joint names), RAPID and KRL for an arm that has not six joints or is a
+/// shipped arm of another vendor, and KRL for an arm without ROS-Industrial's flange link.
 pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> Result<()> {
     let names = robot.joint_names();
     let is_ur = match shipped_profile(robot_file) {
@@ -251,15 +284,28 @@ pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> 
             emg_job::rapid_program::RapidProgramError::Joints(robot.dof()),
         ));
     }
-    if format == ExportFormat::Rapid
+    if format == ExportFormat::Krl && robot.dof() != 6 {
+        return Err(anyhow::Error::new(
+            emg_job::krl_program::KrlProgramError::Joints(robot.dof()),
+        ));
+    }
+    let vendor_arm = match format {
+        ExportFormat::Rapid => Some(("ABB", "irb120")),
+        ExportFormat::Krl => Some(("KUKA", "kr16")),
+        _ => None,
+    };
+    if let Some((vendor, arm)) = vendor_arm
         && let Some(shipped) = robot::shipped(robot_file)
-        && shipped.name != "irb120"
+        && shipped.name != arm
     {
         anyhow::bail!(
-            "rapid runs on ABB controllers: robot {} is the shipped {}, not an ABB arm",
+            "{format} runs on {vendor} controllers: robot {} is the shipped {}, not a {vendor} arm",
             robot_file.display(),
             shipped.name
         );
+    }
+    if format == ExportFormat::Krl {
+        krl_tool(robot_file, robot)?;
     }
     Ok(())
 }

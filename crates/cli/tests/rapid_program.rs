@@ -63,12 +63,12 @@ fn assert_reads_back(report: &RapidReport, plan: &emg_job::JobFile) {
         .iter()
         .filter(|s| matches!(s.kind, emg_job::SegmentKind::Stroke { .. }))
         .count();
-    assert_eq!(report.stroke_parts, parts);
+    assert_eq!(report.drawn.stroke_parts, parts);
     assert!(report.worst_target_rad <= 1e-6, "{report:?}");
     assert!(report.least_spacing_m >= 1e-4, "{report:?}");
-    assert!(report.worst_deviation_m <= plan.constraints.line_tolerance_m);
-    assert!(report.worst_tool_angle_deg <= plan.constraints.theta_max_deg);
-    assert!(report.covered_m >= report.drawn_m - 1e-3 * parts as f64);
+    assert!(report.drawn.worst_deviation_m <= plan.constraints.line_tolerance_m);
+    assert!(report.drawn.worst_tool_angle_deg <= plan.constraints.theta_max_deg);
+    assert!(report.drawn.covered_m >= report.drawn.drawn_m - 1e-3 * parts as f64);
 }
 
 /// `module` with line `line` (1-based) passed through `edit`.
@@ -134,7 +134,7 @@ fn a_small_job_writes_the_module_kept_word_for_word() {
     );
     let report = read_rapid(&module, &plan, &irb120_checker()).expect("the module reads back");
     assert_reads_back(&report, &plan);
-    assert_eq!(report.stroke_parts, 1);
+    assert_eq!(report.drawn.stroke_parts, 1);
 }
 
 #[test]

@@ -24,7 +24,9 @@
 //! directions and zeros, so at the calibration pose (every axis 0°) the configuration is
 //! `[0, 0, 0, 0]`.
 
-use emg_kinematics::{JointVector, Robot, Vec3};
+use emg_kinematics::{JointVector, Robot};
+
+use crate::wrist::WristSides;
 
 /// `[cf1, cf4, cf6, cfx]` of a configuration.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,20 +45,9 @@ impl AbbConfiguration {
     /// The configuration data of `q` on `robot` (six joints, its wrist centre at axis 5's
     /// origin), as the module documentation defines them.
     pub fn of(robot: &Robot, q: &JointVector) -> Self {
-        let kinematics = robot.forward(q);
-        let (o2, o3, wrist) = (
-            kinematics.joint_origin(1),
-            kinematics.joint_origin(2),
-            kinematics.joint_origin(4),
-        );
-        let axis1 = kinematics.joint_axis(0);
-        let forward = turned_about(&Vec3::x(), &axis1, q[0]);
-        let from_axis1 = wrist - kinematics.joint_origin(0);
-        let behind_axis1 = from_axis1.dot(&forward) < 0.0;
-        let behind_lower_arm = (o3 - o2)
-            .cross(&(wrist - o2))
-            .dot(&kinematics.joint_axis(1))
-            < 0.0;
+        let sides = WristSides::of(robot, q);
+        let behind_axis1 = sides.ahead_of_axis1 < 0.0;
+        let behind_lower_arm = sides.beside_lower_arm < 0.0;
         let axis5_negative = q[4] < 0.0;
         Self {
             cf1: quadrant(q[0]),
@@ -77,12 +68,6 @@ impl AbbConfiguration {
 /// The quadrant of an angle (rad): `⌊θ / 90°⌋`.
 pub fn quadrant(angle: f64) -> i32 {
     (angle / std::f64::consts::FRAC_PI_2).floor() as i32
-}
-
-/// `v` turned by `angle` (rad) about the unit vector `axis` (Rodrigues' formula).
-fn turned_about(v: &Vec3, axis: &Vec3, angle: f64) -> Vec3 {
-    let (sin, cos) = libm::sincos(angle);
-    v * cos + axis.cross(v) * sin + axis * (axis.dot(v) * (1.0 - cos))
 }
 
 #[cfg(test)]

@@ -24,6 +24,9 @@ pub mod connect;
 mod controller_targets;
 pub mod demo_jobs;
 pub mod free_space;
+mod industrial;
+pub mod krl_program;
+mod kuka_configuration;
 pub mod measures;
 pub mod motion;
 pub mod order;
@@ -47,6 +50,7 @@ pub mod ur_program;
 pub mod verify;
 pub mod watch;
 pub mod write;
+mod wrist;
 
 pub use abb_configuration::AbbConfiguration;
 pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES, choose_branches};
@@ -60,6 +64,8 @@ pub use free_space::{
     FreeSpace, LIFT_CONE_RUN, MAX_POINT_TRAVEL_M, PART, PEN_UP_CLEARANCE_SHARE, job_part,
     part_surfaces, with_part,
 };
+pub use industrial::MIN_TARGET_SPACING_M;
+pub use kuka_configuration::KukaConfiguration;
 pub use measures::{JOB_TOLERANCE_M, SAME_LENGTH_M};
 pub use motion::Motion;
 pub use order::merge::{Chain, merge_strokes};

@@ -24,7 +24,7 @@
 //!   else one declared (`zEmg2_5` for 2.5 mm), its orientation and external-axis zones as large
 //!   as its TCP zone; no zone reaches past half of either neighbouring line
 //!   ([`crate::controller_targets::BLEND_LENGTH_SHARE`]).
-//! * No two consecutive targets of a stroke lie closer than [`MIN_TARGET_SPACING_M`]: a closer
+//! * No two consecutive targets of a stroke lie closer than [`crate::industrial::MIN_TARGET_SPACING_M`]: a closer
 //!   inner target is left out (the reader checks the path that leaves, within the whole
 //!   tolerance).
 //!
@@ -33,42 +33,15 @@
 
 use emg_control::Task;
 use emg_kinematics::{JointVector, Robot, Vec3};
-use nalgebra::{Isometry3, Rotation3, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Translation3};
 
 use crate::abb_configuration::AbbConfiguration;
 use crate::controller_targets::{Corner, Pose, Step, TargetRules, segment_configurations, walk};
 use crate::free_space::FreeSpace;
+use crate::industrial::{fixed, part_frame, spaced};
 use crate::program::JobFile;
 use crate::reach::WristReach;
 use crate::tool_output::ToolOutput;
-
-/// The closest two consecutive targets of a stroke may lie (m): closer targets leave the
-/// controller's path planner no room for their zones.
-pub const MIN_TARGET_SPACING_M: f64 = 1e-4;
-
-/// The places in `kept` (indices of `poses`, the first where the tool stands) of the targets
-/// written: every one after the first, but an inner one closer than [`MIN_TARGET_SPACING_M`]
-/// to the last written (or to the start), and the inner one before the last where the last
-/// lies that close to it (the stroke part comes to rest there: its last samples crowd).
-fn spaced(poses: &[Pose], kept: &[usize]) -> Vec<usize> {
-    let position = |n: usize| poses[kept[n]].position;
-    let last = kept.len() - 1;
-    let mut written: Vec<usize> = Vec::new();
-    for n in 1..=last {
-        let before = written.last().map_or(position(0), |&m| position(m));
-        if n < last && (position(n) - before).norm() < MIN_TARGET_SPACING_M {
-            continue;
-        }
-        if n == last
-            && let Some(&m) = written.last()
-            && (position(n) - position(m)).norm() < MIN_TARGET_SPACING_M
-        {
-            written.pop();
-        }
-        written.push(n);
-    }
-    written
-}
 
 /// `MoveAbsJ`'s speed between strokes (ABB's predefined speeddata): the axes' own limits bound
 /// it.
@@ -218,23 +191,6 @@ fn tool_length(robot: &Robot) -> Result<f64, RapidProgramError> {
     Ok(offset.dot(&tool_axis))
 }
 
-/// The part's frame: the job's one work surface (origin its point, z out of the part along
-/// `−n`, x along `d`), else the base frame.
-fn part_frame(file: &JobFile) -> Isometry3<f64> {
-    match file.surfaces.as_slice() {
-        [surface] => {
-            let z = -surface.n;
-            let x = surface.d;
-            let rotation = Rotation3::from_basis_unchecked(&[x, z.cross(&x), z]);
-            Isometry3::from_parts(
-                Translation3::from(surface.p0),
-                UnitQuaternion::from_rotation_matrix(&rotation),
-            )
-        }
-        _ => Isometry3::identity(),
-    }
-}
-
 /// `[x, y, z], [q1, q2, q3, q4]` of `pose` (mm to a nanometre, ABB's quaternion order).
 fn pose_text(pose: &Isometry3<f64>) -> String {
     let (p, q) = (pose.translation.vector * 1e3, pose.rotation);
@@ -248,15 +204,6 @@ fn pose_text(pose: &Isometry3<f64>) -> String {
         fixed(q.j, 9),
         fixed(q.k, 9)
     )
-}
-
-/// `value` with `decimals` decimals, without the sign of a value that rounds to zero.
-fn fixed(value: f64, decimals: usize) -> String {
-    let text = format!("{value:.decimals$}");
-    match text.strip_prefix('-') {
-        Some(magnitude) if magnitude.chars().all(|c| c == '0' || c == '.') => magnitude.to_string(),
-        _ => text,
-    }
 }
 
 /// `q`'s axes in degrees as a `jointtarget`, no external axes.
@@ -423,7 +370,7 @@ impl Writer<'_> {
     }
 
     /// A stroke part whose samples are `qs`, along `task`, the tool at rest on its start: the
-    /// tool on, a `MoveL` run through its targets held [`MIN_TARGET_SPACING_M`] apart
+    /// tool on, a `MoveL` run through its targets held [`crate::industrial::MIN_TARGET_SPACING_M`] apart
     /// ([`spaced`]), the tool off.
     fn stroke(&mut self, qs: &[JointVector], task: &Task) {
         let run = self.rules.stroke(qs, task);
@@ -493,28 +440,5 @@ mod tests {
         ] {
             assert_eq!(zone_size_mm(radius_m), expected, "{radius_m}");
         }
-    }
-
-    #[test]
-    fn targets_closer_than_the_spacing_are_left_out_the_last_kept() {
-        let poses: Vec<Pose> = [0.0, 0.05e-3, 0.3e-3, 0.35e-3, 0.6e-3, 0.65e-3]
-            .iter()
-            .map(|&x| Pose {
-                position: Vec3::new(x, 0.0, 0.0),
-                rotation: UnitQuaternion::identity(),
-            })
-            .collect();
-        let kept: Vec<usize> = (0..poses.len()).collect();
-        // 0.05 mm from the start: out; 0.35 after 0.3: out; the last, 0.05 after 0.6, in its
-        // place.
-        assert_eq!(spaced(&poses, &kept), vec![2, 5]);
-    }
-
-    #[test]
-    fn a_number_that_rounds_to_zero_has_no_sign() {
-        assert_eq!(fixed(-1e-12, 9), "0.000000000");
-        assert_eq!(fixed(-0.0, 3), "0.000");
-        assert_eq!(fixed(-0.25, 3), "-0.250");
-        assert_eq!(fixed(12.5, 1), "12.5");
     }
 }

@@ -14,7 +14,7 @@ use crate::robot::Robot;
 /// What an export wrote.
 #[pyclass(frozen, get_all, module = "extreme_line_motion")]
 pub struct ExportReport {
-    /// `"ros2-mcap"`, `"urscript"` or `"rapid"`.
+    /// `"ros2-mcap"`, `"urscript"`, `"rapid"` or `"krl"`.
     format: &'static str,
     /// The files written (several URScript programs for a motion split where it rests).
     files: Vec<PathBuf>,
@@ -35,7 +35,7 @@ pub struct ExportReport {
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"`, `"urscript"`, or `"rapid"` for a job's
+/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"`, `"urscript"`, or `"rapid"` or `"krl"` for a job's
 /// program on a six-joint ABB arm: one RAPID module) to `out`, for its own
 /// robot or `robot` (a shipped robot's name or a robot file), as `emg export` does: nothing is
 /// written on an error, and `out` never replaces `path`. `urscript` is `"native"` (one program of
@@ -123,6 +123,29 @@ pub fn export(
         (Some(job), ExportFormat::Rapid, _) => {
             emg_job::rapid_program::rapid_program_export(job, &robot.inner, &robot.reference, &out)
                 .map_err(|e| InputError::new_err(message(&e)))?
+        }
+        (Some(job), ExportFormat::Krl, _) => {
+            let flange = emg_kinematics::Robot::from_urdf_file(
+                &robot.file,
+                robot.inner.base_link(),
+                "tool0",
+            )
+            .map_err(|e| {
+                InputError::new_err(format!(
+                    "a KRL program gives its tool in the flange's frame: robot {file} has no \
+                     chain to tool0 (ROS-Industrial's flange link): {e}"
+                ))
+            })?;
+            let tool = emg_job::krl_program::tool_in_flange(&robot.inner, &flange)
+                .map_err(|e| InputError::new_err(message(&e)))?;
+            emg_job::krl_program::krl_program_export(
+                job,
+                &robot.inner,
+                &tool,
+                &robot.reference,
+                &out,
+            )
+            .map_err(|e| InputError::new_err(message(&e)))?
         }
         (_, ExportFormat::UrScript, Some(true)) => {
             return Err(InputError::new_err(format!(

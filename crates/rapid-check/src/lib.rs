@@ -3,7 +3,7 @@
 //!
 //! It parses the module ([`parse_module`]), solves every Cartesian target with the arm's own
 //! closed-form inverse kinematics (`rs-opw-kinematics` from ABB's published dimensions,
-//! [`Irb120`]) and picks the solution its configuration data name by ABB's definition, computed
+//! [`Irb120`] on `emg_program_check::OpwArm`) and picks the solution its configuration data name by ABB's definition, computed
 //! here from that geometry; it interpolates the moves as the controller does (`MoveL` on
 //! straight lines with each fly-by corner's path inside the triangle of the points where the
 //! TCP enters and leaves the zone and the target, taken as the parabola tangent to both lines
@@ -19,13 +19,10 @@
 //! besides the module, so a writer's mistake cannot cancel out in its reading.
 
 mod arm;
-mod error;
 mod parse;
 mod read;
 
-pub use arm::{BOUNDARY_SLACK, Configuration, Irb120, Pose, REACH_SLACK_M};
-pub use error::ReadError;
+pub use arm::{Configuration, Irb120, rapid_pose};
+pub use emg_program_check::{BOUNDARY_SLACK, Drawn, Pose, REACH_SLACK_M, ReadError};
 pub use parse::{Argument, Declaration, Instruction, Module, Value, parse_module};
-pub use read::{
-    JOINT_STEP_RAD, MIN_TARGET_SPACING_M, PATH_STEP_M, RapidReport, TARGET_MATCH_RAD, read_rapid,
-};
+pub use read::{MIN_TARGET_SPACING_M, RapidReport, read_rapid};

@@ -4,7 +4,7 @@
 //! aggregates `[...]`; optional arguments `\Name` and `\Name:=value`) up to its `;`. Comments run
 //! from `!` to the end of the line. Anything else is refused naming its line.
 
-use crate::error::{ReadError, fail};
+use emg_program_check::{ReadError, fail};
 
 /// A RAPID value.
 #[derive(Clone, Debug, PartialEq)]

@@ -78,10 +78,10 @@ pub fn read_back(arm: &RapidArm<'_>, name: &str, file: &JobFile) -> RapidRow {
             row.declared_zones = report.declared_zones;
             row.worst_target_rad = report.worst_target_rad;
             row.least_spacing_m = report.least_spacing_m;
-            row.worst_deviation_m = report.worst_deviation_m;
-            row.worst_tool_angle_deg = report.worst_tool_angle_deg;
-            row.covered_m = report.covered_m;
-            row.drawn_m = report.drawn_m;
+            row.worst_deviation_m = report.drawn.worst_deviation_m;
+            row.worst_tool_angle_deg = report.drawn.worst_tool_angle_deg;
+            row.covered_m = report.drawn.covered_m;
+            row.drawn_m = report.drawn.drawn_m;
         }
         Err(why) => row.failure = Some(format!("{name}: {why}")),
     }

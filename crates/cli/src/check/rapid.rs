@@ -64,22 +64,22 @@ pub fn check_module(
         count(report.declared_zones, "zone"),
         report.worst_target_rad,
         report.least_spacing_m * 1e3,
-        count(report.stroke_parts, "stroke part"),
+        count(report.drawn.stroke_parts, "stroke part"),
     );
     println!(
         "  while the tool is on the TCP stays within {:.3} mm of its stroke (line {} mm) and the \
          tool axis within {:.1}° of its normal (cone {}°); {} configurations checked, clear of \
          the arm and the part (least self-clearance {:.1} mm)",
-        report.worst_deviation_m * 1e3,
+        report.drawn.worst_deviation_m * 1e3,
         constraints.line_tolerance_m * 1e3,
-        report.worst_tool_angle_deg,
+        report.drawn.worst_tool_angle_deg,
         constraints.theta_max_deg,
-        report.samples,
-        report.least_clearance_m * 1e3,
+        report.drawn.samples,
+        report.drawn.least_clearance_m * 1e3,
     );
     println!(
         "  the strokes covered {:.4} m of the {:.4} m the program draws",
-        report.covered_m, report.drawn_m
+        report.drawn.covered_m, report.drawn.drawn_m
     );
     println!("OK");
     Ok(())

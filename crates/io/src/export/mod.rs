@@ -8,8 +8,9 @@
 //! * [`ExportFormat::UrScript`]: a URScript program for a six-joint Universal Robots arm on an
 //!   e-Series controller, `movej` to the start, then a `servoj` target every 2 ms.
 //!
-//! A job's program is also written as a controller's own program ([`ExportFormat::Rapid`], and
-//! URScript's native form) by `emg_job`, from its targets rather than its samples.
+//! A job's program is also written as a controller's own program ([`ExportFormat::Rapid`],
+//! [`ExportFormat::Krl`], and URScript's native form) by `emg_job`, from its targets rather than
+//! its samples.
 
 mod drivers;
 mod ros2_mcap;
@@ -48,14 +49,18 @@ pub enum ExportFormat {
     /// `rapid`: a RAPID module for an ABB controller, written from a job's program only
     /// (`emg_job::rapid_program`).
     Rapid,
+    /// `krl`: a KRL program (`.src` and `.dat`) for a KUKA controller, written from a job's
+    /// program only (`emg_job::krl_program`).
+    Krl,
 }
 
 impl ExportFormat {
     /// Every format, by name.
-    pub const ALL: [ExportFormat; 3] = [
+    pub const ALL: [ExportFormat; 4] = [
         ExportFormat::Ros2Mcap,
         ExportFormat::UrScript,
         ExportFormat::Rapid,
+        ExportFormat::Krl,
     ];
 
     /// The name on the command line.
@@ -64,6 +69,7 @@ impl ExportFormat {
             ExportFormat::Ros2Mcap => "ros2-mcap",
             ExportFormat::UrScript => "urscript",
             ExportFormat::Rapid => "rapid",
+            ExportFormat::Krl => "krl",
         }
     }
 
@@ -73,6 +79,7 @@ impl ExportFormat {
             ExportFormat::Ros2Mcap => "mcap",
             ExportFormat::UrScript => "script",
             ExportFormat::Rapid => "mod",
+            ExportFormat::Krl => "src",
         }
     }
 }
@@ -340,7 +347,7 @@ pub fn export(
     match format {
         ExportFormat::Ros2Mcap => ros2(trajectory, out, robot, options),
         ExportFormat::UrScript => ur_script(trajectory, out, robot, options),
-        ExportFormat::Rapid => Err(ExportError::ProgramOnly(format)),
+        ExportFormat::Rapid | ExportFormat::Krl => Err(ExportError::ProgramOnly(format)),
     }
 }
 
