@@ -6,6 +6,7 @@
 //! verified are documented in `docs/joint-trajectory-format.md`.
 
 mod exported;
+mod krl;
 mod rapid;
 mod script;
 
@@ -29,13 +30,15 @@ use crate::robot;
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// The file to verify: `<stem>.json`, `<stem>.joint_trajectory.json`, `<stem>.csv`, a job's
-    /// program (emg-job/3), a URScript program exported from one for the UR5e (`.script`) or a
-    /// RAPID module exported from one for the IRB 120 (`.mod`).
+    /// program (emg-job/3), a URScript program exported from one for the UR5e (`.script`), a
+    /// RAPID module exported from one for the IRB 120 (`.mod`) or a KRL program exported from
+    /// one for the KR 16 (`.src`, its `.dat` beside it).
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
-    /// A URScript program's or RAPID module's job program (emg-job/3), which it is read back
-    /// against. Default: the `.json` of its name (`drawing.job.script`,
-    /// `drawing.job-part1.script` and `drawing.job.mod` → `drawing.job.json`).
+    /// A URScript program's, RAPID module's or KRL program's job program (emg-job/3), which it
+    /// is read back against. Default: the `.json` of its name (`drawing.job.script`,
+    /// `drawing.job-part1.script` and `drawing.job.mod` → `drawing.job.json`; `drawing.src` →
+    /// `drawing.job.json`).
     #[arg(long, value_name = "JOB")]
     pub program: Option<PathBuf>,
     /// Robot: a shipped robot's name (`fr3`, `iiwa14`, `ur5e`, `irb120`, `kr16`) or a robot file (URDF). Default: the
@@ -70,6 +73,14 @@ pub fn run(args: &CheckArgs) -> Result<()> {
     let file = &args.file;
     if file.extension().is_some_and(|e| e == "script") {
         return script::check_script(
+            file,
+            args.program.as_deref(),
+            args.robot.as_deref(),
+            &args.chain,
+        );
+    }
+    if file.extension().is_some_and(|e| e == "src") {
+        return krl::check_program(
             file,
             args.program.as_deref(),
             args.robot.as_deref(),

@@ -299,7 +299,8 @@ pub fn refuse_format(format: ExportFormat, robot_file: &Path, robot: &Robot) -> 
         && shipped.name != arm
     {
         anyhow::bail!(
-            "{format} runs on {vendor} controllers: robot {} is the shipped {}, not a {vendor} arm",
+            "{format} runs on {vendor} controllers, which drive {vendor} arms: robot {} is the \
+             shipped {}",
             robot_file.display(),
             shipped.name
         );

@@ -8,7 +8,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{data_dir, emg, read, temp_dir, text};
+use common::{case, data_dir, emg, line_of, read, temp_dir, text, with_line};
 use emg_rapid_check::{RapidReport, ReadError, read_rapid};
 use emg_verify::ReferenceModel;
 
@@ -20,13 +20,6 @@ fn irb120_checker() -> ReferenceModel {
         "pen_tip",
     )
     .expect("the IRB 120's checker")
-}
-
-/// A drawing of `../shared/cases/`.
-fn case(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/cases")
-        .join(name)
 }
 
 /// `drawing` planned on the IRB 120 by `emg job ... --export rapid` (with `extra` arguments)
@@ -69,28 +62,6 @@ fn assert_reads_back(report: &RapidReport, plan: &emg_job::JobFile) {
     assert!(report.drawn.worst_deviation_m <= plan.constraints.line_tolerance_m);
     assert!(report.drawn.worst_tool_angle_deg <= plan.constraints.theta_max_deg);
     assert!(report.drawn.covered_m >= report.drawn.drawn_m - 1e-3 * parts as f64);
-}
-
-/// `module` with line `line` (1-based) passed through `edit`.
-fn with_line(module: &str, line: usize, edit: impl Fn(&str) -> String) -> String {
-    module
-        .lines()
-        .enumerate()
-        .map(|(k, l)| {
-            if k + 1 == line {
-                edit(l)
-            } else {
-                l.to_string()
-            }
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-        + "\n"
-}
-
-/// The 1-based number of the first line of `module` that `is` says is it.
-fn line_of(module: &str, is: impl Fn(&str) -> bool) -> usize {
-    module.lines().position(is).expect("the line is there") + 1
 }
 
 #[test]

@@ -5,9 +5,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use common::{data_dir, emg, read, temp_dir, text};
+use common::{case, data_dir, emg, read, temp_dir, text};
 use emg_ur_check::{
     Form, NativeReport, Pose, ReadError, Statement, parse_program, read_native, read_servoj,
 };
@@ -21,13 +21,6 @@ fn ur5e_checker() -> ReferenceModel {
         "pen_tip",
     )
     .expect("the UR5e's checker")
-}
-
-/// A drawing of `../shared/cases/`.
-fn case(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/cases")
-        .join(name)
 }
 
 /// `drawing` planned on the UR5e by `emg job ... --export urscript` (with `extra` arguments)

@@ -219,19 +219,43 @@ fn kuka_frame(rotation: &UnitQuaternion<f64>) -> UnitQuaternion<f64> {
     rotation * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), -std::f64::consts::FRAC_PI_2)
 }
 
+/// Below this `cos B` a frame is taken as turned by exactly ±90° about its y axis (`C` = 0):
+/// closer to that lock, `A` and `C` read from the frame's matrix lose more than the frame
+/// itself turns.
+const GIMBAL_LOCK_COS: f64 = 1e-8;
+
+/// KUKA's `A, B, C` (rad) of `rotation`: the angles about z, then the new y, then the new x
+/// that turn the frame there (`Rz(A) Ry(B) Rx(C)`), read from its matrix so that they compose
+/// back to it within about 1e-8 rad wherever `B` stands, ±90° included.
+fn abc(rotation: &UnitQuaternion<f64>) -> [f64; 3] {
+    let r = rotation.to_rotation_matrix().into_inner();
+    let cos_b = r[(0, 0)].hypot(r[(1, 0)]);
+    let b = libm::atan2(-r[(2, 0)], cos_b);
+    if cos_b > GIMBAL_LOCK_COS {
+        [
+            libm::atan2(r[(1, 0)], r[(0, 0)]),
+            b,
+            libm::atan2(r[(2, 1)], r[(2, 2)]),
+        ]
+    } else {
+        // Rz(A) Ry(±90°): its second column is (−sin A, cos A, 0).
+        [libm::atan2(-r[(0, 1)], r[(1, 1)]), b, 0.0]
+    }
+}
+
 /// `X x,Y y,Z z,A a,B b,C c` of `pose` (mm to 0.1 µm, degrees to 1e-6: KUKA's REAL holds no
 /// more).
 fn frame_text(pose: &Isometry3<f64>) -> String {
     let p = pose.translation.vector * 1e3;
-    let (roll, pitch, yaw) = pose.rotation.euler_angles();
+    let [a, b, c] = abc(&pose.rotation);
     format!(
         "X {},Y {},Z {},A {},B {},C {}",
         fixed(p.x, 4),
         fixed(p.y, 4),
         fixed(p.z, 4),
-        fixed(yaw.to_degrees(), 6),
-        fixed(pitch.to_degrees(), 6),
-        fixed(roll.to_degrees(), 6)
+        fixed(a.to_degrees(), 6),
+        fixed(b.to_degrees(), 6),
+        fixed(c.to_degrees(), 6)
     )
 }
 
@@ -287,6 +311,7 @@ pub fn krl_program(
         points: String::new(),
         velocity: None,
         approximation: None,
+        joint_points: 0,
         program: KrlProgram {
             src: String::new(),
             dat: String::new(),
@@ -357,6 +382,8 @@ struct Writer<'a> {
     velocity: Option<f64>,
     /// The `$APO.CDIS` set last (mm).
     approximation: Option<f64>,
+    /// The `J<n>` points declared.
+    joint_points: usize,
     program: KrlProgram,
 }
 
@@ -376,7 +403,13 @@ impl Writer<'_> {
     /// `PTP` to the axes `q`, an exact stop, its point named `name` (else the next `J<n>`).
     fn ptp(&mut self, q: &JointVector, name: Option<&str>) {
         self.program.ptp += 1;
-        let name = name.map_or_else(|| format!("J{}", self.program.ptp), str::to_string);
+        let name = name.map_or_else(
+            || {
+                self.joint_points += 1;
+                format!("J{}", self.joint_points)
+            },
+            str::to_string,
+        );
         let axes = axis_text(self.rules.robot, q);
         self.points
             .push_str(&format!("DECL E6AXIS {name}={axes}\n"));
@@ -507,11 +540,32 @@ mod tests {
         let ros = UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1);
         let kuka = kuka_frame(&ros);
         assert!((kuka * Vec3::x() - ros * Vec3::z()).norm() < 1e-12);
-        // A, B, C are z, y, x Euler angles: the frame they name is Rz(A) Ry(B) Rx(C).
-        let (c, b, a) = kuka.euler_angles();
-        let named = UnitQuaternion::from_axis_angle(&Vec3::z_axis(), a)
+    }
+
+    /// `Rz(a) Ry(b) Rx(c)`.
+    fn named([a, b, c]: [f64; 3]) -> UnitQuaternion<f64> {
+        UnitQuaternion::from_axis_angle(&Vec3::z_axis(), a)
             * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), b)
-            * UnitQuaternion::from_axis_angle(&Vec3::x_axis(), c);
-        assert!(named.angle_to(&kuka) < 1e-12);
+            * UnitQuaternion::from_axis_angle(&Vec3::x_axis(), c)
+    }
+
+    #[test]
+    fn a_b_c_compose_back_to_the_frame_at_and_near_the_gimbal_lock() {
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        for b in [0.3, -1.2, 2.9] {
+            let frame = named([0.86, b, -0.63]);
+            let read = abc(&frame);
+            assert!(named(read).angle_to(&frame) < 1e-12, "{b}");
+        }
+        // A pen held square to a level part: B at ±90°, give or take what a plan's rounding
+        // leaves (a quaternion's own decomposition is off by up to 0.08 rad there).
+        for off in [0.0, 1e-12, 1e-9, 9e-9, 1e-8, 2e-8, 1e-7, 1e-5] {
+            for sign in [1.0, -1.0] {
+                let frame = named([0.86, sign * (half_pi - off), -0.63]);
+                let read = abc(&frame);
+                let error = named(read).angle_to(&frame);
+                assert!(error < 2e-8, "{sign} (90° − {off} rad): {error} rad");
+            }
+        }
     }
 }

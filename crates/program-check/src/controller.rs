@@ -62,6 +62,14 @@ pub struct Pose {
 }
 
 impl Pose {
+    /// The pose of the frame itself: no offset, no turn.
+    pub fn identity() -> Pose {
+        Pose {
+            position: Vec3::zeros(),
+            rotation: UnitQuaternion::identity(),
+        }
+    }
+
     /// `self` then `other` (`other` given in `self`'s frame).
     pub fn then(&self, other: &Pose) -> Pose {
         Pose {

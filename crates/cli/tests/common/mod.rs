@@ -63,3 +63,25 @@ pub fn data_dir() -> std::path::PathBuf {
 pub fn fr3_path() -> std::path::PathBuf {
     data_dir().join("robots/fr3_pen.urdf")
 }
+
+/// A drawing of `../shared/cases/`.
+pub fn case(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/cases")
+        .join(name)
+}
+
+/// `text` with its line `line` (1-based) passed through `edit`, each line ended by a newline.
+pub fn with_line(text: &str, line: usize, edit: impl Fn(&str) -> String) -> String {
+    text.lines()
+        .enumerate()
+        .map(|(k, l)| if k + 1 == line { edit(l) } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
+/// The 1-based number of the first line of `text` that `is` says is it.
+pub fn line_of(text: &str, is: impl Fn(&str) -> bool) -> usize {
+    text.lines().position(is).expect("the line is there") + 1
+}
