@@ -369,7 +369,7 @@ class ExportReport:
 
 def export(
     path: PathLike,
-    format: Literal["ros2-mcap", "urscript", "rapid"],
+    format: Literal["ros2-mcap", "urscript", "rapid", "krl"],
     out: PathLike,
     robot: Optional[PathLike] = None,
     tolerance_rad: Optional[float] = None,
@@ -384,5 +384,8 @@ def export(
     output; a job's program on the shipped UR5e, its default there) or ``"servoj"`` (a servoj
     target every 2 ms, at most ``max_servoj_lines`` per program, default 2500), or ``"rapid"``
     (a job's program on a six-joint ABB arm, the shipped ``irb120``: one RAPID module of MoveAbsJ
-    and MoveL with zones, configuration data and the tool's SetDO). Raises InputError for a
-    wrong input, writing nothing."""
+    and MoveL with zones, configuration data and the tool's SetDO), or ``"krl"`` (a job's
+    program on a six-joint KUKA arm with ROS-Industrial's ``tool0``, the shipped ``kr16``: a KRL
+    program, ``out`` its ``.src`` named as KRL names programs, its points in the ``.dat`` beside
+    it: PTP and LIN with C_DIS, Status and Turn, the tool's $OUT). Raises InputError for a wrong
+    input, writing nothing."""

@@ -35,8 +35,9 @@ pub struct ExportReport {
 }
 
 /// Exports the joint trajectory at `path` (`STEM.joint_trajectory.json`) or the job's program
-/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"`, `"urscript"`, or `"rapid"` or `"krl"` for a job's
-/// program on a six-joint ABB arm: one RAPID module) to `out`, for its own
+/// there (an `emg-job/3` file) as `format` (`"ros2-mcap"`, `"urscript"`, or for a job's program
+/// `"rapid"` on a six-joint ABB arm, one RAPID module, or `"krl"` on a six-joint KUKA arm, a
+/// `.src` and its `.dat`) to `out`, for its own
 /// robot or `robot` (a shipped robot's name or a robot file), as `emg export` does: nothing is
 /// written on an error, and `out` never replaces `path`. `urscript` is `"native"` (one program of
 /// movej, movel and blended movep with the tool's output: a job's program on the shipped UR5e,

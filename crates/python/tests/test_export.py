@@ -156,6 +156,26 @@ def test_a_job_exports_as_one_rapid_module(tmp_path):
     assert sum(line.startswith("MoveL ") for line in lines) >= parts
 
 
+def test_a_job_exports_as_one_krl_program(tmp_path):
+    """A job's program on the KR 16 as a KRL program: the .src with the tool switched on and off
+    once per stroke part, each stroke a LIN run, and its points in the .dat beside it."""
+    icon = Path(__file__).resolve().parents[2] / "io" / "tests" / "data" / "icons" / "pencil.svg"
+    job = tmp_path / "pencil.job.json"
+    elm.Planner("kr16").plan_job(icon).write(job)
+    parts = sum(1 for s in json.loads(job.read_text())["segments"] if s["kind"] == "stroke")
+    out = tmp_path / "pencil.src"
+    report = elm.export(job, "krl", out)
+    assert report.files == [out, tmp_path / "pencil.dat"]
+    assert "KRL for a KUKA controller" in report.summary
+    lines = [line.strip() for line in out.read_text().splitlines()]
+    assert lines[2] == "DEF pencil( )" and lines[-1] == "END"
+    assert lines.count("$OUT[1]=TRUE") == parts
+    assert sum(line.startswith("LIN ") for line in lines) >= parts
+    assert (tmp_path / "pencil.dat").read_text().splitlines()[2] == "DEFDAT pencil"
+    with pytest.raises(elm.InputError, match="not a KRL name"):
+        elm.export(job, "krl", tmp_path / "my-pencil.src")
+
+
 def test_urscript_and_wrong_inputs(ur5e_line, tmp_path):
     report = elm.export(ur5e_line, "urscript", tmp_path / "demo.script")
     assert report.servoj_targets > 0
