@@ -28,6 +28,8 @@ use crate::task_set_options::ROBOT_WITH_JOINT_LIMITS;
 use crate::{progress, workspace};
 
 mod large;
+mod industrial_programs;
+mod krl_programs;
 mod rapid_programs;
 mod ur_programs;
 
@@ -205,13 +207,25 @@ pub struct Record {
     /// On the IRB 120, each program of `rows` written as a RAPID module and read back.
     #[serde(default)]
     pub rapid_programs: Vec<rapid_programs::RapidRow>,
+    /// On the KR 16, each program of `rows` written as a KRL program and read back.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub krl_programs: Vec<krl_programs::KrlRow>,
 }
 
 /// The readers of the controllers' own programs a job-eval arm has: the UR5e's native
-/// programs, the IRB 120's RAPID modules.
+/// programs, the IRB 120's RAPID modules, the KR 16's KRL programs.
 struct Readers<'a> {
     ur: Option<ur_programs::UrArm<'a>>,
     rapid: Option<rapid_programs::RapidArm<'a>>,
+    krl: Option<krl_programs::KrlArm<'a>>,
+}
+
+/// A job's program as each controller of its arm runs it, read back.
+#[derive(Default)]
+struct ProgramRows {
+    ur: Option<ur_programs::UrRow>,
+    rapid: Option<rapid_programs::RapidRow>,
+    krl: Option<krl_programs::KrlRow>,
 }
 
 /// Plans, checks and compares every job; writes the record and its table.
@@ -236,19 +250,37 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         robot_file: &args.common.robot,
         checker: &checker,
     });
+    // The arm whose controller's frames a KRL program is written in: the KR 16.
+    let krl_arm = if shipped.name == "kr16" {
+        let flange = emg_kinematics::Robot::from_urdf_file(
+            &args.common.robot,
+            planner.robot().base_link(),
+            "tool0",
+        )?;
+        Some(krl_programs::KrlArm {
+            robot: planner.robot(),
+            robot_file: &args.common.robot,
+            tool_in_flange: emg_job::krl_program::tool_in_flange(planner.robot(), &flange)?,
+            checker: &checker,
+        })
+    } else {
+        None
+    };
     let readers = Readers {
         ur: ur_arm,
         rapid: rapid_arm,
+        krl: krl_arm,
     };
     let jobs = jobs(&args.common.icons, planner, home)?;
     let bar = progress::bar(jobs.len() as u64, "jobs");
     let mut rows = Vec::new();
-    let (mut ur_rows, mut rapid_rows) = (Vec::new(), Vec::new());
+    let (mut ur_rows, mut rapid_rows, mut krl_rows) = (Vec::new(), Vec::new(), Vec::new());
     for (name, job) in &jobs {
-        let (row, ur_row, rapid_row) = evaluate(&job_planner, &checker, (name, job), &readers)?;
+        let (row, programs) = evaluate(&job_planner, &checker, (name, job), &readers)?;
         rows.push(row);
-        ur_rows.extend(ur_row);
-        rapid_rows.extend(rapid_row);
+        ur_rows.extend(programs.ur);
+        rapid_rows.extend(programs.rapid);
+        krl_rows.extend(programs.krl);
         bar.inc(1);
     }
     bar.finish();
@@ -279,6 +311,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         large: large_rows,
         ur_programs: ur_rows,
         rapid_programs: rapid_rows,
+        krl_programs: krl_rows,
     };
     workspace::write_results(&args.common.out_dir, "jobs", &record, &markdown(&record))?;
     ensure_checked(&record)
@@ -286,10 +319,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// The jobs of the evaluation, each by its name: every icon of `icons` at every place, the
 /// seams on tilted surfaces, the valley seams as given and in the order of least travel, and
-/// the jobs of hundreds of strokes; each starting and ending at the arm's `home`.
+/// the jobs of hundreds of strokes; each starting and ending at the arm's `home`. The places are
+/// the FR3's, moved with the arm's default drawing place (`emg_job::default_placement`: the
+/// same on every shipped arm but the KR 16, whose reach is larger).
 fn jobs(icons: &Path, planner: &Planner, home: &[f64]) -> anyhow::Result<Vec<(String, Job)>> {
+    let offset = Vec3::from(emg_job::default_placement(planner.robot()).origin_m)
+        - Vec3::from(Placement::default().origin_m);
+    let moved = |strokes: Vec<PathSpec>| -> Vec<PathSpec> {
+        if offset == Vec3::zeros() {
+            return strokes;
+        }
+        let motion = nalgebra::Isometry3::translation(offset.x, offset.y, offset.z);
+        strokes.iter().map(|stroke| stroke.moved(&motion)).collect()
+    };
     let with_home = |strokes: Vec<PathSpec>| {
-        Job::from_strokes(strokes, planner.robot())
+        Job::from_strokes(moved(strokes), planner.robot())
             .and_then(|job| job.with_home(home, planner.robot()))
     };
     let mut jobs: Vec<(String, Job)> = Vec::new();
@@ -297,6 +341,9 @@ fn jobs(icons: &Path, planner: &Planner, home: &[f64]) -> anyhow::Result<Vec<(St
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     for icon in &icons {
         for (origin, width) in PLACES {
+            // Moved, to a nanometre, so that the place prints as it reads.
+            let origin: [f64; 3] =
+                std::array::from_fn(|i| ((origin[i] + offset[i]) * 1e9).round() / 1e9);
             let placement = Placement {
                 origin_m: origin,
                 width_m: Some(width),
@@ -378,7 +425,13 @@ fn ensure_checked(record: &Record) -> anyhow::Result<()> {
             record
                 .rapid_programs
                 .iter()
-                .filter_map(|r| r.failure.as_deref()),
+                .filter_map(|r| r.read.failure.as_deref()),
+        )
+        .chain(
+            record
+                .krl_programs
+                .iter()
+                .filter_map(|r| r.read.failure.as_deref()),
         )
         .collect();
     anyhow::ensure!(
@@ -471,24 +524,29 @@ fn evaluate(
     checker: &emg_verify::ReferenceModel,
     (name, job): (&str, &Job),
     readers: &Readers<'_>,
-) -> anyhow::Result<(
-    JobRow,
-    Option<ur_programs::UrRow>,
-    Option<rapid_programs::RapidRow>,
-)> {
+) -> anyhow::Result<(JobRow, ProgramRows)> {
     let planner = job_planner.planner();
     let started = Instant::now();
     let planned = job_planner.plan(job, &Unwatched);
     let planning_s = started.elapsed().as_secs_f64();
     let baseline = baseline(planner, job_planner.timing(), job);
     let total_m: f64 = job.strokes.iter().map(|s| s.length_m()).sum();
-    let ur_row = match (&planned, &readers.ur) {
-        (Ok(program), Some(arm)) => Some(ur_programs::read_back(arm, name, program)),
-        _ => None,
-    };
-    let rapid_row = match (&planned, &readers.rapid) {
-        (Ok(program), Some(arm)) => Some(rapid_programs::read_back(arm, name, program)),
-        _ => None,
+    let programs = match &planned {
+        Ok(program) => ProgramRows {
+            ur: readers
+                .ur
+                .as_ref()
+                .map(|arm| ur_programs::read_back(arm, name, program)),
+            rapid: readers
+                .rapid
+                .as_ref()
+                .map(|arm| rapid_programs::read_back(arm, name, program)),
+            krl: readers
+                .krl
+                .as_ref()
+                .map(|arm| krl_programs::read_back(arm, name, program)),
+        },
+        Err(_) => ProgramRows::default(),
     };
     let row = match planned {
         Ok(program) => {
@@ -552,7 +610,7 @@ fn evaluate(
             baseline_colliding_moves: baseline.colliding,
         },
     };
-    Ok((row, ur_row, rapid_row))
+    Ok((row, programs))
 }
 
 /// The largest distance of a joint from its home value over `program`'s points (rad).
@@ -689,6 +747,9 @@ fn markdown(record: &Record) -> String {
     md.push_str(&job_table(&record.rows));
     if !record.large.is_empty() {
         md.push_str(&large::markdown(&record.large));
+    }
+    if !record.krl_programs.is_empty() {
+        md.push_str(&krl_programs::markdown(&record.krl_programs));
     }
     if !record.rapid_programs.is_empty() {
         md.push_str(&rapid_programs::markdown(&record.rapid_programs));

@@ -167,6 +167,11 @@ const TABLE: &[Row] = &[
         ],
     }),
     Row::Once(Template {
+        name: "job-eval-kr16",
+        args: &["job-eval", "--robot", "kr16"],
+        writes: &["docs/results/kr16/jobs.json", "docs/results/kr16/jobs.md"],
+    }),
+    Row::Once(Template {
         name: "corpus-eval",
         args: &["corpus-eval", "--every", "20"],
         writes: &["docs/results/corpus.json", "docs/results/corpus.md"],

@@ -6,7 +6,7 @@
 use std::sync::Mutex;
 use std::time::Instant;
 
-use emg_io::{Placement, read_svg, scattered_strokes_svg};
+use emg_io::{read_svg, scattered_strokes_svg};
 use emg_job::{JobPlanner, Watch, verify_job};
 use serde::{Deserialize, Serialize};
 
@@ -84,7 +84,7 @@ pub fn evaluate(
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = read_svg(
         &scattered_strokes_svg(strokes),
-        &Placement::default(),
+        &emg_job::default_placement(planner.robot()),
         &tolerance.svg_options(),
     )?;
     let job = tolerance

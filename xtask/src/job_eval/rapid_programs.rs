@@ -10,6 +10,8 @@ use emg_rapid_check::{RapidReport, read_rapid};
 use emg_verify::ReferenceModel;
 use serde::{Deserialize, Serialize};
 
+use super::industrial_programs::ReadBack;
+
 /// One job's module on the IRB 120, read back.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RapidRow {
@@ -21,27 +23,9 @@ pub struct RapidRow {
     pub move_l: usize,
     /// Zones the module declares.
     pub declared_zones: usize,
-    /// Largest distance (rad, any joint) of a target's solution by its configuration data from
-    /// the plan's configuration.
-    pub worst_target_rad: f64,
-    /// Smallest distance (m) between consecutive Cartesian targets.
-    pub least_spacing_m: f64,
-    /// Largest distance (m) of the TCP from its stroke while the tool is on, as the reader
-    /// interpolates the moves, and the tolerance.
-    pub worst_deviation_m: f64,
-    /// See `worst_deviation_m`.
-    pub tolerance_m: f64,
-    /// Largest angle (degrees) of the tool axis from its stroke's normal while the tool is on,
-    /// and the cone.
-    pub worst_tool_angle_deg: f64,
-    /// See `worst_tool_angle_deg`.
-    pub cone_deg: f64,
-    /// Length (m) the TCP covers with the tool on, and the length the plan draws.
-    pub covered_m: f64,
-    /// See `covered_m`.
-    pub drawn_m: f64,
-    /// Why the module was not written or not read back; `None` where it was.
-    pub failure: Option<String>,
+    /// How it read back.
+    #[serde(flatten)]
+    pub read: ReadBack,
 }
 
 /// The IRB 120 as the module needs it.
@@ -56,36 +40,21 @@ pub struct RapidArm<'a> {
 
 /// `file` (the job `name`'s program) written as a module and read back.
 pub fn read_back(arm: &RapidArm<'_>, name: &str, file: &JobFile) -> RapidRow {
-    let mut row = RapidRow {
+    let report = module(arm, file);
+    let counts = report.as_ref().map_or((0, 0, 0), |r| {
+        (r.move_abs_j, r.move_l, r.declared_zones)
+    });
+    RapidRow {
         job: name.to_string(),
-        move_abs_j: 0,
-        move_l: 0,
-        declared_zones: 0,
-        worst_target_rad: 0.0,
-        least_spacing_m: 0.0,
-        worst_deviation_m: 0.0,
-        tolerance_m: file.constraints.line_tolerance_m,
-        worst_tool_angle_deg: 0.0,
-        cone_deg: file.constraints.theta_max_deg,
-        covered_m: 0.0,
-        drawn_m: 0.0,
-        failure: None,
-    };
-    match module(arm, file) {
-        Ok(report) => {
-            row.move_abs_j = report.move_abs_j;
-            row.move_l = report.move_l;
-            row.declared_zones = report.declared_zones;
-            row.worst_target_rad = report.worst_target_rad;
-            row.least_spacing_m = report.least_spacing_m;
-            row.worst_deviation_m = report.drawn.worst_deviation_m;
-            row.worst_tool_angle_deg = report.drawn.worst_tool_angle_deg;
-            row.covered_m = report.drawn.covered_m;
-            row.drawn_m = report.drawn.drawn_m;
-        }
-        Err(why) => row.failure = Some(format!("{name}: {why}")),
+        move_abs_j: counts.0,
+        move_l: counts.1,
+        declared_zones: counts.2,
+        read: ReadBack::of(
+            name,
+            file,
+            report.map(|r| (r.worst_target_rad, r.least_spacing_m, r.drawn)),
+        ),
     }
-    row
 }
 
 /// The module written and read back.
@@ -105,7 +74,7 @@ fn module(arm: &RapidArm<'_>, file: &JobFile) -> anyhow::Result<RapidReport> {
 
 /// The section of `jobs.md`: per module what was written and how it read back.
 pub fn markdown(rows: &[RapidRow]) -> String {
-    let read = rows.iter().filter(|r| r.failure.is_none()).count();
+    let read = rows.iter().filter(|r| r.read.failure.is_none()).count();
     let mut md = format!(
         "\n## RAPID modules\n\n\
          Each program above written as a RAPID module for the IRB 120, in memory (`emg job \
@@ -115,26 +84,19 @@ pub fn markdown(rows: &[RapidRow]) -> String {
          (`rs-opw-kinematics`) and its configuration data, the moves interpolated with each \
          zone's corner inside its triangle and at most half of either neighbouring line, every \
          configuration checked by the checker. **{read} of {} read back.**\n\n\
-         | job | MoveAbsJ / MoveL | zones declared | worst target (rad) | least target spacing (mm) | worst TCP deviation (mm) / tolerance | worst tool angle (°) / cone | covered / drawn (m) | read back |\n\
+         | job | MoveAbsJ / MoveL | zones declared | {}\n\
          |---|---|---|---|---|---|---|---|---|\n",
-        rows.len()
+        rows.len(),
+        ReadBack::HEADER
     );
     for r in rows {
         md.push_str(&format!(
-            "| {} | {} / {} | {} | {:.1e} | {:.3} | {:.4} / {:.1} | {:.2} / {:.0} | {:.3} / {:.3} | {} |\n",
+            "| {} | {} / {} | {} | {}\n",
             r.job,
             r.move_abs_j,
             r.move_l,
             r.declared_zones,
-            r.worst_target_rad,
-            r.least_spacing_m * 1e3,
-            r.worst_deviation_m * 1e3,
-            r.tolerance_m * 1e3,
-            r.worst_tool_angle_deg,
-            r.cone_deg,
-            r.covered_m,
-            r.drawn_m,
-            r.failure.as_deref().map_or("yes", |_| "**no**"),
+            r.read.cells()
         ));
     }
     md
