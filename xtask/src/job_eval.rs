@@ -27,9 +27,9 @@ use serde::{Deserialize, Serialize};
 use crate::task_set_options::ROBOT_WITH_JOINT_LIMITS;
 use crate::{progress, workspace};
 
-mod large;
 mod industrial_programs;
 mod krl_programs;
+mod large;
 mod rapid_programs;
 mod ur_programs;
 

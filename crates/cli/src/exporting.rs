@@ -230,14 +230,15 @@ type ControllerProgram<'a> =
 /// The TCP of `robot` (read from `robot_file`) in the frame of its flange, ROS-Industrial's
 /// `tool0`: where a KRL program's `TOOL_DATA` comes from.
 pub fn krl_tool(robot_file: &Path, robot: &Robot) -> Result<nalgebra::Isometry3<f64>> {
-    let flange = Robot::from_urdf_file(robot_file, robot.base_link(), "tool0").with_context(|| {
-        format!(
-            "a KRL program gives its tool in the flange's frame: robot {} has no chain from {} \
+    let flange =
+        Robot::from_urdf_file(robot_file, robot.base_link(), "tool0").with_context(|| {
+            format!(
+                "a KRL program gives its tool in the flange's frame: robot {} has no chain from {} \
              to tool0 (ROS-Industrial's flange link)",
-            robot_file.display(),
-            robot.base_link()
-        )
-    })?;
+                robot_file.display(),
+                robot.base_link()
+            )
+        })?;
     Ok(emg_job::krl_program::tool_in_flange(robot, &flange)?)
 }
 
@@ -258,7 +259,11 @@ fn controller_program(
         .iter()
         .map(|(path, _)| path.display().to_string())
         .collect();
-    Ok(format!("{}\n  wrote {}", export.summary, written.join(", ")))
+    Ok(format!(
+        "{}\n  wrote {}",
+        export.summary,
+        written.join(", ")
+    ))
 }
 
 /// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when

@@ -90,6 +90,17 @@ fn the_house_program_reads_back_every_target_the_plans_configuration() {
     assert!(text(&run.stdout).contains("KRL read back"));
 }
 
+/// A logo stroke whose path turns sharply where the plan's samples cut the turn within the
+/// tolerance: the approximated corners pass the turn as closely as the samples do.
+#[test]
+fn the_cusped_logo_reads_back() {
+    let dir = temp_dir("krl-cusp");
+    let program = exported(&case("cusp-logo.svg"), dir.path(), &[]);
+    let report = read_krl(&program.src, &program.dat, &program.plan, &kr16_checker())
+        .expect("the program reads back");
+    assert_reads_back(&report, &program.plan);
+}
+
 /// A small job whose program is kept word for word in `tests/data/kr16-triangle.src` and
 /// `.dat`: any change of the writer shows there. `EMG_WRITE_GOLDEN=1` writes them again.
 #[test]
@@ -103,7 +114,11 @@ fn a_small_job_writes_the_program_kept_word_for_word() {
     )
     .expect("drawing written");
     let program = exported(&drawing, dir.path(), &["--width", "0.05"]);
-    assert!(!program.src.contains(dir.path().to_str().expect("utf-8 path")));
+    assert!(
+        !program
+            .src
+            .contains(dir.path().to_str().expect("utf-8 path"))
+    );
     for (text, extension) in [(&program.src, "src"), (&program.dat, "dat")] {
         let golden = Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/data/kr16-triangle")

@@ -216,7 +216,12 @@ fn output_number(tool: &ToolOutput) -> u32 {
 /// A frame in KUKA's terms (x along the tool or out of the flange) from ROS-Industrial's (z
 /// along it): turned by −90° about its own y axis.
 fn kuka_frame(rotation: &UnitQuaternion<f64>) -> UnitQuaternion<f64> {
-    rotation * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), -std::f64::consts::FRAC_PI_2)
+    rotation * about_y(-std::f64::consts::FRAC_PI_2)
+}
+
+/// The turn by `angle` (rad) about the y axis.
+fn about_y(angle: f64) -> UnitQuaternion<f64> {
+    UnitQuaternion::from_rotation_matrix(&emg_kinematics::rotation_about(&Vec3::y(), angle))
 }
 
 /// Below this `cos B` a frame is taken as turned by exactly ±90° about its y axis (`C` = 0):
@@ -229,7 +234,7 @@ const GIMBAL_LOCK_COS: f64 = 1e-8;
 /// back to it within about 1e-8 rad wherever `B` stands, ±90° included.
 fn abc(rotation: &UnitQuaternion<f64>) -> [f64; 3] {
     let r = rotation.to_rotation_matrix().into_inner();
-    let cos_b = r[(0, 0)].hypot(r[(1, 0)]);
+    let cos_b = libm::hypot(r[(0, 0)], r[(1, 0)]);
     let b = libm::atan2(-r[(2, 0)], cos_b);
     if cos_b > GIMBAL_LOCK_COS {
         [
@@ -442,7 +447,11 @@ impl Writer<'_> {
             "DECL E6POS {name}={{{},{configuration},{NO_EXTERNAL_AXES}}}\n",
             frame_text(&in_part)
         ));
-        let approximate = if approximation.is_some() { " C_DIS" } else { "" };
+        let approximate = if approximation.is_some() {
+            " C_DIS"
+        } else {
+            ""
+        };
         self.line(&format!("LIN {name}{approximate}"));
     }
 
@@ -472,7 +481,7 @@ impl Writer<'_> {
         let comments: String = header.iter().map(|line| format!("; {line}\n")).collect();
         // The TCP in KUKA's flange frame, its x along the tool: both frames turned as
         // [`kuka_frame`] turns them.
-        let turn = UnitQuaternion::from_axis_angle(&Vec3::y_axis(), std::f64::consts::FRAC_PI_2);
+        let turn = about_y(std::f64::consts::FRAC_PI_2);
         let tool = Isometry3::from_parts(
             Translation3::from(turn * tool_in_flange.translation.vector),
             turn * kuka_frame(&tool_in_flange.rotation),
@@ -482,13 +491,18 @@ impl Writer<'_> {
         src.push_str("  $TOOL=TOOL_DATA[1]\n  $BASE=BASE_DATA[1]\n  $IPO_MODE=#BASE\n");
         src.push_str("  $ORI_TYPE=#VAR\n  $ADVANCE=3\n");
         for axis in 1..=6 {
-            src.push_str(&format!("  $VEL_AXIS[{axis}]=100\n  $ACC_AXIS[{axis}]=100\n"));
+            src.push_str(&format!(
+                "  $VEL_AXIS[{axis}]=100\n  $ACC_AXIS[{axis}]=100\n"
+            ));
         }
         src.push_str(&self.body);
         src.push_str("END\n");
         let mut dat = format!("&ACCESS RVP\n&REL 1\nDEFDAT {name}\n{comments}");
         dat.push_str(&format!("DECL FRAME EMG_TOOL={{{}}}\n", frame_text(&tool)));
-        dat.push_str(&format!("DECL FRAME EMG_PART={{{}}}\n", frame_text(&self.part)));
+        dat.push_str(&format!(
+            "DECL FRAME EMG_PART={{{}}}\n",
+            frame_text(&self.part)
+        ));
         dat.push_str(&self.points);
         dat.push_str("ENDDAT\n");
         self.program.src = src;
@@ -504,7 +518,12 @@ mod tests {
     fn a_program_is_named_by_its_file_if_krl_allows_the_name() {
         assert_eq!(program_name(Path::new("out/house.src")).unwrap(), "house");
         assert_eq!(program_name(Path::new("_a1.src")).unwrap(), "_a1");
-        for bad in ["my-job.src", "1job.src", "a_name_longer_than_24_chars.src", ".src"] {
+        for bad in [
+            "my-job.src",
+            "1job.src",
+            "a_name_longer_than_24_chars.src",
+            ".src",
+        ] {
             assert!(
                 matches!(program_name(Path::new(bad)), Err(KrlProgramError::Name(_))),
                 "{bad}"
@@ -518,7 +537,10 @@ mod tests {
             ("out/house.job.json", "out/house.src"),
             ("pen-drag-house.job.json", "pen_drag_house.src"),
             ("2024 drawing.json", "_2024_drawing.src"),
-            ("a_very_long_name_of_a_drawing_file.job.json", "a_very_long_name_of_a_dr.src"),
+            (
+                "a_very_long_name_of_a_drawing_file.job.json",
+                "a_very_long_name_of_a_dr.src",
+            ),
         ] {
             let beside = krl_path_beside(Path::new(program));
             assert_eq!(beside, Path::new(expected));
@@ -537,16 +559,19 @@ mod tests {
 
     #[test]
     fn kukas_tool_direction_is_the_ros_frames_z() {
-        let ros = UnitQuaternion::from_euler_angles(0.3, -0.2, 1.1);
+        let ros = UnitQuaternion::from_rotation_matrix(&emg_kinematics::rotation_from_rpy(
+            0.3, -0.2, 1.1,
+        ));
         let kuka = kuka_frame(&ros);
         assert!((kuka * Vec3::x() - ros * Vec3::z()).norm() < 1e-12);
     }
 
     /// `Rz(a) Ry(b) Rx(c)`.
     fn named([a, b, c]: [f64; 3]) -> UnitQuaternion<f64> {
-        UnitQuaternion::from_axis_angle(&Vec3::z_axis(), a)
-            * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), b)
-            * UnitQuaternion::from_axis_angle(&Vec3::x_axis(), c)
+        let about = |axis: Vec3, angle: f64| {
+            UnitQuaternion::from_rotation_matrix(&emg_kinematics::rotation_about(&axis, angle))
+        };
+        about(Vec3::z(), a) * about(Vec3::y(), b) * about(Vec3::x(), c)
     }
 
     #[test]

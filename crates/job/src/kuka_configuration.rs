@@ -46,7 +46,9 @@ impl KukaConfiguration {
             .filter(|&axis| q[axis] < 0.0)
             .fold(0u8, |bits, axis| bits | (1 << axis));
         Self {
-            status: u8::from(overhead) + 2 * u8::from(at_or_above_phi) + 4 * u8::from(axis5_negative),
+            status: u8::from(overhead)
+                + 2 * u8::from(at_or_above_phi)
+                + 4 * u8::from(axis5_negative),
             turn,
         }
     }
@@ -99,7 +101,14 @@ mod tests {
         KukaConfiguration::of(robot, &robot.joint_vector(&q))
     }
 
-    const HOME: [f64; 6] = [0.0, -std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2, 0.0, 0.0, 0.0];
+    const HOME: [f64; 6] = [
+        0.0,
+        -std::f64::consts::FRAC_PI_2,
+        std::f64::consts::FRAC_PI_2,
+        0.0,
+        0.0,
+        0.0,
+    ];
 
     #[test]
     fn home_is_basic_area_above_phi_a5_positive() {
@@ -118,7 +127,12 @@ mod tests {
             q[axis] = 0.0;
             assert_eq!(conf(&robot, q).turn & (1 << axis), 0, "axis {}", axis + 1);
             q[axis] = -e;
-            assert_eq!(conf(&robot, q).turn & (1 << axis), 1 << axis, "axis {}", axis + 1);
+            assert_eq!(
+                conf(&robot, q).turn & (1 << axis),
+                1 << axis,
+                "axis {}",
+                axis + 1
+            );
         }
     }
 
@@ -133,13 +147,21 @@ mod tests {
         // through A2 and A3 where −0.67 sin φ − 0.035 cos φ = 0.
         let phi = libm::atan2(-0.035, 0.67);
         assert!((phi.to_degrees() + 2.99).abs() < 0.01);
-        assert_eq!(conf(&robot, [0.0, -1.2, phi + e, 0.0, 0.4, 0.0]).status & 2, 2);
-        assert_eq!(conf(&robot, [0.0, -1.2, phi - e, 0.0, 0.4, 0.0]).status & 2, 0);
+        assert_eq!(
+            conf(&robot, [0.0, -1.2, phi + e, 0.0, 0.4, 0.0]).status & 2,
+            2
+        );
+        assert_eq!(
+            conf(&robot, [0.0, -1.2, phi - e, 0.0, 0.4, 0.0]).status & 2,
+            0
+        );
         // The overhead area: the lower arm leaning back (A2 below −90°) until the wrist
         // centre passes above A1's axis: its x value 0.26 + 0.68 cos A2 + 0.67 cos(A2 + A3)
         // − 0.035 sin(A2 + A3) in the A1 frame turns negative (found by bisection).
         let a3 = 0.5;
-        let x = |a2: f64| 0.26 + 0.68 * a2.cos() + 0.67 * (a2 + a3).cos() - 0.035 * (a2 + a3).sin();
+        let x = |a2: f64| {
+            0.26 + 0.68 * libm::cos(a2) + 0.67 * libm::cos(a2 + a3) - 0.035 * libm::sin(a2 + a3)
+        };
         let (mut low, mut high) = (-std::f64::consts::PI, -std::f64::consts::FRAC_PI_2);
         for _ in 0..100 {
             let mid = 0.5 * (low + high);

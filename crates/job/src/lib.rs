@@ -49,8 +49,8 @@ pub mod tool_output;
 pub mod ur_program;
 pub mod verify;
 pub mod watch;
-pub mod write;
 mod wrist;
+pub mod write;
 
 pub use abb_configuration::AbbConfiguration;
 pub use branch::{BRANCH_CHANGE_RAD, BranchChoice, Branches, MAX_CARRIED_STROKES, choose_branches};

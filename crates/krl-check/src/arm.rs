@@ -8,7 +8,7 @@ use std::f64::consts::FRAC_PI_2;
 
 use emg_kinematics::Vec3;
 use emg_program_check::{ClosedForm, OpwArm, Pose, on_side};
-use nalgebra::UnitQuaternion;
+use nalgebra::{Quaternion, UnitQuaternion};
 use rs_opw_kinematics::parameters::opw_kinematics::Parameters;
 
 /// KUKA's Status and Turn.
@@ -59,13 +59,23 @@ impl Default for Kr16 {
     }
 }
 
+/// The turn by `angle` (rad) about the unit vector `axis`: the quaternion of its half angle.
+fn about(axis: Vec3, angle: f64) -> UnitQuaternion<f64> {
+    let (sin, cos) = libm::sincos(angle / 2.0);
+    UnitQuaternion::new_normalize(Quaternion::new(
+        cos,
+        axis.x * sin,
+        axis.y * sin,
+        axis.z * sin,
+    ))
+}
+
 /// A frame in ROS-Industrial's terms (z along the tool or out of the flange) from KUKA's (x
 /// along it): turned by +90° about its own y axis.
 pub fn ros_frame(kuka: &Pose) -> Pose {
     Pose {
         position: kuka.position,
-        rotation: kuka.rotation
-            * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), FRAC_PI_2),
+        rotation: kuka.rotation * about(Vec3::y(), FRAC_PI_2),
     }
 }
 
@@ -74,9 +84,9 @@ pub fn ros_frame(kuka: &Pose) -> Pose {
 pub fn kuka_pose([x, y, z, a, b, c]: [f64; 6]) -> Pose {
     Pose {
         position: Vec3::new(x, y, z) / 1e3,
-        rotation: UnitQuaternion::from_axis_angle(&Vec3::z_axis(), a.to_radians())
-            * UnitQuaternion::from_axis_angle(&Vec3::y_axis(), b.to_radians())
-            * UnitQuaternion::from_axis_angle(&Vec3::x_axis(), c.to_radians()),
+        rotation: about(Vec3::z(), a.to_radians())
+            * about(Vec3::y(), b.to_radians())
+            * about(Vec3::x(), c.to_radians()),
     }
 }
 
@@ -204,7 +214,11 @@ mod tests {
             // Within a hair of a singularity or a boundary the data cannot tell the solutions
             // apart; the writer plans away from them.
             let [x, above_phi, a5] = arm.measures(&q);
-            if a5.abs() < 1e-3 || x.abs() < 1e-4 || above_phi.abs() < 1e-4 || q.iter().any(|v| v.abs() < 1e-5) {
+            if a5.abs() < 1e-3
+                || x.abs() < 1e-4
+                || above_phi.abs() < 1e-4
+                || q.iter().any(|v| v.abs() < 1e-5)
+            {
                 continue;
             }
             let back = arm

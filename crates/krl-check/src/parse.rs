@@ -80,7 +80,10 @@ impl Declaration {
             .iter()
             .find(|(key, _)| !keys.contains(&key.as_str()))
         {
-            return Err(format!("{name} (.dat line {}) has a field {key}", self.line));
+            return Err(format!(
+                "{name} (.dat line {}) has a field {key}",
+                self.line
+            ));
         }
         keys.iter()
             .map(|key| {
@@ -213,7 +216,10 @@ fn statement(line: usize, code: &str) -> Result<Statement, ReadError> {
         "WAIT" => {
             let (unit, time) = first_word(rest);
             if unit != "SEC" {
-                return fail(line, "WAIT without SEC: a job's program waits only for time");
+                return fail(
+                    line,
+                    "WAIT without SEC: a job's program waits only for time",
+                );
             }
             Action::WaitSec(number(time, "WAIT SEC's time", line)?)
         }
@@ -255,11 +261,15 @@ pub fn parse_dat(text: &str) -> Result<DataList, ReadError> {
         let (decl, rest) = first_word(code);
         let (data_type, rest) = first_word(rest);
         let Some((name, value)) = rest.split_once('=') else {
-            return Err(at(format!("`{code}` is not a declaration DECL TYPE NAME=value")));
+            return Err(at(format!(
+                "`{code}` is not a declaration DECL TYPE NAME=value"
+            )));
         };
         let name = name.trim();
         if decl != "DECL" || !is_name(name) {
-            return Err(at(format!("`{code}` is not a declaration DECL TYPE NAME=value")));
+            return Err(at(format!(
+                "`{code}` is not a declaration DECL TYPE NAME=value"
+            )));
         }
         let Some(inner) = value
             .trim()

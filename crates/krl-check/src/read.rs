@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use emg_job::JobFile;
 use emg_program_check::{
-    CartesianTarget, Controller, Drawing, Drawn, JointTarget, PlanChecks, PlanConfigurations,
-    Pose, ReadError, TARGET_MATCH_RAD, fail,
+    CartesianTarget, Controller, Drawing, Drawn, JointTarget, PlanChecks, PlanConfigurations, Pose,
+    ReadError, TARGET_MATCH_RAD, fail,
 };
 use emg_verify::ReferenceModel;
 
@@ -149,9 +149,7 @@ pub fn read_krl(
             "the program ends on an approximated point: its last move is no exact stop",
         );
     }
-    let drawn = reading
-        .controller
-        .finish(&state.drawing, file, last_line)?;
+    let drawn = reading.controller.finish(&state.drawing, file, last_line)?;
     Ok(KrlReport {
         ptp: state.moves[0],
         lin: state.moves[1],
@@ -200,7 +198,9 @@ impl Reading<'_> {
         let name = value.to_ascii_uppercase();
         match set.get(&name) {
             Some(frame) => Ok(*frame),
-            None if name.contains('[') => fail(line, format!("{name} is not set before it is used")),
+            None if name.contains('[') => {
+                fail(line, format!("{name} is not set before it is used"))
+            }
             None => self.frame(&name, line),
         }
     }
@@ -340,7 +340,10 @@ impl Reading<'_> {
                     .ok_or_else(|| ReadError::at(line, "C_DIS before $APO.CDIS is set"))?
             }
             Some(other) => {
-                return fail(line, format!("LIN {point} {other}: a job's LIN approximates by C_DIS"));
+                return fail(
+                    line,
+                    format!("LIN {point} {other}: a job's LIN approximates by C_DIS"),
+                );
             }
         };
         let declaration = self.point(point, "E6POS", line)?;
@@ -391,7 +394,10 @@ impl Reading<'_> {
             );
         }
         let Some(joints) = state.joints else {
-            return fail(line, "a LIN before the arm's joints are known (no PTP before it)");
+            return fail(
+                line,
+                "a LIN before the arm's joints are known (no PTP before it)",
+            );
         };
         // A LIN keeps the Status the arm stands in: KUKA ignores a LIN target's S and T.
         let standing = *state

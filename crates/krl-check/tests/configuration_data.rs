@@ -50,7 +50,10 @@ fn the_readers_closed_form_is_the_shipped_arms_flange() {
     for q in configurations(&robot, 1000) {
         let (shipped, solved) = (tcp(&robot, &q), arm.flange(&q));
         let (distance, angle) = shipped.difference(&solved);
-        assert!(distance < 1e-9 && angle < 1e-9, "{q:?}: {distance} m, {angle} rad");
+        assert!(
+            distance < 1e-9 && angle < 1e-9,
+            "{q:?}: {distance} m, {angle} rad"
+        );
     }
 }
 
@@ -74,7 +77,11 @@ fn ten_thousand_configurations_written_are_solved_back_to_their_joints() {
         };
         assert_eq!(configuration, arm.status_turn(&q), "{q:?}");
         let back = arm
-            .solve(&tcp(&robot, &q).then(&tool.inverse()), configuration, &ranges)
+            .solve(
+                &tcp(&robot, &q).then(&tool.inverse()),
+                configuration,
+                &ranges,
+            )
             .unwrap_or_else(|n| panic!("{q:?}: {n} solutions hold {configuration:?}"));
         worst = worst.max(emg_program_check::largest_change(&back, &q));
     }

@@ -21,6 +21,9 @@ pub const JOINT_STEP_RAD: f64 = 0.01;
 /// Largest change (rad) of any joint between consecutive samples of a Cartesian path: more is
 /// a jump through a singularity.
 pub const MAX_JOINT_JUMP_RAD: f64 = 0.05;
+/// Fewest samples taken along a corner's parabola, however short: a corner turns the TCP, and
+/// its progress along the stroke is followed through the turn.
+pub const CORNER_SAMPLES: usize = 16;
 /// How near (rad, every joint) a target's solution must be to a configuration of the plan.
 pub const TARGET_MATCH_RAD: f64 = 1e-6;
 /// How near (m and rad) the program's TCP must be to the checker's tip.
@@ -359,7 +362,8 @@ impl<A: ClosedForm> Controller<'_, A> {
         Ok(joints)
     }
 
-    /// Follows the corner's parabola from `entry` past `target` to `exit`.
+    /// Follows the corner's parabola from `entry` past `target` to `exit`, sampled every
+    /// [`PATH_STEP_M`] and at least [`CORNER_SAMPLES`] times.
     fn follow_corner(
         &self,
         drawing: &mut Drawing,
@@ -369,7 +373,7 @@ impl<A: ClosedForm> Controller<'_, A> {
     ) -> Result<[f64; 6], ReadError> {
         let length =
             (corner.position - entry.position).norm() + (exit.position - corner.position).norm();
-        let count = (length / PATH_STEP_M).ceil().max(2.0) as usize;
+        let count = ((length / PATH_STEP_M).ceil() as usize).max(CORNER_SAMPLES);
         let mut joints = joints;
         for k in 1..=count {
             let t = k as f64 / count as f64;
@@ -396,9 +400,9 @@ impl<A: ClosedForm> Controller<'_, A> {
         target: &CartesianTarget<A::Held>,
     ) -> Result<[f64; 6], ReadError> {
         let flange = pose.then(&self.tool.inverse());
-        let Some((q, change)) =
-            self.arm
-                .follow(&flange, &joints, self.plan.limits(), target.held)
+        let Some((q, change)) = self
+            .arm
+            .follow(&flange, &joints, self.plan.limits(), target.held)
         else {
             let (wrist, reach) = self.arm.wrist_reach(&flange);
             return fail(

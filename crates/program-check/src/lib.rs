@@ -251,12 +251,13 @@ impl<'a> PlanChecks<'a> {
         drawing.worst_tool_angle_deg = drawing.worst_tool_angle_deg.max(angle);
         if deviation > part.bounds.line_tolerance_m + SLACK_M {
             return Err(format!(
-                "the TCP {:?} lies {:.4} mm from stroke part {} (segment {}); the tolerance is \
-                 {:.4} mm",
+                "the TCP {:?} lies {:.4} mm from stroke part {} (segment {}), {:.4} m along \
+                 it; the tolerance is {:.4} mm",
                 position.as_slice(),
                 deviation * 1e3,
                 drawing.parts_on - 1,
                 part.segment,
+                progress_m,
                 part.bounds.line_tolerance_m * 1e3
             ));
         }

@@ -5,8 +5,8 @@ use std::collections::BTreeMap;
 
 use emg_job::JobFile;
 use emg_program_check::{
-    CartesianTarget, Controller, Drawing, Drawn, JointTarget, PlanChecks, PlanConfigurations,
-    Pose, ReadError, TARGET_MATCH_RAD, fail,
+    CartesianTarget, Controller, Drawing, Drawn, JointTarget, PlanChecks, PlanConfigurations, Pose,
+    ReadError, TARGET_MATCH_RAD, fail,
 };
 use emg_verify::ReferenceModel;
 
@@ -115,9 +115,7 @@ pub fn read_rapid(
             "the module ends on a fly-by point: its last move is not fine",
         );
     }
-    let drawn = reading
-        .controller
-        .finish(&state.drawing, file, last_line)?;
+    let drawn = reading.controller.finish(&state.drawing, file, last_line)?;
     Ok(RapidReport {
         move_abs_j: state.moves[0],
         move_l: state.moves[1],
@@ -400,8 +398,11 @@ impl<'a> Reading<'a> {
                             "a MoveL before the arm's joints are known (no MoveAbsJ before it)",
                         );
                     };
-                    state.joints =
-                        Some(self.controller.cartesian_run(&mut state.drawing, joints, &run)?);
+                    state.joints = Some(self.controller.cartesian_run(
+                        &mut state.drawing,
+                        joints,
+                        &run,
+                    )?);
                 }
             }
             other => {

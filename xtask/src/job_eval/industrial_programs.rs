@@ -35,11 +35,7 @@ pub struct ReadBack {
 impl ReadBack {
     /// The record of `file` (the job `name`'s program): the reader's `worst_target_rad`,
     /// `least_spacing_m` and what it drew, or why it was not written or read.
-    pub fn of(
-        name: &str,
-        file: &JobFile,
-        read: anyhow::Result<(f64, f64, Drawn)>,
-    ) -> Self {
+    pub fn of(name: &str, file: &JobFile, read: anyhow::Result<(f64, f64, Drawn)>) -> Self {
         let mut row = Self {
             worst_target_rad: 0.0,
             least_spacing_m: 0.0,

@@ -41,9 +41,9 @@ pub struct RapidArm<'a> {
 /// `file` (the job `name`'s program) written as a module and read back.
 pub fn read_back(arm: &RapidArm<'_>, name: &str, file: &JobFile) -> RapidRow {
     let report = module(arm, file);
-    let counts = report.as_ref().map_or((0, 0, 0), |r| {
-        (r.move_abs_j, r.move_l, r.declared_zones)
-    });
+    let counts = report
+        .as_ref()
+        .map_or((0, 0, 0), |r| (r.move_abs_j, r.move_l, r.declared_zones));
     RapidRow {
         job: name.to_string(),
         move_abs_j: counts.0,

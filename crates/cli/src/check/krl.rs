@@ -22,16 +22,17 @@ fn job_beside(file: &Path) -> PathBuf {
     if beside.exists() {
         return beside;
     }
-    let folder = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let folder = file
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let named_so: Vec<PathBuf> = std::fs::read_dir(folder)
         .into_iter()
         .flatten()
         .flatten()
         .map(|entry| entry.path())
         .filter(|path| path.extension().is_some_and(|e| e == "json"))
-        .filter(|path| {
-            emg_job::krl_program::krl_path_beside(path).file_name() == file.file_name()
-        })
+        .filter(|path| emg_job::krl_program::krl_path_beside(path).file_name() == file.file_name())
         .collect();
     match named_so.as_slice() {
         [only] => only.clone(),

@@ -75,7 +75,13 @@ pub fn case(name: &str) -> std::path::PathBuf {
 pub fn with_line(text: &str, line: usize, edit: impl Fn(&str) -> String) -> String {
     text.lines()
         .enumerate()
-        .map(|(k, l)| if k + 1 == line { edit(l) } else { l.to_string() })
+        .map(|(k, l)| {
+            if k + 1 == line {
+                edit(l)
+            } else {
+                l.to_string()
+            }
+        })
         .collect::<Vec<_>>()
         .join("\n")
         + "\n"
