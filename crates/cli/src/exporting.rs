@@ -73,16 +73,7 @@ pub fn export_to(
     };
     let export = emg_io::export(trajectory, format, out, &target, options)?;
     export.write(&[input, ("robot", robot_file)])?;
-    let written: Vec<String> = export
-        .files
-        .iter()
-        .map(|(path, _)| path.display().to_string())
-        .collect();
-    Ok(format!(
-        "{}\n  wrote {}",
-        export.summary,
-        written.join(", ")
-    ))
+    Ok(written(&export))
 }
 
 /// The file `--export FORMAT` of `emg job` and `emg place` writes beside the program `out`:
@@ -203,6 +194,16 @@ pub fn export_job(
     )
 }
 
+/// What an export says it wrote: its summary and its files.
+fn written(export: &emg_io::Export) -> String {
+    let files: Vec<String> = export
+        .files
+        .iter()
+        .map(|(path, _)| path.display().to_string())
+        .collect();
+    format!("{}\n  wrote {}", export.summary, files.join(", "))
+}
+
 /// Whether a URScript export of a job's program is written native: where `--urscript` asks
 /// (refused for a robot other than the shipped UR5e, the one whose base and flange frames are
 /// known to be the controller's Base and tool flange), and by default on the shipped UR5e;
@@ -254,16 +255,7 @@ fn controller_program(
     let reference = robot::reference(robot_file)?.to_string();
     let export = write(file, robot, &reference, out)?;
     export.write(&[("job program", input), ("robot", robot_file)])?;
-    let written: Vec<String> = export
-        .files
-        .iter()
-        .map(|(path, _)| path.display().to_string())
-        .collect();
-    Ok(format!(
-        "{}\n  wrote {}",
-        export.summary,
-        written.join(", ")
-    ))
+    Ok(written(&export))
 }
 
 /// Refuses URScript for a robot that is not a Universal Robots arm (by its driver profile when

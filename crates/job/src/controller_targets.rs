@@ -213,6 +213,81 @@ pub(crate) struct TargetRules<'a> {
     pub(crate) reach: Option<WristReach>,
 }
 
+impl<'a> TargetRules<'a> {
+    /// The rules of `file`'s program on `robot` in the space `free`: the job's tolerances, rate
+    /// and tool speed, the controller's `corner` path, and its `reach` where it holds every
+    /// point of its path within one.
+    pub(crate) fn for_job(
+        file: &JobFile,
+        (robot, free): (&'a Robot, &'a FreeSpace<'a>),
+        corner: Corner,
+        reach: Option<WristReach>,
+    ) -> Self {
+        Self {
+            robot,
+            free,
+            tolerance: file.constraints.line_tolerance_m,
+            cone_deg: file.constraints.theta_max_deg,
+            rate_hz: file.rate_hz,
+            tool_speed: file.limits.tool_speed_m_per_s,
+            corner,
+            reach,
+        }
+    }
+}
+
+/// What a controller's program says for each step of a job, as an industrial controller's
+/// writer (RAPID, KRL) says it.
+pub(crate) trait StepWriter {
+    /// The rules its targets are chosen by.
+    fn rules(&self) -> &TargetRules<'_>;
+    /// A comment line.
+    fn comment(&mut self, text: &str);
+    /// A stroke part whose samples are `qs`, along `task`, from rest on its start.
+    fn stroke(&mut self, qs: &[JointVector], task: &Task);
+    /// A straight move of the tool to the pose of `q` at `speed` (m/s), stopping there.
+    fn straight_move(&mut self, q: &JointVector, speed: f64);
+    /// A joint move to `q`, its corner radius `radius` (m) there.
+    fn joint_move(&mut self, q: &JointVector, radius: f64);
+}
+
+/// Each segment of `file` (its samples' configurations `samples`) written by `writer`: a
+/// comment, then a stroke part, or a move's targets ([`TargetRules::free_move`]); the index of a
+/// stroke segment without its task, where one is.
+pub(crate) fn write_steps(
+    file: &JobFile,
+    robot: &Robot,
+    samples: &[Vec<JointVector>],
+    writer: &mut impl StepWriter,
+) -> Result<(), usize> {
+    walk(file, robot, samples, |step| match step {
+        Step::Stroke { comment, qs, task } => {
+            writer.comment(&comment);
+            writer.stroke(qs, task);
+        }
+        Step::Move {
+            comment,
+            vertices,
+            qs,
+            off_stroke,
+            onto_stroke,
+        } => {
+            writer.comment(&comment);
+            let targets = writer
+                .rules()
+                .free_move(&vertices, qs, off_stroke, onto_stroke);
+            let speed = writer.rules().tool_speed;
+            for target in targets {
+                if target.straight {
+                    writer.straight_move(&target.q, speed);
+                } else {
+                    writer.joint_move(&target.q, target.radius);
+                }
+            }
+        }
+    })
+}
+
 /// A stroke part's targets: the pose of each of the plan's samples, the samples kept as
 /// targets (the first and the last among them), the corner radius at each kept sample (0 at
 /// the two ends and where the corner stays sharp), and the tool speed into each (none into the

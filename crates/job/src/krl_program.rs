@@ -33,7 +33,9 @@ use emg_control::Task;
 use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
-use crate::controller_targets::{Corner, Pose, Step, TargetRules, segment_configurations, walk};
+use crate::controller_targets::{
+    Corner, Pose, StepWriter, TargetRules, segment_configurations, write_steps,
+};
 use crate::free_space::FreeSpace;
 use crate::industrial::{fixed, part_frame, spaced};
 use crate::kuka_configuration::KukaConfiguration;
@@ -299,16 +301,12 @@ pub fn krl_program(
     }
     let free = FreeSpace::new(robot, file.surfaces.clone(), &file.constraints);
     let mut writer = Writer {
-        rules: TargetRules {
-            robot,
-            free: &free,
-            tolerance: file.constraints.line_tolerance_m,
-            cone_deg: file.constraints.theta_max_deg,
-            rate_hz: file.rate_hz,
-            tool_speed: file.limits.tool_speed_m_per_s,
-            corner: Corner::Parabola,
-            reach: WristReach::of(robot),
-        },
+        rules: TargetRules::for_job(
+            file,
+            (robot, &free),
+            Corner::Parabola,
+            WristReach::of(robot),
+        ),
         part: part_frame(file),
         output: output_number(&file.settings.tool_output),
         tool: file.settings.tool_output,
@@ -340,33 +338,7 @@ pub fn krl_program(
             }
         }
     }
-    walk(file, robot, &samples, |step| match step {
-        Step::Stroke { comment, qs, task } => {
-            writer.line(&format!("; {comment}"));
-            writer.stroke(qs, task);
-        }
-        Step::Move {
-            comment,
-            vertices,
-            qs,
-            off_stroke,
-            onto_stroke,
-        } => {
-            writer.line(&format!("; {comment}"));
-            for target in writer
-                .rules
-                .free_move(&vertices, qs, off_stroke, onto_stroke)
-            {
-                if target.straight {
-                    let speed = writer.rules.tool_speed;
-                    writer.lin(&target.q, speed, 0.0);
-                } else {
-                    writer.ptp(&target.q, None);
-                }
-            }
-        }
-    })
-    .map_err(KrlProgramError::NoTask)?;
+    write_steps(file, robot, &samples, &mut writer).map_err(KrlProgramError::NoTask)?;
     writer.finish(name, tool_in_flange, header);
     Ok(writer.program)
 }
@@ -390,6 +362,28 @@ struct Writer<'a> {
     /// The `J<n>` points declared.
     joint_points: usize,
     program: KrlProgram,
+}
+
+impl StepWriter for Writer<'_> {
+    fn rules(&self) -> &TargetRules<'_> {
+        &self.rules
+    }
+
+    fn comment(&mut self, text: &str) {
+        self.line(&format!("; {text}"));
+    }
+
+    fn stroke(&mut self, qs: &[JointVector], task: &Task) {
+        self.stroke_part(qs, task);
+    }
+
+    fn straight_move(&mut self, q: &JointVector, speed: f64) {
+        self.lin(q, speed, 0.0);
+    }
+
+    fn joint_move(&mut self, q: &JointVector, _radius: f64) {
+        self.ptp(q, None);
+    }
 }
 
 impl Writer<'_> {
@@ -458,7 +452,7 @@ impl Writer<'_> {
     /// A stroke part whose samples are `qs`, along `task`, the tool at rest on its start: the
     /// tool on, a `LIN` run through its targets held [`crate::MIN_TARGET_SPACING_M`] apart
     /// ([`spaced`]), the tool off.
-    fn stroke(&mut self, qs: &[JointVector], task: &Task) {
+    fn stroke_part(&mut self, qs: &[JointVector], task: &Task) {
         let run = self.rules.stroke(qs, task);
         self.program.worst_chord_m = self.program.worst_chord_m.max(run.worst_chord_m);
         self.program.stroke_parts += 1;

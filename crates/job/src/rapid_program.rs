@@ -36,7 +36,9 @@ use emg_kinematics::{JointVector, Robot, Vec3};
 use nalgebra::{Isometry3, Translation3};
 
 use crate::abb_configuration::AbbConfiguration;
-use crate::controller_targets::{Corner, Pose, Step, TargetRules, segment_configurations, walk};
+use crate::controller_targets::{
+    Corner, Pose, StepWriter, TargetRules, segment_configurations, write_steps,
+};
 use crate::free_space::FreeSpace;
 use crate::industrial::{fixed, part_frame, spaced};
 use crate::program::JobFile;
@@ -229,16 +231,12 @@ pub fn rapid_program(
     let tool_length = tool_length(robot)?;
     let free = FreeSpace::new(robot, file.surfaces.clone(), &file.constraints);
     let mut writer = Writer {
-        rules: TargetRules {
-            robot,
-            free: &free,
-            tolerance: file.constraints.line_tolerance_m,
-            cone_deg: file.constraints.theta_max_deg,
-            rate_hz: file.rate_hz,
-            tool_speed: file.limits.tool_speed_m_per_s,
-            corner: Corner::Parabola,
-            reach: WristReach::of(robot),
-        },
+        rules: TargetRules::for_job(
+            file,
+            (robot, &free),
+            Corner::Parabola,
+            WristReach::of(robot),
+        ),
         part: part_frame(file),
         tool: file.settings.tool_output,
         tool_length,
@@ -265,33 +263,7 @@ pub fn rapid_program(
         writer.line("! the program's start, from wherever the arm stands: clear that way");
         writer.move_abs_j(&start, 0.0);
     }
-    walk(file, robot, &samples, |step| match step {
-        Step::Stroke { comment, qs, task } => {
-            writer.line(&format!("! {comment}"));
-            writer.stroke(qs, task);
-        }
-        Step::Move {
-            comment,
-            vertices,
-            qs,
-            off_stroke,
-            onto_stroke,
-        } => {
-            writer.line(&format!("! {comment}"));
-            for target in writer
-                .rules
-                .free_move(&vertices, qs, off_stroke, onto_stroke)
-            {
-                if target.straight {
-                    let speed = writer.rules.tool_speed;
-                    writer.move_l(&target.q, speed, 0.0);
-                } else {
-                    writer.move_abs_j(&target.q, target.radius);
-                }
-            }
-        }
-    })
-    .map_err(RapidProgramError::NoTask)?;
+    write_steps(file, robot, &samples, &mut writer).map_err(RapidProgramError::NoTask)?;
     writer.finish(header);
     Ok(writer.program)
 }
@@ -309,6 +281,28 @@ struct Writer<'a> {
     /// The zones declared, by name, with their radius (mm).
     zones: Vec<(String, f64)>,
     program: RapidProgram,
+}
+
+impl StepWriter for Writer<'_> {
+    fn rules(&self) -> &TargetRules<'_> {
+        &self.rules
+    }
+
+    fn comment(&mut self, text: &str) {
+        self.line(&format!("! {text}"));
+    }
+
+    fn stroke(&mut self, qs: &[JointVector], task: &Task) {
+        self.stroke_part(qs, task);
+    }
+
+    fn straight_move(&mut self, q: &JointVector, speed: f64) {
+        self.move_l(q, speed, 0.0);
+    }
+
+    fn joint_move(&mut self, q: &JointVector, radius: f64) {
+        self.move_abs_j(q, radius);
+    }
 }
 
 impl Writer<'_> {
@@ -372,7 +366,7 @@ impl Writer<'_> {
     /// A stroke part whose samples are `qs`, along `task`, the tool at rest on its start: the
     /// tool on, a `MoveL` run through its targets held [`crate::industrial::MIN_TARGET_SPACING_M`] apart
     /// ([`spaced`]), the tool off.
-    fn stroke(&mut self, qs: &[JointVector], task: &Task) {
+    fn stroke_part(&mut self, qs: &[JointVector], task: &Task) {
         let run = self.rules.stroke(qs, task);
         self.program.worst_chord_m = self.program.worst_chord_m.max(run.worst_chord_m);
         self.program.stroke_parts += 1;

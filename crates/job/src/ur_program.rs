@@ -153,16 +153,7 @@ pub fn ur_program(
     let joint_speed = smallest(&file.limits.max_velocity);
     let joint_acceleration = smallest(&file.limits.max_acceleration);
     let mut writer = Writer {
-        rules: TargetRules {
-            robot,
-            free: &free,
-            tolerance: file.constraints.line_tolerance_m,
-            cone_deg: file.constraints.theta_max_deg,
-            rate_hz: file.rate_hz,
-            tool_speed: file.limits.tool_speed_m_per_s,
-            corner: Corner::Arc,
-            reach: None,
-        },
+        rules: TargetRules::for_job(file, (robot, &free), Corner::Arc, None),
         tool: file.settings.tool_output,
         joint_speed,
         joint_acceleration,

@@ -61,3 +61,24 @@ impl Exported {
         })
     }
 }
+
+/// Prints what the arm drew as a reader ran a controller's program against `job`, then `OK`.
+pub fn print_drawn(drawn: &emg_program_check::Drawn, job: &emg_job::JobFile) {
+    let constraints = &job.constraints;
+    println!(
+        "  while the tool is on the TCP stays within {:.3} mm of its stroke (line {} mm) and the \
+         tool axis within {:.1}° of its normal (cone {}°); {} configurations checked, clear of \
+         the arm and the part (least self-clearance {:.1} mm)",
+        drawn.worst_deviation_m * 1e3,
+        constraints.line_tolerance_m * 1e3,
+        drawn.worst_tool_angle_deg,
+        constraints.theta_max_deg,
+        drawn.samples,
+        drawn.least_clearance_m * 1e3,
+    );
+    println!(
+        "  the strokes covered {:.4} m of the {:.4} m the program draws",
+        drawn.covered_m, drawn.drawn_m
+    );
+    println!("OK");
+}

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, anyhow, bail};
 use emg_planner::ShippedRobot;
 
-use super::exported::Exported;
+use super::exported::{Exported, print_drawn};
 use crate::options::ChainArgs;
 use crate::output::count;
 use crate::robot;
@@ -75,7 +75,6 @@ pub fn check_program(
     let (_, model) = chain.robot_and_checker(&robot_path)?;
     let report = emg_krl_check::read_krl(&text, &dat, &job, &model)
         .map_err(|e| anyhow!("{} does not hold up: {e}", file.display()))?;
-    let constraints = &job.constraints;
     let drawn = &report.drawn;
     println!(
         "{}: KRL read back against {}, robot {}",
@@ -94,21 +93,6 @@ pub fn check_program(
         report.least_spacing_m * 1e3,
         count(drawn.stroke_parts, "stroke part"),
     );
-    println!(
-        "  while the tool is on the TCP stays within {:.3} mm of its stroke (line {} mm) and the \
-         tool axis within {:.1}° of its normal (cone {}°); {} configurations checked, clear of \
-         the arm and the part (least self-clearance {:.1} mm)",
-        drawn.worst_deviation_m * 1e3,
-        constraints.line_tolerance_m * 1e3,
-        drawn.worst_tool_angle_deg,
-        constraints.theta_max_deg,
-        drawn.samples,
-        drawn.least_clearance_m * 1e3,
-    );
-    println!(
-        "  the strokes covered {:.4} m of the {:.4} m the program draws",
-        drawn.covered_m, drawn.drawn_m
-    );
-    println!("OK");
+    print_drawn(drawn, &job);
     Ok(())
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::{Result, anyhow, bail};
 use emg_planner::ShippedRobot;
 
-use super::exported::Exported;
+use super::exported::{Exported, print_drawn};
 use crate::options::ChainArgs;
 use crate::output::count;
 use crate::robot;
@@ -47,7 +47,6 @@ pub fn check_module(
     let (_, model) = chain.robot_and_checker(&robot_path)?;
     let report = emg_rapid_check::read_rapid(&text, &job, &model)
         .map_err(|e| anyhow!("{} does not hold up: {e}", file.display()))?;
-    let constraints = &job.constraints;
     println!(
         "{}: RAPID read back against {}, robot {}",
         file.display(),
@@ -66,21 +65,6 @@ pub fn check_module(
         report.least_spacing_m * 1e3,
         count(report.drawn.stroke_parts, "stroke part"),
     );
-    println!(
-        "  while the tool is on the TCP stays within {:.3} mm of its stroke (line {} mm) and the \
-         tool axis within {:.1}° of its normal (cone {}°); {} configurations checked, clear of \
-         the arm and the part (least self-clearance {:.1} mm)",
-        report.drawn.worst_deviation_m * 1e3,
-        constraints.line_tolerance_m * 1e3,
-        report.drawn.worst_tool_angle_deg,
-        constraints.theta_max_deg,
-        report.drawn.samples,
-        report.drawn.least_clearance_m * 1e3,
-    );
-    println!(
-        "  the strokes covered {:.4} m of the {:.4} m the program draws",
-        report.drawn.covered_m, report.drawn.drawn_m
-    );
-    println!("OK");
+    print_drawn(&report.drawn, &job);
     Ok(())
 }
