@@ -11,7 +11,7 @@ use emg_kinematics::Vec3;
 use emg_verify::ReferenceModel;
 use nalgebra::UnitQuaternion;
 
-use crate::{Drawing, PlanChecks, checker_joints};
+use crate::plan::{Drawing, PlanChecks, checker_joints};
 
 /// Largest spacing (m) of the TCP samples along an interpolated Cartesian path.
 pub const PATH_STEP_M: f64 = 1e-4;
