@@ -71,6 +71,10 @@ const PLACES: [([f64; 3], f64); 4] = [
     ([0.5, -0.25, 0.3], 0.2),
 ];
 
+/// The large drawing whose program is also written for the industrial controllers and read
+/// back (strokes).
+const READ_BACK_STROKES: usize = 500;
+
 /// One job's outcome.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct JobRow {
@@ -289,13 +293,24 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let sizes = progress::bar(2 * args.large.len() as u64, "large jobs");
     for &strokes in &args.large {
         for threads in [None, Some(1)] {
-            large_rows.push(large::evaluate(
-                &job_planner,
-                &checker,
-                home,
-                strokes,
-                threads,
-            )?);
+            let (row, program) = large::evaluate(&job_planner, &checker, home, strokes, threads)?;
+            // The smallest large drawing's program, as the industrial controllers run it.
+            if threads.is_none() && strokes == READ_BACK_STROKES {
+                let name = format!("{strokes} scattered strokes");
+                rapid_rows.extend(
+                    readers
+                        .rapid
+                        .as_ref()
+                        .map(|arm| rapid_programs::read_back(arm, &name, &program)),
+                );
+                krl_rows.extend(
+                    readers
+                        .krl
+                        .as_ref()
+                        .map(|arm| krl_programs::read_back(arm, &name, &program)),
+                );
+            }
+            large_rows.push(row);
             sizes.inc(1);
         }
     }

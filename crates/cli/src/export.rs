@@ -19,8 +19,10 @@ pub struct ExportArgs {
     #[arg(value_name = "FILE")]
     pub file: PathBuf,
     /// `ros2-mcap` (trajectory_msgs/msg/JointTrajectory in an MCAP file), `urscript` (a
-    /// program for a Universal Robots e-Series controller; six-joint UR arms only) or `rapid`
-    /// (a module for an ABB controller; a job's program on a six-joint ABB arm only).
+    /// program for a Universal Robots e-Series controller; six-joint UR arms only), `rapid`
+    /// (a module for an ABB controller; a job's program on a six-joint ABB arm only) or `krl`
+    /// (a KUKA controller's program, OUT the `.src` named as KRL names programs, its `.dat`
+    /// beside it; a job's program on a six-joint KUKA arm only).
     #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub format: ExportFormat,
     /// The file to write (a URScript motion too long for one program is split where the arm

@@ -22,9 +22,10 @@ pub struct JobArgs {
     /// The program to write (an emg-job/3 file; missing parent directories are created).
     #[arg(long, value_name = "FILE", default_value = "job.json")]
     pub out: PathBuf,
-    /// Also export the program for a robot's own stack: `ros2-mcap`, `urscript` or `rapid`
-    /// (an ABB controller's module), written beside `--out` (its extension `.mcap`, `.script`
-    /// or `.mod`; see docs/robot-export.md).
+    /// Also export the program for a robot's own stack: `ros2-mcap`, `urscript`, `rapid` (an
+    /// ABB controller's module) or `krl` (a KUKA controller's `.src` and `.dat`), written beside
+    /// `--out` (its extension `.mcap`, `.script` or `.mod`; a KRL program named as KRL allows,
+    /// `house.job.json` → `house.src`; see docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
     /// How a URScript export is written.

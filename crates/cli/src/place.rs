@@ -80,8 +80,9 @@ pub struct PlaceArgs {
     #[arg(long, value_name = "FILE")]
     pub job_out: Option<PathBuf>,
     /// Also export the program for a robot's own stack, as `emg job --export` does:
-    /// `ros2-mcap`, `urscript` or `rapid`, written beside `--out` (its extension `.mcap`,
-    /// `.script` or `.mod`; see docs/robot-export.md).
+    /// `ros2-mcap`, `urscript`, `rapid` or `krl`, written beside `--out` (its extension
+    /// `.mcap`, `.script`, `.mod` or a KRL program's `.src` and `.dat`; see
+    /// docs/robot-export.md).
     #[arg(long, value_name = "FORMAT", value_parser = exporting::parse_format)]
     pub export: Option<emg_io::ExportFormat>,
     /// How a URScript export is written.

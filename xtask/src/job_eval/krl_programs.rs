@@ -81,7 +81,8 @@ pub fn markdown(rows: &[KrlRow]) -> String {
     let read = rows.iter().filter(|r| r.read.failure.is_none()).count();
     let mut md = format!(
         "\n## KRL programs\n\n\
-         Each program above written as a KRL program for the KR 16, in memory (`emg job \
+         Each program above (and the 500-stroke drawing's, on all threads) written as a \
+         KRL program for the KR 16, in memory (`emg job \
          --export krl`: `PTP` between strokes, `LIN` runs approximated by `C_DIS` along them), \
          and read back by the independent reader (`emg-krl-check`, which shares no code with \
          the writer) against the plan: every target solved by the arm's closed form \

@@ -7,7 +7,7 @@ use std::sync::Mutex;
 use std::time::Instant;
 
 use emg_io::{read_svg, scattered_strokes_svg};
-use emg_job::{JobPlanner, Watch, verify_job};
+use emg_job::{JobFile, JobPlanner, Watch, verify_job};
 use serde::{Deserialize, Serialize};
 
 /// One large job planned on some number of threads.
@@ -72,14 +72,14 @@ impl Watch for StageClock {
 }
 
 /// The drawing of `strokes` scattered strokes planned with `threads` threads (all where `None`),
-/// written and checked.
+/// written and checked; with its program.
 pub fn evaluate(
     job_planner: &JobPlanner,
     checker: &emg_verify::ReferenceModel,
     home: &[f64],
     strokes: usize,
     threads: Option<usize>,
-) -> anyhow::Result<LargeRow> {
+) -> anyhow::Result<(LargeRow, JobFile)> {
     let planner = job_planner.planner();
     let tolerance = emg_job::DrawingTolerance::new(emg_job::JOB_TOLERANCE_M, 0.0)?;
     let drawing = read_svg(
@@ -121,7 +121,7 @@ pub fn evaluate(
     let checked = pool.install(|| verify_job(&program, checker, planner.robot().joint_names()));
     let check_s = checking.elapsed().as_secs_f64();
     let s = &program.summary;
-    Ok(LargeRow {
+    let row = LargeRow {
         drawing_strokes: strokes,
         strokes: job.strokes.len(),
         threads: pool.current_num_threads(),
@@ -137,7 +137,8 @@ pub fn evaluate(
         least_pen_up_s: s.least_pen_up_s,
         check_s,
         checker_failure: checked.err().map(|e| e.to_string()),
-    })
+    };
+    Ok((row, program))
 }
 
 /// Resets the process's peak resident memory to what it holds now (Linux: `clear_refs` 5);

@@ -77,7 +77,8 @@ pub fn markdown(rows: &[RapidRow]) -> String {
     let read = rows.iter().filter(|r| r.read.failure.is_none()).count();
     let mut md = format!(
         "\n## RAPID modules\n\n\
-         Each program above written as a RAPID module for the IRB 120, in memory (`emg job \
+         Each program above (and the 500-stroke drawing's, on all threads) written as a \
+         RAPID module for the IRB 120, in memory (`emg job \
          --export rapid`: `MoveAbsJ` between strokes, `MoveL` runs with zones along them), and \
          read back by the independent reader (`emg-rapid-check`, which shares no code with the \
          writer) against the plan: every target solved by the arm's closed form \
