@@ -8,7 +8,10 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{case, data_dir, emg, line_of, read, temp_dir, text, with_line};
+use common::{
+    assert_export_refused_before_planning, assert_golden, case, data_dir, emg, job_exported,
+    line_of, read, temp_dir, text, triangle, with_line,
+};
 use emg_krl_check::{KrlReport, ReadError, read_krl};
 use emg_verify::ReferenceModel;
 
@@ -33,30 +36,17 @@ struct Exported {
 /// `drawing` planned on the KR 16-2 by `emg job ... --export krl` (with `extra` arguments) into
 /// `dir` as `drawing.job.json`.
 fn exported(drawing: &Path, dir: &Path, extra: &[&str]) -> Exported {
-    let out = dir.join("drawing.job.json");
-    let mut args = vec![
-        "job",
-        drawing.to_str().expect("utf-8 path"),
-        "--robot",
-        "kr16",
-        "--out",
-        out.to_str().expect("utf-8 path"),
-        "--export",
-        "krl",
-    ];
-    args.extend_from_slice(extra);
-    let run = emg(&args);
-    assert!(
-        run.status.success(),
-        "emg job failed:\n{}\n{}",
-        text(&run.stdout),
-        text(&run.stderr)
+    let plan = job_exported(
+        drawing,
+        ("kr16", "krl"),
+        &dir.join("drawing.job.json"),
+        extra,
     );
     let path = dir.join("drawing.src");
     Exported {
         src: read(&path),
         dat: read(&dir.join("drawing.dat")),
-        plan: emg_job::JobFile::parse(&read(&out)).expect("the plan parses"),
+        plan,
         path,
     }
 }
@@ -106,34 +96,14 @@ fn the_cusped_logo_reads_back() {
 #[test]
 fn a_small_job_writes_the_program_kept_word_for_word() {
     let dir = temp_dir("krl-golden");
-    let drawing = dir.path().join("triangle.svg");
-    std::fs::write(
-        &drawing,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 10 10\">\
-         <polygon fill=\"none\" stroke=\"black\" points=\"1,1 9,1 5,8\"/></svg>\n",
-    )
-    .expect("drawing written");
-    let program = exported(&drawing, dir.path(), &["--width", "0.05"]);
+    let program = exported(&triangle(dir.path()), dir.path(), &["--width", "0.05"]);
     assert!(
         !program
             .src
             .contains(dir.path().to_str().expect("utf-8 path"))
     );
-    for (text, extension) in [(&program.src, "src"), (&program.dat, "dat")] {
-        let golden = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/kr16-triangle")
-            .with_extension(extension);
-        if std::env::var_os("EMG_WRITE_GOLDEN").is_some() {
-            std::fs::write(&golden, text).expect("golden written");
-        }
-        assert_eq!(
-            *text,
-            read(&golden),
-            "the program differs from {}: if the change is meant, write it again with \
-             EMG_WRITE_GOLDEN=1",
-            golden.display()
-        );
-    }
+    assert_golden(&program.src, "kr16-triangle.src");
+    assert_golden(&program.dat, "kr16-triangle.dat");
     let report = read_krl(&program.src, &program.dat, &program.plan, &kr16_checker())
         .expect("the program reads back");
     assert_reads_back(&report, &program.plan);
@@ -142,27 +112,7 @@ fn a_small_job_writes_the_program_kept_word_for_word() {
 
 #[test]
 fn krl_for_an_arm_of_another_vendor_is_refused_before_anything_is_planned() {
-    let dir = temp_dir("krl-abb");
-    let out = dir.path().join("a.job.json");
-    for robot in ["irb120", "ur5e", "fr3"] {
-        let run = emg(&[
-            "job",
-            case("pen-drag-house.svg").to_str().expect("utf-8 path"),
-            "--robot",
-            robot,
-            "--out",
-            out.to_str().expect("utf-8 path"),
-            "--export",
-            "krl",
-        ]);
-        assert_eq!(run.status.code(), Some(1), "{robot}");
-        assert!(
-            text(&run.stderr).contains("krl"),
-            "{robot}: {}",
-            text(&run.stderr)
-        );
-        assert!(!out.exists(), "{robot}: nothing is planned or written");
-    }
+    assert_export_refused_before_planning("krl", &["irb120", "ur5e", "fr3"]);
 }
 
 /// `line` with the number after `key ` turned by `change`.

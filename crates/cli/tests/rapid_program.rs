@@ -8,7 +8,10 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{case, data_dir, emg, line_of, read, temp_dir, text, with_line};
+use common::{
+    assert_export_refused_before_planning, assert_golden, case, data_dir, emg, job_exported,
+    line_of, read, temp_dir, text, triangle, with_line,
+};
 use emg_rapid_check::{RapidReport, ReadError, read_rapid};
 use emg_verify::ReferenceModel;
 
@@ -26,26 +29,8 @@ fn irb120_checker() -> ReferenceModel {
 /// into `dir`: the module, its plan and the module's path.
 fn exported(drawing: &Path, dir: &Path, extra: &[&str]) -> (String, emg_job::JobFile, PathBuf) {
     let out = dir.join("drawing.job.json");
-    let mut args = vec![
-        "job",
-        drawing.to_str().expect("utf-8 path"),
-        "--robot",
-        "irb120",
-        "--out",
-        out.to_str().expect("utf-8 path"),
-        "--export",
-        "rapid",
-    ];
-    args.extend_from_slice(extra);
-    let run = emg(&args);
-    assert!(
-        run.status.success(),
-        "emg job failed:\n{}\n{}",
-        text(&run.stdout),
-        text(&run.stderr)
-    );
+    let plan = job_exported(drawing, ("irb120", "rapid"), &out, extra);
     let module = out.with_extension("mod");
-    let plan = emg_job::JobFile::parse(&read(&out)).expect("the plan parses");
     (read(&module), plan, module)
 }
 
@@ -82,27 +67,10 @@ fn the_house_module_reads_back_every_target_the_plans_configuration() {
 #[test]
 fn a_small_job_writes_the_module_kept_word_for_word() {
     let dir = temp_dir("rapid-golden");
-    let drawing = dir.path().join("triangle.svg");
-    std::fs::write(
-        &drawing,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 10 10\">\
-         <polygon fill=\"none\" stroke=\"black\" points=\"1,1 9,1 5,8\"/></svg>\n",
-    )
-    .expect("drawing written");
-    let (module, plan, _) = exported(&drawing, dir.path(), &["--width", "0.05"]);
+    let (module, plan, _) = exported(&triangle(dir.path()), dir.path(), &["--width", "0.05"]);
     // The header names the robot by its digest, no directory of this machine.
     assert!(!module.contains(dir.path().to_str().expect("utf-8 path")));
-    let golden = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/irb120-triangle.mod");
-    if std::env::var_os("EMG_WRITE_GOLDEN").is_some() {
-        std::fs::write(&golden, &module).expect("golden written");
-    }
-    assert_eq!(
-        module,
-        read(&golden),
-        "the module differs from {}: if the change is meant, write it again with \
-         EMG_WRITE_GOLDEN=1",
-        golden.display()
-    );
+    assert_golden(&module, "irb120-triangle.mod");
     let report = read_rapid(&module, &plan, &irb120_checker()).expect("the module reads back");
     assert_reads_back(&report, &plan);
     assert_eq!(report.drawn.stroke_parts, 1);
@@ -110,27 +78,7 @@ fn a_small_job_writes_the_module_kept_word_for_word() {
 
 #[test]
 fn rapid_for_an_arm_of_another_vendor_is_refused_before_anything_is_planned() {
-    let dir = temp_dir("rapid-kuka");
-    let out = dir.path().join("k.job.json");
-    for robot in ["kr16", "ur5e", "fr3"] {
-        let run = emg(&[
-            "job",
-            case("pen-drag-house.svg").to_str().expect("utf-8 path"),
-            "--robot",
-            robot,
-            "--out",
-            out.to_str().expect("utf-8 path"),
-            "--export",
-            "rapid",
-        ]);
-        assert_eq!(run.status.code(), Some(1), "{robot}");
-        assert!(
-            text(&run.stderr).contains("rapid"),
-            "{robot}: {}",
-            text(&run.stderr)
-        );
-        assert!(!out.exists(), "{robot}: nothing is planned or written");
-    }
+    assert_export_refused_before_planning("rapid", &["kr16", "ur5e", "fr3"]);
 }
 
 #[test]

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{case, data_dir, emg, read, temp_dir, text};
+use common::{case, data_dir, emg, job_exported, read, temp_dir, text};
 use emg_ur_check::{
     Form, NativeReport, Pose, ReadError, Statement, parse_program, read_native, read_servoj,
 };
@@ -27,27 +27,8 @@ fn ur5e_checker() -> ReferenceModel {
 /// into `dir`: the program's script and its plan.
 fn exported(drawing: &Path, dir: &Path, extra: &[&str]) -> (String, emg_job::JobFile) {
     let out = dir.join("house.json");
-    let mut args = vec![
-        "job",
-        drawing.to_str().expect("utf-8 path"),
-        "--robot",
-        "ur5e",
-        "--out",
-        out.to_str().expect("utf-8 path"),
-        "--export",
-        "urscript",
-    ];
-    args.extend_from_slice(extra);
-    let run = emg(&args);
-    assert!(
-        run.status.success(),
-        "emg job failed:\n{}\n{}",
-        text(&run.stdout),
-        text(&run.stderr)
-    );
-    let script = read(&out.with_extension("script"));
-    let plan = emg_job::JobFile::parse(&read(&out)).expect("the plan parses");
-    (script, plan)
+    let plan = job_exported(drawing, ("ur5e", "urscript"), &out, extra);
+    (read(&out.with_extension("script")), plan)
 }
 
 /// Reads `script` against `plan`, printing the report.

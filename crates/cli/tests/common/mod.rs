@@ -91,3 +91,87 @@ pub fn with_line(text: &str, line: usize, edit: impl Fn(&str) -> String) -> Stri
 pub fn line_of(text: &str, is: impl Fn(&str) -> bool) -> usize {
     text.lines().position(is).expect("the line is there") + 1
 }
+
+/// `drawing` planned by `emg job ... --robot ROBOT --export FORMAT` (with `extra` arguments)
+/// into `out` (the job's program); its plan, once `emg job` has succeeded.
+pub fn job_exported(
+    drawing: &Path,
+    (robot, format): (&str, &str),
+    out: &Path,
+    extra: &[&str],
+) -> emg_job::JobFile {
+    let mut args = vec![
+        "job",
+        drawing.to_str().expect("utf-8 path"),
+        "--robot",
+        robot,
+        "--out",
+        out.to_str().expect("utf-8 path"),
+        "--export",
+        format,
+    ];
+    args.extend_from_slice(extra);
+    let run = emg(&args);
+    assert!(
+        run.status.success(),
+        "emg job failed:\n{}\n{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
+    emg_job::JobFile::parse(&read(out)).expect("the plan parses")
+}
+
+/// `emg job --export FORMAT` on each of `robots` fails before anything is planned or written,
+/// naming the format.
+pub fn assert_export_refused_before_planning(format: &str, robots: &[&str]) {
+    let dir = temp_dir(&format!("{format}-refused"));
+    let out = dir.path().join("refused.job.json");
+    for robot in robots {
+        let run = emg(&[
+            "job",
+            case("pen-drag-house.svg").to_str().expect("utf-8 path"),
+            "--robot",
+            robot,
+            "--out",
+            out.to_str().expect("utf-8 path"),
+            "--export",
+            format,
+        ]);
+        assert_eq!(run.status.code(), Some(1), "{robot}");
+        assert!(
+            text(&run.stderr).contains(format),
+            "{robot}: {}",
+            text(&run.stderr)
+        );
+        assert!(!out.exists(), "{robot}: nothing is planned or written");
+    }
+}
+
+/// `written` equals the file `tests/data/NAME` kept word for word; `EMG_WRITE_GOLDEN=1` writes
+/// it again.
+pub fn assert_golden(written: &str, name: &str) {
+    let golden = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name);
+    if std::env::var_os("EMG_WRITE_GOLDEN").is_some() {
+        std::fs::write(&golden, written).expect("golden written");
+    }
+    assert_eq!(
+        written,
+        read(&golden),
+        "{} differs: if the change is meant, write it again with EMG_WRITE_GOLDEN=1",
+        golden.display()
+    );
+}
+
+/// A triangle drawing written into `dir`: the small job the golden programs are kept for.
+pub fn triangle(dir: &Path) -> std::path::PathBuf {
+    let drawing = dir.join("triangle.svg");
+    std::fs::write(
+        &drawing,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 10 10\">\
+         <polygon fill=\"none\" stroke=\"black\" points=\"1,1 9,1 5,8\"/></svg>\n",
+    )
+    .expect("drawing written");
+    drawing
+}
