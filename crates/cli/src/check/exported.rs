@@ -62,6 +62,21 @@ impl Exported {
     }
 }
 
+/// Refuses a controller's program (a `kind`) whose robot is not the shipped arm `name`, the one
+/// whose closed form its reader solves.
+pub fn require_shipped(exported: &Exported, name: &str, kind: &str) -> Result<()> {
+    let shipped = emg_planner::ShippedRobot::by_path(&exported.robot_path, &robot::data_dir())
+        .is_some_and(|shipped| shipped.name == name);
+    anyhow::ensure!(
+        shipped,
+        "{} is a program for robot {}: {kind}s are read back for the shipped {name} only (its \
+         closed-form kinematics)",
+        exported.program_path.display(),
+        exported.robot_path.display()
+    );
+    Ok(())
+}
+
 /// Prints what the arm drew as a reader ran a controller's program against `job`, then `OK`.
 pub fn print_drawn(drawn: &emg_program_check::Drawn, job: &emg_job::JobFile) {
     let constraints = &job.constraints;

@@ -6,13 +6,11 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result, anyhow, bail};
-use emg_planner::ShippedRobot;
+use anyhow::{Context, Result, anyhow};
 
-use super::exported::{Exported, print_drawn};
+use super::exported::{Exported, print_drawn, require_shipped};
 use crate::options::ChainArgs;
 use crate::output::count;
-use crate::robot;
 
 /// The job's program a KRL program `file` was written beside: `STEM.job.json` where there is
 /// one, else the one job's program in its folder whose KRL program `--export krl` names so
@@ -49,12 +47,14 @@ pub fn check_program(
     robot: Option<&Path>,
     chain: &ChainArgs,
 ) -> Result<()> {
+    let exported = Exported::read(file, &job_beside(file), program, robot, "KRL program")?;
+    require_shipped(&exported, "kr16", "KRL program")?;
     let Exported {
         text,
         job,
         program_path,
         robot_path,
-    } = Exported::read(file, &job_beside(file), program, robot, "KRL program")?;
+    } = exported;
     let dat_path = file.with_extension("dat");
     let dat = std::fs::read_to_string(&dat_path).with_context(|| {
         format!(
@@ -62,16 +62,6 @@ pub fn check_program(
             dat_path.display()
         )
     })?;
-    let kr16 = ShippedRobot::by_path(&robot_path, &robot::data_dir())
-        .is_some_and(|shipped| shipped.name == "kr16");
-    if !kr16 {
-        bail!(
-            "{} is a program for robot {}: KRL programs are read back for the shipped kr16 \
-             only (its closed-form kinematics)",
-            program_path.display(),
-            robot_path.display()
-        );
-    }
     let (_, model) = chain.robot_and_checker(&robot_path)?;
     let report = emg_krl_check::read_krl(&text, &dat, &job, &model)
         .map_err(|e| anyhow!("{} does not hold up: {e}", file.display()))?;

@@ -5,13 +5,11 @@
 
 use std::path::Path;
 
-use anyhow::{Result, anyhow, bail};
-use emg_planner::ShippedRobot;
+use anyhow::{Result, anyhow};
 
-use super::exported::{Exported, print_drawn};
+use super::exported::{Exported, print_drawn, require_shipped};
 use crate::options::ChainArgs;
 use crate::output::count;
-use crate::robot;
 
 /// Runs `emg check` on a RAPID module `file`: prints what was read and `OK`, or fails naming the
 /// line and what the arm would do wrong there. `program` and `robot` are `--program` and
@@ -22,28 +20,20 @@ pub fn check_module(
     robot: Option<&Path>,
     chain: &ChainArgs,
 ) -> Result<()> {
-    let Exported {
-        text,
-        job,
-        program_path,
-        robot_path,
-    } = Exported::read(
+    let exported = Exported::read(
         file,
         &file.with_extension("json"),
         program,
         robot,
         "RAPID module",
     )?;
-    let irb120 = ShippedRobot::by_path(&robot_path, &robot::data_dir())
-        .is_some_and(|shipped| shipped.name == "irb120");
-    if !irb120 {
-        bail!(
-            "{} is a program for robot {}: RAPID modules are read back for the shipped irb120 \
-             only (its closed-form kinematics)",
-            program_path.display(),
-            robot_path.display()
-        );
-    }
+    require_shipped(&exported, "irb120", "RAPID module")?;
+    let Exported {
+        text,
+        job,
+        program_path,
+        robot_path,
+    } = exported;
     let (_, model) = chain.robot_and_checker(&robot_path)?;
     let report = emg_rapid_check::read_rapid(&text, &job, &model)
         .map_err(|e| anyhow!("{} does not hold up: {e}", file.display()))?;
