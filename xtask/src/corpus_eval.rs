@@ -33,7 +33,8 @@ pub struct Args {
     /// is planned with.
     #[arg(long, value_delimiter = ',', default_value = "0,0.125")]
     corner_tolerances: Vec<f64>,
-    /// Where the fetched packages and the resumable records are kept.
+    /// Where the fetched packages, the generated drawings (`generated/`, each planned again by
+    /// `emg job`) and the resumable records are kept.
     #[arg(long, default_value_os_t = workspace::root().join("target/corpus"))]
     cache: PathBuf,
     /// Output directory of corpus.{json,md}.
@@ -163,12 +164,25 @@ fn drawings(cache: &Path, every: usize) -> anyhow::Result<Vec<Drawing>> {
         ("hershey text", generated::text(&fonts, &fetch::LINES)),
         ("outlines", generated::outlines()),
     ];
+    let written = cache.join("generated");
+    std::fs::create_dir_all(&written)?;
     for (set, list) in sets {
         for (name, svg) in list {
+            std::fs::write(written.join(file_name(&name)), &svg)?;
             drawings.push(Drawing { set, name, svg });
         }
     }
     Ok(drawings)
+}
+
+/// The file a generated drawing is kept in (so that `emg job` can plan it again): its name,
+/// every character but letters and digits a `-`, with `.svg`.
+fn file_name(name: &str) -> String {
+    let plain: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
+    format!("{plain}.svg")
 }
 
 /// The rows of `drawings` on `shipped`: those the cache's record holds, the rest planned and

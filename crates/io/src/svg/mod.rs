@@ -9,6 +9,7 @@ mod outline;
 mod piece;
 mod placement;
 mod scattered;
+mod simplify;
 mod stroke;
 
 use std::path::Path;

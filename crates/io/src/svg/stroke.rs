@@ -8,10 +8,14 @@
 //!   the path passes there without a corner. Where two lines meet so, the corner is rounded by
 //!   the arc tangent to both that leaves it by at most the tolerance, taking at most half of
 //!   each line (a polyline that flattens a curve is drawn without a stop at every vertex).
-//! * Every other corner is rounded within the corner tolerance (0 keeps it): two lines by the
-//!   arc tangent to both, a corner where an arc meets by the biarc between points of its two
-//!   sides, each rounding taking at most half of each piece; a corner whose rounding would be
-//!   shorter than the shortest piece (a reversal) stays one.
+//! * With a corner tolerance, each run of lines first drops the vertices that lie within
+//!   [`SIMPLIFYING_SHARE`] of it of the line replacing them ([`simplified`]: a jagged outline
+//!   keeps its shape and gets lines long enough to round at speed).
+//! * Every other corner is rounded within the corner tolerance (0 keeps it) less what the
+//!   simplification spent beside it: two lines by the arc tangent to both, a corner where an
+//!   arc meets by the biarc between points of its two sides, each rounding taking at most half
+//!   of each piece; a corner whose rounding would be shorter than the shortest piece or tighter
+//!   than its radius (a reversal, a sharp turn between short legs) stays one.
 //! * A `Z` adds the closing line back to the start when it is at least [`MIN_SEGMENT_M`]
 //!   long; a shorter gap stays open (the stroke ends that close to its start).
 //! * An arc of radius under [`MIN_SEGMENT_M`] (a dot) becomes its chord; a piece shorter than
@@ -27,6 +31,7 @@ use super::bezier::{Cubic, V2};
 use super::biarc::{PIECE_SAMPLES, UNSPLIT_PIECES, fit_cubic};
 use super::outline::{Segment, Subpath};
 use super::piece::{Piece, STRAIGHT_RAD, arc_from, arc_to, biarc, distance_to};
+use super::simplify::{Simplified, simplified};
 
 /// The shortest piece or radius produced: the path format's, with a margin for rounding.
 const SHORTEST: f64 = MIN_SEGMENT_M * (1.0 + 1e-6);
@@ -105,12 +110,24 @@ pub(crate) fn pieces(
         smooth_m: tolerance.max(corner_tolerance),
         corner_m: corner_tolerance,
     };
-    rounded(&out, &allowance)
+    // Only joints that cannot be rounded as they are may go: a flattened curve's vertices
+    // round as they are, and dropping some would leave sharper corners.
+    let simple = if corner_tolerance > 0.0 {
+        simplified(&out, SIMPLIFYING_SHARE * corner_tolerance, |k| {
+            rounding(&out[k - 1], &out[k], &allowance, 0.0).is_some()
+        })
+    } else {
+        Simplified::unchanged(out)
+    };
+    rounded(&simple, &allowance)
 }
 
-/// The smallest radius (m) a corner is rounded with: through a tighter arc the tool must slow
-/// almost to rest (its speed there at most `√(a r)` for the acceleration `a` it can reach), and
-/// a stop at the corner itself is as quick.
+/// The share of the corner tolerance a run of lines may be simplified within
+/// ([`simplified`]); what its rounding may leave the simplified corners by is the rest.
+pub(crate) const SIMPLIFYING_SHARE: f64 = 0.75;
+
+/// The smallest radius (m) a corner is rounded with: a tighter arc is passed quicker, but the
+/// timed motion through it leaves the tolerance more often, and its part is cut there.
 pub(crate) const MIN_CORNER_RADIUS_M: f64 = 1e-3;
 
 /// How far the rounding of a joint may leave it: joints turning less than `smooth_rad` are
@@ -141,13 +158,22 @@ struct Rounding {
     arcs: Vec<Piece>,
 }
 
-/// `pieces` with each joint where they turn rounded within its allowance ([`rounding`]); the
-/// chain's ends stay where they are.
-fn rounded(pieces: &[Piece], allowance: &JoinAllowance) -> Vec<Piece> {
+/// `chain`'s pieces with each joint where they turn rounded within its allowance less what
+/// the simplification spent on either side of it ([`rounding`]; the rounding leaves the
+/// simplified joint by at most the rest, which leaves the drawing by at most the allowance);
+/// the chain's ends stay where they are.
+fn rounded(chain: &Simplified, allowance: &JoinAllowance) -> Vec<Piece> {
+    let pieces = &chain.pieces;
     let roundings: Vec<Option<Rounding>> = (0..pieces.len())
         .map(|index| {
+            // A rounding takes at most half of each piece: the halves beside the joint.
+            let spent = if index > 0 {
+                chain.deviation[index - 1][1].max(chain.deviation[index][0])
+            } else {
+                0.0
+            };
             (index > 0)
-                .then(|| rounding(&pieces[index - 1], &pieces[index], allowance))
+                .then(|| rounding(&pieces[index - 1], &pieces[index], allowance, spent))
                 .flatten()
         })
         .collect();
@@ -168,10 +194,10 @@ fn rounded(pieces: &[Piece], allowance: &JoinAllowance) -> Vec<Piece> {
 }
 
 /// The rounding of the joint where `before` ends and `after` starts, leaving it by at most its
-/// allowance, taking at most half of each piece less half the shortest piece (so each keeps a
-/// length); `None` where the joint is smooth already, its allowance is 0, or the rounding would
-/// be shorter than the shortest piece or tighter than its least radius (a reversal, a sharp
-/// corner, or no room): the corner stays.
+/// allowance less `spent` (m), taking at most half of each piece less half the shortest piece
+/// (so each keeps a length); `None` where the joint is smooth already, no allowance is left, or
+/// the rounding would be shorter than the shortest piece or of a smaller radius (a reversal, or
+/// no room): the corner stays.
 ///
 /// Two lines are joined by the arc tangent to both: one of radius `r` on lines turning by `θ`
 /// reaches `r tan(θ/2)` along each and passes `r (1/cos(θ/2) − 1) = r 2 sin²(θ/4) / cos(θ/2)`
@@ -179,10 +205,16 @@ fn rounded(pieces: &[Piece], allowance: &JoinAllowance) -> Vec<Piece> {
 /// arc meets, the two pieces are trimmed by that reach and their new ends joined by the biarc
 /// between them (their tangents kept), the reach halved until the biarc lies within the
 /// allowance of what it replaces.
-fn rounding(before: &Piece, after: &Piece, allowance: &JoinAllowance) -> Option<Rounding> {
+fn rounding(
+    before: &Piece,
+    after: &Piece,
+    allowance: &JoinAllowance,
+    spent: f64,
+) -> Option<Rounding> {
     let (a, b) = (before.end_tangent(), after.start_tangent());
     let turn = libm::acos(a.dot(&b).clamp(-1.0, 1.0));
     let (allowed, least_radius) = allowance.at(turn);
+    let allowed = allowed - spent;
     if turn <= emg_control::CORNER_RAD || allowed <= 0.0 {
         return None;
     }
@@ -546,6 +578,18 @@ mod tests {
             }
             cases.push(points);
         }
+        // Jagged outlines: a circle of 20 mm radius with a vertex every 0.3 mm, each moved by
+        // up to 0.1 mm across it.
+        for _ in 0..4 {
+            let jagged: Vec<V2> = (0..=400)
+                .map(|k| {
+                    let a = k as f64 * 2.0 * PI / 400.0;
+                    let r = 0.02 + rng.random_range(-1e-4..1e-4);
+                    V2::new(r * libm::cos(a), r * libm::sin(a))
+                })
+                .collect();
+            cases.push(jagged);
+        }
         for points in &cases {
             let sharp = pieces(&polyline(points), 5e-5, 0.0, 0.0);
             let round = pieces(&polyline(points), 5e-5, 0.0, corner);
@@ -566,6 +610,23 @@ mod tests {
                         .iter()
                         .filter(|t| **t > emg_control::CORNER_RAD)
                         .count()
+            );
+        }
+        // The jagged outlines are simplified: they stop at far fewer corners.
+        for jagged in &cases[cases.len() - 4..] {
+            let sharp = turns(&pieces(&polyline(jagged), 5e-5, 0.0, 0.0));
+            let round = turns(&pieces(&polyline(jagged), 5e-5, 0.0, corner));
+            let corners = |turns: &[f64]| {
+                turns
+                    .iter()
+                    .filter(|t| **t > emg_control::CORNER_RAD)
+                    .count()
+            };
+            assert!(
+                corners(&round) * 3 < corners(&sharp),
+                "{} of {}",
+                corners(&round),
+                corners(&sharp)
             );
         }
         // The flattened circle is passed without a corner; the square's corners, whose
@@ -591,6 +652,10 @@ mod tests {
         assert!((turns(&round)[0] - back).abs() < 1e-9);
     }
 
+    fn unsimplified(chain: &[Piece]) -> Simplified {
+        Simplified::unchanged(chain.to_vec())
+    }
+
     #[test]
     fn a_corner_where_an_arc_meets_is_rounded_by_a_biarc_within_the_tolerance() {
         // A line, then a quarter circle of 5 mm radius leaving it at a right angle.
@@ -612,13 +677,14 @@ mod tests {
             smooth_m: 0.0,
             corner_m: 2e-3,
         };
-        let round = rounded(&chain, &allowance);
+        let round = rounded(&unsimplified(&chain), &allowance);
         assert!(chained(&round));
         assert!(
             turns(&round).iter().all(|t| *t <= emg_control::CORNER_RAD),
             "{round:?}"
         );
         assert!(apart(&round, &chain) <= 2e-3);
+        assert!(distance_to(&round, line_to) > 1e-5);
         assert!(
             round
                 .iter()
@@ -630,14 +696,26 @@ mod tests {
             corner_m: 2.5e-4,
             ..allowance
         };
-        assert_eq!(rounded(&chain, &tight), chain.to_vec());
-        assert!(distance_to(&round, line_to) > 1e-5);
-        // No allowance, no rounding.
+        assert_eq!(rounded(&unsimplified(&chain), &tight), chain.to_vec());
+        // Within 2 mm less 0.5 mm a simplification spent beside the joint: within 1.5 mm.
+        let spent = Simplified {
+            pieces: chain.to_vec(),
+            deviation: vec![[0.0, 5e-4], [0.0; 2]],
+        };
+        let round = rounded(&spent, &allowance);
+        assert!(turns(&round).iter().all(|t| *t <= emg_control::CORNER_RAD));
+        assert!(apart(&round, &chain) <= 1.5e-3);
+        // No allowance (none, or all of it spent), no rounding.
         let none = JoinAllowance {
             corner_m: 0.0,
             ..allowance
         };
-        assert_eq!(rounded(&chain, &none), chain.to_vec());
+        assert_eq!(rounded(&unsimplified(&chain), &none), chain.to_vec());
+        let all_spent = Simplified {
+            pieces: chain.to_vec(),
+            deviation: vec![[0.0; 2], [2e-3, 0.0]],
+        };
+        assert_eq!(rounded(&all_spent, &allowance), chain.to_vec());
     }
 
     #[test]
