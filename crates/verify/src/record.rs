@@ -201,7 +201,8 @@ pub const PATH_PROGRESS_SLACK_M: f64 = 1e-5;
 
 /// How near (m of arc length) its last known place must lie to a corner of the path (a join
 /// where the tangent turns by more than [`PATH_CORNER_RAD`]) for a recorded TCP's progress to
-/// pass it: a TCP that never came to a corner is measured against it.
+/// pass it, unless the TCP's nearest path point short of the corner is the corner itself (it
+/// stands past it): a TCP that never came to a corner is measured against it.
 pub const PATH_CORNER_PASS_M: f64 = 1e-4;
 
 /// Smallest turn (rad) of the tangent between two pieces that makes their join a corner: far
@@ -285,11 +286,20 @@ impl Line {
         let from_hint = (self.point_on_path(hint) - point).norm();
         let window =
             (PATH_PROGRESS_PER_DISTANCE * from_hint + PATH_PROGRESS_SLACK_M).min(PATH_WINDOW_M);
-        let to = self
-            .corner_after(hint + PATH_CORNER_PASS_M)
-            .map_or(hint + window, |corner| corner.min(hint + window));
-        let (s, _) = self.nearest_on_path(point, hint, hint, to, PATH_CONTINUITY);
-        (s, (self.point_on_path(s) - point).norm())
+        let reach = hint + window;
+        let mut corner = self.corner_after(hint + PATH_CORNER_PASS_M);
+        loop {
+            let to = corner.map_or(reach, |corner| corner.min(reach));
+            let (s, _) = self.nearest_on_path(point, hint, hint, to, PATH_CONTINUITY);
+            // A point whose nearest path point short of the corner is the corner itself stands
+            // past it (or at it): it is measured against what follows the corner too.
+            match corner {
+                Some(at) if s >= at - 1e-9 && at < reach => {
+                    corner = self.corner_after(at + PATH_CORNER_PASS_M);
+                }
+                _ => return (s, (self.point_on_path(s) - point).norm()),
+            }
+        }
     }
 
     /// The arc length in `[from, to]` whose path point lies nearest `point`, each metre of arc
@@ -533,4 +543,87 @@ pub struct Recording {
     pub ending: Ending,
     /// The reported path length `(p_last − p0)·d` (m); on a path, the arc length reached.
     pub path_length_m: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two straight legs of 10 mm from the origin along x, then turning by `turn` (rad).
+    fn corner(turn: f64) -> Line {
+        let x = Vector3::x();
+        let bend = Vector3::new(libm::cos(turn), libm::sin(turn), 0.0);
+        let at = x * 0.01;
+        Line {
+            p0: Vector3::zeros(),
+            d: x,
+            n: Vector3::z(),
+            path: vec![
+                PathPiece::Straight {
+                    start: Vector3::zeros(),
+                    end: at,
+                },
+                PathPiece::Straight {
+                    start: at,
+                    end: at + bend * 0.01,
+                },
+            ],
+        }
+    }
+
+    /// Each point's progress and distance, followed from the start.
+    fn followed(line: &Line, points: &[Vector3<f64>]) -> Vec<(f64, f64)> {
+        let mut hint = 0.0;
+        points
+            .iter()
+            .map(|p| {
+                let (s, distance) = line.follow(p, hint);
+                hint = s;
+                (s, distance)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_point_past_a_corner_is_measured_against_what_follows_it() {
+        // A right-angle corner at (10, 0) mm; the TCP 0.15 mm short of it (farther than
+        // PATH_CORNER_PASS_M), then at (10.2, 0.3) mm: past the corner, 0.2 mm from the second
+        // leg, 0.36 mm from the corner point.
+        let line = corner(std::f64::consts::FRAC_PI_2);
+        let points = [
+            Vector3::new(0.005, 0.0, 0.0),
+            Vector3::new(0.00985, 0.0, 0.0),
+            Vector3::new(0.0102, 0.0003, 0.0),
+            Vector3::new(0.01, 0.001, 0.0),
+        ];
+        let followed = followed(&line, &points);
+        assert!((followed[1].0 - 0.00985).abs() < 1e-12);
+        let (s, distance) = followed[2];
+        assert!((s - 0.0103).abs() < 1e-9, "{s}");
+        assert!((distance - 2e-4).abs() < 1e-9, "{distance}");
+        assert!((followed[3].0 - 0.011).abs() < 1e-9);
+        // Short of the corner's foot, it is measured against the first leg.
+        let (s, distance) = line.follow(&Vector3::new(0.0099, 0.0003, 0.0), 0.00985);
+        assert!((s - 0.0099).abs() < 1e-9 && (distance - 3e-4).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_reversal_turned_back_short_of_its_vertex_is_not_passed() {
+        // Legs turning back by 173°, the TCP along the first leg to 4.65 mm short of the
+        // vertex and back along the second leg's side: it never passes the vertex, and is
+        // measured against the first leg (farther and farther) as it comes back.
+        let line = corner(173f64.to_radians());
+        let mut points: Vec<Vector3<f64>> =
+            (0..=18).map(|i| Vector3::x() * (i as f64 * 3e-4)).collect();
+        let back = Vector3::new(
+            libm::cos(173f64.to_radians()),
+            libm::sin(173f64.to_radians()),
+            0.0,
+        );
+        let turn = Vector3::x() * 0.00535;
+        points.extend((1..=20).map(|i| turn + back * (i as f64 * 3e-4)));
+        let followed = followed(&line, &points);
+        assert!(followed.iter().all(|(s, _)| *s < 0.0054));
+        assert!(followed.last().unwrap().1 > 0.5e-3);
+    }
 }
