@@ -8,14 +8,15 @@
 //!   the path passes there without a corner. Where two lines meet so, the corner is rounded by
 //!   the arc tangent to both that leaves it by at most the tolerance, taking at most half of
 //!   each line (a polyline that flattens a curve is drawn without a stop at every vertex).
-//! * With a corner tolerance, each run of lines first drops the vertices that lie within
-//!   [`SIMPLIFYING_SHARE`] of it of the line replacing them ([`simplified`]: a jagged outline
-//!   keeps its shape and gets lines long enough to round at speed).
+//! * With a corner tolerance, each run of lines first drops, of the vertices whose corner
+//!   cannot be rounded as it is, those within [`SIMPLIFYING_SHARE`] of the corner tolerance of
+//!   the line replacing them ([`simplified`]: a jagged outline keeps its shape and gets lines
+//!   long enough to round).
 //! * Every other corner is rounded within the corner tolerance (0 keeps it) less what the
 //!   simplification spent beside it: two lines by the arc tangent to both, a corner where an
 //!   arc meets by the biarc between points of its two sides, each rounding taking at most half
 //!   of each piece; a corner whose rounding would be shorter than the shortest piece or tighter
-//!   than its radius (a reversal, a sharp turn between short legs) stays one.
+//!   than [`MIN_CORNER_RADIUS_M`] (a reversal, a sharp turn between short legs) stays one.
 //! * A `Z` adds the closing line back to the start when it is at least [`MIN_SEGMENT_M`]
 //!   long; a shorter gap stays open (the stroke ends that close to its start).
 //! * An arc of radius under [`MIN_SEGMENT_M`] (a dot) becomes its chord; a piece shorter than
@@ -166,14 +167,12 @@ fn rounded(chain: &Simplified, allowance: &JoinAllowance) -> Vec<Piece> {
     let pieces = &chain.pieces;
     let roundings: Vec<Option<Rounding>> = (0..pieces.len())
         .map(|index| {
-            // A rounding takes at most half of each piece: the halves beside the joint.
-            let spent = if index > 0 {
-                chain.deviation[index - 1][1].max(chain.deviation[index][0])
-            } else {
-                0.0
-            };
             (index > 0)
-                .then(|| rounding(&pieces[index - 1], &pieces[index], allowance, spent))
+                .then(|| {
+                    // A rounding takes at most half of each piece: the halves beside the joint.
+                    let spent = chain.deviation[index - 1][1].max(chain.deviation[index][0]);
+                    rounding(&pieces[index - 1], &pieces[index], allowance, spent)
+                })
                 .flatten()
         })
         .collect();
@@ -196,8 +195,8 @@ fn rounded(chain: &Simplified, allowance: &JoinAllowance) -> Vec<Piece> {
 /// The rounding of the joint where `before` ends and `after` starts, leaving it by at most its
 /// allowance less `spent` (m), taking at most half of each piece less half the shortest piece
 /// (so each keeps a length); `None` where the joint is smooth already, no allowance is left, or
-/// the rounding would be shorter than the shortest piece or of a smaller radius (a reversal, or
-/// no room): the corner stays.
+/// the rounding would be shorter than the shortest piece or tighter than its least radius (a
+/// reversal, a sharp corner, or no room): the corner stays.
 ///
 /// Two lines are joined by the arc tangent to both: one of radius `r` on lines turning by `θ`
 /// reaches `r tan(θ/2)` along each and passes `r (1/cos(θ/2) − 1) = r 2 sin²(θ/4) / cos(θ/2)`
